@@ -1,0 +1,375 @@
+"""Blocks as arrays: convex polyhedra with planar faces (SPEC 4.5).
+
+A :class:`Blocks` is a struct of arrays. Vertices and faces of all blocks are stored flat,
+with offsets (as meshio stores cells), so a scene of 10,000 bricks is a handful of numpy
+arrays, not 60,000 Python objects. Derived quantities (face normals, volumes, centroids)
+are computed once on first use and cached.
+
+Glossary
+--------
+- main face / complementary face: thesis 3.2.4; the interface detector's words.
+- ``t1, t2``: in-plane basis of a face; ``(t1, t2, normal)`` is right-handed.
+"""
+
+import dataclasses
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+BLOCK_CLASSES = ("ground", "regular", "pattern", "fill_in", "block")
+"""Names of the ``block_class`` codes. ``block`` is an imported or scene block (arch)."""
+
+# Corner order of a hexahedral brick: index = ix + 2 * iy + 4 * iz, with local axes
+# x = through the wall (0 inner, 1 outer), y = along the wall, z = up the course.
+HEX_FACES = np.array(
+    [
+        [0, 4, 6, 2],  # inner (intrados)
+        [1, 3, 7, 5],  # outer
+        [0, 1, 5, 4],  # -y end
+        [2, 6, 7, 3],  # +y end
+        [0, 2, 3, 1],  # bottom
+        [4, 5, 7, 6],  # top
+    ]
+)
+
+
+def _unit(v):
+    return v / np.linalg.norm(v, axis=-1, keepdims=True)
+
+
+def tangent_basis(normal):
+    """In-plane basis for unit normals.
+
+    ``t1`` is horizontal (``z x n``) where the face is not horizontal, else the x axis
+    projected into the plane; ``t2 = n x t1``.
+
+    Parameters
+    ----------
+    normal : (k, 3) float
+
+    Returns
+    -------
+    t1, t2 : (k, 3) float
+    """
+    normal = np.asarray(normal, dtype=float).reshape(-1, 3)
+    t1 = np.cross(np.array([0.0, 0.0, 1.0]), normal)
+    flat = np.linalg.norm(t1, axis=1) < 1e-6
+    ex = np.array([1.0, 0.0, 0.0])
+    t1[flat] = ex - normal[flat] * (normal[flat] @ ex)[:, None]
+    t1 = _unit(t1)
+    t2 = np.cross(normal, t1)
+    return t1, t2
+
+
+@dataclass(frozen=True, eq=False)
+class Blocks:
+    """Convex blocks with planar polygonal faces.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float, metres
+        Vertices of all blocks, block after block.
+    vertex_offsets : (B + 1,) int
+        Block ``i`` owns ``vertices[vertex_offsets[i]:vertex_offsets[i + 1]]``.
+    face_vertices : (FV,) int
+        Global vertex indices of every face polygon, counter-clockwise seen from outside.
+    face_offsets : (F + 1,) int
+        Face ``f`` is ``face_vertices[face_offsets[f]:face_offsets[f + 1]]``.
+    face_block : (F,) int
+        Owner block of every face.
+    block_class : (B,) int8
+        Code into :data:`BLOCK_CLASSES`.
+    block_course : (B,) int
+        Course index (1 = first course on the ground, 0 = ground or not in a course).
+    block_is_support : (B,) bool
+        Fixed supports (the ground): no equilibrium rows.
+    block_name : (B,) str
+        Unique names, e.g. ``b0042_regular_c12``.
+    block_web : (B,) int
+        Web index in a full dome (0 in a section).
+    """
+
+    vertices: np.ndarray
+    vertex_offsets: np.ndarray
+    face_vertices: np.ndarray
+    face_offsets: np.ndarray
+    face_block: np.ndarray
+    block_class: np.ndarray
+    block_course: np.ndarray
+    block_is_support: np.ndarray
+    block_name: np.ndarray
+    block_web: np.ndarray
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_hexahedra(cls, corners, block_class, block_course=None, block_is_support=None,
+                       block_name=None, block_web=None):
+        """Blocks from hexahedra with corners in the :data:`HEX_FACES` order.
+
+        Parameters
+        ----------
+        corners : (B, 8, 3) float, metres
+            Corner ``ix + 2 iy + 4 iz`` of each block (see :data:`HEX_FACES`). Faces must
+            be planar (boxes, and boxes clipped by planes through whole edges, are).
+        block_class : (B,) int or str
+        """
+        corners = np.asarray(corners, dtype=float)
+        count = len(corners)
+        face_vertices = (HEX_FACES[None, :, :] + 8 * np.arange(count)[:, None, None])
+        # orient every face outward, whatever the handedness of the corner frame
+        vertices = corners.reshape(-1, 3)
+        quads = vertices[face_vertices]  # (B, 6, 4, 3)
+        normal = _newell(quads.reshape(-1, 4, 3)).reshape(count, 6, 3)
+        outward = quads.mean(axis=2) - corners.mean(axis=1)[:, None, :]
+        flip = np.einsum("bfk,bfk->bf", normal, outward) < 0
+        face_vertices[flip] = face_vertices[flip][:, ::-1]
+        return cls.from_arrays(
+            vertices=vertices,
+            vertex_offsets=np.arange(count + 1) * 8,
+            face_vertices=face_vertices.reshape(-1),
+            face_offsets=np.arange(count * 6 + 1) * 4,
+            face_block=np.repeat(np.arange(count), 6),
+            block_class=block_class,
+            block_course=block_course,
+            block_is_support=block_is_support,
+            block_name=block_name,
+            block_web=block_web,
+        )
+
+    @classmethod
+    def from_arrays(cls, vertices, vertex_offsets, face_vertices, face_offsets, face_block,
+                    block_class, block_course=None, block_is_support=None, block_name=None,
+                    block_web=None):
+        """Blocks from flat arrays, filling defaults for the optional per-block fields."""
+        count = len(vertex_offsets) - 1
+        block_class = np.broadcast_to(np.asarray(block_class), (count,))
+        if block_class.dtype.kind in "US":
+            block_class = np.array([BLOCK_CLASSES.index(c) for c in block_class])
+        block_class = block_class.astype(np.int8)
+        block_course = (np.zeros(count, int) if block_course is None
+                        else np.asarray(block_course, dtype=int))
+        block_is_support = (block_class == BLOCK_CLASSES.index("ground")
+                            if block_is_support is None
+                            else np.asarray(block_is_support, dtype=bool))
+        block_web = np.zeros(count, int) if block_web is None else np.asarray(block_web, int)
+        if block_name is None:
+            block_name = [
+                f"b{i:04d}_{BLOCK_CLASSES[k]}_c{c}"
+                for i, (k, c) in enumerate(zip(block_class, block_course))
+            ]
+        return cls(
+            vertices=np.ascontiguousarray(vertices, dtype=float),
+            vertex_offsets=np.asarray(vertex_offsets, dtype=np.int64),
+            face_vertices=np.asarray(face_vertices, dtype=np.int64),
+            face_offsets=np.asarray(face_offsets, dtype=np.int64),
+            face_block=np.asarray(face_block, dtype=np.int64),
+            block_class=block_class,
+            block_course=block_course,
+            block_is_support=block_is_support,
+            block_name=np.asarray(block_name, dtype=object),
+            block_web=block_web,
+        )
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n_blocks(self) -> int:
+        return len(self.vertex_offsets) - 1
+
+    @property
+    def n_faces(self) -> int:
+        return len(self.face_offsets) - 1
+
+    def __len__(self) -> int:
+        return self.n_blocks
+
+    # ------------------------------------------------------------------ derived, cached
+    @cached_property
+    def face_polygon_count(self) -> np.ndarray:
+        """(F,) int: vertices per face."""
+        return np.diff(self.face_offsets)
+
+    @cached_property
+    def triangles(self) -> np.ndarray:
+        """(T, 3) int global vertex indices: every face fanned from its first vertex."""
+        counts = self.face_polygon_count - 2
+        face = np.repeat(np.arange(self.n_faces), counts)
+        k = np.arange(len(face)) - np.repeat(np.cumsum(counts) - counts, counts)
+        start = self.face_offsets[face]
+        fv = self.face_vertices
+        return np.stack([fv[start], fv[start + k + 1], fv[start + k + 2]], axis=1)
+
+    @cached_property
+    def triangle_face(self) -> np.ndarray:
+        """(T,) int: face of every triangle in :attr:`triangles`."""
+        return np.repeat(np.arange(self.n_faces), self.face_polygon_count - 2)
+
+    @cached_property
+    def _face_area_vectors(self) -> np.ndarray:
+        tri = self.vertices[self.triangles]
+        cross = 0.5 * np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        out = np.zeros((self.n_faces, 3))
+        np.add.at(out, self.triangle_face, cross)
+        return out
+
+    @cached_property
+    def face_area(self) -> np.ndarray:
+        """(F,) float, m^2."""
+        return np.linalg.norm(self._face_area_vectors, axis=1)
+
+    @cached_property
+    def face_normal(self) -> np.ndarray:
+        """(F, 3) float: outward unit normals."""
+        return self._face_area_vectors / self.face_area[:, None]
+
+    @cached_property
+    def face_centre(self) -> np.ndarray:
+        """(F, 3) float: area centroid of each face polygon, metres."""
+        tri = self.vertices[self.triangles]
+        area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
+                                    axis=1)
+        out = np.zeros((self.n_faces, 3))
+        np.add.at(out, self.triangle_face, tri.mean(axis=1) * area[:, None])
+        weight = np.bincount(self.triangle_face, area, minlength=self.n_faces)
+        return out / weight[:, None]
+
+    @cached_property
+    def face_basis(self) -> tuple:
+        """``(t1, t2)``, each (F, 3) float: in-plane basis of every face."""
+        return tangent_basis(self.face_normal)
+
+    @cached_property
+    def block_vertex_mean(self) -> np.ndarray:
+        """(B, 3) float: mean of each block's vertices (a point inside a convex block)."""
+        counts = np.diff(self.vertex_offsets)
+        owner = np.repeat(np.arange(self.n_blocks), counts)
+        out = np.zeros((self.n_blocks, 3))
+        np.add.at(out, owner, self.vertices)
+        return out / counts[:, None]
+
+    @cached_property
+    def _volume_moments(self) -> tuple:
+        # divergence theorem on tetrahedra (reference point, triangle); the reference is
+        # inside the block, which keeps the sum free of cancellation
+        tri_block = self.face_block[self.triangle_face]
+        ref = self.block_vertex_mean[tri_block]
+        tri = self.vertices[self.triangles]
+        a, b, c = tri[:, 0] - ref, tri[:, 1] - ref, tri[:, 2] - ref
+        vol = np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0
+        volume = np.bincount(tri_block, vol, minlength=self.n_blocks)
+        moment = np.zeros((self.n_blocks, 3))
+        np.add.at(moment, tri_block, vol[:, None] * (ref + (a + b + c) / 4.0))
+        return volume, moment
+
+    @cached_property
+    def block_volume(self) -> np.ndarray:
+        """(B,) float, m^3."""
+        return self._volume_moments[0]
+
+    @cached_property
+    def block_centroid(self) -> np.ndarray:
+        """(B, 3) float: centre of mass of each block (uniform density), metres."""
+        volume, moment = self._volume_moments
+        return moment / volume[:, None]
+
+    @cached_property
+    def block_bounds(self) -> np.ndarray:
+        """(B, 2, 3) float: axis-aligned bounding box (min, max) of each block."""
+        counts = np.diff(self.vertex_offsets)
+        starts = self.vertex_offsets[:-1]
+        lo = np.minimum.reduceat(self.vertices, starts, axis=0)
+        hi = np.maximum.reduceat(self.vertices, starts, axis=0)
+        lo[counts == 0] = np.nan
+        return np.stack([lo, hi], axis=1)
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """(2, 3) float: bounding box of the whole scene."""
+        return np.stack([self.vertices.min(axis=0), self.vertices.max(axis=0)])
+
+    def face_polygon(self, face: int) -> np.ndarray:
+        """(k, 3) float: vertices of one face, counter-clockwise seen from outside."""
+        return self.vertices[self.face_vertices[self.face_offsets[face]:self.face_offsets[face + 1]]]
+
+    def block_faces(self, block: int) -> np.ndarray:
+        """Face indices of one block (faces are stored block after block)."""
+        return np.flatnonzero(self.face_block == block)
+
+    def block_vertices(self, block: int) -> np.ndarray:
+        return self.vertices[self.vertex_offsets[block]:self.vertex_offsets[block + 1]]
+
+    # ------------------------------------------------------------------ trimesh
+    def meshes(self):
+        """One ``trimesh.Trimesh`` per block, built from the arrays (no hull, no processing)."""
+        import trimesh
+
+        tri_block = self.face_block[self.triangle_face]
+        order = np.argsort(tri_block, kind="stable")
+        tris = self.triangles[order]
+        splits = np.searchsorted(tri_block[order], np.arange(1, self.n_blocks))
+        out = []
+        for i, faces in enumerate(np.split(tris, splits)):
+            lo, hi = self.vertex_offsets[i], self.vertex_offsets[i + 1]
+            out.append(trimesh.Trimesh(self.vertices[lo:hi], faces - lo, process=False))
+        return out
+
+    def subset(self, mask) -> "Blocks":
+        """The blocks selected by a boolean mask or index array, in their order."""
+        index = np.arange(self.n_blocks)[mask]
+        vcount = np.diff(self.vertex_offsets)[index]
+        vsel = np.concatenate([np.arange(self.vertex_offsets[i], self.vertex_offsets[i + 1])
+                               for i in index]) if len(index) else np.zeros(0, int)
+        remap = np.full(len(self.vertices), -1)
+        remap[vsel] = np.arange(len(vsel))
+        fsel = np.flatnonzero(np.isin(self.face_block, index))
+        fcount = self.face_polygon_count[fsel]
+        fv = np.concatenate([self.face_vertices[self.face_offsets[f]:self.face_offsets[f + 1]]
+                             for f in fsel]) if len(fsel) else np.zeros(0, int)
+        block_remap = np.full(self.n_blocks, -1)
+        block_remap[index] = np.arange(len(index))
+        return Blocks(
+            vertices=self.vertices[vsel],
+            vertex_offsets=np.concatenate([[0], np.cumsum(vcount)]),
+            face_vertices=remap[fv],
+            face_offsets=np.concatenate([[0], np.cumsum(fcount)]),
+            face_block=block_remap[self.face_block[fsel]],
+            block_class=self.block_class[index],
+            block_course=self.block_course[index],
+            block_is_support=self.block_is_support[index],
+            block_name=self.block_name[index],
+            block_web=self.block_web[index],
+        )
+
+    def transformed(self, matrix) -> "Blocks":
+        """A copy moved by a 4x4 rigid transform (faces keep their orientation)."""
+        matrix = np.asarray(matrix, dtype=float)
+        vertices = self.vertices @ matrix[:3, :3].T + matrix[:3, 3]
+        return dataclasses.replace(self, vertices=vertices)
+
+
+def concatenate(parts) -> Blocks:
+    """One :class:`Blocks` from several, in order."""
+    parts = list(parts)
+    vbase = np.cumsum([0] + [len(p.vertices) for p in parts])
+    fvbase = np.cumsum([0] + [len(p.face_vertices) for p in parts])
+    bbase = np.cumsum([0] + [p.n_blocks for p in parts])
+    return Blocks(
+        vertices=np.concatenate([p.vertices for p in parts]),
+        vertex_offsets=np.concatenate(
+            [[0]] + [p.vertex_offsets[1:] + vbase[i] for i, p in enumerate(parts)]),
+        face_vertices=np.concatenate([p.face_vertices + vbase[i] for i, p in enumerate(parts)]),
+        face_offsets=np.concatenate(
+            [[0]] + [p.face_offsets[1:] + fvbase[i] for i, p in enumerate(parts)]),
+        face_block=np.concatenate([p.face_block + bbase[i] for i, p in enumerate(parts)]),
+        block_class=np.concatenate([p.block_class for p in parts]),
+        block_course=np.concatenate([p.block_course for p in parts]),
+        block_is_support=np.concatenate([p.block_is_support for p in parts]),
+        block_name=np.concatenate([p.block_name for p in parts]),
+        block_web=np.concatenate([p.block_web for p in parts]),
+    )
+
+
+def _newell(polygons):
+    """(k, m, 3) polygons -> (k, 3) Newell normals (area-weighted, not normalised)."""
+    nxt = np.roll(polygons, -1, axis=1)
+    return 0.5 * np.cross(polygons, nxt).sum(axis=1)
