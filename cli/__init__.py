@@ -1,0 +1,1 @@
+"""Command-line front end of masonry: parses, calls the library, reports."""

@@ -1,0 +1,45 @@
+"""Entry point of the ``masonry`` command. ``main(argv)`` returns the exit code."""
+
+import logging
+import sys
+
+from masonry.params import ParameterError
+
+from . import build
+from .options import Parser
+
+SUBCOMMANDS = (build,)
+
+
+def make_parser():
+    parser = Parser(prog="masonry", description=(
+        "Brunelleschi-style double-helix masonry domes: bricks, interfaces, rigid block "
+        "equilibrium, printable exports."))
+    subparsers = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    for module in SUBCOMMANDS:
+        module.register(subparsers)
+    return parser
+
+
+def main(argv=None) -> int:
+    args = make_parser().parse_args(argv)
+    quiet = getattr(args, "quiet", False)
+    logging.basicConfig(level=logging.WARNING if quiet else logging.INFO,
+                        format="masonry: %(message)s", stream=sys.stderr)
+    logging.getLogger("matplotlib").setLevel(logging.WARNING)
+
+    def report(line):
+        print(line)
+
+    try:
+        return args.handler(args, report)
+    except ParameterError as error:
+        print(f"masonry: error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("masonry: interrupted; the previous output is untouched", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

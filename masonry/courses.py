@@ -1,0 +1,237 @@
+"""Courses: regular and fill-in bricks between the pattern bricks (SPEC 4.4, thesis 3.2.3).
+
+Works in the flattened section (``s`` along the wall in units, course ``k = 1..L``).
+Each course's pattern cells split ``[-W_k, W_k]`` into sequences; each sequence gets
+regular bricks (4 units) and fill-in bricks for the remainder. The layout is
+mirror-symmetric about ``s = 0``: a sequence left of the centre is filled and mirrored,
+the centre sequence gets a symmetric fill.
+
+Joints are staggered: among the fills a sequence admits (the fill-in at either end or in
+between, or split into two fill-ins), the one whose joints keep farthest from the joints of
+the course below is chosen. What could not be staggered is counted and reported.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .blocks import BLOCK_CLASSES
+from .pattern import Pattern
+
+REGULAR = 4.0  # regular brick length, units
+_EPS = 1e-9
+
+REG, PAT, FILL = (BLOCK_CLASSES.index(c) for c in ("regular", "pattern", "fill_in"))
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Bricks of a section in the flattened coordinates, one row per brick.
+
+    Parameters
+    ----------
+    course : (B,) int
+        Course the brick starts on (pattern bricks also cover ``course + 1``).
+    s0, s1 : (B,) float
+        Extent along the wall, units (nominal: mitered ends reach the corner planes).
+    klass : (B,) int8
+        Code into ``BLOCK_CLASSES`` (regular, pattern, fill_in).
+    miter_left, miter_right : (B,) bool
+        End bricks, clipped by the corner plane at ``-pi/n`` / ``+pi/n``.
+    repeated_joints : (L,) int
+        Per course, joints within one unit of a joint of the course below (pattern
+        bricks excepted), SPEC 4.4's measure of staggering.
+    short_fill_ins : int
+        Fill-ins shorter than ``min_fill`` that could not be avoided (an end gap beside a
+        pattern brick that is not the course's end brick).
+    """
+
+    course: np.ndarray
+    s0: np.ndarray
+    s1: np.ndarray
+    klass: np.ndarray
+    miter_left: np.ndarray
+    miter_right: np.ndarray
+    repeated_joints: np.ndarray
+    short_fill_ins: int
+
+    def __len__(self) -> int:
+        return len(self.course)
+
+
+def _split(length, min_fill):
+    """Regular count and remainder of a sequence, the remainder >= min_fill or zero."""
+    m = int(np.floor(length / REGULAR + _EPS))
+    rem = length - REGULAR * m
+    if rem < _EPS * max(length, 1.0):
+        return m, 0.0
+    if rem < min_fill and m > 0:
+        return m - 1, rem + REGULAR
+    return m, rem
+
+
+def _side_candidates(length, min_fill):
+    """Piece lengths (left to right) that fill a sequence of ``length`` units."""
+    m, rem = _split(length, min_fill)
+    if rem == 0:
+        out = [[REGULAR] * m]
+        if m >= 1:  # split a regular brick into two fill-ins, one at each end
+            out.append([REGULAR / 2] + [REGULAR] * (m - 1) + [REGULAR / 2])
+        return out
+    out = [[REGULAR] * i + [rem] + [REGULAR] * (m - i) for i in range(m + 1)]
+    if m >= 1:  # two fill-ins at the ends, one regular brick fewer
+        total = rem + REGULAR
+        for left in {total / 2, REGULAR / 2, total - REGULAR / 2}:
+            if min(left, total - left) >= min_fill - _EPS:
+                out.append([left] + [REGULAR] * (m - 1) + [total - left])
+    return out
+
+
+def _half_fill(half, min_fill):
+    """Pieces from the centre outward that fill ``half`` units with one end fill-in."""
+    m, rem = _split(half, min_fill)
+    return [REGULAR] * m + ([rem] if rem else [])
+
+
+def _centre_candidates(length, min_fill):
+    """Symmetric piece lengths filling a sequence centred on ``s = 0``."""
+    half = length / 2
+    out = []
+    # a joint on the centre line
+    side = _half_fill(half, min_fill)
+    if side and min(side) >= min_fill - _EPS:
+        out.append(side[::-1] + side)
+    # a regular brick across the centre line
+    if half >= REGULAR / 2 - _EPS:
+        side = _half_fill(half - REGULAR / 2, min_fill)
+        if not side or min(side) >= min_fill - _EPS:
+            out.append(side[::-1] + [REGULAR] + side)
+    # a fill-in across the centre line, regular bricks to both ends
+    j = int(np.floor((length - min_fill) / (2 * REGULAR) + _EPS))
+    middle = length - 2 * REGULAR * max(j, 0)
+    if j >= 0 and min_fill - _EPS <= middle < REGULAR + min_fill:
+        out.append([REGULAR] * j + [middle] + [REGULAR] * j)
+    return out or [[length]]
+
+
+def _joints(start, pieces):
+    return start + np.cumsum(pieces)[:-1]
+
+
+def _score(joints, below):
+    """(repeated joints, -closest distance, fill-ins): smaller is better."""
+    if len(joints) == 0 or len(below) == 0:
+        return 0, 0.0
+    d = np.abs(joints[:, None] - below[None, :]).min(axis=1)
+    return int((d < 1 - _EPS).sum()), -float(d.min())
+
+
+def _choose(candidates, start, below):
+    def key(pieces):
+        repeated, closest = _score(_joints(start, pieces), below)
+        fill_ins = sum(abs(x - REGULAR) > _EPS for x in pieces)
+        return repeated, fill_ins, closest
+    return min(candidates, key=key)
+
+
+def fill_courses(half_width, pattern: Pattern, min_fill: float = 1.0,
+                 miter: bool = True) -> Layout:
+    """Lay every course: pattern bricks, then regular and fill-in bricks between them.
+
+    Parameters
+    ----------
+    half_width : (L,) float
+        ``W_k`` (index ``k - 1``), units.
+    pattern : Pattern
+    min_fill : float
+        Shortest fill-in, units (SPEC 4.4).
+    miter : bool
+        End bricks are clipped by the corner planes (a dome web); False for a straight wall.
+    """
+    half_width = np.asarray(half_width, dtype=float)
+    n_courses = len(half_width)
+    rows = []  # (course, s0, s1, class, miter_left, miter_right)
+
+    # pattern bricks: the outermost one on both its courses, within min_fill of the
+    # boundary on its upper course, becomes the mitered end brick of both courses
+    cells = pattern.cells(n_courses)
+    lo = [c[0] if c else np.inf for c in cells]
+    hi = [c[-1] if c else -np.inf for c in cells]
+    pattern_end = {}
+    for k, s in zip(pattern.course, pattern.s):
+        upper = min(k + 1, n_courses)
+        w = half_width[upper - 1]
+        left = miter and s == lo[k - 1] == lo[upper - 1] and s + w < min_fill - _EPS
+        right = miter and s == hi[k - 1] == hi[upper - 1] and w - (s + 1) < min_fill - _EPS
+        rows.append((k, float(s), float(s + 1), PAT, left, right))
+        for c in {k, upper}:
+            if left:
+                pattern_end[(c, "left")] = True
+            if right:
+                pattern_end[(c, "right")] = True
+
+    repeated = np.zeros(n_courses, int)
+    short = 0
+    below = np.zeros(0)
+    for k in range(1, n_courses + 1):
+        w = half_width[k - 1]
+        occupied = sorted(cells[k - 1])
+        # sequences between boundaries and pattern cells, as (start, end, at_left, at_right)
+        edges = [(-w, True)]
+        for c in occupied:
+            edges += [(float(c), False), (float(c + 1), False)]
+        edges.append((w, True))
+        seqs = []
+        for (u, u_bound), (v, v_bound) in zip(edges[0::2], edges[1::2]):
+            if (u_bound and pattern_end.get((k, "left"))) or (
+                    v_bound and pattern_end.get((k, "right"))):
+                continue  # absorbed by the mitered pattern brick
+            if v - u > _EPS:
+                seqs.append((u, v, u_bound, v_bound))
+        joints = []
+        for u, v, u_bound, v_bound in seqs:
+            if v <= _EPS:  # left half: fill, then mirror
+                if v - u < min_fill - _EPS:
+                    pieces = [v - u]
+                    short += 2
+                else:
+                    pieces = _choose(_side_candidates(v - u, min_fill), u, below)
+                mirrored = u < -_EPS or v < -_EPS
+                for start, parts, lb, rb in (
+                        (u, pieces, u_bound, v_bound),
+                        (-v, pieces[::-1], v_bound, u_bound)) if mirrored else (
+                        (u, pieces, u_bound, v_bound),):
+                    edges_s = start + np.concatenate([[0.0], np.cumsum(parts)])
+                    for i, (a, b) in enumerate(zip(edges_s[:-1], edges_s[1:])):
+                        klass = REG if abs(b - a - REGULAR) < 1e-6 else FILL
+                        rows.append((k, a, b, klass, miter and lb and i == 0,
+                                     miter and rb and i == len(parts) - 1))
+                    joints.extend(edges_s[1:-1])
+            elif u < -_EPS:  # the centre sequence
+                if v - u < min_fill - _EPS:
+                    pieces = [v - u]
+                    short += 1
+                else:
+                    pieces = _choose(_centre_candidates(v - u, min_fill), u, below)
+                edges_s = u + np.concatenate([[0.0], np.cumsum(pieces)])
+                for i, (a, b) in enumerate(zip(edges_s[:-1], edges_s[1:])):
+                    klass = REG if abs(b - a - REGULAR) < 1e-6 else FILL
+                    rows.append((k, a, b, klass, miter and u_bound and i == 0,
+                                 miter and v_bound and i == len(pieces) - 1))
+                joints.extend(edges_s[1:-1])
+        joints = np.sort(np.array(joints))
+        repeated[k - 1] = _score(joints, below)[0]
+        below = joints
+
+    rows.sort(key=lambda row: (row[0], row[1]))
+    arr = list(zip(*rows)) if rows else [[]] * 6
+    return Layout(
+        course=np.array(arr[0], dtype=int),
+        s0=np.array(arr[1], dtype=float),
+        s1=np.array(arr[2], dtype=float),
+        klass=np.array(arr[3], dtype=np.int8),
+        miter_left=np.array(arr[4], dtype=bool),
+        miter_right=np.array(arr[5], dtype=bool),
+        repeated_joints=repeated,
+        short_fill_ins=short,
+    )

@@ -1,0 +1,172 @@
+"""Parameters, modes, presets and the structure id (SPEC 3).
+
+Every input of a run is a field of :class:`Params`. :func:`validate` checks them all
+before any work starts; a bad value raises one :class:`ParameterError` that names the
+parameter, the value and the valid range.
+"""
+
+import dataclasses
+import logging
+import math
+import tomllib
+from dataclasses import dataclass
+
+log = logging.getLogger(__name__)
+
+SCENES = ("section", "wall", "dome", "assembly", "arch")
+FRICTIONS = ("net", "plus", "auto")
+BOUNDARIES = ("free", "rigid", "cyclic")
+SOLVERS = ("osqp", "clarabel")
+
+PRESETS = {
+    # SPEC 3 / thesis 3.4.1: the three structures of the thesis
+    "1": dict(stretch=1.0, n=8, r=1, p=10, cut=0.1),
+    "2": dict(stretch=2.0, n=6, r=1, p=8, cut=0.05),
+    "3": dict(stretch=0.8, n=4, r=1, p=13, cut=0.01),
+    # thesis 3.3.6 straight wall test: 10 courses of 8 regular bricks, about 12.5 kN
+    "wall": dict(scene="wall", wall_length=32.0, wall_courses=10),
+}
+
+
+class ParameterError(ValueError):
+    """A parameter is out of its valid range. The message names parameter, value, range."""
+
+    def __init__(self, name, value, expected):
+        super().__init__(f"invalid parameter {name}={value!r}: expected {expected}")
+        self.name = name
+        self.value = value
+        self.expected = expected
+
+
+@dataclass(frozen=True)
+class Params:
+    """All inputs of a run.
+
+    Geometry (units of ``unit`` metres unless stated): ``stretch`` dome height /
+    circumradius; ``n`` walls of the polygonal dome; ``r`` full rhombi across the section;
+    ``p`` pattern bricks per rhombus side; ``cut`` fraction of the height cut off at the
+    top; ``unit`` brick unit in metres; ``min_fill`` shortest fill-in brick (units).
+    Scene: ``scene`` (section, wall, dome, ...), ``boundary`` of a section (free, rigid,
+    cyclic), ``wall_length`` (units) and ``wall_courses`` for the wall scene.
+    Analysis: ``mu`` friction coefficient, ``density`` kg/m^3, ``friction`` net | plus |
+    auto, ``solver``. Output: ``fast`` (one view, low resolution), ``cad_offset`` (units).
+    """
+
+    stretch: float = 1.0
+    n: int = 8
+    r: int = 1
+    p: int = 10
+    cut: float = 0.1
+    unit: float = 0.1
+    min_fill: float = 1.0
+    scene: str = "section"
+    boundary: str = "free"
+    wall_length: float = 32.0
+    wall_courses: int = 10
+    mu: float = 0.7
+    density: float = 2000.0
+    friction: str = "auto"
+    solver: str = "osqp"
+    fast: bool = False
+    cad_offset: float = 1.0
+
+    def replace(self, **changes) -> "Params":
+        return dataclasses.replace(self, **changes)
+
+    @property
+    def geometry_key(self) -> dict:
+        """The inputs that decide the geometry and interfaces (the cache key)."""
+        if self.scene == "wall":
+            keys = ("scene", "wall_length", "wall_courses", "unit")
+        else:
+            keys = ("scene", "stretch", "n", "r", "p", "cut", "unit", "min_fill", "boundary")
+        return {k: getattr(self, k) for k in keys}
+
+
+def from_preset(name, **overrides) -> Params:
+    """Parameters of a preset (``1``, ``2``, ``3`` or ``wall``) with overrides."""
+    key = str(name)
+    if key not in PRESETS:
+        raise ParameterError("preset", name, f"one of {', '.join(PRESETS)}")
+    return validate(Params(**{**PRESETS[key], **overrides}))
+
+
+def load(path, **overrides) -> Params:
+    """Parameters from a TOML file of ``Params`` fields (e.g. ``fixtures/presets/*.toml``)."""
+    with open(path, "rb") as f:
+        data = tomllib.load(f)
+    data = data.get("params", data)
+    unknown = set(data) - {f.name for f in dataclasses.fields(Params)}
+    if unknown:
+        raise ParameterError("file", str(path), f"only Params fields, not {sorted(unknown)}")
+    return validate(Params(**{**data, **overrides}))
+
+
+def _check(name, value, ok, expected):
+    if not ok:
+        raise ParameterError(name, value, expected)
+
+
+def _number(name, value, integer=False):
+    kinds = (int,) if integer else (int, float)
+    if isinstance(value, bool) or not isinstance(value, kinds):
+        raise ParameterError(name, value, "an integer" if integer else "a number")
+    if not math.isfinite(value):
+        raise ParameterError(name, value, "a finite number")
+    return value
+
+
+def validate(params: Params) -> Params:
+    """Check every parameter; return ``params`` or raise :class:`ParameterError`."""
+    p = params
+    _check("scene", p.scene, p.scene in SCENES, f"one of {', '.join(SCENES)}")
+    _check("boundary", p.boundary, p.boundary in BOUNDARIES, f"one of {', '.join(BOUNDARIES)}")
+    _check("friction", p.friction, p.friction in FRICTIONS, f"one of {', '.join(FRICTIONS)}")
+    _check("solver", p.solver, p.solver in SOLVERS, f"one of {', '.join(SOLVERS)}")
+    _check("stretch", p.stretch, _number("stretch", p.stretch) > 0, "> 0")
+    _check("n", p.n, _number("n", p.n, integer=True) >= 3, "an integer >= 3")
+    _check("r", p.r, _number("r", p.r, integer=True) >= 0, "an integer >= 0")
+    _check("p", p.p, _number("p", p.p, integer=True) >= 1, "an integer >= 1")
+    _check("cut", p.cut, 0 <= _number("cut", p.cut) < 1, "0 <= cut < 1")
+    _check("unit", p.unit, _number("unit", p.unit) > 0, "> 0 (metres)")
+    _check("min_fill", p.min_fill, 0 < _number("min_fill", p.min_fill) <= 4,
+           "0 < min_fill <= 4 (units)")
+    _check("mu", p.mu, _number("mu", p.mu) > 0, "> 0")
+    _check("density", p.density, _number("density", p.density) > 0, "> 0 (kg/m^3)")
+    _check("cad_offset", p.cad_offset, _number("cad_offset", p.cad_offset) >= 0,
+           ">= 0 (units)")
+    _check("wall_length", p.wall_length, _number("wall_length", p.wall_length) >= 4,
+           ">= 4 (units, one regular brick)")
+    _check("wall_courses", p.wall_courses,
+           _number("wall_courses", p.wall_courses, integer=True) >= 1, "an integer >= 1")
+    if p.scene in ("section", "dome") and not 0.2 <= p.stretch <= 5:
+        log.warning("stretch=%g is outside 0.2..5: the dome is unusually flat or tall",
+                    p.stretch)
+    return p
+
+
+def structure_id(params: Params) -> str:
+    """Name of a run's output folder, built from every input that changes the result.
+
+    The thesis's form for defaults, e.g. ``dome0_fast0_fricauto_s1_n8_r1_p10_c0.1_u0.1``;
+    inputs away from their defaults are appended (``_mu0.3``), so a run overwrites only the
+    folder of an identical input.
+    """
+    p = params
+    default = Params()
+    if p.scene == "wall":
+        head = f"wall_fast{int(p.fast)}_fric{p.friction}_L{p.wall_length:g}_k{p.wall_courses}"
+    else:
+        mode = "dome" if p.scene == "dome" else f"dome{int(p.boundary != 'free')}"
+        head = (f"{mode}_fast{int(p.fast)}_fric{p.friction}_s{p.stretch:g}_n{p.n}_r{p.r}"
+                f"_p{p.p}_c{p.cut:g}")
+    head += f"_u{p.unit:g}"
+    extras = [("boundary", "b"), ("mu", "mu"), ("density", "rho"), ("min_fill", "mf"),
+              ("solver", ""), ("cad_offset", "cad")]
+    for name, tag in extras:
+        value = getattr(p, name)
+        if name == "boundary" and (p.scene == "wall" or value != "rigid"):
+            continue  # dome0 / dome1 already say free / cyclic
+        if value != getattr(default, name):
+            head += f"_{tag}{value:g}" if isinstance(value, float) else f"_{tag}{value}"
+    return head

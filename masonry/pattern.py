@@ -1,0 +1,167 @@
+"""The double-helix pattern in the flattened section (SPEC 4.3, thesis 3.2.2).
+
+Coordinates: ``s`` is the position along the wall in units (``s = 0`` on the mid-plane),
+courses are numbered ``k = 1..L``. A pattern brick started on course ``k`` at ``s``
+covers ``[s, s + 1]`` on courses ``k`` and ``k + 1``. Since the ground half width
+``Y_0 = (p + 1)(r + 1)`` is a whole number, every pattern brick sits on the integer
+lattice, and the mirror image of ``[s, s + 1]`` is ``[-s - 1, -s]``.
+
+Patternlines are zigzag paths that move one unit sideways per course. They leave the
+ground nodes ``s = -Y_0 + 2 j (p + 1)``, ``j = 0..r+1`` (the two corners and the nodes
+between them), in both directions, clamped inside the section at the corners. A line
+bounces (reverses) where its next brick would leave the section (the rhombi close at
+the boundary) or would run into another line (the rhombi meet in a node: two pattern
+bricks side by side on one course). A line that can go neither on nor back (the section
+has become too narrow) ends.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+# slack for comparing positions in units against the section's half widths
+_EPS = 1e-9
+
+
+@dataclass(frozen=True)
+class Pattern:
+    """Pattern bricks and what the rules did.
+
+    Parameters
+    ----------
+    course : (P,) int
+        Course each pattern brick starts on (it covers ``course`` and ``course + 1``).
+    s : (P,) int
+        Left edge of each brick along the wall, units.
+    line : (P,) int
+        Patternline of each brick.
+    nodes : (N, 2) int
+        ``(course, s)`` of every node: two bricks of two lines side by side on one course
+        (``s`` is the shared edge).
+    near_nodes : (M, 2) int
+        ``(course, s)`` where two lines met one unit apart and bounced without forming a
+        node (the narrowing section or the corner clamp shifted their parity); ``s`` is
+        the middle of the one-unit gap. This is the rhombus deviation SPEC 4.3 asks to
+        report.
+    boundary_bounces : (Q, 2) int
+        ``(course, s)`` of the brick at which a line turned back at the boundary.
+    ended : (E, 2) int
+        ``(course, s)`` of the last brick of lines that ended below the top.
+    """
+
+    course: np.ndarray
+    s: np.ndarray
+    line: np.ndarray
+    nodes: np.ndarray
+    near_nodes: np.ndarray
+    boundary_bounces: np.ndarray
+    ended: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.course)
+
+    def cells(self, n_courses: int) -> list:
+        """Per course ``k = 1..n_courses`` (list index ``k - 1``), the sorted left edges of
+        the pattern cells it holds (bricks started on ``k`` and on ``k - 1``)."""
+        out = [[] for _ in range(n_courses)]
+        for k, s in zip(self.course, self.s):
+            out[k - 1].append(int(s))
+            if k < n_courses:
+                out[k].append(int(s))
+        return [sorted(c) for c in out]
+
+
+def _fits(s, half_width):
+    return (s >= -half_width - _EPS) & (s + 1 <= half_width + _EPS)
+
+
+def _conflicts(old, new):
+    """Lines whose new brick overlaps another line's new or old brick, or crosses a line."""
+    bad = np.zeros(len(new), bool)
+    for i in range(len(new)):
+        others = np.arange(len(new)) != i
+        same = new[others] == new[i]
+        onto_old = old[others] == new[i]
+        crossing = np.sign(old[i] - old[others]) * np.sign(new[i] - new[others]) < 0
+        bad[i] = (same | onto_old | crossing).any()
+    return bad
+
+
+def build_pattern(half_width, p: int, r: int) -> Pattern:
+    """Pattern bricks for a section whose course ``k`` spans ``[-W_k, W_k]``.
+
+    Parameters
+    ----------
+    half_width : (L,) float
+        ``W_k`` (index ``k - 1``): half width of course ``k`` at its top intrados edge,
+        units (the narrowest part of the course). A brick started on course ``k`` must lie
+        within ``[-W_k, W_k]``; on course ``k + 1`` it may then poke out of the web by
+        ``W_k - W_{k+1}`` (a few hundredths of a unit), which the corner miter of SPEC 4.5
+        cuts off. This is the rule ``shared/pattern-sketch-preset1.png`` was drawn with.
+    p, r : int
+        Pattern bricks per rhombus side, full rhombi across the section.
+    """
+    half_width = np.asarray(half_width, dtype=float)
+    n_courses = len(half_width)
+    empty = np.zeros((0, 2), int)
+    if n_courses < 2:
+        return Pattern(np.zeros(0, int), np.zeros(0, int), np.zeros(0, int),
+                       empty, empty, empty, empty)
+    y0 = (p + 1) * (r + 1)
+    nodes_ground = [-y0 + 2 * j * (p + 1) for j in range(r + 2)]
+    pos, step = [], []
+    for node in nodes_ground:
+        if node > -y0:
+            pos.append(node - 1)
+            step.append(-1)
+        if node < y0:
+            pos.append(node)
+            step.append(+1)
+    pos, step = np.array(pos), np.array(step)
+    # clamp the corner lines inside the first course
+    w = half_width[0]
+    pos = np.clip(pos, np.ceil(-w - _EPS), np.floor(w + _EPS) - 1).astype(int)
+    alive = np.ones(len(pos), bool)
+
+    course, s, line = [], [], []
+    nodes, near, bounces, ended = [], [], [], []
+
+    def record(k, idx):
+        course.extend([k] * len(idx))
+        s.extend(pos[idx])
+        line.extend(idx)
+
+    record(1, np.flatnonzero(alive))
+    for k in range(2, n_courses):  # a brick on course k needs course k + 1
+        idx = np.flatnonzero(alive)
+        if len(idx) == 0:
+            break
+        w = half_width[k - 1]  # W_k, as the reference sketch does (see build_pattern)
+        old = pos[idx]
+        new = old + step[idx]
+        turn = ~_fits(new, w)
+        for i in np.flatnonzero(turn):
+            bounces.append((k - 1, old[i]))
+        clash = _conflicts(old, new) & ~turn
+        # record where two lines met: adjacent bricks (a node) or one unit apart
+        order = np.argsort(old)
+        for a, b in zip(order[:-1], order[1:]):
+            if clash[a] and clash[b] and step[idx[a]] > 0 > step[idx[b]]:
+                gap = old[b] - old[a] - 1
+                if gap == 0:
+                    nodes.append((k - 1, old[b]))
+                elif gap == 1:
+                    near.append((k - 1, old[a] + 1))
+        turn |= clash
+        new[turn] = old[turn] - step[idx][turn]
+        step[idx[turn]] *= -1
+        stuck = ~_fits(new, w) | _conflicts(old, new)
+        for i in np.flatnonzero(stuck):
+            ended.append((k - 1, old[i]))
+        alive[idx[stuck]] = False
+        pos[idx] = new
+        record(k, idx[~stuck])
+    as_pairs = [np.array(v, dtype=int).reshape(-1, 2) for v in (nodes, near, bounces, ended)]
+    order = np.lexsort((s, course))
+    return Pattern(np.array(course)[order], np.array(s)[order], np.array(line)[order],
+                   *as_pairs)

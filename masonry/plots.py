@@ -1,0 +1,129 @@
+"""Plots as PNG bytes (matplotlib, Agg): the flattened pattern and the structure views.
+
+Every function returns ``{relative path: png bytes}`` so the run folder writer is the one
+place that touches the disk.
+"""
+
+import io
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+from matplotlib.patches import Rectangle  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+
+from .blocks import BLOCK_CLASSES  # noqa: E402
+
+CLASS_COLOURS = {
+    "ground": "#9e9e9e",
+    "regular": "#e8d5b0",
+    "pattern": "#d62728",
+    "fill_in": "#f2a541",
+    "block": "#c9b79c",
+}
+
+# (folder, elevation, azimuth): the thesis's four views (section 3.4)
+VIEWS = {
+    "01_angle": (25, -50),
+    "02_front": (0, 0),
+    "03_top": (90, -90),
+    "04_side": (0, -90),
+}
+
+
+def _png(fig, dpi) -> bytes:
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def pattern_png(scene, fast=False) -> bytes:
+    """The flattened section (thesis figures 3.8-3.9): position along the wall (units)
+    against course, pattern, regular and fill-in bricks in distinct colours, the web's
+    half width at every course in blue."""
+    layout, levels, unit = scene.layout, scene.levels, scene.params.unit
+    height = np.where(layout.klass == BLOCK_CLASSES.index("pattern"), 2, 1)
+    # mitered ends reach the web's boundary (at the course's lower, wider edge)
+    w_low = levels.y[layout.course - 1] / unit
+    s0 = np.where(layout.miter_left, -w_low, layout.s0)
+    s1 = np.where(layout.miter_right, w_low, layout.s1)
+    fig, ax = plt.subplots(figsize=(6, 7.5))
+    for k, s0, s1, klass, h in zip(layout.course, s0, s1, layout.klass, height):
+        name = BLOCK_CLASSES[klass]
+        ax.add_patch(Rectangle((s0, k - 1), s1 - s0, h, facecolor=CLASS_COLOURS[name],
+                               edgecolor="k", linewidth=0.3, zorder=3 if h == 2 else 2))
+    w = levels.y / unit
+    z = np.arange(len(w))
+    ax.plot(w, z, "b-", -w, z, "b-", linewidth=1.2)
+    for name in ("pattern", "regular", "fill_in"):
+        ax.add_patch(Rectangle((0, 0), 0, 0, facecolor=CLASS_COLOURS[name], label=name))
+    ax.legend(loc="upper right", fontsize=7)
+    ax.set_xlabel("position along the wall s [units]")
+    ax.set_ylabel("course")
+    ax.set_xlim(-w.max() - 1, w.max() + 1)
+    ax.set_ylim(-0.5, len(w) + 0.5)
+    ax.set_title(f"{scene.params.scene}: {len(layout)} bricks, "
+                 f"{int((layout.klass == BLOCK_CLASSES.index('pattern')).sum())} pattern")
+    return _png(fig, 80 if fast else 130)
+
+
+def _faces_3d(blocks, mask):
+    faces = np.flatnonzero(mask[blocks.face_block])
+    polys = [blocks.face_polygon(f) for f in faces]
+    colours = [CLASS_COLOURS[BLOCK_CLASSES[blocks.block_class[blocks.face_block[f]]]]
+               for f in faces]
+    return polys, colours
+
+
+def _axes3d(bounds, view):
+    fig = plt.figure(figsize=(7, 7))
+    ax = fig.add_subplot(projection="3d")
+    centre = bounds.mean(axis=0)
+    half = (bounds[1] - bounds[0]).max() / 2
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    ax.set_box_aspect((1, 1, 1))
+    ax.view_init(*VIEWS[view])
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    ax.set_zlabel("z [m]")
+    return fig, ax
+
+
+def _outline(ax, scene):
+    levels = scene.levels
+    if levels is None or scene.dims is None:
+        return
+    for sign in (-1, 1):
+        ax.plot(levels.x, sign * levels.y, levels.z, color="b", linewidth=1)
+    ax.plot(levels.x[[0, 0]], levels.y[[0, 0]] * [-1, 1], [0, 0], color="b", linewidth=1)
+
+
+def structure_pngs(scene, fast=False) -> dict:
+    """Structure plots in the thesis's stages (figures 3.7, 3.10, 3.11): the web's
+    boundaries, the pattern bricks, the complete structure; in the four views, or one
+    view at lower resolution when ``fast``."""
+    blocks = scene.blocks
+    bounds = blocks.bounds
+    pattern = blocks.block_class == BLOCK_CLASSES.index("pattern")
+    stages = {"3_structure": np.ones(blocks.n_blocks, bool)}
+    if pattern.any():
+        stages = {"1_boundaries": np.zeros(blocks.n_blocks, bool),
+                  "2_pattern": pattern, **stages}
+    views = ["01_angle"] if fast else list(VIEWS)
+    out = {}
+    for view in views:
+        for stage, mask in stages.items():
+            fig, ax = _axes3d(bounds, view)
+            _outline(ax, scene)
+            if mask.any():
+                polys, colours = _faces_3d(blocks, mask)
+                ax.add_collection3d(Poly3DCollection(polys, facecolors=colours,
+                                                     edgecolors="k", linewidths=0.1))
+            ax.set_title(f"{stage[2:]}: {int(mask.sum())} bricks")
+            out[f"{view}/{stage}.png"] = _png(fig, 60 if fast else 110)
+    return out

@@ -1,0 +1,73 @@
+"""The one place that writes a run's files, atomically (SPEC 7).
+
+A run writes into a hidden temporary folder beside its target and swaps it into place
+only when everything is written. A failed or interrupted run removes its temporary folder
+and leaves the previous output exactly as it was.
+"""
+
+import json
+import os
+import shutil
+import uuid
+from pathlib import Path
+
+
+class RunFolder:
+    """Collects a run's files and publishes them as ``root/name`` in one step.
+
+    Use as a context manager: the folder is published when the block ends normally and
+    discarded when it raises (including ``KeyboardInterrupt``).
+    """
+
+    def __init__(self, root, name):
+        self.root = Path(root)
+        self.target = self.root / name
+        tag = uuid.uuid4().hex[:8]
+        self.tmp = self.root / f".{name}.tmp-{tag}"
+        self._old = self.root / f".{name}.old-{tag}"
+
+    def __enter__(self):
+        self.root.mkdir(parents=True, exist_ok=True)
+        self.tmp.mkdir()
+        return self
+
+    def __exit__(self, kind, value, traceback):
+        if kind is None:
+            self.publish()
+        else:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+        return False
+
+    def path(self, relative) -> Path:
+        """Where ``relative`` lives in the temporary folder (for writers that need a path)."""
+        path = self.tmp / relative
+        path.parent.mkdir(parents=True, exist_ok=True)
+        return path
+
+    def write(self, relative, data):
+        """Write bytes or text to ``relative`` inside the run folder."""
+        mode = "wb" if isinstance(data, bytes) else "w"
+        with open(self.path(relative), mode) as f:
+            f.write(data)
+
+    def write_json(self, relative, record):
+        self.write(relative, json.dumps(record, indent=2, sort_keys=False, default=_jsonable)
+                   + "\n")
+
+    def publish(self):
+        # two renames: the old folder moves aside, the new one takes its name, then the
+        # old one is removed; at no moment is a half-written folder under the target name
+        if self.target.exists():
+            os.rename(self.target, self._old)
+        os.rename(self.tmp, self.target)
+        shutil.rmtree(self._old, ignore_errors=True)
+
+
+def _jsonable(value):
+    import numpy as np
+
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
