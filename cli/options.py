@@ -35,7 +35,7 @@ def add_model_options(parser):
                    help="wall scene: length in units (default 32)")
     g.add_argument("--wall-courses", dest="wall_courses", type=int,
                    help="wall scene: number of courses (default 10)")
-    g.add_argument("--fast", action="store_true",
+    g.add_argument("--fast", action="store_true", default=None,
                    help="reduced output: one view, lower resolution")
 
 
@@ -59,10 +59,7 @@ def add_output_options(parser):
 def params_from_args(args) -> Params:
     """Preset or file first, then every option the user gave; validated."""
     given = {k: v for k, v in vars(args).items()
-             if k in {f for f in Params.__dataclass_fields__} and v not in (None, False)}
-    given.pop("fast", None)
-    if args.fast:
-        given["fast"] = True
+             if k in Params.__dataclass_fields__ and v is not None}
     if args.params:
         return load(args.params, **given)
     if args.preset:

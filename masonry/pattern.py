@@ -95,9 +95,11 @@ def build_pattern(half_width, p: int, r: int) -> Pattern:
     half_width : (L,) float
         ``W_k`` (index ``k - 1``): half width of course ``k`` at its top intrados edge,
         units (the narrowest part of the course). A brick started on course ``k`` must lie
-        within ``[-W_k, W_k]``; on course ``k + 1`` it may then poke out of the web by
-        ``W_k - W_{k+1}`` (a few hundredths of a unit), which the corner miter of SPEC 4.5
-        cuts off. This is the rule ``shared/pattern-sketch-preset1.png`` was drawn with.
+        within ``[-W_{k+1}, W_{k+1}]``: it may not leave the web on either course it
+        spans. (``shared/pattern-sketch-preset1.png`` checks the start course only; from
+        course 34 of preset 1 on, its bounces come one course later, with bricks that stick
+        out of the web by up to ``W_k - W_{k+1}``: 0.2 units there, 0.9 units on preset 3,
+        into the neighbouring web.)
     p, r : int
         Pattern bricks per rhombus side, full rhombi across the section.
     """
@@ -118,8 +120,8 @@ def build_pattern(half_width, p: int, r: int) -> Pattern:
             pos.append(node)
             step.append(+1)
     pos, step = np.array(pos), np.array(step)
-    # clamp the corner lines inside the first course
-    w = half_width[0]
+    # clamp the corner lines inside the first two courses (the brick spans both)
+    w = half_width[1]
     pos = np.clip(pos, np.ceil(-w - _EPS), np.floor(w + _EPS) - 1).astype(int)
     alive = np.ones(len(pos), bool)
 
@@ -136,7 +138,7 @@ def build_pattern(half_width, p: int, r: int) -> Pattern:
         idx = np.flatnonzero(alive)
         if len(idx) == 0:
             break
-        w = half_width[k - 1]  # W_k, as the reference sketch does (see build_pattern)
+        w = half_width[k]  # W_{k+1}: the brick must fit both courses it spans
         old = pos[idx]
         new = old + step[idx]
         turn = ~_fits(new, w)

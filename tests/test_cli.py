@@ -1,0 +1,103 @@
+"""The command line, in-process (``main([...])``)."""
+
+import json
+
+import numpy as np
+import pytest
+import trimesh
+
+from masonry_cli.main import main
+
+
+def test_build_writes_the_run_folder(tmp_path, capsys):
+    assert main(["build", "--preset", "1", "--fast", "--out", str(tmp_path), "-q"]) == 0
+    (folder,) = tmp_path.iterdir()
+    assert folder.name == "dome0_fast1_fricauto_s1_n8_r1_p10_c0.1_u0.1"
+    for name in ("00_parameters.txt", "run.json", "locations.csv", "bricks.obj",
+                 "00_pattern.png", "01_angle/3_structure.png"):
+        assert (folder / name).is_file(), name
+    assert not (folder / "02_front").exists()  # fast: one view
+    record = json.loads((folder / "run.json").read_text())
+    for key in ("params", "structure_id", "scene", "counts", "volume_m3", "weight_N",
+                "timings_s", "versions"):
+        assert key in record
+    assert record["counts"]["bricks"] == 790
+    assert record["weight_N"] == pytest.approx(record["volume_m3"] * 2000 * 9.81)
+    # locations.csv: one row per brick vertex (the ground slab included)
+    rows = (folder / "locations.csv").read_text().splitlines()
+    assert len(rows) == 1 + 8 * 791
+    assert "790 bricks" in capsys.readouterr().out
+
+
+def test_bricks_obj_splits_into_one_mesh_per_brick(tmp_path):
+    assert main(["build", "--preset", "wall", "--no-plots", "--out", str(tmp_path),
+                 "-q"]) == 0
+    (folder,) = tmp_path.iterdir()
+    scene = trimesh.load(folder / "bricks.obj", split_objects=True, group_material=False,
+                         process=False)
+    meshes = scene.geometry if hasattr(scene, "geometry") else {"one": scene}
+    assert len(meshes) == 86
+    assert "b0001_fill_in_c1" in meshes or "b0001_regular_c1" in meshes
+    volume = sum(abs(m.volume) for m in meshes.values())
+    assert volume == pytest.approx(0.64 + 0.1 * 0.2 * 3.2, rel=1e-9)  # bricks + ground
+
+
+@pytest.mark.parametrize("args, name", [
+    (["--n", "2"], "n"),
+    (["--stretch", "0"], "stretch"),
+    (["--stretch", "nan"], "stretch"),
+    (["--r", "-1"], "r"),
+    (["--p", "0"], "p"),
+    (["--cut", "1"], "cut"),
+    (["--cut", "-0.1"], "cut"),
+    (["--unit", "0"], "unit"),
+    (["--min-fill", "0"], "min_fill"),
+    (["--wall-courses", "0", "--scene", "wall"], "wall_courses"),
+])
+def test_bad_parameter_gets_one_line_and_writes_nothing(tmp_path, capsys, args, name):
+    assert main(["build", *args, "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"{name}=" in err[0] and "expected" in err[0]
+    assert not (tmp_path / "out").exists()
+
+
+def test_unparsable_value_exits_2(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["build", "--n", "eight"])
+    assert exit_info.value.code == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_params_file(tmp_path, fixtures_dir):
+    assert main(["build", "--params", str(fixtures_dir / "presets" / "preset3.toml"),
+                 "--no-plots", "--out", str(tmp_path), "-q"]) == 0
+    (folder,) = tmp_path.iterdir()
+    assert folder.name.startswith("dome0_fast0_fricauto_s0.8_n4_r1_p13_c0.01")
+
+
+def test_failed_run_leaves_previous_output(tmp_path, monkeypatch):
+    assert main(["build", "--preset", "wall", "--no-plots", "--out", str(tmp_path),
+                 "-q"]) == 0
+    (folder,) = tmp_path.iterdir()
+    before = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("injected failure")
+
+    monkeypatch.setattr("masonry.pipeline.blocks_obj", broken)
+    with pytest.raises(RuntimeError):
+        main(["build", "--preset", "wall", "--no-plots", "--out", str(tmp_path), "-q"])
+    after = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+    assert after == before
+    assert [p.name for p in tmp_path.iterdir()] == [folder.name]  # no temporary left
+
+
+def test_cad_offset_moves_bricks_inward(tmp_path):
+    from masonry.params import from_preset
+    from masonry.pipeline import cad_vertices
+    from masonry.scenes import build
+
+    scene = build(from_preset("1"))
+    moved = cad_vertices(scene) - scene.blocks.vertices
+    np.testing.assert_allclose(np.linalg.norm(moved, axis=1), 0.1, rtol=1e-12)
+    assert np.all(moved[:, 0] < 0)  # the section faces +x: inward is -x
