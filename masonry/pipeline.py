@@ -13,8 +13,9 @@ import numpy as np
 
 from . import __version__, plots
 from .blocks import BLOCK_CLASSES
-from .export.csv import locations_csv
+from .export.csv import interfaces_csv, locations_csv
 from .export.obj import blocks_obj
+from .interfaces import detect
 from .params import Params, structure_id, validate
 from .runfolder import RunFolder
 from .scenes import build
@@ -112,22 +113,29 @@ def build_run(params: Params, out_root="exports", plots_wanted=True) -> dict:
     timer = Timer()
     with timer.stage("model"):
         scene = build(params)
+    with timer.stage("interfaces"):
+        interfaces = detect(scene.blocks, up=scene.block_up)
     record = {
         "structure_id": sid,
         "scene": params.scene,
         "params": dataclasses.asdict(params),
         **model_record(scene),
     }
+    record["counts"]["interfaces"] = interfaces.counts()
     with RunFolder(out_root, sid) as folder:
         with timer.stage("exports"):
             folder.write("00_parameters.txt", parameters_text(params, sid))
             folder.write("locations.csv", locations_csv(scene.blocks, cad_vertices(scene)))
             folder.write("bricks.obj", blocks_obj(scene.blocks))
+            folder.write("interfaces.csv", interfaces_csv(scene.blocks, interfaces))
         if plots_wanted:
             with timer.stage("plots"):
                 if scene.layout is not None:
                     folder.write("00_pattern.png", plots.pattern_png(scene, params.fast))
                 for name, png in plots.structure_pngs(scene, params.fast).items():
+                    folder.write(name, png)
+                for name, png in plots.interface_pngs(scene.blocks, interfaces,
+                                                      params.fast).items():
                     folder.write(name, png)
         record["timings_s"] = timer.seconds
         record["versions"] = versions()

@@ -127,3 +127,74 @@ def structure_pngs(scene, fast=False) -> dict:
             ax.set_title(f"{stage[2:]}: {int(mask.sum())} bricks")
             out[f"{view}/{stage}.png"] = _png(fig, 60 if fast else 110)
     return out
+
+
+def _polygons(interfaces, index):
+    return [interfaces.polygon(k) for k in index]
+
+
+def _colour_plot(blocks, interfaces, index, values, title, view, fast, label="N"):
+    fig, ax = _axes3d(blocks.bounds, view)
+    if len(index):
+        values = np.asarray(values, dtype=float)
+        norm = matplotlib.colors.Normalize(vmin=values.min(), vmax=max(values.max(),
+                                                                        values.min() + 1e-12))
+        cmap = matplotlib.colormaps["viridis"]
+        ax.add_collection3d(Poly3DCollection(_polygons(interfaces, index),
+                                             facecolors=cmap(norm(values)),
+                                             edgecolors="k", linewidths=0.05))
+        bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
+                           shrink=0.6, pad=0.1)
+        bar.set_label(label)
+    ax.set_title(f"{title} ({len(index)} interfaces)")
+    return _png(fig, 60 if fast else 110)
+
+
+def interface_pngs(blocks, interfaces, fast=False) -> dict:
+    """Horizontal and vertical interfaces drawn as polygons (thesis figures 3.12-3.13),
+    coloured by area."""
+    from .interfaces import INTERFACE_KINDS
+
+    out = {}
+    views = ["01_angle"] if fast else list(VIEWS)
+    horizontal = np.isin(interfaces.kind, [INTERFACE_KINDS.index("horizontal"),
+                                           INTERFACE_KINDS.index("support")])
+    groups = {"interfaces_horizontal": np.flatnonzero(horizontal),
+              "interfaces_vertical": np.flatnonzero(~horizontal)}
+    for view in views:
+        for name, index in groups.items():
+            out[f"{view}/{name}.png"] = _colour_plot(
+                blocks, interfaces, index, interfaces.area[index] * 1e4,
+                name.replace("_", " "), view, fast, label="area [cm^2]")
+    return out
+
+
+FORCE_PLOTS = (
+    # (file, result key, interface selection, title): thesis figures 4.1-4.8
+    ("compression_horizontal", "compression", "horizontal", "horizontal interfaces - compression"),
+    ("compression_vertical", "compression", "vertical", "vertical interfaces - compression"),
+    ("tension", "tension", "all", "all interfaces - tension"),
+    ("normal", "normal", "all", "all interfaces - normal force (tension - compression)"),
+    ("t1", "t1", "all", "all interfaces - t1"),
+    ("t2", "t2", "all", "all interfaces - t2"),
+    ("friction", "friction", "all", "all interfaces - friction"),
+)
+
+
+def force_pngs(blocks, interfaces, forces: dict, fast=False) -> dict:
+    """Force plots with colour bars in newtons, per view (``RBE/<view>/<name>.png``)."""
+    from .interfaces import INTERFACE_KINDS
+
+    horizontal = np.isin(interfaces.kind, [INTERFACE_KINDS.index("horizontal"),
+                                           INTERFACE_KINDS.index("support")])
+    select = {"horizontal": np.flatnonzero(horizontal),
+              "vertical": np.flatnonzero(~horizontal),
+              "all": np.arange(len(interfaces))}
+    out = {}
+    views = ["01_angle"] if fast else list(VIEWS)
+    for view in views:
+        for name, key, group, title in FORCE_PLOTS:
+            index = select[group]
+            out[f"{view}/{name}.png"] = _colour_plot(
+                blocks, interfaces, index, np.asarray(forces[key])[index], title, view, fast)
+    return out

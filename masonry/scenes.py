@@ -36,6 +36,13 @@ class Scene:
     layout: Layout | None = None
     dims: Dimensions | None = None
 
+    @property
+    def block_up(self) -> np.ndarray:
+        """(B, 3) float: each brick's course direction, the normal of its top face (face 5
+        of a hexahedral brick): bed joints are the interfaces across it."""
+        first = np.searchsorted(self.blocks.face_block, np.arange(self.blocks.n_blocks))
+        return self.blocks.face_normal[first + 5]
+
 
 def _corners(base, gamma, width, height, y0, y1, tan_left, tan_right):
     """Corners (B, 8, 3) of posed boxes, optionally mitered.

@@ -1,0 +1,348 @@
+"""Contact interface detection (SPEC 5, thesis 3.2.4) on boxes built by hand."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from masonry.blocks import Blocks
+from masonry.interfaces import INTERFACE_KINDS, candidate_pairs, detect
+from masonry.tolerances import Tolerances
+
+KIND = {name: code for code, name in enumerate(INTERFACE_KINDS)}
+REL = 1e-9  # relative tolerance on areas of exact geometry
+
+# the running-bond wall below: courses of 4 full bricks alternate with courses of
+# half + 3 full + half; every brick is 2 thick and 1 high, on a ground slab
+WALL_COURSES = 5
+WALL_FULL = 4
+# 4 bricks of course 1 stand on the slab; head joints: 3 per 4-brick course (x3) plus
+# 4 per 5-brick course (x2); every one of the 4 course transitions has 8 bed joints
+# (each full brick overlaps two bricks of the next course by half its length)
+WALL_COUNTS = {"horizontal": 4 * 8, "vertical": 3 * 3 + 2 * 4, "support": 4, "boundary": 0}
+
+
+# ---------------------------------------------------------------------- builders
+def box_corners(lo, hi):
+    """(8, 3) corners of an axis-aligned box, corner index ``ix + 2 iy + 4 iz``."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    index = np.arange(8)
+    bits = np.stack([index & 1, (index >> 1) & 1, (index >> 2) & 1], axis=1)
+    return lo + bits * (hi - lo)
+
+
+def running_bond_wall(courses=WALL_COURSES, n_full=WALL_FULL):
+    """A running-bond wall along y (thickness 2 along x, courses 1 high) on a ground slab.
+
+    Returns the blocks (slab first) and their boxes, (B, 2, 3) float (min, max corner).
+    """
+    length = 4.0 * n_full
+    boxes = [([0.0, 0.0, -1.0], [2.0, length, 0.0])]
+    for course in range(courses):
+        if course % 2 == 0:
+            joints = np.arange(0.0, length + 1.0, 4.0)
+        else:
+            joints = np.concatenate([[0.0], np.arange(2.0, length, 4.0), [length]])
+        boxes += [([0.0, y0, course], [2.0, y1, course + 1.0])
+                  for y0, y1 in zip(joints[:-1], joints[1:])]
+    boxes = np.array(boxes)
+    corners = np.array([box_corners(lo, hi) for lo, hi in boxes])
+    block_class = ["ground"] + ["regular"] * (len(boxes) - 1)
+    return Blocks.from_hexahedra(corners, block_class), boxes
+
+
+def wedge_pair(angle_deg, lift=0.0, upper_first=False):
+    """A box with a second, narrower box on top, tilted open by a wedge angle.
+
+    Lower box ``[0, 2] x [0, 4] x [0, 1]``; upper box ``[0, 1.5] x [1, 5] x [1, 2]``
+    rotated by ``angle_deg`` about the line ``x = 0, z = 1`` (its bottom face keeps the
+    edge ``x = 0`` on the lower top face and rises towards +x), then lifted by ``lift``.
+    """
+    lower = box_corners([0, 0, 0], [2, 4, 1])
+    upper = box_corners([0, 1, 1], [1.5, 5, 2])
+    a = np.radians(angle_deg)
+    rotation = np.array([[np.cos(a), 0, -np.sin(a)], [0, 1, 0], [np.sin(a), 0, np.cos(a)]])
+    hinge = np.array([0.0, 0.0, 1.0])
+    upper = (upper - hinge) @ rotation.T + hinge + [0.0, 0.0, lift]
+    corners = np.array([upper, lower] if upper_first else [lower, upper])
+    return Blocks.from_hexahedra(corners, "regular")
+
+
+def random_rotation(rng, keep_z=False):
+    """A seeded proper rotation (3, 3); about z only when ``keep_z``."""
+    if keep_z:
+        a = rng.uniform(0, 2 * np.pi)
+        return np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    q = q * np.sign(np.diag(r))
+    return q if np.linalg.det(q) > 0 else -q
+
+
+def rigid(rotation, translation):
+    matrix = np.eye(4)
+    matrix[:3, :3], matrix[:3, 3] = rotation, translation
+    return matrix
+
+
+def box_contact_area(box_i, box_j):
+    """Area shared by two touching axis-aligned boxes: the two largest overlaps' product."""
+    overlap = np.minimum(box_i[1], box_j[1]) - np.maximum(box_i[0], box_j[0])
+    return np.sort(overlap)[1] * np.sort(overlap)[2], overlap
+
+
+def area_by_pair(interfaces):
+    """{(i, j) with i < j: area}; fails on a pair reported twice."""
+    out = {}
+    for (i, j), area in zip(interfaces.pair, interfaces.area):
+        key = (min(i, j), max(i, j))
+        assert key not in out
+        out[key] = area
+    return out
+
+
+def polygon_area_vector(polygon):
+    """Newell area vector of a closed 3D polygon, (3,) float."""
+    return 0.5 * np.cross(polygon, np.roll(polygon, -1, axis=0)).sum(axis=0)
+
+
+# ---------------------------------------------------------------------- running bond
+def test_wall_counts_and_areas_match_box_overlaps():
+    blocks, boxes = running_bond_wall()
+    found = detect(blocks, Tolerances(scale=20.0))
+
+    assert found.counts() == WALL_COUNTS
+    # every pair of boxes sharing a face patch of positive area, and only those
+    expected = {}
+    for i, j in itertools.combinations(range(len(boxes)), 2):
+        area, overlap = box_contact_area(boxes[i], boxes[j])
+        if np.sum(overlap == 0.0) == 1 and np.all(overlap >= 0.0) and area > 0:
+            expected[(i, j)] = area
+    got = area_by_pair(found)
+    assert got.keys() == expected.keys()
+    for key, area in expected.items():
+        assert got[key] == pytest.approx(area, rel=REL)
+
+
+def test_wall_main_block_normal_and_kind():
+    blocks, boxes = running_bond_wall()
+    found = detect(blocks, Tolerances(scale=20.0))
+    centre = boxes.mean(axis=1)
+    for (main, other), kind, normal in zip(found.pair, found.kind, found.normal):
+        step = centre[other] - centre[main]
+        if kind == KIND["vertical"]:
+            # a head joint: same course, parallel faces, the smaller index is main
+            assert main < other
+            np.testing.assert_allclose(normal, np.sign(step[1]) * np.array([0, 1, 0]))
+        else:
+            # bed joints and the ground: the lower block (the slab) is main, normal up
+            assert step[2] == pytest.approx(1.0)
+            assert (kind == KIND["support"]) == (main == 0)
+            np.testing.assert_allclose(normal, [0, 0, 1])
+    assert np.array_equal(found.pair, found.pair[np.lexsort(found.pair.T[::-1])])
+
+
+def test_wall_polygons_are_consistent_frames():
+    blocks, _ = running_bond_wall()
+    found = detect(blocks, Tolerances(scale=20.0))
+    # overlaps of rectangles with parallel edges are rectangles: shared edges and
+    # corners left no duplicate or collinear vertices
+    assert np.all(found.vertex_count == 4)
+    frame = np.stack([found.t1, found.t2, found.normal], axis=1)
+    np.testing.assert_allclose(frame @ frame.transpose(0, 2, 1),
+                               np.broadcast_to(np.eye(3), frame.shape), atol=1e-12)
+    np.testing.assert_allclose(np.linalg.det(frame), 1.0)
+    for k in range(len(found)):
+        polygon = found.polygon(k)
+        # counter-clockwise about the normal, with the reported area
+        area_vector = polygon_area_vector(polygon)
+        assert area_vector @ found.normal[k] == pytest.approx(found.area[k], rel=REL)
+        # vertices in the plane through the centre; rectangles: centre = vertex mean
+        np.testing.assert_allclose((polygon - found.centre[k]) @ found.normal[k], 0.0, atol=1e-12)
+        np.testing.assert_allclose(found.centre[k], polygon.mean(axis=0), atol=1e-12)
+
+
+def test_default_tolerances_match_explicit():
+    blocks, _ = running_bond_wall()
+    default = detect(blocks)
+    explicit = detect(blocks, Tolerances.for_points(blocks.vertices))
+    assert np.array_equal(default.pair, explicit.pair)
+    assert np.array_equal(default.area, explicit.area)
+
+
+# ---------------------------------------------------------------------- invariance
+@pytest.mark.parametrize("seed", [0, 1])
+def test_wall_invariant_under_rotation_about_z(seed):
+    rng = np.random.default_rng(seed)
+    blocks, _ = running_bond_wall()
+    tol = Tolerances(scale=20.0)
+    reference = detect(blocks, tol)
+    moved = detect(blocks.transformed(rigid(random_rotation(rng, keep_z=True),
+                                            rng.uniform(-50, 50, 3))), tol)
+    assert moved.counts() == reference.counts()
+    assert np.array_equal(moved.pair, reference.pair)
+    np.testing.assert_allclose(moved.area, reference.area, rtol=REL)
+
+
+@pytest.mark.parametrize("seed", [2, 3])
+def test_wall_areas_invariant_under_any_rigid_motion(seed):
+    # z decides kinds and main blocks, so compare unordered pairs and areas only
+    rng = np.random.default_rng(seed)
+    blocks, _ = running_bond_wall()
+    tol = Tolerances(scale=20.0)
+    reference = area_by_pair(detect(blocks, tol))
+    moved = area_by_pair(detect(blocks.transformed(rigid(random_rotation(rng),
+                                                         rng.uniform(-50, 50, 3))), tol))
+    assert moved.keys() == reference.keys()
+    for key, area in reference.items():
+        assert moved[key] == pytest.approx(area, rel=REL)
+
+
+# ---------------------------------------------------------------------- gap closing
+# Rotating the upper box's bottom face back about the hinge x = 0 restores
+# [0, 1.5] x [1, 5] in the plane z = 1; it overlaps the lower top face [0, 2] x [0, 4] in
+# [0, 1.5] x [1, 4]. (Projecting instead would give 1.5 cos(angle) x 3.)
+WEDGE_AREA = 1.5 * 3.0
+
+
+@pytest.mark.parametrize("angle_deg", [0.0, 3.0, 9.0])
+@pytest.mark.parametrize("upper_first", [False, True])
+def test_wedge_is_closed_onto_the_lower_face(angle_deg, upper_first):
+    blocks = wedge_pair(angle_deg, upper_first=upper_first)
+    lower, upper = (1, 0) if upper_first else (0, 1)
+    found = detect(blocks, Tolerances(scale=10.0))
+
+    assert len(found) == 1
+    assert found.pair.tolist() == [[lower, upper]]
+    assert found.kind.tolist() == [KIND["horizontal"]]
+    assert found.area[0] == pytest.approx(WEDGE_AREA, rel=REL)
+    np.testing.assert_allclose(found.normal[0], [0, 0, 1], atol=1e-15)
+    polygon = found.polygon(0)
+    np.testing.assert_allclose(polygon[:, 2], 1.0, atol=1e-12)
+    np.testing.assert_allclose(np.sort(polygon[:, 0]), [0, 0, 1.5, 1.5], atol=1e-12)
+    np.testing.assert_allclose(np.sort(polygon[:, 1]), [1, 1, 4, 4], atol=1e-12)
+    np.testing.assert_allclose(found.centre[0], [0.75, 2.5, 1.0], atol=1e-12)
+
+
+def test_wedge_invariant_under_rigid_motion():
+    rng = np.random.default_rng(4)
+    tol = Tolerances(scale=10.0)
+    for keep_z in (True, False):
+        rotation = random_rotation(rng, keep_z=keep_z)
+        found = detect(wedge_pair(4.0).transformed(rigid(rotation, rng.uniform(-5, 5, 3))),
+                       tol)
+        assert len(found) == 1
+        assert found.area[0] == pytest.approx(WEDGE_AREA, rel=REL)
+        if keep_z:  # the lower box stays main: its top face, moved
+            np.testing.assert_allclose(found.normal[0], rotation[:, 2], atol=1e-12)
+
+
+def test_wedge_within_contact_tolerance_is_found_beyond_it_is_not():
+    tol = Tolerances(scale=10.0)  # contact = 1e-5
+    assert len(detect(wedge_pair(3.0, lift=0.5 * tol.contact), tol)) == 1
+    assert len(detect(wedge_pair(3.0, lift=10.0 * tol.contact), tol)) == 0
+    assert len(detect(wedge_pair(0.0, lift=10.0 * tol.contact), tol)) == 0
+
+
+def test_wedge_wider_than_max_gap_angle_is_open():
+    tol = Tolerances(scale=10.0)
+    assert np.degrees(tol.max_gap_angle) == pytest.approx(10.0)
+    assert len(detect(wedge_pair(12.0), tol)) == 0
+
+
+def test_planes_meeting_outside_the_faces_do_not_touch():
+    # the upper box's hinge x = 2.5 lies beyond the lower top face (x <= 2); its bottom
+    # face rises over the lower box, so the two faces never touch although rotating
+    # about the hinge would make them overlap
+    lower = box_corners([0, 0, 0], [2, 4, 1])
+    upper = box_corners([1, 0, 1], [2.5, 4, 2])
+    a = np.radians(3.0)
+    rotation = np.array([[np.cos(a), 0, np.sin(a)], [0, 1, 0], [-np.sin(a), 0, np.cos(a)]])
+    hinge = np.array([2.5, 0.0, 1.0])
+    upper = (upper - hinge) @ rotation.T + hinge
+    blocks = Blocks.from_hexahedra(np.array([lower, upper]), "regular")
+    assert len(detect(blocks, Tolerances(scale=10.0))) == 0
+
+
+def test_faces_reaching_the_hinge_at_different_places_do_not_touch():
+    # The upper box's bottom edge lies on the line x + y = 6 of the plane z = 1 between
+    # (3, 3) and (6, 0); the lower top face [0, 2] x [0, 4] reaches that line only at its
+    # corner (2, 4). Both faces have vertices on the planes' common line, and rotating
+    # the upper face back would overlap the lower one, but they touch nowhere.
+    along, inward = np.array([1.0, -1.0, 0.0]) / np.sqrt(2), -np.array([1.0, 1.0, 0.0]) / np.sqrt(2)
+    hinge = np.array([3.0, 3.0, 1.0])
+    index = np.arange(8)
+    upper = (hinge + np.outer(3 * np.sqrt(2) * (index & 1), along)
+             + np.outer(3.0 * ((index >> 1) & 1), inward)
+             + np.outer((index >> 2) & 1, [0.0, 0.0, 1.0]))
+    a = np.radians(3.0)  # about -along, so that the inward side rises
+    k = -along
+    v = upper - hinge
+    upper = hinge + (v * np.cos(a) + np.cross(k, v) * np.sin(a)
+                     + np.outer(v @ k, k) * (1 - np.cos(a)))
+    assert upper[2, 2] > 1.0 + 0.1  # the inward bottom edge has risen
+    blocks = Blocks.from_hexahedra(np.array([box_corners([0, 0, 0], [2, 4, 1]), upper]),
+                                   "regular")
+    assert len(detect(blocks, Tolerances(scale=10.0))) == 0
+
+
+def test_square_on_square_turned_by_45_degrees_is_an_octagon():
+    lower = box_corners([-1, -1, 0], [1, 1, 1])
+    a = np.pi / 4
+    turn = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    upper = box_corners([-1, -1, 1], [1, 1, 2]) @ turn.T
+    found = detect(Blocks.from_hexahedra(np.array([lower, upper]), "regular"),
+                   Tolerances(scale=10.0))
+    assert found.vertex_count.tolist() == [8]
+    # a regular octagon with inradius 1: 8 tan(22.5 deg) = 8 (sqrt 2 - 1)
+    assert found.area[0] == pytest.approx(8 * (np.sqrt(2) - 1), rel=REL)
+    assert polygon_area_vector(found.polygon(0))[2] == pytest.approx(found.area[0], rel=REL)
+    np.testing.assert_allclose(found.centre[0], [0, 0, 1], atol=1e-12)
+
+
+# ---------------------------------------------------------------------- supports, empty
+def test_support_is_main_even_above_a_free_block():
+    corners = np.array([box_corners([0, 0, 0], [2, 4, 1]), box_corners([-1, -1, 1], [3, 5, 2])])
+    blocks = Blocks.from_hexahedra(corners, ["regular", "ground"])
+    found = detect(blocks, Tolerances(scale=10.0))
+    assert found.pair.tolist() == [[1, 0]]
+    assert found.kind.tolist() == [KIND["support"]]
+    np.testing.assert_allclose(found.normal[0], [0, 0, -1])
+    assert found.area[0] == pytest.approx(8.0, rel=REL)
+
+
+def test_two_supports_are_never_paired():
+    corners = np.array([box_corners([0, 0, 0], [2, 4, 1]), box_corners([0, 4, 0], [2, 8, 1])])
+    blocks = Blocks.from_hexahedra(corners, "ground")
+    tol = Tolerances(scale=10.0)
+    assert len(candidate_pairs(blocks, tol)) == 0
+    assert len(detect(blocks, tol)) == 0
+
+
+def test_blocks_far_apart_give_an_empty_result():
+    corners = np.array([box_corners([0, 0, 0], [2, 4, 1]), box_corners([100, 0, 0], [102, 4, 1])])
+    blocks = Blocks.from_hexahedra(corners, "regular")
+    found = detect(blocks)
+    assert len(found) == 0
+    assert found.pair.shape == (0, 2)
+    assert found.offsets.tolist() == [0]
+    assert len(candidate_pairs(blocks)) == 0
+
+
+# ---------------------------------------------------------------------- spatial index
+def test_candidate_pairs_are_the_touching_boxes():
+    blocks, boxes = running_bond_wall()
+    tol = Tolerances(scale=20.0)
+    expected = [[i, j] for i, j in itertools.combinations(range(len(boxes)), 2)
+                if np.all(np.minimum(boxes[i, 1], boxes[j, 1])
+                          - np.maximum(boxes[i, 0], boxes[j, 0]) >= -tol.contact)]
+    assert candidate_pairs(blocks, tol).tolist() == expected
+
+
+@pytest.mark.parametrize("n_full", [10, 100])
+def test_candidate_pairs_grow_linearly(n_full):
+    # each brick touches at most 2 bricks in its course and 2 above (or the slab): a
+    # spatial index finds about 3 pairs per block, all pairs would be n (n - 1) / 2
+    blocks, _ = running_bond_wall(courses=6, n_full=n_full)
+    pairs = candidate_pairs(blocks, Tolerances.for_points(blocks.vertices))
+    assert len(pairs) <= 3 * blocks.n_blocks
+    assert len(detect(blocks)) == len(pairs)
