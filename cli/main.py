@@ -5,10 +5,10 @@ import sys
 
 from masonry.params import ParameterError
 
-from . import build
+from . import build, run
 from .options import Parser
 
-SUBCOMMANDS = (build,)
+SUBCOMMANDS = (build, run)
 
 
 def make_parser():
@@ -23,8 +23,9 @@ def make_parser():
 
 def main(argv=None) -> int:
     args = make_parser().parse_args(argv)
-    quiet = getattr(args, "quiet", False)
-    logging.basicConfig(level=logging.WARNING if quiet else logging.INFO,
+    # progress on a terminal only; --quiet silences it there too
+    verbose = sys.stderr.isatty() and not getattr(args, "quiet", False)
+    logging.basicConfig(level=logging.INFO if verbose else logging.WARNING,
                         format="masonry: %(message)s", stream=sys.stderr)
     logging.getLogger("matplotlib").setLevel(logging.WARNING)
 

@@ -45,7 +45,10 @@ def add_analysis_options(parser):
     g.add_argument("--density", type=float, help="kg/m^3 (default 2000)")
     g.add_argument("--friction", choices=FRICTIONS,
                    help="net, plus, or auto (net, then plus if infeasible; default)")
-    g.add_argument("--solver", choices=SOLVERS, help="QP solver (default osqp)")
+    g.add_argument("--solver", choices=SOLVERS,
+                   help="QP solver: clarabel (interior point, default) or osqp")
+    g.add_argument("--boundary", choices=["free"],
+                   help="boundary of the section: free (free-standing, the default)")
 
 
 def add_output_options(parser):
@@ -53,6 +56,10 @@ def add_output_options(parser):
     g.add_argument("--out", default="exports", metavar="DIR",
                    help="output root; the run folder is DIR/<structure id> (default exports)")
     g.add_argument("--no-plots", dest="plots", action="store_false", help="skip all plots")
+    g.add_argument("--no-printable", dest="printable", action="store_false",
+                   help="skip the printable body (dome.stl, dome.obj)")
+    g.add_argument("--force", action="store_true",
+                   help="recompute even if the run folder holds this input's results")
     g.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
 
 
@@ -67,3 +74,15 @@ def params_from_args(args) -> Params:
     if given.get("scene") == "wall":
         return from_preset("wall", **given)
     return validate(Params(**given))
+
+
+def summary(record, report):
+    """The lines every subcommand prints about the model it wrote."""
+    counts = record["counts"]
+    interfaces = sum(counts.get("interfaces", {}).values())
+    state = "up to date, reused" if record.get("reused") else "written"
+    report(f"{record['structure_id']}: {counts['bricks']} bricks "
+           f"({counts['regular']} regular, {counts['pattern']} pattern, "
+           f"{counts['fill_in']} fill-in) in {counts['courses']} courses, "
+           f"{interfaces} interfaces, weight {record['weight_N']:.4g} N")
+    report(f"{state}: {record['path']}")

@@ -66,7 +66,7 @@ class Params:
     mu: float = 0.7
     density: float = 2000.0
     friction: str = "auto"
-    solver: str = "osqp"
+    solver: str = "clarabel"
     fast: bool = False
     cad_offset: float = 1.0
 

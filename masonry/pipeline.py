@@ -1,19 +1,25 @@
-"""A whole run: parameters to bricks (and later interfaces and forces) to a run folder.
+"""A whole run: parameters to bricks, interfaces, forces and exports in a run folder.
 
 The library logs progress; it never prints. Timings of every stage go into ``run.json``.
+Geometry and interfaces are cached under ``<out>/.cache`` keyed by the geometric inputs,
+so a run that changes only ``mu``, ``friction``, ``density`` or the solver reuses them.
 """
 
 import dataclasses
+import hashlib
+import json
 import logging
+import pickle
 import time
 from contextlib import contextmanager
 from importlib import metadata
+from pathlib import Path
 
 import numpy as np
 
 from . import __version__, plots
 from .blocks import BLOCK_CLASSES
-from .export.csv import interfaces_csv, locations_csv
+from .export.csv import forces_csv, interfaces_csv, locations_csv
 from .export.obj import blocks_obj
 from .interfaces import detect
 from .params import Params, structure_id, validate
@@ -103,42 +109,179 @@ def parameters_text(params: Params, sid: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def build_run(params: Params, out_root="exports", plots_wanted=True) -> dict:
-    """Build the model of ``params`` and write its run folder ``out_root/<structure id>``.
+def objective_text(result) -> str:
+    """``RBE/00_objective.txt``: the thesis's summary of a solve, readable."""
+    d = result.to_dict()
+    verdict = "feasible" if d["feasible"] else "infeasible"
+    lines = [
+        f"feasibility:        {verdict}",
+        f"friction method:    friction-{d['friction']} (mu = {d['mu']:g})",
+        f"objective:          {d['objective']:.6g} N^2",
+        f"MoI:                {d['moi']:.6g} N",
+        f"MoI factor:         {d['moi_factor']:.6g}",
+        f"weight:             {d['weight_N']:.6g} N",
+        f"solver:             {d['solver']} ({d['status']}, {d['iterations']} iterations)",
+        f"residual (eq):      {d['residual_eq']:.3g}",
+        f"friction violation: {d['friction_violation']:.3g}",
+        f"LP check (HiGHS):   {d['lp_feasible']}",
+        f"time:               {d['time_s']:.3g} s",
+    ]
+    return "\n".join(lines) + "\n"
 
-    Returns the run record (the content of ``run.json``).
-    """
-    params = validate(params)
-    sid = structure_id(params)
-    timer = Timer()
+
+# ---------------------------------------------------------------------------- cache
+def _geometry_key(params: Params) -> str:
+    key = json.dumps({**params.geometry_key, "version": __version__}, sort_keys=True)
+    return hashlib.sha1(key.encode()).hexdigest()[:16]
+
+
+def _model(params: Params, out_root, timer: Timer):
+    """Scene and interfaces, from the geometry cache when present."""
+    cache = Path(out_root) / ".cache" / f"{_geometry_key(params)}.pickle"
+    if cache.is_file():
+        with timer.stage("model (cached)"):
+            with open(cache, "rb") as f:
+                scene, interfaces = pickle.load(f)
+            # the cached scene carries the geometry; the rest of the inputs are this run's
+            scene = dataclasses.replace(scene, params=params)
+        return scene, interfaces, "reused"
     with timer.stage("model"):
         scene = build(params)
     with timer.stage("interfaces"):
         interfaces = detect(scene.blocks, up=scene.block_up)
+    cache.parent.mkdir(parents=True, exist_ok=True)
+    tmp = cache.with_suffix(f".tmp{id(scene)}")
+    with open(tmp, "wb") as f:
+        pickle.dump((scene, interfaces), f, protocol=pickle.HIGHEST_PROTOCOL)
+    tmp.replace(cache)
+    return scene, interfaces, "computed"
+
+
+def _previous(target: Path, params: Params, outputs: dict):
+    """The record of a complete earlier run of the same input, else None."""
+    try:
+        record = json.loads((target / "run.json").read_text())
+    except (OSError, ValueError):
+        return None
+    same = (record.get("params") == json.loads(json.dumps(dataclasses.asdict(params)))
+            and record.get("outputs") == outputs and record.get("complete"))
+    return record if same else None
+
+
+# ---------------------------------------------------------------------------- the run
+def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
+        printable=True, force=False) -> dict:
+    """Build, analyse and export ``params`` into ``out_root/<structure id>``.
+
+    Parameters
+    ----------
+    analyse : bool
+        Solve the rigid block equilibrium (``masonry run``); False only builds the model
+        and its interfaces (``masonry build``).
+    plots_wanted, printable : bool
+        Write the plots; unite and write the printable body.
+    force : bool
+        Recompute even when the folder holds a complete run of the same input.
+
+    Returns
+    -------
+    dict
+        The run record (the content of ``run.json``) and its ``path``.
+    """
+    params = validate(params)
+    sid = structure_id(params)
+    target = Path(out_root) / sid
+    outputs = {"analyse": analyse, "plots": plots_wanted, "printable": printable}
+    if not force:
+        previous = _previous(target, params, outputs)
+        if previous is not None:
+            log.info("%s is up to date (use --force to recompute)", sid)
+            return {**previous, "path": str(target), "reused": True}
+
+    timer = Timer()
+    scene, interfaces, cached = _model(params, out_root, timer)
     record = {
         "structure_id": sid,
         "scene": params.scene,
         "params": dataclasses.asdict(params),
+        "outputs": outputs,
         **model_record(scene),
+        "cache": {"geometry": cached},
     }
     record["counts"]["interfaces"] = interfaces.counts()
+    result = forces = None
+    if analyse:
+        from .solve import solve_rbe
+
+        with timer.stage("solve"):
+            result = solve_rbe(scene.blocks, interfaces, mu=params.mu,
+                               density=params.density, friction=params.friction,
+                               solver=params.solver)
+        record["rbe"] = result.to_dict()
+        forces = result.per_interface() if result.x is not None else None
+
     with RunFolder(out_root, sid) as folder:
         with timer.stage("exports"):
             folder.write("00_parameters.txt", parameters_text(params, sid))
-            folder.write("locations.csv", locations_csv(scene.blocks, cad_vertices(scene)))
+            cad = cad_vertices(scene)
+            folder.write("locations.csv", locations_csv(scene.blocks, cad))
             folder.write("bricks.obj", blocks_obj(scene.blocks))
             folder.write("interfaces.csv", interfaces_csv(scene.blocks, interfaces))
+            _write_rhino(folder, scene.blocks)
+            if result is not None:
+                folder.write("RBE/00_objective.txt", objective_text(result))
+            if forces is not None:
+                from .export.vtu import interfaces_vtu
+
+                folder.write("RBE/forces.csv", forces_csv(scene.blocks, interfaces, forces))
+                if len(interfaces):
+                    folder.write("RBE/interfaces.vtu", interfaces_vtu(interfaces, forces))
+        if printable:
+            with timer.stage("printable"):
+                record["printable"] = _write_printable(folder, scene.blocks, cad)
         if plots_wanted:
             with timer.stage("plots"):
-                if scene.layout is not None:
-                    folder.write("00_pattern.png", plots.pattern_png(scene, params.fast))
-                for name, png in plots.structure_pngs(scene, params.fast).items():
-                    folder.write(name, png)
-                for name, png in plots.interface_pngs(scene.blocks, interfaces,
-                                                      params.fast).items():
-                    folder.write(name, png)
+                _write_plots(folder, scene, interfaces, forces)
         record["timings_s"] = timer.seconds
         record["versions"] = versions()
+        record["complete"] = True
         folder.write_json("run.json", record)
     record["path"] = str(folder.target)
     return record
+
+
+def _write_printable(folder, blocks, cad) -> dict:
+    from .export.stl import obj_body_bytes, readback_check, stl_bytes
+    from .printable import printable_body
+
+    body, report = printable_body(blocks, cad)
+    stl = stl_bytes(body)
+    report["readback"] = readback_check(stl, report["volume_m3"], rtol=1e-5)
+    folder.write("dome.stl", stl)
+    folder.write("dome.obj", obj_body_bytes(body))
+    return report
+
+
+def _write_rhino(folder, blocks):
+    """``bricks.3dm`` when the optional rhino3dm package is installed."""
+    try:
+        import rhino3dm  # noqa: F401
+    except ImportError:
+        log.info("bricks.3dm skipped: pip install 'masonry[rhino]' to write it")
+        return
+    from .export.rhino import blocks_3dm
+
+    folder.write("bricks.3dm", blocks_3dm(blocks))
+
+
+def _write_plots(folder, scene, interfaces, forces):
+    fast = scene.params.fast
+    if scene.layout is not None:
+        folder.write("00_pattern.png", plots.pattern_png(scene, fast))
+    for name, png in plots.structure_pngs(scene, fast).items():
+        folder.write(name, png)
+    for name, png in plots.interface_pngs(scene.blocks, interfaces, fast).items():
+        folder.write(name, png)
+    if forces is not None:
+        for name, png in plots.force_pngs(scene.blocks, interfaces, forces, fast).items():
+            folder.write(f"RBE/{name}", png)

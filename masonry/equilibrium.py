@@ -1,0 +1,310 @@
+"""Rigid block equilibrium (RBE) matrices, without a solver (SPEC 6.1-6.3, thesis 3.3).
+
+This module only assembles; :mod:`masonry.solve` calls a solver. Keeping the two apart
+makes the matrices testable on their own (the peers compas_cra keep ``cra_helper.py``
+apart from ``rbe_pyomo.py`` for the same reason).
+
+Glossary (thesis 3.3 symbol -> name here)
+-----------------------------------------
+- ``f`` (eq. 3.18, 3.23), the stacked nodal forces ``(f_n-, f_n+, f_t1, f_t2)`` of every
+  interface vertex -> ``x``, with per-vertex columns ``(c, t, f1, f2)``; see
+  :class:`VariableLayout`.
+- ``A_eq`` (eq. 3.14-3.17), force and moment coefficients -> ``A_eq``, 6 rows per free
+  block: force x, y, z, then moment x, y, z about the block's centroid.
+- ``f_ext`` / ``f_weight`` (eq. 3.14, 3.20), external loads -> ``f_ext``: self weight only.
+  The thesis's hoop term (eq. 3.19-3.20) is not reproduced (SPEC 6.4); the cyclic and
+  rigid boundary modes route interface forces instead (``side_block``, ``side_rotation``).
+- ``A_fr`` (eq. 3.24-3.26), friction pyramid -> ``A_fr['net']`` (friction-net, eq. 3.26)
+  and ``A_fr['plus']`` (friction+, eq. 3.25), 4 rows per vertex, ``A_fr x <= 0``.
+- ``alpha`` (eq. 3.25), static friction coefficient -> ``mu``.
+- ``H`` (eq. 3.27), diagonal penalty -> ``h`` (its diagonal): 1 for tension, 1e-3 for
+  compression and friction. The solver minimises with ``h_solver``, ``h`` times 1e3.
+- ``I_lb`` (eq. 3.27), lower bounds -> ``lower``: 0 for c and t, -inf for f1, f2.
+
+Sign convention: at a vertex of interface ``k`` with frame ``(t1, t2, n)``, the force on
+the *other* block ``pair[k, 1]`` is ``F = (c - t) n + f1 t1 + f2 t2`` and the main block
+``pair[k, 0]`` receives ``-F``; ``n`` points from the main block into the other, so
+compression ``c`` pushes the two apart (SPEC 6.1).
+
+Scaling (SPEC 6.2, STYLE "Tolerances and numerics")
+---------------------------------------------------
+The matrices are stored scaled, and all scaling lives in :class:`EquilibriumSystem`:
+variables are in units of a reference weight ``W_ref`` (newtons) and moment rows are
+divided by a reference length ``L_ref`` (metres), so every coefficient and right-hand
+side is of order one whatever the brick size or ``unit``, and the objective's diagonal
+is multiplied by 1e3 (:attr:`EquilibriumSystem.h_solver`). Row scaling, a uniform
+variable scaling and a positive factor on the objective change neither the feasible set
+nor the minimiser of ``1/2 x^T H x``; use :meth:`EquilibriumSystem.to_newtons` to report
+results.
+"""
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import ClassVar
+
+import numpy as np
+import scipy.sparse as sp
+
+G = 9.81
+"""Gravitational acceleration, m/s^2 (SPEC 2)."""
+
+TENSION_WEIGHT = 1.0
+"""Diagonal of ``H`` for tension (thesis eq. 3.27)."""
+
+OTHER_WEIGHT = 1e-3
+"""Diagonal of ``H`` for compression and friction (thesis eq. 3.27)."""
+
+COEFFICIENT_NOISE = 1e-12
+"""Scaled ``A_eq`` coefficients (unit directions, arms per ``L_ref``: of order one) at or
+below this are floating-point noise of exact zeros and are not stored."""
+
+FRICTION_METHODS = ("net", "plus")
+"""``net``: friction-net, ``|f1|, |f2| <= mu (c - t)`` (thesis eq. 3.26);
+``plus``: friction+, ``|f1|, |f2| <= mu c`` (thesis eq. 3.25)."""
+
+
+@dataclass(frozen=True, eq=False)
+class VariableLayout:
+    """Where each interface vertex's unknowns sit in the variable vector ``x``.
+
+    Vertex ``i`` (a row of ``Interfaces.vertices``) owns the 4 consecutive columns
+    ``4 i + (0, 1, 2, 3)`` = ``(c, t, f1, f2)``: compression, tension and the friction
+    components along ``t1`` and ``t2`` (thesis eq. 3.23). Defined once and used by the
+    assembly, the solver wrapper and the results.
+
+    Parameters
+    ----------
+    offsets : (K + 1,) int
+        ``Interfaces.offsets``: interface ``k`` owns vertices ``offsets[k]:offsets[k+1]``.
+    """
+
+    offsets: np.ndarray
+
+    COMPONENTS: ClassVar[tuple] = ("c", "t", "f1", "f2")
+    WIDTH: ClassVar[int] = 4
+
+    @classmethod
+    def from_interfaces(cls, interfaces) -> "VariableLayout":
+        return cls(np.asarray(interfaces.offsets, dtype=np.int64))
+
+    @property
+    def n_interfaces(self) -> int:
+        return len(self.offsets) - 1
+
+    @property
+    def n_vertices(self) -> int:
+        return int(self.offsets[-1])
+
+    @property
+    def n_columns(self) -> int:
+        return self.WIDTH * self.n_vertices
+
+    @cached_property
+    def vertex_interface(self) -> np.ndarray:
+        """(IV,) int: interface of every vertex."""
+        return np.repeat(np.arange(self.n_interfaces), np.diff(self.offsets))
+
+    def columns(self, component: str) -> np.ndarray:
+        """(IV,) int: the column of ``component`` (``'c' | 't' | 'f1' | 'f2'``) per vertex."""
+        return self.WIDTH * np.arange(self.n_vertices) + self.COMPONENTS.index(component)
+
+    def vertex_columns(self, vertex: int) -> slice:
+        """Columns ``(c, t, f1, f2)`` of one vertex."""
+        return slice(self.WIDTH * vertex, self.WIDTH * (vertex + 1))
+
+    def component(self, x, component: str) -> np.ndarray:
+        """(IV,) view of one component of ``x`` ((n_columns,) float)."""
+        return np.asarray(x).reshape(-1, self.WIDTH)[:, self.COMPONENTS.index(component)]
+
+    def interface_sum(self, values) -> np.ndarray:
+        """(K,) float: per-interface sums of per-vertex ``values`` ((IV,) float)."""
+        return np.bincount(self.vertex_interface, weights=values,
+                           minlength=self.n_interfaces)
+
+
+@dataclass(frozen=True, eq=False)
+class EquilibriumSystem:
+    """The scaled RBE constraint matrices of one scene (thesis eq. 3.14-3.27).
+
+    With ``x_s = x / weight_ref`` (``x`` in newtons, layout :class:`VariableLayout`)::
+
+        A_eq x_s + f_ext = 0          (6 rows per free block)
+        A_fr[method] x_s <= 0         (4 rows per vertex)
+        x_s >= lower
+
+    Parameters
+    ----------
+    layout : VariableLayout
+    free_block : (F,) int
+        The blocks with equilibrium rows (non-supports), in order; block ``free_block[r]``
+        owns rows ``6 r : 6 r + 6``.
+    A_eq : (6 F, n) scipy.sparse.csr_array, dimensionless
+        Force rows in units of ``weight_ref``, moment rows (about each block's centroid)
+        in units of ``weight_ref * length_ref``.
+    f_ext : (6 F,) float, dimensionless
+        Self weight in the same units (moment rows are zero: the weight acts at the
+        centroid).
+    A_fr : dict str -> (4 IV, n) scipy.sparse.csr_array
+        ``'net'`` and ``'plus'`` friction pyramids (thesis eq. 3.26, 3.25). Rows of
+        vertex ``i``: ``4 i + (0, 1, 2, 3)`` bound ``+f1, -f1, +f2, -f2``.
+    lower : (n,) float
+        0 for c and t, ``-inf`` for f1 and f2.
+    h : (n,) float
+        Diagonal of ``H``: 1 for t, 1e-3 for c, f1, f2.
+    mu : float
+        Friction coefficient.
+    block_weight : (B,) float, newtons
+        ``density * g * volume`` of every block (supports included, for reference).
+    weight_ref : float, newtons
+        Mean weight of the free blocks.
+    length_ref : float, metres
+        Mean cube root of the free blocks' volumes.
+    """
+
+    layout: VariableLayout
+    free_block: np.ndarray
+    A_eq: sp.csr_array
+    f_ext: np.ndarray
+    A_fr: dict
+    lower: np.ndarray
+    h: np.ndarray
+    mu: float
+    block_weight: np.ndarray
+    weight_ref: float
+    length_ref: float
+
+    @property
+    def total_weight(self) -> float:
+        """Weight of the free blocks, newtons (the denominator of the MoI factor)."""
+        return float(self.block_weight[self.free_block].sum())
+
+    @property
+    def row_scale(self) -> np.ndarray:
+        """(6 F,) float: newtons (force rows) or newton-metres (moment rows) per unit row."""
+        per_block = np.array([1.0, 1.0, 1.0] + [self.length_ref] * 3) * self.weight_ref
+        return np.tile(per_block, len(self.free_block))
+
+    @property
+    def h_solver(self) -> np.ndarray:
+        """(n,) float: the diagonal of ``H`` the solver sees, ``h / 1e-3`` (1 for c, f1,
+        f2 and 1e3 for t). Same minimiser; but with ``h`` itself the objective of a small
+        scene is about 1e-4 in solver units, below the absolute gap tolerance of interior
+        point solvers (Clarabel left 2e-5 of the weight as spurious tension), and OSQP
+        needed more iterations."""
+        return self.h / OTHER_WEIGHT
+
+    def to_scaled(self, x) -> np.ndarray:
+        """Variables in newtons -> solver units."""
+        return np.asarray(x, dtype=float) / self.weight_ref
+
+    def to_newtons(self, x_scaled) -> np.ndarray:
+        """Solver units -> newtons."""
+        return np.asarray(x_scaled, dtype=float) * self.weight_ref
+
+    def contact_wrench(self, x) -> np.ndarray:
+        """(F, 6) float: net contact force (N) and moment about the centroid (N m) on
+        every free block, for ``x`` in newtons. This is ``A_eq x`` in physical units."""
+        return (self.row_scale * (self.A_eq @ self.to_scaled(x))).reshape(-1, 6)
+
+    def external_wrench(self) -> np.ndarray:
+        """(F, 6) float: ``f_ext`` in newtons and newton-metres."""
+        return (self.row_scale * self.f_ext).reshape(-1, 6)
+
+
+def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
+             side_rotation=None) -> EquilibriumSystem:
+    """Assemble the scaled RBE matrices (vectorized: COO triplets built with numpy).
+
+    Parameters
+    ----------
+    blocks : masonry.blocks.Blocks
+    interfaces : masonry.interfaces.Interfaces
+    mu : float
+        Friction coefficient (thesis ``alpha``).
+    density : float, kg/m^3
+    side_block : (K, 2) int, optional
+        The block that receives the force of each interface side: side 0 receives
+        ``-F``, side 1 receives ``+F``. Default ``interfaces.pair``. A side routed to a
+        support block contributes no row (the support absorbs it).
+    side_rotation : (K, 2, 3, 3) float, optional
+        Rotation ``Q`` (about the origin) applied to each side before its force reaches
+        ``side_block``: that side's force ``Q (+-F)`` acts at the point ``Q v``. Default
+        identity. Cyclic symmetry (SPEC 6.4) routes the side on the rotated copy of a
+        section block back onto that block with the inverse rotation.
+
+    Returns
+    -------
+    EquilibriumSystem
+    """
+    layout = VariableLayout.from_interfaces(interfaces)
+    n_vertices = layout.n_vertices
+    is_support = np.asarray(blocks.block_is_support, dtype=bool)
+    free_block = np.flatnonzero(~is_support)
+    if len(free_block) == 0:
+        raise ValueError("no free block: every block is a support")
+
+    volume = blocks.block_volume
+    block_weight = density * G * volume
+    weight_ref = float(block_weight[free_block].mean())
+    length_ref = float(np.cbrt(volume[free_block]).mean())
+
+    block_row = np.full(blocks.n_blocks, -1)
+    block_row[free_block] = np.arange(len(free_block))
+
+    side_block = (np.asarray(interfaces.pair, dtype=np.int64) if side_block is None
+                  else np.asarray(side_block, dtype=np.int64))
+    vertex_interface = layout.vertex_interface
+    point = np.asarray(interfaces.vertices, dtype=float)
+    # direction of each variable's unit force on the other block: c -> n, t -> -n,
+    # f1 -> t1, f2 -> t2; (IV, 4, 3)
+    normal = interfaces.normal[vertex_interface]
+    direction = np.stack([normal, -normal, interfaces.t1[vertex_interface],
+                          interfaces.t2[vertex_interface]], axis=1)
+    columns = (layout.WIDTH * np.arange(n_vertices))[:, None] + np.arange(layout.WIDTH)
+
+    rows, cols, vals = [], [], []
+    for side, sign in ((0, -1.0), (1, 1.0)):
+        block = side_block[vertex_interface, side]
+        side_direction, side_point = sign * direction, point
+        if side_rotation is not None:
+            rotation = np.asarray(side_rotation, dtype=float)[vertex_interface, side]
+            side_direction = np.einsum("vij,vqj->vqi", rotation, side_direction)
+            side_point = np.einsum("vij,vj->vi", rotation, point)
+        arm = (side_point - blocks.block_centroid[block]) / length_ref
+        moment = np.cross(arm[:, None, :], side_direction)
+        coeff = np.concatenate([side_direction, moment], axis=2)  # (IV, 4, 6)
+        row = 6 * block_row[block][:, None, None] + np.arange(6)[None, None, :]
+        # drop rows of supports, and the zeros and rounding noise of axis-aligned frames
+        # (about 40% of the triplets of a wall; HiGHS warns about them and every solver
+        # would carry them)
+        keep = (block_row[block] >= 0)[:, None, None] & (np.abs(coeff) > COEFFICIENT_NOISE)
+        rows.append(np.broadcast_to(row, coeff.shape)[keep])
+        cols.append(np.broadcast_to(columns[:, :, None], coeff.shape)[keep])
+        vals.append(coeff[keep])
+    shape = (6 * len(free_block), layout.n_columns)
+    # COO -> CSR sums duplicates: a vertex routed twice to one block adds up
+    A_eq = sp.coo_array((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                        shape=shape).tocsr()
+
+    f_ext = np.zeros((len(free_block), 6))
+    f_ext[:, 2] = -block_weight[free_block] / weight_ref
+
+    # rows +f1, -f1, +f2, -f2 of one vertex, columns (c, t, f1, f2)
+    pyramid_net = np.array([[-mu, mu, 1.0, 0.0],
+                            [-mu, mu, -1.0, 0.0],
+                            [-mu, mu, 0.0, 1.0],
+                            [-mu, mu, 0.0, -1.0]])
+    pyramid_plus = pyramid_net.copy()
+    pyramid_plus[:, 1] = 0.0  # friction+: tension is decoupled (thesis eq. 3.25)
+    eye = sp.identity(n_vertices, format="csr")
+    A_fr = {
+        "net": sp.csr_array(sp.kron(eye, pyramid_net, format="csr")),
+        "plus": sp.csr_array(sp.kron(eye, pyramid_plus, format="csr")),
+    }
+
+    lower = np.tile([0.0, 0.0, -np.inf, -np.inf], n_vertices)
+    h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], n_vertices)
+    return EquilibriumSystem(layout=layout, free_block=free_block, A_eq=A_eq,
+                             f_ext=f_ext.ravel(), A_fr=A_fr, lower=lower, h=h, mu=float(mu),
+                             block_weight=block_weight, weight_ref=weight_ref,
+                             length_ref=length_ref)

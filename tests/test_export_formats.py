@@ -1,0 +1,134 @@
+"""Round trips of the VTU and 3DM exporters (SPEC 7)."""
+
+import functools
+import sys
+
+import meshio
+import numpy as np
+import pytest
+from conftest import scene_of
+
+from masonry.blocks import BLOCK_CLASSES
+from masonry.export.rhino import blocks_3dm
+from masonry.export.vtu import interfaces_vtu
+from masonry.interfaces import INTERFACE_KINDS, Interfaces, detect
+
+# binary VTU stores float64 as is
+VTU_RTOL = 1e-12
+# the per-interface resultants of RBE/forces.csv (SPEC 7)
+FORCE_NAMES = ("compression", "tension", "normal", "t1", "t2", "friction")
+
+
+@functools.cache
+def interfaces_of(name):
+    scene = scene_of(name)
+    return detect(scene.blocks, up=scene.block_up)
+
+
+def random_forces(count, seed=0):
+    rng = np.random.default_rng(seed)
+    return {key: rng.normal(scale=1e3, size=count) for key in FORCE_NAMES}
+
+
+def polygon_interfaces():
+    """Three interfaces by hand: a triangle, a pentagon and a quad, in that order, so
+    that the file's cell blocks (by vertex count) reorder them."""
+    polygons = [np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)]
+    angle = 2 * np.pi * np.arange(5) / 5
+    polygons.append(np.column_stack([np.cos(angle), np.sin(angle), np.ones(5)]))
+    polygons.append(np.array([[0, 0, 2], [1, 0, 2], [1, 1, 2], [0, 1, 2]], float))
+    count = len(polygons)
+    z3 = np.tile([0.0, 0.0, 1.0], (count, 1))
+    return Interfaces(
+        pair=np.array([[0, 1], [1, 2], [2, 3]]), kind=np.array([0, 1, 2], np.int8),
+        vertices=np.concatenate(polygons),
+        offsets=np.concatenate([[0], np.cumsum([len(p) for p in polygons])]),
+        area=np.array([0.5, 2.5 * np.sin(2 * np.pi / 5), 1.0]),
+        centre=np.array([p.mean(axis=0) for p in polygons]), normal=z3,
+        t1=np.tile([1.0, 0.0, 0.0], (count, 1)), t2=np.tile([0.0, 1.0, 0.0], (count, 1)))
+
+
+def read_vtu(data, tmp_path):
+    path = tmp_path / "interfaces.vtu"
+    path.write_bytes(data)
+    return meshio.read(path)
+
+
+def check_vtu_round_trip(interfaces, forces, tmp_path):
+    """The file holds one cell per interface with its polygon and all cell data."""
+    mesh = read_vtu(interfaces_vtu(interfaces, forces), tmp_path)
+    assert sum(len(block.data) for block in mesh.cells) == len(interfaces)
+    data = {name: np.concatenate(arrays) for name, arrays in mesh.cell_data.items()}
+    row = data["interface"]
+    np.testing.assert_array_equal(np.sort(row), np.arange(len(interfaces)))
+    expected = dict(forces, kind=interfaces.kind, area=interfaces.area,
+                    frame_normal=interfaces.normal, frame_t1=interfaces.t1,
+                    frame_t2=interfaces.t2)
+    assert set(data) == set(expected) | {"interface"}
+    for name, value in expected.items():
+        np.testing.assert_allclose(data[name], np.asarray(value)[row], rtol=VTU_RTOL,
+                                   atol=0, err_msg=name)
+    assert data["kind"].dtype.kind == "i"
+    # every cell's polygon is its interface's polygon, vertex for vertex
+    cell_rows = np.split(row, np.cumsum([len(block.data) for block in mesh.cells])[:-1])
+    for block, rows in zip(mesh.cells, cell_rows):
+        size = block.data.shape[1]
+        assert block.type == {3: "triangle", 4: "quad"}.get(size, "polygon")
+        np.testing.assert_array_equal(interfaces.vertex_count[rows], size)
+        for cell, k in zip(block.data, rows):
+            np.testing.assert_allclose(mesh.points[cell], interfaces.polygon(k),
+                                       rtol=VTU_RTOL, atol=0)
+
+
+def test_vtu_round_trips_triangle_quad_and_polygon_cells(tmp_path):
+    interfaces = polygon_interfaces()
+    check_vtu_round_trip(interfaces, random_forces(len(interfaces)), tmp_path)
+
+
+def test_vtu_round_trips_the_interfaces_of_preset_1(tmp_path):
+    interfaces = interfaces_of("1")
+    assert set(np.unique(interfaces.vertex_count)) >= {4, 6}  # quads and hexagons
+    check_vtu_round_trip(interfaces, random_forces(len(interfaces), seed=1), tmp_path)
+
+
+def test_vtu_names_the_kinds_and_is_compressed():
+    data = interfaces_vtu(polygon_interfaces(), {})
+    legend = ", ".join(f"{code} {name}" for code, name in enumerate(INTERFACE_KINDS))
+    assert f"<!--masonry interfaces, kind: {legend}-->".encode() in data
+    assert b'compressor="vtkZLibDataCompressor"' in data
+
+
+def test_vtu_rejects_bad_forces():
+    interfaces = polygon_interfaces()
+    with pytest.raises(ValueError, match="shape"):
+        interfaces_vtu(interfaces, {"compression": np.zeros(len(interfaces) + 1)})
+    with pytest.raises(ValueError, match="reserved"):
+        interfaces_vtu(interfaces, {"kind": np.zeros(len(interfaces))})
+    with pytest.raises(ValueError, match="no interfaces"):
+        interfaces_vtu(Interfaces.empty(), {})
+
+
+# ---------------------------------------------------------------------- 3dm
+def test_3dm_has_one_named_closed_mesh_per_brick_on_its_class_layer():
+    rhino3dm = pytest.importorskip("rhino3dm")
+    blocks = scene_of("1").blocks
+    model = rhino3dm.File3dm.FromByteArray(blocks_3dm(blocks))
+    assert model.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Meters
+    layers = [layer.Name for layer in model.Layers]
+    assert layers == [BLOCK_CLASSES[c] for c in np.unique(blocks.block_class)]
+    assert len(model.Objects) == blocks.n_blocks
+    for i, item in enumerate(model.Objects):
+        assert item.Attributes.Name == blocks.block_name[i]
+        assert layers[item.Attributes.LayerIndex] == BLOCK_CLASSES[blocks.block_class[i]]
+        mesh = item.Geometry
+        assert mesh.IsClosed
+        assert len(mesh.Faces) == len(blocks.block_faces(i))  # hexahedra: six quads
+        points = np.array([[p.X, p.Y, p.Z] for p in mesh.Vertices.ToPoint3dArray()])
+        # double-precision vertices: exact
+        np.testing.assert_array_equal(points, blocks.block_vertices(i))
+
+
+def test_3dm_without_rhino3dm_names_the_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "rhino3dm", None)  # import now raises ImportError
+    with pytest.raises(ImportError, match=r"masonry\[rhino\]"):
+        blocks_3dm(scene_of("wall").blocks)
