@@ -9,9 +9,14 @@ import trimesh
 from masonry_cli.main import main
 
 
+def run_folders(root):
+    """The run folders under an output root (not the hidden geometry cache)."""
+    return [p for p in root.iterdir() if not p.name.startswith(".")]
+
+
 def test_build_writes_the_run_folder(tmp_path, capsys):
     assert main(["build", "--preset", "1", "--fast", "--out", str(tmp_path), "-q"]) == 0
-    (folder,) = tmp_path.iterdir()
+    (folder,) = run_folders(tmp_path)
     assert folder.name == "dome0_fast1_fricauto_s1_n8_r1_p10_c0.1_u0.1"
     for name in ("00_parameters.txt", "run.json", "locations.csv", "bricks.obj",
                  "00_pattern.png", "01_angle/3_structure.png"):
@@ -32,7 +37,7 @@ def test_build_writes_the_run_folder(tmp_path, capsys):
 def test_bricks_obj_splits_into_one_mesh_per_brick(tmp_path):
     assert main(["build", "--preset", "wall", "--no-plots", "--out", str(tmp_path),
                  "-q"]) == 0
-    (folder,) = tmp_path.iterdir()
+    (folder,) = run_folders(tmp_path)
     scene = trimesh.load(folder / "bricks.obj", split_objects=True, group_material=False,
                          process=False)
     meshes = scene.geometry if hasattr(scene, "geometry") else {"one": scene}
@@ -71,14 +76,14 @@ def test_unparsable_value_exits_2(capsys):
 def test_params_file(tmp_path, fixtures_dir):
     assert main(["build", "--params", str(fixtures_dir / "presets" / "preset3.toml"),
                  "--no-plots", "--out", str(tmp_path), "-q"]) == 0
-    (folder,) = tmp_path.iterdir()
+    (folder,) = run_folders(tmp_path)
     assert folder.name.startswith("dome0_fast0_fricauto_s0.8_n4_r1_p13_c0.01")
 
 
 def test_failed_run_leaves_previous_output(tmp_path, monkeypatch):
     assert main(["build", "--preset", "wall", "--no-plots", "--out", str(tmp_path),
                  "-q"]) == 0
-    (folder,) = tmp_path.iterdir()
+    (folder,) = run_folders(tmp_path)
     before = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
 
     def broken(*args, **kwargs):
@@ -86,10 +91,11 @@ def test_failed_run_leaves_previous_output(tmp_path, monkeypatch):
 
     monkeypatch.setattr("masonry.pipeline.blocks_obj", broken)
     with pytest.raises(RuntimeError):
-        main(["build", "--preset", "wall", "--no-plots", "--out", str(tmp_path), "-q"])
+        main(["build", "--preset", "wall", "--no-plots", "--force", "--out", str(tmp_path),
+              "-q"])
     after = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
     assert after == before
-    assert [p.name for p in tmp_path.iterdir()] == [folder.name]  # no temporary left
+    assert [p.name for p in tmp_path.iterdir() if ".tmp-" in p.name] == []  # none left
 
 
 def test_cad_offset_moves_bricks_inward(tmp_path):

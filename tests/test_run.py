@@ -1,0 +1,107 @@
+"""``masonry run`` end to end, in-process: files, records, round trips, cache, atomicity."""
+
+import csv
+import json
+
+import meshio
+import numpy as np
+import pytest
+import trimesh
+
+from masonry.params import from_preset
+from masonry.scenes import build
+from masonry_cli.main import main
+
+RBE_KEYS = ("feasible", "friction", "mu", "objective", "moi", "moi_factor", "weight_N",
+            "solver", "status", "iterations", "residual_eq", "friction_violation", "time_s",
+            "lp_feasible")
+
+
+@pytest.fixture(scope="module")
+def wall_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("runs")
+    assert main(["run", "--preset", "wall", "--fast", "--out", str(out), "-q"]) == 0
+    return out, out / "wall_fast1_fricauto_L32_k10_u0.1"
+
+
+def test_run_writes_every_output(wall_run):
+    _, folder = wall_run
+    for name in ("00_parameters.txt", "run.json", "locations.csv", "bricks.obj",
+                 "interfaces.csv", "dome.stl", "dome.obj", "RBE/00_objective.txt",
+                 "RBE/forces.csv", "RBE/interfaces.vtu", "RBE/01_angle/tension.png",
+                 "RBE/01_angle/compression_horizontal.png", "RBE/01_angle/friction.png"):
+        assert (folder / name).is_file(), name
+    record = json.loads((folder / "run.json").read_text())
+    assert set(RBE_KEYS) <= set(record["rbe"])
+    assert record["rbe"]["feasible"] is True
+    assert record["counts"]["interfaces"] == {"horizontal": 144, "vertical": 75,
+                                              "support": 8, "boundary": 0}
+    assert record["printable"]["readback"]["watertight"]
+    assert record["printable"]["readback"]["bodies"] == 1
+    text = (folder / "RBE/00_objective.txt").read_text()
+    assert "feasible" in text and "MoI factor" in text and "friction-net" in text
+
+
+def _forces_table(folder):
+    with open(folder / "RBE/forces.csv") as f:
+        rows = list(csv.DictReader(f))
+    return {k: np.array([float(r[k]) for r in rows]) for k in
+            ("compression_N", "tension_N", "normal_N", "t1_N", "t2_N", "friction_N")}
+
+
+def test_interfaces_vtu_round_trips_with_the_forces(wall_run):
+    _, folder = wall_run
+    table = _forces_table(folder)
+    mesh = meshio.read(folder / "RBE/interfaces.vtu")
+    order = np.concatenate(mesh.cell_data["interface"]).astype(int)
+    assert sorted(order) == list(range(len(table["compression_N"])))
+    for name in ("compression", "tension", "normal", "t1", "t2", "friction"):
+        values = np.concatenate(mesh.cell_data[name])
+        np.testing.assert_allclose(values, table[f"{name}_N"][order], rtol=1e-9, atol=1e-9)
+
+
+def test_bricks_obj_round_trips(wall_run):
+    _, folder = wall_run
+    blocks = build(from_preset("wall")).blocks
+    scene = trimesh.load(folder / "bricks.obj", split_objects=True, group_material=False,
+                         process=False)
+    assert len(scene.geometry) == blocks.n_blocks
+    for i, name in enumerate(blocks.block_name):
+        mine = np.unique(np.round(blocks.block_vertices(i), 9), axis=0)
+        theirs = np.unique(np.round(scene.geometry[name].vertices, 9), axis=0)
+        np.testing.assert_allclose(theirs, mine, atol=1e-10)
+
+
+def test_rerun_is_reused_and_other_mu_reuses_geometry(wall_run, capsys):
+    out, folder = wall_run
+    stamp = (folder / "run.json").stat().st_mtime_ns
+    assert main(["run", "--preset", "wall", "--fast", "--out", str(out), "-q"]) == 0
+    assert (folder / "run.json").stat().st_mtime_ns == stamp
+    assert "up to date" in capsys.readouterr().out
+    assert main(["run", "--preset", "wall", "--fast", "--mu", "0.4", "--no-plots",
+                 "--out", str(out), "-q"]) == 0
+    record = json.loads((out / "wall_fast1_fricauto_L32_k10_u0.1_mu0.4" / "run.json")
+                        .read_text())
+    assert record["cache"] == {"geometry": "reused"}
+    assert record["rbe"]["mu"] == 0.4
+
+
+def test_run_failing_midway_leaves_the_earlier_folder(wall_run, monkeypatch):
+    out, folder = wall_run
+    before = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+
+    def broken(*args, **kwargs):
+        raise KeyboardInterrupt  # an interrupted run, halfway through its exports
+
+    monkeypatch.setattr("masonry.pipeline.forces_csv", broken)
+    assert main(["run", "--preset", "wall", "--fast", "--force", "--out", str(out),
+                 "-q"]) == 130
+    after = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+    assert after == before
+    assert not [p for p in out.iterdir() if p.name.startswith(".wall")]
+
+
+def test_invalid_mu_writes_nothing(tmp_path, capsys):
+    assert main(["run", "--mu", "-1", "--out", str(tmp_path / "x")]) == 2
+    assert "mu=-1.0" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
