@@ -62,11 +62,11 @@ class Timer:
 
 def cad_vertices(scene) -> np.ndarray:
     """Vertices moved inward by ``cad_offset`` units along each brick's inward normal
-    (the normal of its inner face, face 0 of a hexahedral brick; thesis 3.4.1)."""
+    (``scene.block_inward``; thesis 3.4.1). Scenes without one are not moved."""
     blocks = scene.blocks
-    first_face = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks))
-    inward = blocks.face_normal[first_face]
-    shift = scene.params.cad_offset * scene.params.unit * inward
+    if scene.block_inward is None:
+        return blocks.vertices
+    shift = scene.params.cad_offset * scene.params.unit * scene.block_inward
     return blocks.vertices + np.repeat(shift, np.diff(blocks.vertex_offsets), axis=0)
 
 

@@ -27,7 +27,13 @@ _SECTION = {REG: (2.0, 1.0), PAT: (4.0, 2.0)}
 
 @dataclass(frozen=True)
 class Scene:
-    """A built scene: its blocks and, for dome scenes, how they were laid out."""
+    """A built scene: its blocks and, for dome scenes, how they were laid out.
+
+    ``block_up`` (B, 3): each block's course direction (bed joints are the interfaces
+    across it; the interface detector names kinds by it), the z axis when None.
+    ``block_inward`` (B, 3): the direction the CAD offset moves each block (thesis
+    3.4.1), no offset when None.
+    """
 
     params: Params
     blocks: Blocks
@@ -35,13 +41,15 @@ class Scene:
     pattern: Pattern | None = None
     layout: Layout | None = None
     dims: Dimensions | None = None
+    block_up: np.ndarray | None = None
+    block_inward: np.ndarray | None = None
 
-    @property
-    def block_up(self) -> np.ndarray:
-        """(B, 3) float: each brick's course direction, the normal of its top face (face 5
-        of a hexahedral brick): bed joints are the interfaces across it."""
-        first = np.searchsorted(self.blocks.face_block, np.arange(self.blocks.n_blocks))
-        return self.blocks.face_normal[first + 5]
+
+def hexahedra_frames(blocks: Blocks):
+    """``(up, inward)`` of hexahedral bricks: the normals of their top face (face 5) and of
+    their inner face (face 0), see :data:`masonry.blocks.HEX_FACES`."""
+    first = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks))
+    return blocks.face_normal[first + 5], blocks.face_normal[first]
 
 
 def _corners(base, gamma, width, height, y0, y1, tan_left, tan_right):
@@ -106,7 +114,7 @@ def build_section(params: Params) -> Scene:
                       np.array([u]), np.zeros(1), np.zeros(1),
                       np.array([tan]), np.array([tan]))[0]
     blocks = _blocks_from_layout(layout, levels, u, tan, ground)
-    return Scene(params, blocks, levels, pattern, layout, dims)
+    return Scene(params, blocks, levels, pattern, layout, dims, *hexahedra_frames(blocks))
 
 
 def build_wall(params: Params) -> Scene:
@@ -126,7 +134,7 @@ def build_wall(params: Params) -> Scene:
                       np.array([-half * u]), np.array([half * u]),
                       np.full(1, np.nan), np.full(1, np.nan))[0]
     blocks = _blocks_from_layout(layout, levels, u, np.nan, ground)
-    return Scene(params, blocks, levels, None, layout, None)
+    return Scene(params, blocks, levels, None, layout, None, *hexahedra_frames(blocks))
 
 
 BUILDERS = {"section": build_section, "wall": build_wall}
