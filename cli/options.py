@@ -2,8 +2,8 @@
 
 import argparse
 
-from masonry.params import (FRICTIONS, PRESETS, SCENES, SOLVERS, Params, from_preset, load,
-                            validate)
+from masonry.params import (BOUNDARIES, FRICTIONS, PRESETS, SCENES, SOLVERS, Params,
+                            from_preset, load, validate)
 
 GEOMETRY = ("stretch", "n", "r", "p", "cut", "unit", "min_fill", "wall_length",
             "wall_courses")
@@ -22,7 +22,8 @@ def add_model_options(parser):
                    help="a thesis structure (1 spherical, 2 stretched, 3 compressed) or the "
                         "validation wall; explicit options below override it")
     g.add_argument("--params", metavar="FILE", help="parameters from a TOML file")
-    g.add_argument("--scene", choices=[s for s in SCENES if s in ("section", "wall")])
+    g.add_argument("--scene", choices=[s for s in SCENES if s in ("section", "wall", "dome")],
+                   help="section (one web, default), dome (all n webs), wall (validation)")
     g.add_argument("--stretch", type=float, help="dome height / circumradius (> 0)")
     g.add_argument("--n", type=int, help="walls of the polygonal dome (>= 3)")
     g.add_argument("--r", type=int, help="full rhombi across the section (>= 0)")
@@ -47,8 +48,12 @@ def add_analysis_options(parser):
                    help="net, plus, or auto (net, then plus if infeasible; default)")
     g.add_argument("--solver", choices=SOLVERS,
                    help="QP solver: clarabel (interior point, default) or osqp")
-    g.add_argument("--boundary", choices=["free"],
-                   help="boundary of the section: free (free-standing, the default)")
+    g.add_argument("--boundary", choices=BOUNDARIES,
+                   help="boundary of a section: free (free-standing, default), rigid "
+                        "(immovable neighbouring webs) or cyclic (exact rotational symmetry)")
+    g.add_argument("--dome", action="store_true",
+                   help="dome mode: the section with its neighbours, cyclic unless "
+                        "--boundary says otherwise")
 
 
 def add_output_options(parser):
@@ -67,6 +72,8 @@ def params_from_args(args) -> Params:
     """Preset or file first, then every option the user gave; validated."""
     given = {k: v for k, v in vars(args).items()
              if k in Params.__dataclass_fields__ and v is not None}
+    if getattr(args, "dome", False) and "boundary" not in given:
+        given["boundary"] = "cyclic"
     if args.params:
         return load(args.params, **given)
     if args.preset:

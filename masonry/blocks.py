@@ -38,15 +38,21 @@ def _unit(v):
     return v / np.linalg.norm(v, axis=-1, keepdims=True)
 
 
-def tangent_basis(normal):
+def tangent_basis(normal, reference=None):
     """In-plane basis for unit normals.
 
-    ``t1`` is horizontal (``z x n``) where the face is not horizontal, else the x axis
-    projected into the plane; ``t2 = n x t1``.
+    ``t1`` is horizontal (``z x n``) where the face is not horizontal; on a horizontal
+    face it is ``reference`` projected into the plane (a direction of the face's own, so
+    the basis turns with the model), or the x axis without one; ``t2 = n x t1``. The
+    friction pyramid of SPEC 6.3 is aligned with ``(t1, t2)``: a global x axis on the
+    ground slabs of a full dome would align the pyramids of some webs with their web and
+    turn those of others by 2 pi/n, and the dome would lose its rotational symmetry.
 
     Parameters
     ----------
     normal : (k, 3) float
+    reference : (k, 3) float, optional
+        In-plane direction for horizontal faces (e.g. the face's longest edge).
 
     Returns
     -------
@@ -55,8 +61,9 @@ def tangent_basis(normal):
     normal = np.asarray(normal, dtype=float).reshape(-1, 3)
     t1 = np.cross(np.array([0.0, 0.0, 1.0]), normal)
     flat = np.linalg.norm(t1, axis=1) < 1e-6
-    ex = np.array([1.0, 0.0, 0.0])
-    t1[flat] = ex - normal[flat] * (normal[flat] @ ex)[:, None]
+    ref = (np.broadcast_to([1.0, 0.0, 0.0], normal.shape) if reference is None
+           else np.asarray(reference, dtype=float).reshape(-1, 3))[flat]
+    t1[flat] = ref - normal[flat] * np.einsum("ij,ij->i", normal[flat], ref)[:, None]
     t1 = _unit(t1)
     t2 = np.cross(normal, t1)
     return t1, t2
@@ -234,9 +241,27 @@ class Blocks:
         return out / weight[:, None]
 
     @cached_property
+    def face_longest_edge(self) -> np.ndarray:
+        """(F, 3) float: the longest edge vector of every face polygon."""
+        fv = self.face_vertices
+        nxt = np.arange(len(fv)) + 1
+        ends = self.face_offsets[1:] - 1
+        nxt[ends] = self.face_offsets[:-1]  # close every polygon
+        edge = self.vertices[fv[nxt]] - self.vertices[fv]
+        length = np.linalg.norm(edge, axis=1)
+        owner = np.repeat(np.arange(self.n_faces), self.face_polygon_count)
+        # the first edge of maximal length (up to rounding) in each face
+        longest = np.maximum.reduceat(length, self.face_offsets[:-1])
+        is_longest = length >= longest[owner] * (1 - 1e-9)
+        first = np.full(self.n_faces, len(fv))
+        np.minimum.at(first, owner[is_longest], np.flatnonzero(is_longest))
+        return edge[first]
+
+    @cached_property
     def face_basis(self) -> tuple:
-        """``(t1, t2)``, each (F, 3) float: in-plane basis of every face."""
-        return tangent_basis(self.face_normal)
+        """``(t1, t2)``, each (F, 3) float: in-plane basis of every face (horizontal faces
+        take ``t1`` along their longest edge, see :func:`tangent_basis`)."""
+        return tangent_basis(self.face_normal, self.face_longest_edge)
 
     @cached_property
     def block_vertex_mean(self) -> np.ndarray:

@@ -107,6 +107,7 @@ def detect(blocks: Blocks, tol: Tolerances | None = None, up=None) -> Interfaces
       comes within ``contact`` of 0; the same test on the interface polygon.
     - ``max_gap_angle``: largest angle between ``n_a`` and ``-n_b`` (the wedge angle).
     - ``min_area_rel``: smallest kept area, relative to the smaller of the two faces.
+    - ``grid``: precision grid of the shapely intersection (robust on coincident faces).
     - ``length``: faces whose wedge moves the complementary face by at most ``length``
       count as parallel (projected, no rotation); interface vertices closer than
       ``length`` to the line through their neighbours (collinear or duplicate) are
@@ -327,7 +328,7 @@ def _intersect(blocks, main, comp, tol, up):
     row_m, xyz_m, _, count_m = _face_vertex_rows(blocks, main)
     main_poly = _polygons_2d(xyz_m, row_m, count_m, origin, t1[main], t2[main])
 
-    overlap = shapely.intersection(main_poly, comp_poly)
+    overlap = shapely.intersection(main_poly, comp_poly, grid_size=tol.grid)
     keep = (shapely.get_type_id(overlap) == shapely.GeometryType.POLYGON) & (
         shapely.area(overlap) > tol.min_area_rel * np.minimum(area[main], area[comp]))
     # drop collinear and duplicate vertices, then make every ring counter-clockwise

@@ -83,6 +83,17 @@ class LevelTable:
     def n_courses(self) -> int:
         return len(self.x) - 1
 
+    @property
+    def wedge_angles(self) -> np.ndarray:
+        """Angles (radians) of the wedges between touching bricks of consecutive courses:
+        course 1 on the ground, course k on course k - 1, and a pattern brick on the
+        course below it and under the course above it (the gaps thesis 3.2.4 closes)."""
+        reg, pat = self.gamma_reg, self.gamma_pat[:-1]
+        below = np.concatenate([[0.0], reg[:-1]])  # what each course stands on
+        above = reg[2:]  # what stands on a pattern brick started one course lower
+        parts = [reg - below, pat - below[: len(pat)], above - pat[: len(above)]]
+        return np.abs(np.concatenate(parts))
+
 
 def _ellipse(a, c, theta):
     return np.array([a * np.cos(theta), c * np.sin(theta)])

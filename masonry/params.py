@@ -17,6 +17,7 @@ SCENES = ("section", "wall", "dome", "assembly", "arch")
 FRICTIONS = ("net", "plus", "auto")
 BOUNDARIES = ("free", "rigid", "cyclic")
 SOLVERS = ("osqp", "clarabel")
+ARCH_SHAPES = ("semicircular", "pointed", "segmental")
 
 PRESETS = {
     # SPEC 3 / thesis 3.4.1: the three structures of the thesis
@@ -48,6 +49,10 @@ class Params:
     top; ``unit`` brick unit in metres; ``min_fill`` shortest fill-in brick (units).
     Scene: ``scene`` (section, wall, dome, ...), ``boundary`` of a section (free, rigid,
     cyclic), ``wall_length`` (units) and ``wall_courses`` for the wall scene.
+    Arch scene (metres, :mod:`masonry.arch`): ``arch_blocks`` voussoirs, ``arch_span`` and
+    ``arch_rise`` (None: the shape's default) of the centre line, ``arch_thickness``,
+    ``arch_depth`` (along y), ``arch_shape``. Assembly scene: ``assembly``, the name of
+    the imported model (``<file stem>_<content hash>``, set by ``masonry analyze``).
     Analysis: ``mu`` friction coefficient, ``density`` kg/m^3, ``friction`` net | plus |
     auto, ``solver``. Output: ``fast`` (one view, low resolution), ``cad_offset`` (units).
     """
@@ -69,6 +74,13 @@ class Params:
     solver: str = "clarabel"
     fast: bool = False
     cad_offset: float = 1.0
+    arch_blocks: int = 16
+    arch_span: float = 10.0
+    arch_thickness: float = 0.6
+    arch_depth: float = 1.0
+    arch_shape: str = "semicircular"
+    arch_rise: float | None = None
+    assembly: str = ""
 
     def replace(self, **changes) -> "Params":
         return dataclasses.replace(self, **changes)
@@ -78,6 +90,9 @@ class Params:
         """The inputs that decide the geometry and interfaces (the cache key)."""
         if self.scene == "wall":
             keys = ("scene", "wall_length", "wall_courses", "unit")
+        elif self.scene == "arch":
+            keys = ("scene", "arch_blocks", "arch_span", "arch_thickness", "arch_depth",
+                    "arch_shape", "arch_rise")
         else:
             keys = ("scene", "stretch", "n", "r", "p", "cut", "unit", "min_fill", "boundary")
         return {k: getattr(self, k) for k in keys}
@@ -139,6 +154,22 @@ def validate(params: Params) -> Params:
            ">= 4 (units, one regular brick)")
     _check("wall_courses", p.wall_courses,
            _number("wall_courses", p.wall_courses, integer=True) >= 1, "an integer >= 1")
+    _check("arch_blocks", p.arch_blocks,
+           _number("arch_blocks", p.arch_blocks, integer=True) >= 1, "an integer >= 1")
+    for name in ("arch_span", "arch_thickness", "arch_depth"):
+        _check(name, getattr(p, name), _number(name, getattr(p, name)) > 0, "> 0 (metres)")
+    _check("arch_shape", p.arch_shape, p.arch_shape in ARCH_SHAPES,
+           f"one of {', '.join(ARCH_SHAPES)}")
+    if p.arch_rise is not None:
+        _check("arch_rise", p.arch_rise, _number("arch_rise", p.arch_rise) > 0,
+               "> 0 (metres) or none")
+    if p.scene == "arch":
+        from .arch import check_arch  # the checks that depend on the arch's shape
+
+        check_arch(p)
+    if p.scene == "assembly":
+        _check("assembly", p.assembly, bool(p.assembly),
+               "the name of an imported model (masonry analyze sets it)")
     if p.scene in ("section", "dome") and not 0.2 <= p.stretch <= 5:
         log.warning("stretch=%g is outside 0.2..5: the dome is unusually flat or tall",
                     p.stretch)
@@ -156,11 +187,18 @@ def structure_id(params: Params) -> str:
     default = Params()
     if p.scene == "wall":
         head = f"wall_fast{int(p.fast)}_fric{p.friction}_L{p.wall_length:g}_k{p.wall_courses}"
+    elif p.scene == "arch":
+        head = (f"arch_fast{int(p.fast)}_fric{p.friction}_{p.arch_shape}_N{p.arch_blocks}"
+                f"_s{p.arch_span:g}_t{p.arch_thickness:g}_d{p.arch_depth:g}"
+                + ("" if p.arch_rise is None else f"_h{p.arch_rise:g}"))
+    elif p.scene == "assembly":
+        head = f"assembly_{p.assembly}_fast{int(p.fast)}_fric{p.friction}"
     else:
-        mode = "dome" if p.scene == "dome" else f"dome{int(p.boundary != 'free')}"
+        mode = "fulldome" if p.scene == "dome" else f"dome{int(p.boundary != 'free')}"
         head = (f"{mode}_fast{int(p.fast)}_fric{p.friction}_s{p.stretch:g}_n{p.n}_r{p.r}"
                 f"_p{p.p}_c{p.cut:g}")
-    head += f"_u{p.unit:g}"
+    if p.scene not in ("arch", "assembly"):  # no brick unit in these scenes
+        head += f"_u{p.unit:g}"
     extras = [("boundary", "b"), ("mu", "mu"), ("density", "rho"), ("min_fill", "mf"),
               ("solver", ""), ("cad_offset", "cad")]
     for name, tag in extras:

@@ -21,7 +21,7 @@ from . import __version__, plots
 from .blocks import BLOCK_CLASSES
 from .export.csv import forces_csv, interfaces_csv, locations_csv
 from .export.obj import blocks_obj
-from .interfaces import detect
+from .boundary import analysis_model
 from .params import Params, structure_id, validate
 from .runfolder import RunFolder
 from .scenes import build
@@ -136,25 +136,26 @@ def _geometry_key(params: Params) -> str:
 
 
 def _model(params: Params, out_root, timer: Timer):
-    """Scene and interfaces, from the geometry cache when present."""
+    """Scene and analysis model (interfaces, boundary routing), from the geometry cache
+    when present."""
     cache = Path(out_root) / ".cache" / f"{_geometry_key(params)}.pickle"
     if cache.is_file():
         with timer.stage("model (cached)"):
             with open(cache, "rb") as f:
-                scene, interfaces = pickle.load(f)
+                scene, model = pickle.load(f)
             # the cached scene carries the geometry; the rest of the inputs are this run's
             scene = dataclasses.replace(scene, params=params)
-        return scene, interfaces, "reused"
+        return scene, model, "reused"
     with timer.stage("model"):
         scene = build(params)
     with timer.stage("interfaces"):
-        interfaces = detect(scene.blocks, up=scene.block_up)
+        model = analysis_model(scene)
     cache.parent.mkdir(parents=True, exist_ok=True)
     tmp = cache.with_suffix(f".tmp{id(scene)}")
     with open(tmp, "wb") as f:
-        pickle.dump((scene, interfaces), f, protocol=pickle.HIGHEST_PROTOCOL)
+        pickle.dump((scene, model), f, protocol=pickle.HIGHEST_PROTOCOL)
     tmp.replace(cache)
-    return scene, interfaces, "computed"
+    return scene, model, "computed"
 
 
 def _previous(target: Path, params: Params, outputs: dict):
@@ -199,7 +200,8 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
             return {**previous, "path": str(target), "reused": True}
 
     timer = Timer()
-    scene, interfaces, cached = _model(params, out_root, timer)
+    scene, model, cached = _model(params, out_root, timer)
+    interfaces = model.interfaces
     record = {
         "structure_id": sid,
         "scene": params.scene,
@@ -214,9 +216,10 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
         from .solve import solve_rbe
 
         with timer.stage("solve"):
-            result = solve_rbe(scene.blocks, interfaces, mu=params.mu,
+            result = solve_rbe(model.blocks, interfaces, mu=params.mu,
                                density=params.density, friction=params.friction,
-                               solver=params.solver)
+                               solver=params.solver, side_block=model.side_block,
+                               side_rotation=model.side_rotation)
         record["rbe"] = result.to_dict()
         forces = result.per_interface() if result.x is not None else None
 
@@ -226,28 +229,44 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
             cad = cad_vertices(scene)
             folder.write("locations.csv", locations_csv(scene.blocks, cad))
             folder.write("bricks.obj", blocks_obj(scene.blocks))
-            folder.write("interfaces.csv", interfaces_csv(scene.blocks, interfaces))
+            folder.write("interfaces.csv", interfaces_csv(model.blocks, interfaces))
             _write_rhino(folder, scene.blocks)
             if result is not None:
                 folder.write("RBE/00_objective.txt", objective_text(result))
             if forces is not None:
                 from .export.vtu import interfaces_vtu
 
-                folder.write("RBE/forces.csv", forces_csv(scene.blocks, interfaces, forces))
+                folder.write("RBE/forces.csv", forces_csv(model.blocks, interfaces, forces))
                 if len(interfaces):
                     folder.write("RBE/interfaces.vtu", interfaces_vtu(interfaces, forces))
         if printable:
             with timer.stage("printable"):
-                record["printable"] = _write_printable(folder, scene.blocks, cad)
+                record["printable"] = _write_printable(folder, *printable_blocks(scene))
         if plots_wanted:
             with timer.stage("plots"):
-                _write_plots(folder, scene, interfaces, forces)
+                _write_plots(folder, scene, model, forces)
         record["timings_s"] = timer.seconds
         record["versions"] = versions()
         record["complete"] = True
         folder.write_json("run.json", record)
     record["path"] = str(folder.target)
     return record
+
+
+def printable_blocks(scene):
+    """Blocks and CAD-offset vertices of the printable body: the whole dome in dome mode
+    (a section with a boundary, or the dome scene; SPEC 7), else the scene itself."""
+    params = scene.params
+    if params.scene == "section" and params.boundary != "free":
+        from .boundary import rotated_web, rotation_z
+        from .blocks import concatenate
+
+        n = params.n
+        cad = cad_vertices(scene)
+        blocks = concatenate([rotated_web(scene.blocks, k, n) for k in range(n)])
+        vertices = np.concatenate([cad @ rotation_z(2 * np.pi * k / n).T for k in range(n)])
+        return blocks, vertices
+    return scene.blocks, cad_vertices(scene)
 
 
 def _write_printable(folder, blocks, cad) -> dict:
@@ -274,14 +293,15 @@ def _write_rhino(folder, blocks):
     folder.write("bricks.3dm", blocks_3dm(blocks))
 
 
-def _write_plots(folder, scene, interfaces, forces):
+def _write_plots(folder, scene, model, forces):
     fast = scene.params.fast
+    interfaces = model.interfaces
     if scene.layout is not None:
         folder.write("00_pattern.png", plots.pattern_png(scene, fast))
     for name, png in plots.structure_pngs(scene, fast).items():
         folder.write(name, png)
-    for name, png in plots.interface_pngs(scene.blocks, interfaces, fast).items():
+    for name, png in plots.interface_pngs(model.blocks, interfaces, fast).items():
         folder.write(name, png)
     if forces is not None:
-        for name, png in plots.force_pngs(scene.blocks, interfaces, forces, fast).items():
+        for name, png in plots.force_pngs(model.blocks, interfaces, forces, fast).items():
             folder.write(f"RBE/{name}", png)

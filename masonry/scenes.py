@@ -8,14 +8,17 @@ intrados, built directly from its eight corners (no hull). End bricks are mitere
 end face lies in the corner plane ``y = +-x tan(pi/n)`` where this web meets the next.
 """
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
 
-from .blocks import BLOCK_CLASSES, Blocks
+from .arch import build_arch
+from .blocks import BLOCK_CLASSES, Blocks, concatenate
 from .courses import PAT, REG, Layout, fill_courses
 from .levels import Dimensions, LevelTable, level_table
-from .params import Params
+from .params import ParameterError, Params
+from .tolerances import Tolerances
 from .pattern import Pattern, build_pattern
 
 GROUND = BLOCK_CLASSES.index("ground")
@@ -101,9 +104,25 @@ def _blocks_from_layout(layout: Layout, levels: LevelTable, unit, tan_miter, gro
 
 
 def build_section(params: Params) -> Scene:
-    """One web of the dome (SPEC 4.2 to 4.5) on its ground slab (block 0)."""
+    """One web of the dome (SPEC 4.2 to 4.5) on its ground slab (block 0).
+
+    Raises :class:`ParameterError` when the dome is too small or too flat for its bricks:
+    consecutive courses would meet in wedges wider than the interface detector's
+    ``max_gap_angle`` closes, and the courses would not bear on each other.
+    """
     dims = Dimensions.of(params)
     levels = level_table(params, dims)
+    if levels.n_courses < 2:
+        raise ParameterError("cut", params.cut, "a dome at least two courses high "
+                             f"(this one holds {levels.n_courses}); lower cut or unit")
+    widest = float(levels.wedge_angles.max())
+    limit = Tolerances().max_gap_angle
+    if widest > limit:
+        raise ParameterError(
+            "p", params.p,
+            f"a dome large enough for its bricks: its courses meet in wedges of up to "
+            f"{np.degrees(widest):.1f} degrees, more than the {np.degrees(limit):g} "
+            f"degrees whose gaps can be closed; raise p or r, or the stretch")
     half_width = levels.y[1:] / params.unit
     pattern = build_pattern(half_width, params.p, params.r)
     layout = fill_courses(half_width, pattern, params.min_fill, miter=True)
@@ -137,7 +156,23 @@ def build_wall(params: Params) -> Scene:
     return Scene(params, blocks, levels, None, layout, None, *hexahedra_frames(blocks))
 
 
-BUILDERS = {"section": build_section, "wall": build_wall}
+def build_dome(params: Params) -> Scene:
+    """All ``n`` webs explicitly: the section rotated by ``2 pi k / n`` (SPEC 4.6). The
+    mitered end bricks of neighbouring webs meet face to face in the corner planes.
+    Blocks are ordered web after web; every web keeps its ground slab as a support."""
+    from .boundary import rotated_web, rotation_z
+
+    section = build_section(params)
+    n = params.n
+    blocks = concatenate([rotated_web(section.blocks, k, n) for k in range(n)])
+    turns = [rotation_z(2 * np.pi * k / n).T for k in range(n)]
+    up = np.concatenate([section.block_up @ q for q in turns])
+    inward = np.concatenate([section.block_inward @ q for q in turns])
+    return dataclasses.replace(section, blocks=blocks, block_up=up, block_inward=inward)
+
+
+BUILDERS = {"section": build_section, "wall": build_wall, "dome": build_dome,
+            "arch": build_arch}
 
 
 def build(params: Params) -> Scene:

@@ -1,0 +1,122 @@
+"""Dome boundary conditions of a section, and the full dome (SPEC 4.6, 6.4).
+
+A section's boundary mode decides what its end bricks bear on in the corner planes:
+
+- ``free``: nothing (the thesis's ``dome = False``).
+- ``rigid``: the neighbouring webs, immovable. Their end bricks are added as *images*
+  (the section's own end bricks rotated by +-2 pi/n) that are fixed supports.
+- ``cyclic``: exact rotational symmetry. The image of the next web (+2 pi/n) is added;
+  the force an image receives at an interface is the force the brick it copies receives,
+  rotated by 2 pi/n, so the RBE routes that side of the interface onto the copied brick
+  with the rotation ``R(-2 pi/n)``. Under self weight the full dome is rotationally
+  symmetric and the QP's objective strictly convex, so its unique solution is symmetric:
+  the cyclic section reproduces the full dome's forces on that web.
+
+The thesis's ``dome = True`` adds a hoop term (eq. 3.19-3.20) that it doubts itself (5.5);
+``rigid`` and ``cyclic`` replace it with two well-defined models.
+
+Interfaces between blocks of different webs are named ``boundary``, in a section with
+images and in the full dome alike.
+"""
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from .blocks import Blocks, concatenate
+from .interfaces import INTERFACE_KINDS, Interfaces, detect
+
+BOUNDARY = INTERFACE_KINDS.index("boundary")
+
+
+def rotation_z(angle) -> np.ndarray:
+    """(3, 3) rotation by ``angle`` radians about the dome axis (z)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rotated_web(blocks: Blocks, web: int, n: int, mask=None) -> Blocks:
+    """Blocks (or those selected by ``mask``) rotated by ``2 pi web / n`` about z, named
+    ``w<web>_<name>`` and marked as web ``web % n``."""
+    part = blocks if mask is None else blocks.subset(mask)
+    motion = np.eye(4)
+    motion[:3, :3] = rotation_z(2 * np.pi * web / n)
+    part = part.transformed(motion)
+    return dataclasses.replace(
+        part,
+        block_name=np.array([f"w{web % n}_{name}" for name in part.block_name], dtype=object),
+        block_web=np.full(part.n_blocks, web % n))
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """What the RBE analyses: blocks (the scene's, then any images), interfaces, and the
+    routing of interface sides for cyclic symmetry (None: every side acts on its block).
+
+    Parameters
+    ----------
+    blocks : Blocks
+        The scene's blocks first (indices unchanged), then the neighbour images.
+    interfaces : Interfaces
+    side_block : (K, 2) int or None
+        Block that receives each side's force (see :func:`masonry.equilibrium.assemble`).
+    side_rotation : (K, 2, 3, 3) float or None
+        Rotation applied to each side's force and lever arm.
+    """
+
+    blocks: Blocks
+    interfaces: Interfaces
+    side_block: np.ndarray | None = None
+    side_rotation: np.ndarray | None = None
+
+    @property
+    def boundary_count(self) -> int:
+        return int((self.interfaces.kind == BOUNDARY).sum())
+
+
+def _end_masks(scene):
+    """Bricks mitered at the left (-pi/n) and right (+pi/n) corner planes."""
+    layout = scene.layout
+    ground = np.zeros(1, bool)  # the ground slab is a support: it bears on no image
+    return (np.concatenate([ground, layout.miter_left]),
+            np.concatenate([ground, layout.miter_right]))
+
+
+def _mark_web_boundaries(interfaces: Interfaces, blocks: Blocks) -> Interfaces:
+    web = blocks.block_web[interfaces.pair]
+    kind = np.where(web[:, 0] != web[:, 1], BOUNDARY, interfaces.kind).astype(np.int8)
+    return dataclasses.replace(interfaces, kind=kind)
+
+
+def analysis_model(scene) -> Model:
+    """Blocks, interfaces and routing for the scene and its boundary mode."""
+    params = scene.params
+    mode = params.boundary if params.scene == "section" else "free"
+    if mode == "free":
+        interfaces = detect(scene.blocks, up=scene.block_up)
+        return Model(scene.blocks, _mark_web_boundaries(interfaces, scene.blocks))
+
+    n = params.n
+    left, right = _end_masks(scene)
+    # images of the next web's left end, and (rigid) of the previous web's right end
+    images = [(1, left)] + ([(-1, right)] if mode == "rigid" else [])
+    parts, sources, ups = [scene.blocks], [], [scene.block_up]
+    for web, mask in images:
+        part = rotated_web(scene.blocks, web, n, mask)
+        parts.append(dataclasses.replace(part, block_is_support=np.ones(part.n_blocks, bool)))
+        sources.append(np.flatnonzero(mask))
+        ups.append(scene.block_up[mask] @ rotation_z(2 * np.pi * web / n).T)
+    blocks = concatenate(parts)
+    interfaces = _mark_web_boundaries(detect(blocks, up=np.concatenate(ups)), blocks)
+    if mode == "rigid":
+        return Model(blocks, interfaces)
+
+    # cyclic: an image's side acts on the brick it copies, rotated back by -2 pi/n
+    count = scene.blocks.n_blocks
+    source = np.concatenate([np.arange(count), *sources])
+    side_block = source[interfaces.pair]
+    is_image = interfaces.pair >= count
+    side_rotation = np.broadcast_to(np.eye(3), (len(interfaces), 2, 3, 3)).copy()
+    side_rotation[is_image] = rotation_z(-2 * np.pi / n)
+    return Model(blocks, interfaces, side_block, side_rotation)
