@@ -3,12 +3,13 @@
 import logging
 import sys
 
+from masonry.assembly import AssemblyError
 from masonry.params import ParameterError
 
-from . import build, run
+from . import analyze, arch_thickness, build, run, structures
 from .options import Parser
 
-SUBCOMMANDS = (build, run)
+SUBCOMMANDS = (build, run, structures, analyze, arch_thickness)
 
 
 def make_parser():
@@ -34,7 +35,7 @@ def main(argv=None) -> int:
 
     try:
         return args.handler(args, report)
-    except ParameterError as error:
+    except (ParameterError, AssemblyError) as error:
         print(f"masonry: error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:

@@ -130,3 +130,17 @@ def test_a_dome_too_small_for_its_bricks_is_refused():
 
     with pytest.raises(ParameterError, match="wedges of up to"):
         build(from_preset("1", n=6, p=2, r=0))
+
+
+def test_structures_table_rows_and_formats():
+    from masonry.structures import ROWS, structures_table, table_csv, table_markdown
+
+    rows = structures_table(rows=[r for r in ROWS if r[0] == "3.2 rigid"])
+    (row,) = rows
+    assert row["feasible"] is True and row["boundary"] == "rigid"
+    assert row["moi_factor"] < 1e-5 and row["residual_eq"] <= 1e-5
+    csv_lines = table_csv(rows).decode().splitlines()
+    assert csv_lines[0].startswith("structure,preset,scene,boundary")
+    assert csv_lines[1].startswith("3.2 rigid,3,section,rigid")
+    markdown = table_markdown(rows)
+    assert "| 3 |  | feasible, MoI factor" in markdown

@@ -1,0 +1,30 @@
+"""``masonry structures``: the thesis's table 4.1 and friction test, every boundary model
+side by side."""
+
+from masonry.runfolder import RunFolder
+from masonry.structures import structures_table, table_csv, table_markdown
+
+
+def register(subparsers):
+    parser = subparsers.add_parser(
+        "structures", help="reproduce the thesis's structures 1.1 to 3.2 and its friction "
+                           "test, with free, rigid and cyclic sections and the full dome")
+    parser.add_argument("--out", default="exports", metavar="DIR",
+                        help="output root: writes DIR/structures/table.csv and table.md")
+    parser.add_argument("--no-full-dome", dest="full_dome", action="store_false",
+                        help="leave out the full domes (the slowest rows)")
+    parser.add_argument("--lp-check", action="store_true",
+                        help="also run the HiGHS feasibility LP on every row")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    parser.set_defaults(handler=handle)
+
+
+def handle(args, report):
+    rows = structures_table(full_dome=args.full_dome, lp_check=args.lp_check)
+    markdown = table_markdown(rows)
+    with RunFolder(args.out, "structures") as folder:
+        folder.write("table.csv", table_csv(rows))
+        folder.write("table.md", markdown)
+    report(markdown)
+    report(f"written: {folder.target}")
+    return 0
