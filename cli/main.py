@@ -6,10 +6,10 @@ import sys
 from masonry.assembly import AssemblyError
 from masonry.params import ParameterError
 
-from . import analyze, arch_thickness, build, run, structures
+from . import analyze, arch_thickness, bench, build, run, structures, sweep
 from .options import Parser
 
-SUBCOMMANDS = (build, run, structures, analyze, arch_thickness)
+SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, bench)
 
 
 def make_parser():

@@ -2,8 +2,8 @@
 
 import argparse
 
-from masonry.params import (BOUNDARIES, FRICTIONS, PRESETS, SCENES, SOLVERS, Params,
-                            from_preset, load, validate)
+from masonry.params import (ACCURACIES, ARCH_SHAPES, BOUNDARIES, FRICTIONS, PRESETS,
+                            SCENES, SOLVERS, Params, from_preset, load, validate)
 
 GEOMETRY = ("stretch", "n", "r", "p", "cut", "unit", "min_fill", "wall_length",
             "wall_courses")
@@ -22,8 +22,9 @@ def add_model_options(parser):
                    help="a thesis structure (1 spherical, 2 stretched, 3 compressed) or the "
                         "validation wall; explicit options below override it")
     g.add_argument("--params", metavar="FILE", help="parameters from a TOML file")
-    g.add_argument("--scene", choices=[s for s in SCENES if s in ("section", "wall", "dome")],
-                   help="section (one web, default), dome (all n webs), wall (validation)")
+    g.add_argument("--scene", choices=[s for s in SCENES if s != "assembly"],
+                   help="section (one web, default), dome (all n webs), wall (validation), "
+                        "arch (voussoirs, see the arch options)")
     g.add_argument("--stretch", type=float, help="dome height / circumradius (> 0)")
     g.add_argument("--n", type=int, help="walls of the polygonal dome (>= 3)")
     g.add_argument("--r", type=int, help="full rhombi across the section (>= 0)")
@@ -38,6 +39,24 @@ def add_model_options(parser):
                    help="wall scene: number of courses (default 10)")
     g.add_argument("--fast", action="store_true", default=None,
                    help="reduced output: one view, lower resolution")
+    add_arch_options(parser)
+
+
+def add_arch_options(parser, thickness=True):
+    g = parser.add_argument_group("arch scene (metres; the span and rise of the centre line)")
+    g.add_argument("--blocks", dest="arch_blocks", type=int,
+                   help="number of voussoirs (default 16; even for a pointed arch)")
+    if thickness:
+        g.add_argument("--thickness", dest="arch_thickness", type=float,
+                       help="thickness t along the joints (default 0.6)")
+    g.add_argument("--span", dest="arch_span", type=float, help="span (default 10)")
+    g.add_argument("--shape", dest="arch_shape", choices=ARCH_SHAPES,
+                   help="semicircular (default), pointed or segmental")
+    g.add_argument("--rise", dest="arch_rise", type=float,
+                   help="rise of a pointed (> span/2, default equilateral) or segmental "
+                        "(< span/2, default span/4) arch")
+    g.add_argument("--depth", dest="arch_depth", type=float,
+                   help="depth along y (default 1)")
 
 
 def add_analysis_options(parser):
@@ -46,8 +65,14 @@ def add_analysis_options(parser):
     g.add_argument("--density", type=float, help="kg/m^3 (default 2000)")
     g.add_argument("--friction", choices=FRICTIONS,
                    help="net, plus, or auto (net, then plus if infeasible; default)")
+    g.add_argument("--accuracy", choices=ACCURACIES,
+                   help="solver preset: fast, balanced (default; fast with --fast) or "
+                        "accurate (interior point, tight tolerances, LP check); see "
+                        "'masonry bench'")
     g.add_argument("--solver", choices=SOLVERS,
-                   help="QP solver: clarabel (interior point, default) or osqp")
+                   help="override the preset's QP solver: newton (semismooth Newton, "
+                        "friction-net), clarabel (interior point), osqp (ADMM), or "
+                        "clarabel-cvxpy / osqp-cvxpy (through cvxpy, the reference)")
     g.add_argument("--boundary", choices=BOUNDARIES,
                    help="boundary of a section: free (free-standing, default), rigid "
                         "(immovable neighbouring webs) or cyclic (exact rotational symmetry)")
@@ -88,8 +113,18 @@ def summary(record, report):
     counts = record["counts"]
     interfaces = sum(counts.get("interfaces", {}).values())
     state = "up to date, reused" if record.get("reused") else "written"
-    report(f"{record['structure_id']}: {counts['bricks']} bricks "
-           f"({counts['regular']} regular, {counts['pattern']} pattern, "
-           f"{counts['fill_in']} fill-in) in {counts['courses']} courses, "
-           f"{interfaces} interfaces, weight {record['weight_N']:.4g} N")
+    what = (f"{counts['bricks']} blocks" if record["scene"] in ("arch", "assembly") else
+            f"{counts['bricks']} bricks ({counts['regular']} regular, {counts['pattern']} "
+            f"pattern, {counts['fill_in']} fill-in) in {counts['courses']} courses")
+    report(f"{record['structure_id']}: {what}, {interfaces} interfaces, "
+           f"weight {record['weight_N']:.4g} N")
     report(f"{state}: {record['path']}")
+
+
+def rbe_summary(record, report):
+    """The line about the rigid block equilibrium of a run record."""
+    rbe = record["rbe"]
+    verdict = "feasible" if rbe["feasible"] else "infeasible"
+    report(f"RBE: {verdict} (friction-{rbe['friction']}, mu {rbe['mu']:g}), "
+           f"MoI {rbe['moi']:.4g} N, MoI factor {rbe['moi_factor']:.4g}, "
+           f"residual {rbe['residual_eq']:.2g}, {rbe['solver']} {rbe['time_s']:.3g} s")

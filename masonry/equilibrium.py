@@ -38,6 +38,7 @@ nor the minimiser of ``1/2 x^T H x``; use :meth:`EquilibriumSystem.to_newtons` t
 results.
 """
 
+import dataclasses
 from dataclasses import dataclass
 from functools import cached_property
 from typing import ClassVar
@@ -159,6 +160,15 @@ class EquilibriumSystem:
         Mean weight of the free blocks.
     length_ref : float, metres
         Mean cube root of the free blocks' volumes.
+    side_row : (K, 2) int
+        The free-block index (``A_eq`` rows ``6 r : 6 r + 6``) that receives each side of
+        every interface, -1 for a support.
+    vertex_coefficients : (IV, 2, 6, 4) float
+        ``A_eq`` by vertex: the six rows a vertex's ``(c, t, f1, f2)`` give the block of
+        each side (zero for a support side). ``A_eq`` is their sum, so Newton matrices
+        ``A_eq D A_eq^T`` with block-diagonal ``D`` can be formed interface by interface
+        (:mod:`masonry.solvers.newton`) instead of by sparse products.
+    density : float, kg/m^3
     """
 
     layout: VariableLayout
@@ -172,6 +182,26 @@ class EquilibriumSystem:
     block_weight: np.ndarray
     weight_ref: float
     length_ref: float
+    side_row: np.ndarray
+    vertex_coefficients: np.ndarray
+
+    density: float = 1.0
+
+    def with_material(self, mu=None, density=None) -> "EquilibriumSystem":
+        """The same scene with another friction coefficient or density, without
+        assembling again: ``mu`` changes only the pyramids, and ``density`` only the
+        newtons per solver unit (the scaled ``A_eq`` and ``f_ext`` depend on neither,
+        since the reference weight grows with the density)."""
+        out = self
+        if mu is not None and float(mu) != self.mu:
+            out = dataclasses.replace(out, A_fr=friction_pyramids(self.layout.n_vertices, mu),
+                                      mu=float(mu))
+        if density is not None and float(density) != self.density:
+            ratio = float(density) / self.density
+            out = dataclasses.replace(out, block_weight=self.block_weight * ratio,
+                                      weight_ref=self.weight_ref * ratio,
+                                      density=float(density))
+        return out
 
     @property
     def total_weight(self) -> float:
@@ -262,7 +292,7 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
                           interfaces.t2[vertex_interface]], axis=1)
     columns = (layout.WIDTH * np.arange(n_vertices))[:, None] + np.arange(layout.WIDTH)
 
-    rows, cols, vals = [], [], []
+    rows, cols, vals, side_coefficients = [], [], [], []
     for side, sign in ((0, -1.0), (1, 1.0)):
         block = side_block[vertex_interface, side]
         side_direction, side_point = sign * direction, point
@@ -278,6 +308,7 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
         # (about 40% of the triplets of a wall; HiGHS warns about them and every solver
         # would carry them)
         keep = (block_row[block] >= 0)[:, None, None] & (np.abs(coeff) > COEFFICIENT_NOISE)
+        side_coefficients.append(np.where(keep, coeff, 0.0).transpose(0, 2, 1))
         rows.append(np.broadcast_to(row, coeff.shape)[keep])
         cols.append(np.broadcast_to(columns[:, :, None], coeff.shape)[keep])
         vals.append(coeff[keep])
@@ -289,7 +320,20 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     f_ext = np.zeros((len(free_block), 6))
     f_ext[:, 2] = -block_weight[free_block] / weight_ref
 
-    # rows +f1, -f1, +f2, -f2 of one vertex, columns (c, t, f1, f2)
+    lower = np.tile([0.0, 0.0, -np.inf, -np.inf], n_vertices)
+    h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], n_vertices)
+    return EquilibriumSystem(layout=layout, free_block=free_block, A_eq=A_eq,
+                             f_ext=f_ext.ravel(), A_fr=friction_pyramids(n_vertices, mu),
+                             lower=lower, h=h, mu=float(mu), block_weight=block_weight,
+                             weight_ref=weight_ref, length_ref=length_ref,
+                             side_row=block_row[side_block],
+                             vertex_coefficients=np.stack(side_coefficients, axis=1),
+                             density=float(density))
+
+
+def friction_pyramids(n_vertices: int, mu: float) -> dict:
+    """``A_fr['net']`` and ``A_fr['plus']`` (thesis eq. 3.26, 3.25): 4 rows per vertex,
+    ``A_fr x <= 0``, rows ``+f1, -f1, +f2, -f2`` over columns ``(c, t, f1, f2)``."""
     pyramid_net = np.array([[-mu, mu, 1.0, 0.0],
                             [-mu, mu, -1.0, 0.0],
                             [-mu, mu, 0.0, 1.0],
@@ -297,14 +341,7 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     pyramid_plus = pyramid_net.copy()
     pyramid_plus[:, 1] = 0.0  # friction+: tension is decoupled (thesis eq. 3.25)
     eye = sp.identity(n_vertices, format="csr")
-    A_fr = {
+    return {
         "net": sp.csr_array(sp.kron(eye, pyramid_net, format="csr")),
         "plus": sp.csr_array(sp.kron(eye, pyramid_plus, format="csr")),
     }
-
-    lower = np.tile([0.0, 0.0, -np.inf, -np.inf], n_vertices)
-    h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], n_vertices)
-    return EquilibriumSystem(layout=layout, free_block=free_block, A_eq=A_eq,
-                             f_ext=f_ext.ravel(), A_fr=A_fr, lower=lower, h=h, mu=float(mu),
-                             block_weight=block_weight, weight_ref=weight_ref,
-                             length_ref=length_ref)

@@ -328,7 +328,7 @@ def _intersect(blocks, main, comp, tol, up):
     row_m, xyz_m, _, count_m = _face_vertex_rows(blocks, main)
     main_poly = _polygons_2d(xyz_m, row_m, count_m, origin, t1[main], t2[main])
 
-    overlap = shapely.intersection(main_poly, comp_poly, grid_size=tol.grid)
+    overlap = _polygon_part(shapely.intersection(main_poly, comp_poly, grid_size=tol.grid))
     keep = (shapely.get_type_id(overlap) == shapely.GeometryType.POLYGON) & (
         shapely.area(overlap) > tol.min_area_rel * np.minimum(area[main], area[comp]))
     # drop collinear and duplicate vertices, then make every ring counter-clockwise
@@ -376,6 +376,24 @@ def _intersect(blocks, main, comp, tol, up):
         t1=t1_k,
         t2=t2_k,
     )
+
+
+def _polygon_part(overlap):
+    """The polygon of each overlay result. Two convex polygons meet in one convex
+    polygon, but GEOS may return it in a collection with a sliver line or point of 1e-12 m
+    (whether depends on where the face polygons start); those would drop the interface."""
+    collection = np.flatnonzero(shapely.get_type_id(overlap) > shapely.GeometryType.POLYGON)
+    if len(collection):
+        parts, owner = shapely.get_parts(overlap[collection], return_index=True)
+        polygon = shapely.get_type_id(parts) == shapely.GeometryType.POLYGON
+        parts, owner = parts[polygon], owner[polygon]
+        overlap = overlap.copy()
+        overlap[collection] = shapely.from_wkt("POLYGON EMPTY")  # points, lines only
+        if len(parts):
+            largest = np.lexsort((shapely.area(parts), owner))  # by owner, then area
+            last = np.r_[owner[largest][1:] != owner[largest][:-1], True]
+            overlap[collection[owner[largest][last]]] = parts[largest][last]
+    return overlap
 
 
 def _close_wedge(xyz, row, is_wedge, n_m, point_m, n_c, point_c):

@@ -16,7 +16,9 @@ log = logging.getLogger(__name__)
 SCENES = ("section", "wall", "dome", "assembly", "arch")
 FRICTIONS = ("net", "plus", "auto")
 BOUNDARIES = ("free", "rigid", "cyclic")
-SOLVERS = ("osqp", "clarabel")
+# QP solvers (masonry.solvers.BACKENDS) and accuracy presets (masonry.solve.ACCURACY)
+SOLVERS = ("newton", "clarabel", "osqp", "clarabel-cvxpy", "osqp-cvxpy")
+ACCURACIES = ("fast", "balanced", "accurate")
 ARCH_SHAPES = ("semicircular", "pointed", "segmental")
 
 PRESETS = {
@@ -54,7 +56,9 @@ class Params:
     ``arch_depth`` (along y), ``arch_shape``. Assembly scene: ``assembly``, the name of
     the imported model (``<file stem>_<content hash>``, set by ``masonry analyze``).
     Analysis: ``mu`` friction coefficient, ``density`` kg/m^3, ``friction`` net | plus |
-    auto, ``solver``. Output: ``fast`` (one view, low resolution), ``cad_offset`` (units).
+    auto, ``accuracy`` solver preset (fast | balanced | accurate; None: fast in fast
+    mode, else balanced, SPEC 3), ``solver`` (None: the preset's; a name overrides it).
+    Output: ``fast`` (one view, low resolution), ``cad_offset`` (units).
     """
 
     stretch: float = 1.0
@@ -71,7 +75,8 @@ class Params:
     mu: float = 0.7
     density: float = 2000.0
     friction: str = "auto"
-    solver: str = "clarabel"
+    accuracy: str | None = None
+    solver: str | None = None
     fast: bool = False
     cad_offset: float = 1.0
     arch_blocks: int = 16
@@ -84,6 +89,14 @@ class Params:
 
     def replace(self, **changes) -> "Params":
         return dataclasses.replace(self, **changes)
+
+    @property
+    def solver_accuracy(self) -> str:
+        """The accuracy preset a run uses: ``accuracy``, else ``fast`` in fast mode (SPEC
+        3), else ``balanced``."""
+        if self.accuracy is not None:
+            return self.accuracy
+        return "fast" if self.fast else "balanced"
 
     @property
     def geometry_key(self) -> dict:
@@ -137,7 +150,10 @@ def validate(params: Params) -> Params:
     _check("scene", p.scene, p.scene in SCENES, f"one of {', '.join(SCENES)}")
     _check("boundary", p.boundary, p.boundary in BOUNDARIES, f"one of {', '.join(BOUNDARIES)}")
     _check("friction", p.friction, p.friction in FRICTIONS, f"one of {', '.join(FRICTIONS)}")
-    _check("solver", p.solver, p.solver in SOLVERS, f"one of {', '.join(SOLVERS)}")
+    _check("solver", p.solver, p.solver is None or p.solver in SOLVERS,
+           f"one of {', '.join(SOLVERS)}")
+    _check("accuracy", p.accuracy, p.accuracy is None or p.accuracy in ACCURACIES,
+           f"one of {', '.join(ACCURACIES)}")
     _check("stretch", p.stretch, _number("stretch", p.stretch) > 0, "> 0")
     _check("n", p.n, _number("n", p.n, integer=True) >= 3, "an integer >= 3")
     _check("r", p.r, _number("r", p.r, integer=True) >= 0, "an integer >= 0")
@@ -200,7 +216,7 @@ def structure_id(params: Params) -> str:
     if p.scene not in ("arch", "assembly"):  # no brick unit in these scenes
         head += f"_u{p.unit:g}"
     extras = [("boundary", "b"), ("mu", "mu"), ("density", "rho"), ("min_fill", "mf"),
-              ("solver", ""), ("cad_offset", "cad")]
+              ("accuracy", ""), ("solver", ""), ("cad_offset", "cad")]
     for name, tag in extras:
         value = getattr(p, name)
         if name == "boundary" and (p.scene == "wall" or value != "rigid"):

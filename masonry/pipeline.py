@@ -171,11 +171,18 @@ def _previous(target: Path, params: Params, outputs: dict):
 
 # ---------------------------------------------------------------------------- the run
 def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
-        printable=True, force=False) -> dict:
+        printable=True, force=False, scene=None, source=None) -> dict:
     """Build, analyse and export ``params`` into ``out_root/<structure id>``.
 
     Parameters
     ----------
+    scene : Scene, optional
+        An already built scene (``masonry analyze``: blocks read from files, see
+        :func:`masonry.assembly.load_assembly`), used as is instead of building
+        ``params``, and never cached; ``params`` (with its ``assembly`` name) still names
+        the run folder.
+    source : dict, optional
+        Where such a scene came from (files, supports), recorded in run.json.
     analyse : bool
         Solve the rigid block equilibrium (``masonry run``); False only builds the model
         and its interfaces (``masonry build``).
@@ -200,7 +207,12 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
             return {**previous, "path": str(target), "reused": True}
 
     timer = Timer()
-    scene, model, cached = _model(params, out_root, timer)
+    if scene is None:
+        scene, model, cached = _model(params, out_root, timer)
+    else:
+        scene, cached = dataclasses.replace(scene, params=params), "given"
+        with timer.stage("interfaces"):
+            model = analysis_model(scene)
     interfaces = model.interfaces
     record = {
         "structure_id": sid,
@@ -210,17 +222,21 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
         **model_record(scene),
         "cache": {"geometry": cached},
     }
+    if source is not None:
+        record["source"] = source
     record["counts"]["interfaces"] = interfaces.counts()
     result = forces = None
     if analyse:
-        from .solve import solve_rbe
+        from .solve import RBEProblem
 
+        with timer.stage("assembly"):
+            problem = RBEProblem(model.blocks, interfaces, side_block=model.side_block,
+                                 side_rotation=model.side_rotation)
         with timer.stage("solve"):
-            result = solve_rbe(model.blocks, interfaces, mu=params.mu,
-                               density=params.density, friction=params.friction,
-                               solver=params.solver, side_block=model.side_block,
-                               side_rotation=model.side_rotation)
-        record["rbe"] = result.to_dict()
+            result = problem.solve(mu=params.mu, density=params.density,
+                                   friction=params.friction, solver=params.solver,
+                                   accuracy=params.solver_accuracy)
+        record["rbe"] = {**result.to_dict(), "attempts": list(result.attempts)}
         forces = result.per_interface() if result.x is not None else None
 
     with RunFolder(out_root, sid) as folder:

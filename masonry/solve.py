@@ -1,45 +1,116 @@
 """Solve rigid block equilibrium (RBE) as a quadratic program (SPEC 6.5-6.7, thesis 3.3.4).
 
-The matrices come from :mod:`masonry.equilibrium`; this module only builds the cvxpy
-problem, calls a solver, checks what the solver returned and packs the result. A
-solver's status is never trusted alone: the equilibrium residual and the friction
-violation are recomputed from the returned point, and an independent linear program
-(scipy's HiGHS) checks friction-net feasibility.
+The matrices come from :mod:`masonry.equilibrium`, the solvers from
+:mod:`masonry.solvers`; this module chooses them by accuracy preset (SPEC 6.6), runs the
+thesis's friction flow (friction-net, then friction+ when the structure is infeasible),
+checks what every solver returned and packs the result. A solver's status is never
+trusted alone: the equilibrium residual and the friction violation are recomputed from
+the returned point, and an independent linear program (scipy's HiGHS) can check
+friction-net feasibility.
+
+:class:`RBEProblem` keeps one scene's matrices, symbolic factorizations and solver
+objects between solves, so a sweep over ``mu`` or ``density``, or friction+ after
+friction-net, does not start from scratch; :func:`solve_rbe` is one solve.
 """
 
+import dataclasses
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
-import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 from scipy.optimize import linprog
 
 from .equilibrium import FRICTION_METHODS, EquilibriumSystem, VariableLayout, assemble
+from .solvers import BACKENDS, FAMILY
+from .solvers.base import INFEASIBLE, OPTIMAL
 from .tolerances import Tolerances
 
 log = logging.getLogger(__name__)
 
-SOLVERS = {
-    # OSQP (the thesis's solver): cvxpy's defaults (eps 1e-5, 10,000 iterations) leave
-    # residuals near the acceptance tolerance; 1e-6 keeps a margin below
-    # Tolerances.residual (1e-5), and polishing recovers an active-set accurate point on
-    # small and medium scenes (it failed on 10,000 bricks, SPEC 6.6, at no harm).
-    "osqp": (cp.OSQP, {"eps_abs": 1e-6, "eps_rel": 1e-6, "max_iter": 100_000,
-                       "polishing": True}),
-    # Clarabel, interior point: the accurate reference. Its default gap tolerances (1e-8)
-    # leave interior-point residue of 2.6e-6 of the weight in the tension variables of
-    # the straight wall; 1e-10 brings it to 2.4e-7 at the same time (16 vs 13 iterations,
-    # 5.0 vs 4.8 s on preset 1).
-    "clarabel": (cp.CLARABEL, {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10,
-                               "tol_feas": 1e-10}),
+
+@dataclass(frozen=True)
+class AccuracyPreset:
+    """A documented choice of solvers and tolerances (SPEC 6.6).
+
+    Parameters
+    ----------
+    name : str
+    net_solver, plus_solver : str
+        :data:`masonry.solvers.BACKENDS` names for friction-net and friction+. An
+        explicit ``solver`` argument replaces both.
+    residual : float
+        Acceptance: a returned point counts when its relative equilibrium residual and
+        friction violation are at most this (``Tolerances.residual``).
+    lp_check : bool
+        Run the independent friction-net LP (HiGHS).
+    polish : bool
+        Refine an accepted interior-point or ADMM point with Newton steps started from
+        its multipliers (:mod:`masonry.solvers.newton`): one or two steps find the exact
+        active set, which leaves residuals near rounding and no interior-point tension
+        (Clarabel at 1e-10 left 1e-6 of the weight as tension on a feasible section).
+        Kept only if it converges within :data:`POLISH_STEPS`.
+    options : dict
+        Solver settings per family (``newton``, ``clarabel``, ``osqp``).
+    """
+
+    name: str
+    net_solver: str
+    plus_solver: str
+    residual: float
+    lp_check: bool
+    polish: bool = False
+    options: dict = field(default_factory=dict)
+
+
+POLISH_STEPS = 5
+"""Newton steps a polish may take (2 sufficed from Clarabel at 1e-8 on the thesis's
+sections, friction+ included; from 1e-5, 8 did not)."""
+
+
+ACCURACY = {
+    # Newton for friction-net: its steps are exact once the active pyramid faces are
+    # found, so a looser stop saves little; the savings are Clarabel's last iterations
+    # on friction+ and the acceptance of OSQP's ADMM points at 1e-4.
+    "fast": AccuracyPreset(
+        "fast", "newton", "clarabel", residual=1e-4, lp_check=False, polish=False,
+        options={"newton": {"tol": 1e-6},
+                 "clarabel": {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-6},
+                 "osqp": {"eps_abs": 1e-4, "eps_rel": 1e-4, "max_iter": 100_000,
+                          "polishing": False}}),
+    # the default: friction-net by Newton (preset 1's full dome: 10 factorizations
+    # of a 38,000-row system where Clarabel factors a 790,000-row one 16 times);
+    # friction+ by Clarabel with its default tolerances (Newton's dual of friction+ is
+    # ill-conditioned by the 1,000:1 tension weight: 60 steps without convergence on
+    # preset 1's free section).
+    "balanced": AccuracyPreset(
+        "balanced", "newton", "clarabel", residual=1e-5, lp_check=False, polish=True,
+        options={"newton": {"tol": 1e-9},
+                 "clarabel": {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8},
+                 # cvxpy's defaults (eps 1e-5, 10,000 iterations) leave residuals near
+                 # the acceptance tolerance; 1e-6 keeps a margin
+                 "osqp": {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iter": 100_000,
+                          "polishing": True}}),
+    # the reference: interior point with tight gaps for both models, and the LP check.
+    # Clarabel's default gaps (1e-8) leave 2.6e-6 of the weight as interior-point
+    # tension on the straight wall; 1e-10 leaves 2.4e-7 at the same cost.
+    "accurate": AccuracyPreset(
+        "accurate", "clarabel", "clarabel", residual=1e-6, lp_check=True, polish=True,
+        options={"newton": {"tol": 1e-12},
+                 "clarabel": {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10,
+                              "tol_feas": 1e-10},
+                 "osqp": {"eps_abs": 1e-8, "eps_rel": 1e-8, "max_iter": 200_000,
+                          "polishing": True}}),
 }
-"""Solver name -> (cvxpy solver name, solver options)."""
+"""Accuracy preset name -> :class:`AccuracyPreset`."""
+
+SOLVERS = tuple(BACKENDS)
+"""Every solver name :func:`solve_rbe` accepts."""
 
 RESULT_KEYS = ("feasible", "friction", "mu", "objective", "moi", "moi_factor", "weight_N",
                "solver", "status", "iterations", "residual_eq", "friction_violation",
-               "net_friction_violation", "time_s", "lp_feasible")
+               "net_friction_violation", "time_s", "lp_feasible", "accuracy", "lp_time_s")
 """Scalar fields of :class:`RBEResult` written to run.json, in order."""
 
 INTERFACE_FORCE_KEYS = ("compression", "tension", "normal", "t1", "t2", "friction")
@@ -67,9 +138,10 @@ class RBEResult:
     weight_N : float, N
         Total weight of the free blocks.
     solver, status : str
-        Solver name and its status (cvxpy's words) for the problem that produced ``x``.
+        Solver name and its status (cvxpy's words) for the problem that produced ``x``
+        (the last attempt).
     iterations : int
-        Solver iterations, -1 when not reported.
+        That solver's iterations, -1 when not reported.
     residual_eq : float
         ``||A_eq x + f_ext||_inf / ||f_ext||_inf`` (scaled rows: forces per reference
         weight, moments per reference weight times reference length).
@@ -79,13 +151,21 @@ class RBEResult:
     net_friction_violation : float
         The same on the friction-net rows, whatever problem was solved.
     time_s : float, s
-        Wall time of :func:`solve_rbe` (assembly, every QP, the LP check).
+        Wall time of the solve (every QP and the LP check; assembly too for
+        :func:`solve_rbe`).
     lp_feasible : bool or None
         Verdict of the independent friction-net LP (HiGHS); None when not run or
         inconclusive.
     x : (4 IV,) float or None, N
         Solution in the :class:`~masonry.equilibrium.VariableLayout` order.
     layout : VariableLayout
+    accuracy : str
+        The accuracy preset.
+    lp_time_s : float, s
+        Time of the LP check (0 when not run).
+    attempts : tuple of dict
+        Every QP solved, in order: friction model, solver, status, iterations, setup and
+        solve seconds (a fallback shows as a second attempt of the same model).
     """
 
     feasible: bool
@@ -105,6 +185,9 @@ class RBEResult:
     lp_feasible: bool | None
     x: np.ndarray | None
     layout: VariableLayout
+    accuracy: str = "balanced"
+    lp_time_s: float = 0.0
+    attempts: tuple = ()
 
     def to_dict(self) -> dict:
         """The scalar fields (:data:`RESULT_KEYS`) as plain Python values, for run.json."""
@@ -142,9 +225,143 @@ def interface_forces(layout, x) -> dict:
     return dict(zip(INTERFACE_FORCE_KEYS, (c, t, t - c, f1, f2, np.hypot(f1, f2))))
 
 
-def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solver="clarabel",
-              tol=None, *, lp_check=True, lp_time_limit=60.0, side_block=None,
-              side_rotation=None) -> RBEResult:
+class RBEProblem:
+    """One scene's rigid block equilibrium, prepared for any number of solves.
+
+    Assembles the scaled matrices once (:func:`masonry.equilibrium.assemble`); every
+    :meth:`solve` reuses them with its own ``mu`` and ``density``, and every solver keeps
+    its workspace (Newton's symbolic Cholesky factorization and last dual point, the
+    OSQP and Clarabel solver objects, updated in place) between friction-net and
+    friction+ and between solves.
+
+    Parameters
+    ----------
+    blocks : masonry.blocks.Blocks
+    interfaces : masonry.interfaces.Interfaces
+    side_block, side_rotation : optional
+        Force routing for boundary modes, see :func:`masonry.equilibrium.assemble`.
+    """
+
+    def __init__(self, blocks, interfaces, *, side_block=None, side_rotation=None):
+        if len(interfaces) == 0:
+            raise ValueError("no interfaces: nothing can carry the blocks")
+        start = time.perf_counter()
+        self.system = assemble(blocks, interfaces, side_block=side_block,
+                               side_rotation=side_rotation)
+        self.assembly_time = time.perf_counter() - start
+        self._workspaces = {}
+
+    def solve(self, mu=0.7, density=2000.0, friction="auto", solver=None, tol=None, *,
+              accuracy="balanced", lp_check=None, lp_time_limit=60.0) -> RBEResult:
+        """Solve at ``mu`` and ``density``; see :func:`solve_rbe` for the parameters."""
+        start = time.perf_counter()
+        if friction not in ("auto",) + FRICTION_METHODS:
+            raise ValueError(f"friction must be 'auto', 'net' or 'plus', not {friction!r}")
+        if accuracy not in ACCURACY:
+            raise ValueError(f"unknown accuracy {accuracy!r}; choose from {list(ACCURACY)}")
+        if solver is not None and solver not in BACKENDS:
+            raise ValueError(f"unknown solver {solver!r}; choose from {list(BACKENDS)}")
+        preset = ACCURACY[accuracy]
+        if tol is None:
+            tol = Tolerances(residual=preset.residual)
+        if lp_check is None:
+            lp_check = preset.lp_check
+        system = self.system.with_material(mu=mu, density=density)
+
+        attempts = []
+        for method in ("net", "plus") if friction == "auto" else (friction,):
+            chosen = solver or (preset.net_solver if method == "net" else preset.plus_solver)
+            names = [chosen]
+            # Newton is the presets' fast path; when it neither converges nor certifies
+            # infeasibility, Clarabel decides (logged and kept in ``attempts``)
+            if solver is None and chosen == "newton":
+                names.append("clarabel")
+            for name in names:
+                outcome = self._run(system, method, name, preset)
+                checks = _check(system, outcome.x, method)
+                accepted = checks is not None and max(checks[0], checks[1]) <= tol.residual
+                attempts.append({"friction": method, "solver": name,
+                                 "status": outcome.status, "iterations": outcome.iterations,
+                                 "setup_s": round(outcome.setup_time, 4),
+                                 "solve_s": round(outcome.solve_time, 4)})
+                if outcome.x is not None and not accepted:
+                    log.warning("%s rejected the %s solution with status %r: equilibrium "
+                                "residual %.2e, friction violation %.2e (tolerance %.1e)",
+                                name, method, outcome.status, checks[0], checks[1],
+                                tol.residual)
+                if accepted and preset.polish and name != "newton" and outcome.y is not None:
+                    polished = self._polish(system, method, outcome, tol)
+                    attempts.append(polished[1])
+                    if polished[0] is not None:
+                        outcome, checks = polished[0], _check(system, polished[0].x, method)
+                        name = f"{name}+newton"
+                if accepted or outcome.status == INFEASIBLE:
+                    break
+                if name != names[-1]:
+                    log.warning("%s found no %s solution (%s); trying %s", name, method,
+                                outcome.status, names[-1])
+            if method == "net":
+                net_status = outcome.status
+            if accepted:
+                break
+
+        lp_start = time.perf_counter()
+        lp_feasible = _lp_feasible(system, lp_time_limit) if lp_check else None
+        lp_time = time.perf_counter() - lp_start if lp_check else 0.0
+        residual_eq, violation, net_violation = (np.nan,) * 3 if checks is None else checks
+        # a rejected point is no solution: its residuals are reported, its forces are not
+        x = system.to_newtons(outcome.x) if accepted else None
+        feasible = bool(accepted and net_violation <= tol.residual)
+        if feasible and friction == "auto" and method == "plus":
+            log.warning("friction-net was not solved (%s), yet the friction+ solution meets "
+                        "the friction-net pyramid: reported feasible", net_status)
+        if lp_feasible is not None and lp_feasible != feasible:
+            log.warning("the friction-net LP says %s, the %s QP says %s (status %r)",
+                        "feasible" if lp_feasible else "infeasible", name,
+                        "feasible" if feasible else "infeasible", outcome.status)
+
+        weight = system.total_weight
+        if x is None:
+            objective = moi = np.nan
+        else:
+            objective = float(0.5 * np.sum(system.h * x**2))
+            moi = float(system.layout.component(x, "t").sum())
+        return RBEResult(
+            feasible=feasible, friction=method, mu=float(mu), objective=objective, moi=moi,
+            moi_factor=moi / weight, weight_N=weight, solver=name, status=outcome.status,
+            iterations=outcome.iterations, residual_eq=float(residual_eq),
+            friction_violation=float(violation), net_friction_violation=float(net_violation),
+            time_s=time.perf_counter() - start, lp_feasible=lp_feasible, x=x,
+            layout=system.layout, accuracy=accuracy, lp_time_s=lp_time,
+            attempts=tuple(attempts))
+
+    def _polish(self, system, method, outcome, tol):
+        """Newton steps from ``outcome``'s multipliers: (the polished outcome or None,
+        its attempt record)."""
+        workspace = self._workspaces.setdefault("newton", {})
+        options = {"tol": min(tol.residual, 1e-9), "max_iter": POLISH_STEPS}
+        polished = BACKENDS["newton"](system, method, options, workspace, y0=outcome.y)
+        checks = _check(system, polished.x, method)
+        kept = (polished.status == OPTIMAL and checks is not None
+                and max(checks[0], checks[1]) <= tol.residual)
+        if not kept:
+            log.info("Newton polish of the %s solution did not converge in %d steps (%s); "
+                     "the unpolished point is kept", method, POLISH_STEPS, polished.status)
+        record = {"friction": method, "solver": "newton-polish", "status": polished.status,
+                  "iterations": polished.iterations,
+                  "setup_s": round(polished.setup_time, 4),
+                  "solve_s": round(polished.solve_time, 4)}
+        return (polished if kept else None), record
+
+    def _run(self, system, method, name, preset):
+        options = preset.options.get(FAMILY[name], {})
+        workspace = self._workspaces.setdefault(name, {})
+        return BACKENDS[name](system, method, dict(options), workspace)
+
+
+def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solver=None,
+              tol=None, *, accuracy="balanced", lp_check=None, lp_time_limit=60.0,
+              side_block=None, side_rotation=None) -> RBEResult:
     """Rigid block equilibrium as a quadratic program (thesis 3.3.4).
 
     With ``x`` the vertex forces ``(c, t, f1, f2)`` of every interface vertex (thesis
@@ -170,14 +387,19 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
     friction : {'auto', 'net', 'plus'}
         ``'auto'`` (thesis 3.3.3): friction-net first; when it has no accepted solution,
         friction+ and report that.
-    solver : {'osqp', 'clarabel'}
-        See :data:`SOLVERS`.
+    solver : str, optional
+        A :data:`masonry.solvers.BACKENDS` name (``newton``, ``clarabel``, ``osqp``,
+        ``clarabel-cvxpy``, ``osqp-cvxpy``) for both friction models, with the preset's
+        tolerances for its family. Default: the preset's solvers.
     tol : Tolerances, optional
         ``tol.residual`` bounds the relative equilibrium residual and the friction
-        violation of an accepted solution. Default ``Tolerances()``.
-    lp_check : bool
-        Run the independent friction-net feasibility LP (HiGHS, zero objective). Its
-        time grows faster than the QP's: 22 s for a 1,000-block wall (Clarabel: 2.4 s).
+        violation of an accepted solution. Default: the preset's ``residual``.
+    accuracy : {'fast', 'balanced', 'accurate'}
+        The :data:`ACCURACY` preset.
+    lp_check : bool, optional
+        Run the independent friction-net feasibility LP (HiGHS, zero objective).
+        Default: the preset's (``accurate`` only). Its time grows faster than the QP's:
+        22 s for a 1,000-block wall (Clarabel: 2.4 s).
     lp_time_limit : float, s
         HiGHS's time limit; when reached, ``lp_feasible`` is None and a warning is logged.
     side_block, side_rotation : optional
@@ -200,86 +422,16 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
     accepted point moves on to friction+, so a spurious "infeasible" on a nearly
     feasible structure is caught when the friction+ point meets the friction-net
     pyramid (then ``feasible`` is True and a warning is logged), and the LP's verdict
-    is reported beside the QP's (a disagreement is logged).
+    is reported beside the QP's (a disagreement is logged). For several solves of one
+    scene use :class:`RBEProblem`.
     """
     start = time.perf_counter()
-    if tol is None:
-        tol = Tolerances()
-    if friction not in ("auto",) + FRICTION_METHODS:
-        raise ValueError(f"friction must be 'auto', 'net' or 'plus', not {friction!r}")
-    if solver not in SOLVERS:
-        raise ValueError(f"unknown solver {solver!r}; choose from {sorted(SOLVERS)}")
-    if len(interfaces) == 0:
-        raise ValueError("no interfaces: nothing can carry the blocks")
-
-    system = assemble(blocks, interfaces, mu=mu, density=density, side_block=side_block,
-                      side_rotation=side_rotation)
-    for method in ("net", "plus") if friction == "auto" else (friction,):
-        status, x_scaled, iterations = _solve_qp(system, method, solver)
-        checks = _check(system, x_scaled, method)
-        if method == "net":
-            net_status = status
-        accepted = checks is not None and max(checks[0], checks[1]) <= tol.residual
-        if x_scaled is not None and not accepted:
-            log.warning("%s rejected the %s solution with status %r: equilibrium residual "
-                        "%.2e, friction violation %.2e (tolerance %.1e)", solver, method,
-                        status, checks[0], checks[1], tol.residual)
-        if accepted:
-            break
-
-    lp_feasible = _lp_feasible(system, lp_time_limit) if lp_check else None
-    residual_eq, violation, net_violation = (np.nan,) * 3 if checks is None else checks
-    # a rejected point is no solution: its residuals are reported, its forces are not
-    x = system.to_newtons(x_scaled) if accepted else None
-    feasible = bool(accepted and net_violation <= tol.residual)
-    if feasible and friction == "auto" and method == "plus":
-        log.warning("friction-net was not solved (%s), yet the friction+ solution meets "
-                    "the friction-net pyramid: reported feasible", net_status)
-    if lp_feasible is not None and lp_feasible != feasible:
-        log.warning("the friction-net LP says %s, the %s QP says %s (status %r)",
-                    "feasible" if lp_feasible else "infeasible", solver,
-                    "feasible" if feasible else "infeasible", status)
-
-    weight = system.total_weight
-    if x is None:
-        objective = moi = np.nan
-    else:
-        objective = float(0.5 * np.sum(system.h * x**2))
-        moi = float(system.layout.component(x, "t").sum())
-    return RBEResult(
-        feasible=feasible, friction=method, mu=float(mu), objective=objective, moi=moi,
-        moi_factor=moi / weight, weight_N=weight, solver=solver, status=status,
-        iterations=iterations, residual_eq=float(residual_eq),
-        friction_violation=float(violation), net_friction_violation=float(net_violation),
-        time_s=time.perf_counter() - start, lp_feasible=lp_feasible, x=x,
-        layout=system.layout)
-
-
-def _solve_qp(system: EquilibriumSystem, method: str, solver: str):
-    """Solve the scaled QP. Returns (cvxpy status, x in solver units or None, iterations)."""
-    n = system.layout.n_columns
-    x = cp.Variable(n)
-    bounded = np.flatnonzero(np.isfinite(system.lower))
-    # H is a constant positive diagonal: psd_wrap skips cvxpy's eigenvalue check
-    objective = cp.Minimize(0.5 * cp.quad_form(x, cp.psd_wrap(sp.diags_array(system.h_solver))))
-    constraints = [system.A_eq @ x == -system.f_ext,
-                   system.A_fr[method] @ x <= 0,
-                   x[bounded] >= system.lower[bounded]]
-    problem = cp.Problem(objective, constraints)
-    name, options = SOLVERS[solver]
-    try:
-        problem.solve(solver=name, **options)
-    except cp.error.SolverError as error:
-        # cvxpy raises when the solver ends without a usable status (numerical error)
-        log.warning("%s failed on the %s problem: %s", solver, method, error)
-        return cp.SOLVER_ERROR, None, -1
-    stats = problem.solver_stats
-    iterations = stats.num_iters
-    if iterations is None:
-        # cvxpy drops OSQP's count when there is no solution; OSQP's own info has it
-        iterations = getattr(getattr(stats.extra_stats, "info", None), "iter", None)
-    x_value = x.value if problem.status in cp.settings.SOLUTION_PRESENT else None
-    return problem.status, x_value, -1 if iterations is None else int(iterations)
+    problem = RBEProblem(blocks, interfaces, side_block=side_block,
+                         side_rotation=side_rotation)
+    result = problem.solve(mu=mu, density=density, friction=friction, solver=solver,
+                           tol=tol, accuracy=accuracy, lp_check=lp_check,
+                           lp_time_limit=lp_time_limit)
+    return dataclasses.replace(result, time_s=time.perf_counter() - start)
 
 
 def _check(system: EquilibriumSystem, x_scaled, method: str):

@@ -197,7 +197,7 @@ def test_supports_have_no_rows_and_friction_rows():
 def test_squat_block_slides_past_the_friction_angle(offset_deg, feasible):
     theta = np.arctan(MU) + np.radians(offset_deg)
     blocks, interfaces = incline(theta, base=1.0, height=0.1)  # tips only past 84 deg
-    result = solve_rbe(blocks, interfaces, mu=MU, friction="net")
+    result = solve_rbe(blocks, interfaces, mu=MU, friction="net", lp_check=True)
     assert result.feasible is feasible
     assert result.lp_feasible is feasible
 
@@ -207,7 +207,7 @@ def test_tall_block_tips_past_base_over_height(offset_deg, feasible):
     base, height = 0.1, 0.4  # base / height = 0.25 < mu: tips before it slides
     theta = np.arctan(base / height) + np.radians(offset_deg)
     blocks, interfaces = incline(theta, base=base, height=height)
-    result = solve_rbe(blocks, interfaces, mu=MU, friction="net")
+    result = solve_rbe(blocks, interfaces, mu=MU, friction="net", lp_check=True)
     assert result.feasible is feasible
     assert result.lp_feasible is feasible
 
@@ -229,7 +229,7 @@ def test_incline_reactions_carry_the_weight():
 
 def test_stack_bed_joints_carry_the_weight_above():
     blocks, interfaces = stack(3)
-    result = solve_rbe(blocks, interfaces, mu=MU)
+    result = solve_rbe(blocks, interfaces, mu=MU, lp_check=True)
     assert result.feasible and result.lp_feasible
     assert result.residual_eq < Tolerances().residual
     weight = block_weight(blocks, 1)
@@ -248,12 +248,12 @@ def test_stack_bed_joints_carry_the_weight_above():
 @pytest.mark.parametrize("solver", ["osqp", "clarabel"])
 def test_cantilever_is_infeasible_and_friction_plus_measures_it(solver):
     blocks, interfaces = cantilever()
-    net = solve_rbe(blocks, interfaces, mu=MU, friction="net", solver=solver)
+    net = solve_rbe(blocks, interfaces, mu=MU, friction="net", solver=solver, lp_check=True)
     assert not net.feasible and net.friction == "net"
     assert net.x is None and np.isnan(net.moi)  # no fake optimum
     assert net.lp_feasible is False
 
-    auto = solve_rbe(blocks, interfaces, mu=MU, friction="auto", solver=solver)
+    auto = solve_rbe(blocks, interfaces, mu=MU, friction="auto", solver=solver, lp_check=True)
     assert not auto.feasible and auto.friction == "plus" and auto.lp_feasible is False
     assert auto.residual_eq < 1e-5 and auto.friction_violation < 1e-5
     # moments about the support's edge x = 0.3: the weight's arm is 0.2, the tension's

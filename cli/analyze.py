@@ -1,0 +1,51 @@
+"""``masonry analyze``: interfaces and rigid block equilibrium of blocks read from files."""
+
+from masonry.assembly import load_assembly
+from masonry.params import FRICTIONS, SOLVERS, Params, validate
+from masonry.pipeline import run
+
+from .options import add_output_options, rbe_summary, summary
+
+ANALYSIS = ("mu", "density", "friction", "solver", "fast")
+
+
+def register(subparsers):
+    parser = subparsers.add_parser(
+        "analyze", help="any assembly of convex blocks from OBJ, STL or PLY files: "
+                        "interfaces, rigid block equilibrium, exports")
+    parser.add_argument("files", nargs="+", metavar="FILE",
+                        help="OBJ (one block per object or group), STL or PLY (one block "
+                             "per connected body); several files add up")
+    g = parser.add_argument_group("supports (at least one)")
+    g.add_argument("--support", action="append", default=[], metavar="NAME_OR_PATTERN",
+                   help="blocks fixed in place, by name or shell pattern ('pier_*'); "
+                        "repeat for more")
+    g.add_argument("--support-below", dest="support_below", type=float, metavar="Z",
+                   help="every block reaching down to z <= Z (metres) is a support")
+    g.add_argument("--ground", action="store_true",
+                   help="add a ground slab (a support) under the lowest blocks")
+    g = parser.add_argument_group("analysis")
+    g.add_argument("--mu", type=float, help="friction coefficient (default 0.7)")
+    g.add_argument("--density", type=float, help="kg/m^3 (default 2000)")
+    g.add_argument("--friction", choices=FRICTIONS,
+                   help="net, plus, or auto (net, then plus if infeasible; default)")
+    g.add_argument("--solver", choices=SOLVERS,
+                   help="QP solver: clarabel (interior point, default) or osqp")
+    g.add_argument("--fast", action="store_true", default=None,
+                   help="reduced output: one view, lower resolution")
+    add_output_options(parser)
+    parser.set_defaults(handler=handle)
+
+
+def handle(args, report):
+    given = {k: getattr(args, k) for k in ANALYSIS if getattr(args, k) is not None}
+    params = validate(Params(**given))
+    scene, source = load_assembly(args.files, params, supports=args.support,
+                                  support_below=args.support_below, ground=args.ground)
+    record = run(scene.params, args.out, analyse=True, plots_wanted=args.plots,
+                 printable=args.printable, force=args.force, scene=scene, source=source)
+    report(f"read {scene.blocks.n_blocks} blocks ({source['supports']} supports) from "
+           f"{len(source['files'])} file(s) in {source['read_s']:.3g} s")
+    summary(record, report)
+    rbe_summary(record, report)
+    return 0

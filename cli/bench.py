@@ -1,0 +1,58 @@
+"""``masonry bench``: time against accuracy for every solver preset (SPEC 6.6)."""
+
+import resource
+
+from masonry.bench import SCENES, bench, frontier_png, table_csv, table_markdown
+from masonry.params import ACCURACIES, SOLVERS
+from masonry.runfolder import RunFolder
+
+
+def register(subparsers):
+    parser = subparsers.add_parser(
+        "bench", help="measure time, iterations and accuracy of every solver preset on the "
+                      "thesis structures (section, cyclic section, full dome)")
+    parser.add_argument("--presets", nargs="+", default=["1", "2", "3"],
+                        choices=["1", "2", "3"], help="thesis presets (default 1 2 3)")
+    parser.add_argument("--scenes", nargs="+", default=list(SCENES), choices=list(SCENES),
+                        help="free section, cyclic section, full dome (default all)")
+    parser.add_argument("--accuracy", nargs="+", default=list(ACCURACIES),
+                        choices=ACCURACIES, help="accuracy presets (default all)")
+    parser.add_argument("--solvers", nargs="+", default=[], choices=SOLVERS,
+                        help="extra rows: the balanced preset with another solver")
+    parser.add_argument("--p", type=int, metavar="P",
+                        help="override the presets' pattern bricks per rhombus side "
+                             "(smaller: smaller domes, for a quick look)")
+    parser.add_argument("--repeats", type=int, default=3,
+                        help="runs per row; times are medians (default 3)")
+    parser.add_argument("--out", default="exports", metavar="DIR",
+                        help="writes DIR/bench/bench.csv, bench.md and frontier.png")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    parser.set_defaults(handler=handle)
+
+
+def handle(args, report):
+    if args.repeats < 1:
+        report("masonry: --repeats must be at least 1")
+        return 2
+    rows = bench(presets=args.presets, scenes=args.scenes, accuracies=args.accuracy,
+                 repeats=args.repeats, solvers=args.solvers,
+                 overrides=None if args.p is None else {"p": args.p},
+                 progress=None if args.quiet else _progress)
+    markdown = table_markdown(rows)
+    # ru_maxrss is in kilobytes on Linux
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
+    with RunFolder(args.out, "bench") as folder:
+        folder.write("bench.csv", table_csv(rows))
+        folder.write("bench.md", markdown + f"\npeak memory of the bench process: "
+                                            f"{peak:.2f} GiB\n")
+        folder.write("frontier.png", frontier_png(rows))
+    report(markdown)
+    report(f"peak memory: {peak:.2f} GiB")
+    report(f"written: {folder.target}")
+    return 0
+
+
+def _progress(message):
+    import logging
+
+    logging.getLogger("masonry.bench").info(message)

@@ -1,0 +1,696 @@
+"""Any assembly of convex blocks, read from mesh files (SPEC 4.6, scene ``assembly``).
+
+The interface detector and the rigid block equilibrium serve blocks that did not come
+from our dome: an arch drawn in Rhino, a tower, a scan, a peer tool's model. This module
+turns mesh files into :class:`~masonry.blocks.Blocks`:
+
+- OBJ: one block per object (``o``); a file without objects, one block per group
+  (``g``); a file with neither, one block per connected body. Names are kept (a name used
+  twice gets ``_2``, ``_3``, ...). The ``bricks.obj`` of our own runs is such a file, and
+  its names (``b0042_regular_c12``) give back each brick's class and course.
+- STL (binary or ASCII) and PLY: one block per connected body, named after the file
+  (``wall_0007``), or after the file alone when it holds one body, so one file per block
+  works too.
+
+Every block must be a closed convex solid. A block that is open, non-manifold, inside
+out, flat, or concave beyond :data:`CONVEXITY_REL` raises :class:`AssemblyError` naming
+the block and its file; so does a file that cannot be read. Each accepted block is
+replaced by its convex hull, whose coplanar triangles are merged into whole planar
+polygons, so an interface is a whole face and not a triangle of it.
+
+Bodies in one STL or PLY that touch each other share vertices and edges: an edge where
+two blocks touch belongs to four triangles. Connectivity therefore pairs the triangles
+around such an edge by their angle about it (each solid wedge is bounded by the nearest
+face on either side), instead of joining everything that shares an edge.
+"""
+
+import dataclasses
+import hashlib
+import io
+import logging
+import re
+import time
+from fnmatch import fnmatchcase
+from pathlib import Path
+
+import numpy as np
+from scipy.sparse import coo_array
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import ConvexHull, QhullError, cKDTree
+
+from .blocks import BLOCK_CLASSES, Blocks, concatenate, tangent_basis
+from .tolerances import Tolerances
+
+log = logging.getLogger(__name__)
+
+FORMATS = (".obj", ".stl", ".ply")
+"""File suffixes :func:`read_blocks` reads (case-insensitive)."""
+
+CONVEXITY_REL = 1e-4
+"""A block is convex when its volume falls short of its convex hull's by at most this
+fraction of the hull's. Float32 rounding (binary STL) of a brick 20 m from the origin
+moves its corners by about 1e-6 m and its volume by about 1e-5 of a 0.2 m brick; a real
+concavity (an L-shaped block, a notch) is a few percent or more."""
+
+COINCIDENT_ANGLE = 1e-6
+"""Radians. Two triangles around an edge whose half-planes are closer than this lie on
+top of each other: the faces of two blocks in contact, never the two faces of one block's
+edge (no block has a dihedral angle that small)."""
+
+OUR_NAME = re.compile(r"^b\d+_(" + "|".join(BLOCK_CLASSES) + r")_c(\d+)$")
+"""Block names written by :func:`masonry.export.obj.blocks_obj`: class and course."""
+
+
+class AssemblyError(ValueError):
+    """A mesh file cannot be read, or one of its blocks is not a closed convex solid.
+    The message names the file and, for a bad block, the block."""
+
+
+# ---------------------------------------------------------------------- public API
+def read_blocks(paths, tol: Tolerances | None = None) -> Blocks:
+    """Convex blocks from mesh files, in file order; no block is a support yet.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        OBJ, STL or PLY files (see the module docstring for how each splits into blocks).
+    tol : Tolerances, optional
+        ``length`` merges duplicate vertices, ``contact`` decides which hull triangles
+        are coplanar (one face). Default ``Tolerances.for_points`` of all the vertices.
+
+    Returns
+    -------
+    Blocks
+        Class ``block`` (or the class in one of our own names), course 0 (or our name's),
+        names unique, vertices in metres as read (no unit conversion).
+
+    Raises
+    ------
+    AssemblyError
+        A file cannot be read or holds no block, or a block is not a closed convex solid.
+    """
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise AssemblyError("no mesh file given")
+    soups = [_read_file(p) for p in paths]
+    points = np.concatenate([s.vertices for s in soups])
+    if tol is None:
+        tol = Tolerances.for_points(points)
+    parts = []
+    for path, soup in zip(paths, soups):
+        soup = soup.merged(tol.length)
+        if soup.split_bodies:
+            soup = soup.bodies(path.stem)
+        parts.append(_convex_blocks(soup, path, tol))
+    blocks = concatenate(parts)
+    names = _unique_names(blocks.block_name)
+    block_class, block_course = _classes_from_names(names)
+    return Blocks.from_arrays(
+        blocks.vertices, blocks.vertex_offsets, blocks.face_vertices, blocks.face_offsets,
+        blocks.face_block, block_class=block_class, block_course=block_course,
+        block_is_support=np.zeros(blocks.n_blocks, bool), block_name=names)
+
+
+def select_supports(blocks: Blocks, names=(), below=None, tol: Tolerances | None = None):
+    """Which blocks are fixed supports.
+
+    Parameters
+    ----------
+    blocks : Blocks
+    names : sequence of str
+        Block names or shell-style patterns (``fnmatch``: ``pier_*``, ``*_ground_*``),
+        case-sensitive. Each must match at least one block.
+    below : float, optional, metres
+        Also every block whose lowest point is at or below ``z = below`` (within
+        ``tol.contact``): the blocks touching (or under) that plane.
+    tol : Tolerances, optional
+        Default ``Tolerances.for_points(blocks.vertices)``.
+
+    Returns
+    -------
+    (B,) bool
+        ``blocks.block_is_support`` or'ed with the selection.
+
+    Raises
+    ------
+    AssemblyError
+        A name matches no block, or ``below`` lies under every block.
+    """
+    if tol is None:
+        tol = Tolerances.for_points(blocks.vertices)
+    is_support = np.array(blocks.block_is_support, dtype=bool)
+    block_name = [str(n) for n in blocks.block_name]
+    for pattern in names:
+        hit = np.array([fnmatchcase(n, pattern) for n in block_name], dtype=bool)
+        if not hit.any():
+            raise AssemblyError(f"--support {pattern!r} matches no block (names are like "
+                                f"{block_name[0]!r})")
+        is_support |= hit
+    if below is not None:
+        hit = blocks.block_bounds[:, 0, 2] <= below + tol.contact
+        if not hit.any():
+            lowest = float(blocks.block_bounds[:, 0, 2].min())
+            raise AssemblyError(f"--support-below {below:g}: no block reaches down to "
+                                f"z = {below:g} (the lowest is at z = {lowest:.6g})")
+        is_support |= hit
+    return is_support
+
+
+def with_ground(blocks: Blocks, tol: Tolerances | None = None) -> Blocks:
+    """``blocks`` with a ground slab (class ``ground``, a support) added as block 0.
+
+    The slab's top is the plane of the lowest vertex; it reaches under every block that
+    comes within ``tol.contact`` of that plane, with a margin of 5% of that footprint's
+    larger side on every side, and is as thick as the margin. Only those lowest blocks
+    touch it; what else rests on what is left to the interface detector.
+    """
+    if "ground" in set(blocks.block_name):
+        raise AssemblyError("--ground: a block is already named 'ground'")
+    if tol is None:
+        tol = Tolerances.for_points(blocks.vertices)
+    lo, hi = blocks.block_bounds[:, 0], blocks.block_bounds[:, 1]
+    top = float(lo[:, 2].min())
+    lowest = lo[:, 2] <= top + tol.contact
+    foot_lo, foot_hi = lo[lowest, :2].min(axis=0), hi[lowest, :2].max(axis=0)
+    margin = 0.05 * float((foot_hi - foot_lo).max())
+    x0, y0 = foot_lo - margin
+    x1, y1 = foot_hi + margin
+    corners = np.array([[x, y, z] for z in (top - margin, top) for y in (y0, y1)
+                        for x in (x0, x1)])
+    ground = Blocks.from_hexahedra(corners[None], block_class="ground",
+                                   block_is_support=[True], block_name=["ground"])
+    return concatenate([ground, blocks])
+
+
+def assembly_name(paths, blocks: Blocks) -> str:
+    """``<stem of the first file>_<8 hex digits>``: the hash covers every vertex, face,
+    name and support, so a changed file or support choice gets its own run folder."""
+    stem = re.sub(r"[^A-Za-z0-9_.-]+", "-", Path(next(iter(paths))).stem) or "assembly"
+    digest = hashlib.sha1()
+    for array in (blocks.vertices, blocks.face_vertices, blocks.face_offsets,
+                  blocks.face_block, blocks.block_is_support, blocks.block_class):
+        digest.update(np.ascontiguousarray(array).tobytes())
+    digest.update("\0".join(map(str, blocks.block_name)).encode())
+    return f"{stem}_{digest.hexdigest()[:8]}"
+
+
+def load_assembly(paths, params, *, supports=(), support_below=None, ground=False):
+    """The ``assembly`` scene of mesh files: blocks, supports, optional ground slab.
+
+    Parameters
+    ----------
+    paths : sequence of str or Path
+        Mesh files, see :func:`read_blocks`.
+    params : masonry.params.Params
+        Analysis inputs (``mu``, ``density``, ``friction``, ``solver``, ``fast``); the
+        scene's params are these with ``scene='assembly'`` and ``assembly`` set to
+        :func:`assembly_name`.
+    supports, support_below : see :func:`select_supports`
+    ground : bool
+        Add a ground slab under the lowest blocks (:func:`with_ground`).
+
+    Returns
+    -------
+    scene : masonry.scenes.Scene
+        No course directions (bed and head joints are named with respect to z) and no
+        CAD offset.
+    source : dict
+        Provenance for run.json: ``files``, ``support``, ``support_below``, ``ground``,
+        the number of ``supports`` and the reading time ``read_s`` (seconds).
+
+    Raises
+    ------
+    AssemblyError
+        A file or a block is bad (:func:`read_blocks`), a support pattern matches
+        nothing, or no block (or every block) is a support.
+    """
+    from .params import validate
+    from .scenes import Scene
+
+    start = time.perf_counter()
+    blocks = read_blocks(paths)
+    tol = Tolerances.for_points(blocks.vertices)
+    if ground:
+        blocks = with_ground(blocks, tol)
+    is_support = select_supports(blocks, supports, support_below, tol)
+    if not is_support.any():
+        raise AssemblyError("no support: name the fixed blocks (--support NAME), take every "
+                            "block at the bottom (--support-below Z) or add a slab (--ground)")
+    if is_support.all():
+        raise AssemblyError(f"every one of the {len(is_support)} blocks is a support: "
+                            "nothing is left to analyse")
+    blocks = dataclasses.replace(blocks, block_is_support=is_support)
+    params = validate(params.replace(scene="assembly", assembly=assembly_name(paths, blocks)))
+    source = {"files": [str(p) for p in paths], "support": list(supports),
+              "support_below": support_below, "ground": bool(ground),
+              "supports": int(is_support.sum()),
+              "read_s": round(time.perf_counter() - start, 4)}
+    log.info("read %d blocks (%d supports) in %.3g s", blocks.n_blocks, source["supports"],
+             source["read_s"])
+    return Scene(params, blocks), source
+
+
+# ---------------------------------------------------------------------- triangle soups
+class _Soup:
+    """Triangles of named blocks, as read.
+
+    ``vertices`` (V, 3) float; ``triangles`` (T, 3) int into ``vertices``; ``triangle_block``
+    (T,) int into ``names``; ``split_bodies``: the file names no blocks, so its connected
+    bodies are the blocks.
+    """
+
+    def __init__(self, names, vertices, triangles, triangle_block, split_bodies=False):
+        self.names = list(names)
+        self.vertices = np.asarray(vertices, dtype=float).reshape(-1, 3)
+        self.triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
+        self.triangle_block = np.asarray(triangle_block, dtype=np.int64)
+        self.split_bodies = split_bodies
+
+    def merged(self, distance) -> "_Soup":
+        """Per-block vertices (a vertex shared by two blocks is copied; blocks own
+        contiguous ranges) with coincident ones (within ``distance``) merged, and the
+        triangles that collapse dropped. A soup still to be split keeps one pool, so
+        that touching bodies share their vertices until :meth:`bodies` pairs them."""
+        block = self.triangle_block
+        if self.split_bodies:
+            block = np.zeros_like(block)
+        key = block[:, None] * len(self.vertices) + self.triangles
+        unique, inverse = np.unique(key, return_inverse=True)
+        vertices = self.vertices[unique % len(self.vertices)]
+        owner = unique // len(self.vertices)
+        triangles = inverse.reshape(-1, 3)
+        # coincident vertices of one block: a k-d tree over all, pairs kept within a block
+        pairs = cKDTree(vertices).query_pairs(distance, output_type="ndarray")
+        pairs = pairs[owner[pairs[:, 0]] == owner[pairs[:, 1]]]
+        if len(pairs):
+            n = len(vertices)
+            graph = coo_array((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+            _, label = connected_components(graph, directed=False)
+            # the smallest index of each cluster stands for it (same block: same range)
+            first = np.full(label.max() + 1, n)
+            np.minimum.at(first, label, np.arange(n))
+            triangles = first[label][triangles]
+        keep = ((triangles[:, 0] != triangles[:, 1]) & (triangles[:, 1] != triangles[:, 2])
+                & (triangles[:, 2] != triangles[:, 0]))
+        used, triangles = np.unique(triangles[keep], return_inverse=True)
+        return _Soup(self.names, vertices[used], triangles.reshape(-1, 3),
+                     self.triangle_block[keep], self.split_bodies)
+
+    def bodies(self, stem) -> "_Soup":
+        """One block per connected body (see :func:`_body_labels`), named ``stem`` when
+        there is one body, else ``stem_0000``, ... (or ``<name>_0000`` when the file named
+        its only object)."""
+        label = _body_labels(self.vertices, self.triangles)
+        count = int(label.max()) + 1 if len(label) else 0
+        # bodies in the order of their first triangle in the file
+        first = np.full(count, len(label))
+        np.minimum.at(first, label, np.arange(len(label)))
+        rank = np.empty(count, int)
+        rank[np.argsort(first)] = np.arange(count)
+        base = self.names[0] if self.names and self.names[0] else stem
+        names = [base] if count == 1 else [f"{base}_{k:04d}" for k in range(count)]
+        # merging again gives every body its own copy of the vertices it shares
+        return _Soup(names, self.vertices, self.triangles, rank[label]).merged(0.0)
+
+
+def _body_labels(vertices, triangles):
+    """(T,) int: connected body of every triangle.
+
+    Two triangles are joined across an edge they share with opposite directions. An edge
+    shared by more than two triangles (blocks in contact share it) joins each triangle
+    that opens a solid wedge about the edge with the nearest triangle, turning the same
+    way, that closes it; triangles lying on top of each other (within
+    :data:`COINCIDENT_ANGLE`) bound two touching blocks and are never partners.
+    """
+    n_tri = len(triangles)
+    if n_tri == 0:
+        return np.zeros(0, int)
+    start = triangles.reshape(-1)
+    end = np.roll(triangles, -1, axis=1).reshape(-1)
+    third = np.roll(triangles, -2, axis=1).reshape(-1)
+    tri = np.repeat(np.arange(n_tri), 3)
+    lo, hi = np.minimum(start, end), np.maximum(start, end)
+    _, edge, count = np.unique(lo * len(vertices) + hi, return_inverse=True,
+                               return_counts=True)
+    forward = start == lo  # the triangle runs along the edge from lo to hi
+    order = np.argsort(edge, kind="stable")
+    bounds = np.concatenate([[0], np.cumsum(count)])
+    links = []
+
+    two = np.flatnonzero(count == 2)
+    first, second = order[bounds[two]], order[bounds[two] + 1]
+    opposite = forward[first] != forward[second]
+    links.append(np.stack([tri[first[opposite]], tri[second[opposite]]], axis=1))
+
+    for e in np.flatnonzero(count > 2):
+        half = order[bounds[e]:bounds[e + 1]]
+        links.append(_pair_about_edge(vertices, lo[half[0]], hi[half[0]], third[half],
+                                      forward[half], tri[half]))
+    links = np.concatenate(links).reshape(-1, 2)
+    graph = coo_array((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(n_tri, n_tri))
+    return connected_components(graph, directed=False)[1]
+
+
+def _pair_about_edge(vertices, lo, hi, third, forward, tri):
+    """Triangle pairs that bound one solid wedge about the edge ``lo -> hi``.
+
+    Angles are measured about the axis ``hi - lo``. A triangle running ``lo -> hi`` has
+    its outward normal towards increasing angle, so its solid lies at smaller angles
+    (it closes a wedge); one running ``hi -> lo`` opens a wedge towards larger angles.
+    Each opening triangle pairs with the closing one at the smallest positive angle
+    beyond it. Returns (k, 2) int triangle pairs.
+    """
+    axis = vertices[hi] - vertices[lo]
+    axis /= np.linalg.norm(axis)
+    arm = vertices[third] - vertices[lo]
+    arm -= np.outer(arm @ axis, axis)
+    e1 = arm[0] / np.linalg.norm(arm[0])
+    e2 = np.cross(axis, e1)
+    angle = np.arctan2(arm @ e2, arm @ e1)
+    opening, closing = np.flatnonzero(~forward), np.flatnonzero(forward)
+    if len(opening) == 0 or len(closing) == 0:
+        return np.zeros((0, 2), int)
+    gap = np.mod(angle[closing][None, :] - angle[opening][:, None], 2 * np.pi)
+    gap[(gap < COINCIDENT_ANGLE) | (gap > 2 * np.pi - COINCIDENT_ANGLE)] = np.inf
+    partner = np.argmin(gap, axis=1)
+    ok = np.isfinite(gap[np.arange(len(opening)), partner])
+    return np.stack([tri[opening[ok]], tri[closing[partner[ok]]]], axis=1)
+
+
+# ---------------------------------------------------------------------- readers
+def _read_file(path: Path) -> _Soup:
+    suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise AssemblyError(f"{path}: unknown format {path.suffix!r}; masonry reads "
+                            f"{', '.join(FORMATS)}")
+    try:
+        data = path.read_bytes()
+    except OSError as error:
+        raise AssemblyError(f"{path}: cannot be read: {error.strerror or error}") from None
+    if not data.strip():
+        raise AssemblyError(f"{path}: the file is empty")
+    reader = {".obj": _read_obj, ".stl": _read_stl, ".ply": _read_ply}[suffix]
+    try:
+        soup = reader(data)
+    except AssemblyError as error:
+        raise AssemblyError(f"{path}: {error}") from None
+    except (ValueError, IndexError, KeyError, TypeError, UnicodeDecodeError) as error:
+        raise AssemblyError(f"{path}: not a readable {suffix[1:].upper()} file "
+                            f"({type(error).__name__}: {error})") from None
+    if len(soup.triangles) == 0:
+        raise AssemblyError(f"{path}: no faces, so no block")
+    return soup
+
+
+def _read_obj(data: bytes) -> _Soup:
+    """Wavefront OBJ: ``v``, ``f`` (polygons, ``i``, ``i/t``, ``i/t/n``, ``i//n``,
+    negative indices), ``o`` and ``g``; everything else is skipped."""
+    vertices, faces, face_object, face_group = [], [], [], []
+    objects, groups = [], {}
+    current_object = current_group = -1
+    for number, line in enumerate(data.decode("utf-8", errors="replace").splitlines(), 1):
+        parts = line.split()
+        if not parts:
+            continue
+        tag = parts[0]
+        if tag == "v":
+            if len(parts) < 4:
+                raise AssemblyError(f"line {number}: a vertex needs three coordinates")
+            vertices.append(parts[1:4])
+        elif tag == "f":
+            if len(parts) < 4:
+                raise AssemblyError(f"line {number}: a face needs three vertices")
+            count = len(vertices)
+            ids = [int(p.split("/", 1)[0]) for p in parts[1:]]
+            ids = [i - 1 if i > 0 else count + i for i in ids]
+            if min(ids) < 0 or max(ids) >= count:
+                raise AssemblyError(f"line {number}: the face refers to a vertex that is not "
+                                    f"defined before it (the file has {count} by then)")
+            faces.append(ids)
+            face_object.append(current_object)
+            face_group.append(current_group)
+        elif tag == "o":
+            objects.append(" ".join(parts[1:]))
+            current_object = len(objects) - 1
+        elif tag == "g":
+            name = " ".join(parts[1:])
+            current_group = groups.setdefault(name, len(groups))
+    if not faces:
+        return _Soup([], np.array(vertices, dtype=float), np.zeros((0, 3)), np.zeros(0))
+    vertices = np.array(vertices, dtype=float)
+    counts = np.array([len(f) for f in faces])
+    flat = np.fromiter((i for f in faces for i in f), dtype=np.int64, count=int(counts.sum()))
+    triangles, face = _fan(flat, counts)
+    face_object, face_group = np.array(face_object), np.array(face_group)
+    if len(set(face_object)) >= 2:
+        names, key = objects, face_object
+    elif len(set(face_group)) >= 2:
+        names, key = list(groups), face_group
+    else:
+        named = (objects[face_object[0]] if face_object[0] >= 0
+                 else list(groups)[face_group[0]] if face_group[0] >= 0 else "")
+        return _Soup([named], vertices, triangles, np.zeros(len(triangles)),
+                     split_bodies=True)
+    # faces before the first object or group form a block of their own
+    if (key < 0).any():
+        names = names + ["unnamed"]
+        key = np.where(key < 0, len(names) - 1, key)
+    used, key = np.unique(key, return_inverse=True)
+    return _Soup([names[i] for i in used], vertices, triangles, key[face])
+
+
+def _fan(flat, counts):
+    """Polygons (flat indices, (n,) vertex counts) -> fan triangles (T, 3) and their
+    polygon (T,)."""
+    ntri = counts - 2
+    face = np.repeat(np.arange(len(counts)), ntri)
+    start = np.cumsum(counts) - counts
+    k = np.arange(len(face)) - np.repeat(np.cumsum(ntri) - ntri, ntri)
+    s = start[face]
+    return np.stack([flat[s], flat[s + k + 1], flat[s + k + 2]], axis=1), face
+
+
+_STL_RECORD = np.dtype([("normal", "<f4", 3), ("points", "<f4", (3, 3)), ("attr", "<u2")])
+
+
+def _read_stl(data: bytes) -> _Soup:
+    """Binary STL (exactly 84 + 50 n bytes) or ASCII STL (``vertex x y z`` lines)."""
+    if len(data) >= 84:
+        count = int.from_bytes(data[80:84], "little")
+        if len(data) == 84 + 50 * count:
+            points = np.frombuffer(data, _STL_RECORD, count=count, offset=84)["points"]
+            return _soup_of_triangles(points.astype(float))
+    text = data.decode("ascii", errors="replace")
+    if not text.lstrip().startswith("solid"):
+        raise AssemblyError(f"not an STL file: {len(data)} bytes is not 84 + 50 n (binary "
+                            f"STL; truncated?) and the text does not start with 'solid'")
+    if "endsolid" not in text:
+        raise AssemblyError("ASCII STL without 'endsolid': the file is truncated")
+    values = re.findall(r"^\s*vertex\s+(\S+)\s+(\S+)\s+(\S+)", text, flags=re.MULTILINE)
+    if len(values) % 3:
+        raise AssemblyError(f"ASCII STL with {len(values)} vertices, not a multiple of 3")
+    return _soup_of_triangles(np.array(values, dtype=float).reshape(-1, 3, 3))
+
+
+def _read_ply(data: bytes) -> _Soup:
+    import trimesh
+
+    mesh = trimesh.load(io.BytesIO(data), file_type="ply", process=False)
+    if not isinstance(mesh, trimesh.Trimesh):
+        raise AssemblyError("no triangle mesh in the PLY file (a point cloud?)")
+    return _Soup([""], mesh.vertices, mesh.faces, np.zeros(len(mesh.faces)),
+                 split_bodies=True)
+
+
+def _soup_of_triangles(points):
+    """(T, 3, 3) triangle corners -> a soup to be split into bodies."""
+    return _Soup([""], points.reshape(-1, 3), np.arange(points.shape[0] * 3).reshape(-1, 3),
+                 np.zeros(points.shape[0]), split_bodies=True)
+
+
+# ---------------------------------------------------------------------- checks, hulls
+def _convex_blocks(soup: _Soup, path: Path, tol: Tolerances) -> Blocks:
+    """Check every block of a merged soup and rebuild it as its hull's planar faces."""
+    n_blocks = len(soup.names)
+    tri_block = soup.triangle_block
+
+    def fail(block, why):
+        raise AssemblyError(f"{path}: block {soup.names[block]!r} {why}")
+
+    present = np.bincount(tri_block, minlength=n_blocks)
+    for block in np.flatnonzero(present < 4):
+        fail(block, f"has {present[block]} triangles: too few for a solid")
+
+    # closed, manifold, consistently oriented: every edge used by exactly two triangles,
+    # once in each direction
+    t = soup.triangles
+    start, end = t.reshape(-1), np.roll(t, -1, axis=1).reshape(-1)
+    lo, hi = np.minimum(start, end), np.maximum(start, end)
+    _, edge, count = np.unique(lo * len(soup.vertices) + hi, return_inverse=True,
+                               return_counts=True)
+    forward = np.bincount(edge, weights=(start == lo).astype(float))
+    edge_block = np.empty(len(count), int)
+    edge_block[edge] = np.repeat(tri_block, 3)
+    problems = [
+        (count == 1, "is not closed: {n} edges belong to one face only{last}"),
+        (count > 2, "is not manifold: {n} edges are shared by more than two faces"),
+        ((count == 2) & (forward != 1),
+         "is not consistently oriented: {n} edges are run twice in the same direction"),
+    ]
+    bad_block = n_blocks
+    for bad, _ in problems:
+        if bad.any():
+            bad_block = min(bad_block, int(edge_block[bad].min()))
+    for bad, why in problems:
+        n = int((bad & (edge_block == bad_block)).sum())
+        if n:
+            # a cut-off file leaves its last block open
+            last = (" (the last block in the file: is the file truncated?)"
+                    if bad_block == n_blocks - 1 else "")
+            fail(bad_block, why.format(n=n, last=last))
+
+    # blocks own contiguous vertex ranges (_Soup.merged)
+    vertex_block = np.empty(len(soup.vertices), int)
+    vertex_block[t.reshape(-1)] = np.repeat(tri_block, 3)
+    vstart = np.searchsorted(vertex_block, np.arange(n_blocks + 1))
+    # signed volume by the divergence theorem about each block's first vertex
+    tri = soup.vertices[t]
+    ref = soup.vertices[vstart[tri_block]]
+    six = np.einsum("ij,ij->i", tri[:, 0] - ref, np.cross(tri[:, 1] - ref, tri[:, 2] - ref))
+    volume = np.bincount(tri_block, six, minlength=n_blocks) / 6.0
+    size = np.linalg.norm(np.maximum.reduceat(soup.vertices, vstart[:-1])
+                          - np.minimum.reduceat(soup.vertices, vstart[:-1]), axis=1)
+    flat = np.abs(volume) <= tol.length * size**2
+    for b in np.flatnonzero((volume < 0) & ~flat)[:1]:
+        fail(b, f"is inside out: its faces point inward (volume {volume[b]:.4g} m^3)")
+    for b in np.flatnonzero(flat)[:1]:
+        fail(b, "is flat: it has no volume")
+
+    hull_points, hull_faces, hull_volume = [], [], np.zeros(n_blocks)
+    for b in range(n_blocks):
+        points = soup.vertices[vstart[b]:vstart[b + 1]]
+        try:
+            hull = ConvexHull(points)
+        except QhullError:
+            fail(b, "is flat: it has no volume")
+        deficit = 1.0 - volume[b] / hull.volume
+        if deficit > CONVEXITY_REL:
+            bodies = int(_body_labels(points, soup.triangles[tri_block == b]
+                                      - vstart[b]).max()) + 1
+            why = (f"holds {bodies} separate bodies" if bodies > 1
+                   else f"is not convex: its volume is {100 * deficit:.3g}% below its convex "
+                        f"hull's (tolerance {100 * CONVEXITY_REL:g}%)")
+            fail(b, why)
+        hull_points.append(points)
+        hull_faces.append(_hull_faces(points, hull, tol.contact))
+        hull_volume[b] = hull.volume
+    blocks = _blocks_from_hulls(soup.names, hull_points, hull_faces, path)
+    # the merged polygons must enclose the hull: faces that overlap or leave holes (a
+    # surface too curved for tol.contact to tell its facets apart) change the volume
+    mismatch = np.abs(blocks.block_volume / hull_volume - 1.0)
+    if (mismatch > CONVEXITY_REL).any():
+        fail(int(np.argmax(mismatch > CONVEXITY_REL)),
+             "has faces that cannot be merged into planar polygons (nearly coplanar "
+             "facets: a curved surface?)")
+    return blocks
+
+
+def _hull_faces(points, hull, distance):
+    """Planar faces of a convex hull: ``(face_of_entry, point_of_entry, normal)``.
+
+    The points within ``distance`` of a hull triangle's plane form that triangle's face;
+    triangles with the same point set are one face (qhull's own merged facets, and
+    facets that rounding split). Returns, per (face, point) entry, the face index and the
+    point index ((e,) int each, by face), and (F, 3) outward unit normals.
+    """
+    normal, offset = hull.equations[:, :3], hull.equations[:, 3]
+    # only the hull's vertices: a point inside a face (a T-junction) is no corner
+    corner = hull.vertices
+    on = np.abs(normal @ points[corner].T + offset[:, None]) <= distance  # (T, n)
+    if on.shape[1] <= 62:
+        key = on @ (np.int64(1) << np.arange(on.shape[1], dtype=np.int64))
+    else:
+        key = np.packbits(on, axis=1).view(f"V{(on.shape[1] + 7) // 8}").reshape(-1)
+    _, first = np.unique(key, return_index=True)
+    entry_face, entry_corner = np.nonzero(on[first])
+    return entry_face, corner[entry_corner], normal[first]
+
+
+def _blocks_from_hulls(names, hull_points, hull_faces, path) -> Blocks:
+    """Assemble :class:`Blocks` from per-block hull faces: every face's points ordered
+    counter-clockwise about its outward normal, collinear points dropped (vectorized
+    over all faces of all blocks)."""
+    point_base = np.cumsum([0] + [len(p) for p in hull_points])
+    face_base = np.cumsum([0] + [len(f[2]) for f in hull_faces])
+    points = np.concatenate(hull_points)
+    entry_face = np.concatenate([f[0] + face_base[b] for b, f in enumerate(hull_faces)])
+    entry_point = np.concatenate([f[1] + point_base[b] for b, f in enumerate(hull_faces)])
+    normal = np.concatenate([f[2] for f in hull_faces])
+    face_block = np.repeat(np.arange(len(names)), np.diff(face_base))
+
+    # counter-clockwise about the outward normal: angle in the face's (t1, t2) basis
+    t1, t2 = tangent_basis(normal)
+    n_faces = len(normal)
+    centre = np.zeros((n_faces, 3))
+    np.add.at(centre, entry_face, points[entry_point])
+    centre /= np.bincount(entry_face, minlength=n_faces)[:, None]
+    arm = points[entry_point] - centre[entry_face]
+    angle = np.arctan2(np.einsum("ij,ij->i", arm, t2[entry_face]),
+                       np.einsum("ij,ij->i", arm, t1[entry_face]))
+    order = np.lexsort((angle, entry_face))
+    entry_face, entry_point = entry_face[order], entry_point[order]
+    # drop points where the ring goes straight on (they lie inside an edge of the block
+    # and are dropped from both faces of that edge alike) or turns back (a point inside
+    # the face); repeat, as a point inside the face can hide a straight neighbour
+    while True:
+        count = np.bincount(entry_face, minlength=n_faces)
+        start = np.cumsum(count) - count
+        k = np.arange(len(entry_face)) - start[entry_face]
+        prev = start[entry_face] + (k - 1) % count[entry_face]
+        nxt = start[entry_face] + (k + 1) % count[entry_face]
+        p = points[entry_point]
+        a, b = p - p[prev], p[nxt] - p
+        turn = np.einsum("ij,ij->i", np.cross(a, b), normal[entry_face])
+        scale = np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1)
+        straight = turn <= 1e-9 * scale
+        if not straight.any():
+            break
+        entry_face, entry_point = entry_face[~straight], entry_point[~straight]
+    count = np.bincount(entry_face, minlength=n_faces)
+    if (count < 3).any():
+        bad = int(face_block[np.flatnonzero(count < 3)[0]])
+        raise AssemblyError(f"{path}: block {names[bad]!r}: a face of its convex hull "
+                            "collapses to a line; the block is degenerate")
+    # keep only points used by a face, block after block
+    used, face_vertices = np.unique(entry_point, return_inverse=True)
+    point_block = np.repeat(np.arange(len(names)), np.diff(point_base))
+    vertex_offsets = np.searchsorted(point_block[used], np.arange(len(names) + 1))
+    return Blocks.from_arrays(
+        vertices=points[used], vertex_offsets=vertex_offsets,
+        face_vertices=face_vertices.reshape(-1),
+        face_offsets=np.concatenate([[0], np.cumsum(count)]), face_block=face_block,
+        block_class="block", block_name=list(names))
+
+
+def _unique_names(names):
+    """Names with repeats numbered ``_2``, ``_3``, ... and empty names replaced."""
+    seen, out = {}, []
+    for i, name in enumerate(names):
+        name = str(name) or f"block{i:04d}"
+        k = seen.get(name, 0) + 1
+        seen[name] = k
+        out.append(name if k == 1 else f"{name}_{k}")
+    return out
+
+
+def _classes_from_names(names):
+    """(B,) class and course from our own names (``b0042_regular_c12``), else ``block``
+    and 0."""
+    block_class = np.full(len(names), BLOCK_CLASSES.index("block"), dtype=np.int8)
+    block_course = np.zeros(len(names), int)
+    for i, name in enumerate(names):
+        match = OUR_NAME.match(name)
+        if match:
+            block_class[i] = BLOCK_CLASSES.index(match.group(1))
+            block_course[i] = int(match.group(2))
+    return block_class, block_course

@@ -1,0 +1,252 @@
+"""Speed against accuracy, measured (SPEC 6.6): the table users choose a preset from.
+
+For every structure (a thesis preset as a free-standing section, a cyclic section and the
+full dome) and every accuracy preset, :func:`bench` runs the whole process from
+parameters to exported forces several times and reports the median time of each stage
+(model, interfaces, assembly, solve, exports) and of the whole, with the solve's
+iterations, objective, MoI, relative equilibrium residual and largest friction
+violation, and how far its MoI and forces are from the most accurate solution (the
+``accurate`` preset's). The library returns rows; :func:`table_markdown`,
+:func:`table_csv` and :func:`frontier_png` format them, the ``masonry bench`` command
+prints and writes them.
+
+Every repeat builds everything again (a fresh :class:`~masonry.solve.RBEProblem`), so no
+solver reuses a factorization or a warm start from an earlier run: the times are what a
+user's first run costs.
+"""
+
+import csv
+import io
+import logging
+import statistics
+import time
+
+import numpy as np
+
+from .boundary import analysis_model
+from .export.csv import forces_csv, interfaces_csv, locations_csv
+from .export.obj import blocks_obj
+from .params import from_preset
+from .scenes import build
+from .solve import ACCURACY, RBEProblem
+
+log = logging.getLogger(__name__)
+
+SCENES = {
+    "section": dict(scene="section", boundary="free"),
+    "cyclic": dict(scene="section", boundary="cyclic"),
+    "dome": dict(scene="dome"),
+}
+"""Bench scene name -> :class:`~masonry.params.Params` fields."""
+
+STAGES = ("model", "interfaces", "assembly", "solve", "exports")
+
+COLUMNS = ("preset", "scene", "accuracy", "solver", "bricks", "unknowns", "feasible",
+           "friction", "model_s", "interfaces_s", "assembly_s", "solve_s", "lp_s",
+           "exports_s", "total_s", "iterations", "objective", "moi", "moi_factor",
+           "residual_eq", "friction_violation", "moi_deviation", "force_deviation",
+           "lp_feasible")
+"""Columns of a bench row. Times are medians over the repeats, in seconds; ``lp_s`` is
+the part of ``solve_s`` spent in the LP check. ``solver`` and ``iterations`` list every
+QP solved, joined by ``+`` (e.g. Newton's certificate of infeasibility, Clarabel on
+friction+, Newton's polish). ``moi_deviation``: ``|MoI - MoI_ref| / weight``;
+``force_deviation``: the largest difference of a vertex force from the reference, over
+the reference's largest vertex force; the reference is the ``accurate`` preset's
+solution of the same structure."""
+
+
+def bench(presets=("1", "2", "3"), scenes=tuple(SCENES), accuracies=tuple(ACCURACY),
+          repeats=3, solvers=(), mu=0.7, density=2000.0, overrides=None,
+          progress=None) -> list:
+    """Measure every (preset, scene, accuracy) and return one row per combination.
+
+    Parameters
+    ----------
+    presets : sequence of str
+        Thesis presets (``'1'``, ``'2'``, ``'3'``).
+    scenes : sequence of str
+        Keys of :data:`SCENES`.
+    accuracies : sequence of str
+        Accuracy presets. ``accurate`` is always solved once per structure (it is the
+        reference for the deviations), and timed only if listed.
+    repeats : int
+        Runs per combination; stage times are their medians.
+    solvers : sequence of str
+        Extra rows: the ``balanced`` preset with this solver in place of its own (e.g.
+        ``'osqp'``, the thesis's solver, or ``'clarabel-cvxpy'``).
+    mu, density : float
+    overrides : dict, optional
+        Further :class:`~masonry.params.Params` fields for every structure (e.g.
+        ``{'p': 3}`` for small domes).
+    progress : callable, optional
+        Called with a short message before every combination.
+
+    Returns
+    -------
+    list of dict
+        Rows with the :data:`COLUMNS` keys.
+    """
+    rows = []
+    runs = [(accuracy, None) for accuracy in accuracies]
+    runs += [("balanced", solver) for solver in solvers]
+    for preset in presets:
+        for scene_name in scenes:
+            params = from_preset(preset, mu=mu, density=density,
+                                 **{**SCENES[scene_name], **(overrides or {})})
+            reference = None
+            if "accurate" not in accuracies:
+                reference = _run(params, "accurate", None, exports=False)[1]
+            measured = {}
+            for accuracy, solver in sorted(runs, key=lambda r: r[0] != "accurate"):
+                if progress is not None:
+                    progress(f"preset {preset} {scene_name}: {accuracy}"
+                             + (f" ({solver})" if solver else ""))
+                times, result, counts = [], None, None
+                for _ in range(max(1, int(repeats))):
+                    stage_times, result, counts = _run(params, accuracy, solver)
+                    times.append(stage_times)
+                if accuracy == "accurate" and solver is None:
+                    reference = result
+                measured[(accuracy, solver)] = (times, result, counts)
+            for (accuracy, solver), (times, result, counts) in measured.items():
+                rows.append(_row(preset, scene_name, accuracy, solver, times, result,
+                                 counts, reference))
+    return rows
+
+
+def _run(params, accuracy, solver, exports=True):
+    """One whole process; returns ({stage: seconds}, RBEResult, counts)."""
+    seconds = {}
+    start = time.perf_counter()
+    scene = build(params)
+    seconds["model"] = time.perf_counter() - start
+    start = time.perf_counter()
+    model = analysis_model(scene)
+    seconds["interfaces"] = time.perf_counter() - start
+    start = time.perf_counter()
+    problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
+                         side_rotation=model.side_rotation)
+    seconds["assembly"] = time.perf_counter() - start
+    start = time.perf_counter()
+    result = problem.solve(mu=params.mu, density=params.density, friction=params.friction,
+                           solver=solver, accuracy=accuracy)
+    seconds["solve"] = time.perf_counter() - start
+    seconds["lp"] = result.lp_time_s
+    start = time.perf_counter()
+    if exports:
+        # what a run writes about the model and its forces (not the plots and the
+        # printable body, which are the same for every accuracy)
+        locations_csv(scene.blocks)
+        blocks_obj(scene.blocks)
+        interfaces_csv(model.blocks, model.interfaces)
+        if result.x is not None:
+            from .export.vtu import interfaces_vtu
+
+            forces = result.per_interface()
+            forces_csv(model.blocks, model.interfaces, forces)
+            interfaces_vtu(model.interfaces, forces)
+    seconds["exports"] = time.perf_counter() - start
+    counts = {"bricks": int((~scene.blocks.block_is_support).sum()),
+              "unknowns": problem.system.layout.n_columns}
+    return seconds, result, counts
+
+
+def _row(preset, scene, accuracy, solver, times, result, counts, reference) -> dict:
+    median = {stage: statistics.median(t[stage] for t in times) for stage in STAGES}
+    total = statistics.median(sum(t[stage] for stage in STAGES) for t in times)
+    lp = statistics.median(t["lp"] for t in times)
+    moi_dev = force_dev = np.nan
+    if reference is not None and result.x is not None and reference.x is not None:
+        moi_dev = abs(result.moi - reference.moi) / reference.weight_N
+        force_dev = (np.abs(result.x - reference.x).max()
+                     / max(np.abs(reference.x).max(), np.finfo(float).tiny))
+    return {
+        "preset": preset, "scene": scene, "accuracy": accuracy,
+        "solver": "+".join(a["solver"] for a in result.attempts),
+        "bricks": counts["bricks"], "unknowns": counts["unknowns"],
+        "feasible": result.feasible, "friction": result.friction,
+        **{f"{stage}_s": median[stage] for stage in STAGES}, "lp_s": lp, "total_s": total,
+        "iterations": "+".join(str(a["iterations"]) for a in result.attempts),
+        "objective": result.objective, "moi": result.moi, "moi_factor": result.moi_factor,
+        "residual_eq": result.residual_eq, "friction_violation": result.friction_violation,
+        "moi_deviation": moi_dev, "force_deviation": force_dev,
+        "lp_feasible": result.lp_feasible,
+    }
+
+
+# ---------------------------------------------------------------------- formatting
+def _cell(key, value) -> str:
+    if isinstance(value, float):
+        if np.isnan(value):
+            return "-"
+        if key.endswith("_s"):
+            return f"{value:.2f}"
+        return f"{value:.3g}" if key in ("moi_factor",) else f"{value:.2e}"
+    if value is None:
+        return "-"
+    return str(value)
+
+
+MARKDOWN_COLUMNS = ("preset", "scene", "bricks", "accuracy", "solver", "feasible",
+                    "model_s", "interfaces_s", "assembly_s", "solve_s", "lp_s",
+                    "exports_s", "total_s", "iterations", "objective", "moi_factor",
+                    "residual_eq", "friction_violation", "moi_deviation",
+                    "force_deviation")
+
+
+def table_markdown(rows, columns=MARKDOWN_COLUMNS) -> str:
+    """A Markdown table of bench rows (times in seconds, medians)."""
+    lines = ["| " + " | ".join(columns) + " |",
+             "|" + "|".join("---" for _ in columns) + "|"]
+    for row in rows:
+        lines.append("| " + " | ".join(_cell(c, row[c]) for c in columns) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def table_csv(rows, columns=COLUMNS) -> bytes:
+    """Bench rows as CSV (full precision)."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(columns)
+    for row in rows:
+        writer.writerow(["" if row[c] is None else row[c] for c in columns])
+    return buffer.getvalue().encode()
+
+
+def frontier_png(rows) -> bytes:
+    """The speed/accuracy frontier: solve time against the forces' deviation from the
+    reference (and the equilibrium residual where the deviation is zero, i.e. for the
+    reference itself), one line per structure through its accuracy presets."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7.5, 5.0), dpi=120)
+    structures = dict.fromkeys((r["preset"], r["scene"]) for r in rows)
+    markers = {"fast": "o", "balanced": "s", "accurate": "^"}
+    floor = 1e-16
+    for (preset, scene), colour in zip(structures, plt.cm.tab10.colors * 3):
+        own = [r for r in rows if (r["preset"], r["scene"]) == (preset, scene)]
+        own.sort(key=lambda r: r["solve_s"])
+        x = [r["solve_s"] for r in own]
+        y = [max(r["force_deviation"] if r["force_deviation"] > 0 else r["residual_eq"],
+                 floor) if np.isfinite(r["force_deviation"]) else np.nan for r in own]
+        ax.plot(x, y, "-", color=colour, alpha=0.5)
+        for r, xi, yi in zip(own, x, y):
+            ax.plot(xi, yi, markers.get(r["accuracy"], "x"), color=colour,
+                    label=f"{preset} {scene}" if r is own[0] else None)
+    for name, marker in markers.items():
+        ax.plot([], [], marker, color="grey", label=name)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("solve time, s (median)")
+    ax.set_ylabel("force deviation from the accurate solution")
+    ax.set_title("speed / accuracy frontier (lower left is better)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    buffer = io.BytesIO()
+    fig.tight_layout()
+    fig.savefig(buffer, format="png")
+    plt.close(fig)
+    return buffer.getvalue()

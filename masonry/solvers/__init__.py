@@ -1,0 +1,33 @@
+"""QP backends for the rigid block equilibrium (SPEC 6.5, 6.6).
+
+Every backend is ``solve(system, method, options, workspace) -> QPOutcome``: it solves
+the scaled QP of an :class:`~masonry.equilibrium.EquilibriumSystem` for the friction
+model ``method`` (``'net'`` or ``'plus'``) with solver ``options``, and may keep
+whatever it can reuse (factorizations, solver objects, warm starts) in ``workspace``, a
+dict that :class:`masonry.solve.RBEProblem` keeps per scene and backend. Adding a solver
+is adding a module and a line here.
+
+- ``newton``: semismooth Newton on the dual (:mod:`.newton`); friction-net only in the
+  presets (friction+ goes to Clarabel).
+- ``clarabel``, ``osqp``: the solvers called directly on sparse matrices
+  (:mod:`.standard_form`).
+- ``clarabel-cvxpy``, ``osqp-cvxpy``: the same through cvxpy, the readable reference.
+"""
+
+from . import direct_clarabel, direct_osqp, newton, via_cvxpy
+from .base import QPOutcome
+
+BACKENDS = {
+    "newton": newton.backend,
+    "clarabel": direct_clarabel.solve,
+    "osqp": direct_osqp.solve,
+    "clarabel-cvxpy": via_cvxpy.solver_for("CLARABEL"),
+    "osqp-cvxpy": via_cvxpy.solver_for("OSQP"),
+}
+"""Solver name -> backend function."""
+
+FAMILY = {"newton": "newton", "clarabel": "clarabel", "osqp": "osqp",
+          "clarabel-cvxpy": "clarabel", "osqp-cvxpy": "osqp"}
+"""Solver name -> whose options it takes (the accuracy presets set them per family)."""
+
+__all__ = ["BACKENDS", "FAMILY", "QPOutcome"]

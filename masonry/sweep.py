@@ -1,0 +1,221 @@
+"""Parameter studies: many ordinary runs, serially or on a Dask cluster.
+
+A study is a base of fixed inputs, a grid whose Cartesian product gives the variants, and
+optionally random samples of some inputs. Every variant is an ordinary run of
+:func:`masonry.pipeline.run` with its own run folder and ``run.json``, so a study is
+resumable for free: a variant whose folder already holds a complete run of the same input
+is reused, not recomputed, and variants that differ only in ``mu`` or the friction mode
+share the cached geometry. A variant that fails is recorded with its error; the others go
+on. The distributed engine is Dask (an optional extra); without it the study runs
+serially.
+"""
+
+import dataclasses
+import itertools
+import logging
+import time
+import traceback
+from dataclasses import dataclass
+
+import numpy as np
+
+from .params import Params, ParameterError
+
+log = logging.getLogger(__name__)
+
+SUMMARY_COLUMNS = ("variant", "status", "error", "feasible", "friction_used", "moi",
+                   "moi_factor",
+                   "objective", "weight_N", "bricks", "interfaces", "residual_eq",
+                   "time_s", "structure_id")
+"""Result columns of the summary; the swept inputs come first."""
+
+
+@dataclass(frozen=True)
+class Study:
+    """A parameter study over :class:`~masonry.params.Params` fields.
+
+    Parameters
+    ----------
+    base : dict
+        Fixed inputs (``Params`` field names).
+    grid : dict of lists
+        Inputs whose Cartesian product gives the variants.
+    sample : dict of (low, high)
+        Inputs drawn uniformly at random, ``count`` draws (integers where both bounds are
+        integers), seeded by ``seed``; combined with every grid point.
+    count, seed : int
+    analyse, plots, printable : bool
+        What each run does and writes (defaults: solve, no plots, no printable body).
+    """
+
+    base: dict
+    grid: dict
+    sample: dict = dataclasses.field(default_factory=dict)
+    count: int = 0
+    seed: int = 0
+    analyse: bool = True
+    plots: bool = False
+    printable: bool = False
+
+    @property
+    def swept(self) -> list:
+        """Names of the inputs that vary, grid first."""
+        return list(self.grid) + [k for k in self.sample if k not in self.grid]
+
+    def variants(self) -> list:
+        """One dict of inputs per variant (base, then grid point, then sample)."""
+        fields = {f.name for f in dataclasses.fields(Params)}
+        unknown = (set(self.base) | set(self.grid) | set(self.sample)) - fields
+        if unknown:
+            raise ParameterError("study", sorted(unknown), "inputs named as run options")
+        for name, values in self.grid.items():
+            if not isinstance(values, list) or not values:
+                raise ParameterError(f"grid.{name}", values, "a non-empty list")
+        points = [dict(zip(self.grid, combo))
+                  for combo in itertools.product(*self.grid.values())] or [{}]
+        draws = [{}]
+        if self.sample:
+            if self.count < 1:
+                raise ParameterError("sample.count", self.count, "an integer >= 1")
+            rng = np.random.default_rng(self.seed)
+            draws = []
+            for _ in range(self.count):
+                draw = {}
+                for name, bounds in self.sample.items():
+                    low, high = bounds
+                    if isinstance(low, int) and isinstance(high, int):
+                        draw[name] = int(rng.integers(low, high + 1))
+                    else:
+                        draw[name] = float(rng.uniform(low, high))
+                draws.append(draw)
+        return [{**self.base, **point, **draw} for point in points for draw in draws]
+
+
+def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=False) -> dict:
+    """Run one variant; never raises: a failure becomes a row with its error."""
+    from .params import validate
+    from .pipeline import run
+
+    start = time.perf_counter()
+    row = {"status": "failed", "error": ""}
+    try:
+        record = run(validate(Params(**inputs)), out_root, analyse=analyse,
+                     plots_wanted=plots, printable=printable)
+    except Exception as error:  # a variant's failure is data, not the study's end
+        row["error"] = f"{type(error).__name__}: {error}"
+        log.debug("variant failed: %s", traceback.format_exc())
+    else:
+        rbe = record.get("rbe", {})
+        row.update(
+            status="reused" if record.get("reused") else "computed",
+            feasible=rbe.get("feasible"), friction_used=rbe.get("friction"),
+            moi=rbe.get("moi"), moi_factor=rbe.get("moi_factor"),
+            objective=rbe.get("objective"), weight_N=record.get("weight_N"),
+            bricks=record["counts"]["bricks"],
+            interfaces=sum(record["counts"].get("interfaces", {}).values()),
+            residual_eq=rbe.get("residual_eq"), structure_id=record["structure_id"])
+    row["time_s"] = round(time.perf_counter() - start, 3)
+    return row
+
+
+def execute(study: Study, out_root, workers=1, scheduler=None):
+    """Run every variant; yield ``(index, inputs, row)`` as each finishes.
+
+    ``workers=1`` and no ``scheduler``: serially, in this process. Otherwise on Dask: a
+    ``LocalCluster`` of ``workers`` single-threaded processes, or the scheduler at
+    ``scheduler`` (``tcp://host:port``). A variant whose worker dies is recorded as failed.
+    """
+    variants = study.variants()
+    options = dict(analyse=study.analyse, plots=study.plots, printable=study.printable)
+    if workers == 1 and scheduler is None:
+        for i, inputs in enumerate(variants):
+            yield i, inputs, run_variant(inputs, str(out_root), **options)
+        return
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    cluster = None
+    if scheduler is None:
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                               host="127.0.0.1", dashboard_address=None)
+    client = Client(cluster if cluster is not None else scheduler)
+    try:
+        futures = {client.submit(run_variant, inputs, str(out_root), **options,
+                                 key=f"variant-{i}-{time.time_ns()}", pure=False): i
+                   for i, inputs in enumerate(variants)}
+        for future in as_completed(futures):
+            i = futures[future]
+            try:
+                row = future.result()
+            except Exception as error:  # the worker died (KilledWorker) or was lost
+                row = {"status": "failed", "error": f"{type(error).__name__}: {error}",
+                       "time_s": None}
+            yield i, variants[i], row
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def summary_rows(study: Study, results) -> list:
+    """Rows of the summary table in variant order: swept inputs, then results."""
+    rows = []
+    for i, inputs, row in sorted(results, key=lambda r: r[0]):
+        rows.append({**{k: inputs.get(k) for k in study.swept}, "variant": i,
+                     **{k: row.get(k) for k in SUMMARY_COLUMNS if k != "variant"}})
+    return rows
+
+
+def summary_csv(study: Study, rows) -> bytes:
+    columns = study.swept + list(SUMMARY_COLUMNS)
+    lines = [",".join(columns)]
+    for row in rows:
+        cells = []
+        for c in columns:
+            v = row.get(c)
+            text = "" if v is None else (f"{v:.6g}" if isinstance(v, float) else str(v))
+            cells.append('"' + text.replace('"', "'") + '"' if "," in text else text)
+        lines.append(",".join(cells))
+    return ("\n".join(lines) + "\n").encode()
+
+
+def summary_parquet(study: Study, rows):
+    """Parquet bytes of the summary, or None when pyarrow is not installed."""
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        return None
+    import io
+
+    columns = study.swept + list(SUMMARY_COLUMNS)
+    table = pa.table({c: [None if r.get(c) is None else str(r.get(c))
+                          if c in ("error", "status", "friction_used", "structure_id")
+                          else r.get(c) for r in rows] for c in columns})
+    buf = io.BytesIO()
+    pq.write_table(table, buf)
+    return buf.getvalue()
+
+
+def summary_pngs(study: Study, rows) -> dict:
+    """MoI factor and feasibility against each swept input (one figure per input)."""
+    from .plots import _png, plt
+
+    out = {}
+    done = [r for r in rows if r["status"] != "failed"]
+    for name in study.swept:
+        fig, (top, bottom) = plt.subplots(2, 1, figsize=(6, 6), sharex=True)
+        x = [r[name] for r in done]
+        numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in x)
+        labels = sorted({str(v) for v in x}) if not numeric else None
+        xs = x if numeric else [labels.index(str(v)) for v in x]
+        top.scatter(xs, [r["moi_factor"] for r in done], c="C3", s=18)
+        top.set_yscale("symlog", linthresh=1e-3)
+        top.set_ylabel("MoI factor")
+        bottom.scatter(xs, [1 if r["feasible"] else 0 for r in done], c="C0", s=18)
+        bottom.set_yticks([0, 1], ["infeasible", "feasible"])
+        bottom.set_xlabel(name)
+        if labels is not None:
+            bottom.set_xticks(range(len(labels)), labels)
+        top.set_title(f"{len(done)} variants ({len(rows) - len(done)} failed)")
+        out[f"moi_factor_{name}.png"] = _png(fig, 100)
+    return out

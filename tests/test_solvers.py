@@ -1,0 +1,272 @@
+"""QP backends and accuracy presets (SPEC 6.5, 6.6): every path gives the same answer.
+
+The direct paths (OSQP, Clarabel on sparse matrices), the cvxpy reference path and the
+semismooth Newton method must agree; the presets must meet their residuals; reuse
+between friction models and friction coefficients must not change results. Speed is
+measured by ``masonry bench``, never here.
+"""
+
+import functools
+
+import numpy as np
+import pytest
+
+from masonry.bench import COLUMNS, bench, frontier_png, table_csv, table_markdown
+from masonry.boundary import analysis_model
+from masonry.equilibrium import assemble
+from masonry.params import ACCURACIES, SOLVERS, ParameterError, Params, from_preset, structure_id
+from masonry.scenes import build
+from masonry.solve import ACCURACY, RBEProblem, solve_rbe
+from masonry.solvers import BACKENDS
+from masonry.solvers.cholesky import BlockCholesky
+from masonry.solvers.newton import NewtonSystem, project_pyramid
+from masonry.solvers.standard_form import standard_form
+from masonry_cli.main import main
+
+
+@functools.lru_cache(maxsize=None)
+def model(preset, **overrides):
+    return analysis_model(build(from_preset(preset, **overrides)))
+
+
+def small(boundary):
+    """Preset 3 with p = 5: 135 bricks, a free section (infeasible) or cyclic (feasible)."""
+    return model("3", p=5, boundary=boundary)
+
+
+def problem(m):
+    return RBEProblem(m.blocks, m.interfaces, side_block=m.side_block,
+                      side_rotation=m.side_rotation)
+
+
+def scale(result):
+    return np.abs(result.x).max()
+
+
+# ---------------------------------------------------------------------- registries
+def test_solver_and_accuracy_names_agree():
+    assert SOLVERS == tuple(BACKENDS)
+    assert ACCURACIES == tuple(ACCURACY)
+
+
+def test_params_accuracy_validation_and_structure_id():
+    assert Params().solver_accuracy == "balanced"
+    assert Params(fast=True).solver_accuracy == "fast"  # SPEC 3: fast mode, unless chosen
+    assert Params(fast=True, accuracy="accurate").solver_accuracy == "accurate"
+    assert structure_id(from_preset("1")) == "dome0_fast0_fricauto_s1_n8_r1_p10_c0.1_u0.1"
+    assert structure_id(from_preset("1", accuracy="accurate")).endswith("_accurate")
+    assert structure_id(from_preset("1", solver="osqp")).endswith("_osqp")
+    with pytest.raises(ParameterError, match="accuracy"):
+        from_preset("1", accuracy="exact")
+    with pytest.raises(ParameterError, match="solver"):
+        from_preset("1", solver="gurobi")
+
+
+# ---------------------------------------------------------------------- kernels
+def test_pyramid_projection_is_the_nearest_point_and_its_jacobian_is_exact():
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(4000, 3))
+    for mu in (0.05, 0.7, 5.0):
+        x, jacobian = project_pyramid(points, mu)
+        # inside the pyramid
+        assert np.all(np.abs(x[:, 1:]) <= mu * x[:, :1] + 1e-12)
+        # the projection of a cone: x . (p - x) = 0 and p - x in the polar cone, which
+        # for every generator g = (1, +-mu, +-mu) means (p - x) . g <= 0
+        residual = points - x
+        assert np.abs(np.einsum("ij,ij->i", x, residual)).max() < 1e-12
+        for s1 in (-1, 1):
+            for s2 in (-1, 1):
+                assert np.all(residual @ np.array([1.0, s1 * mu, s2 * mu]) <= 1e-12)
+        step = rng.normal(size=points.shape) * 1e-7
+        moved, _ = project_pyramid(points + step, mu)
+        linear = np.einsum("vij,vj->vi", jacobian, step)
+        assert np.abs(moved - x - linear).max() < 1e-12
+
+
+def test_block_cholesky_solves_and_refuses_indefinite_matrices():
+    rng = np.random.default_rng(0)
+    n = 60
+    edges = np.unique(np.sort(rng.integers(0, n, size=(150, 2)), axis=1), axis=0)
+    edges = edges[edges[:, 0] != edges[:, 1]]
+    sym = BlockCholesky(n, edges, block_size=6)
+    dense = np.zeros((6 * n, 6 * n))
+    values = np.empty((len(sym.lower_rows), 6, 6))
+    for k, (i, j) in enumerate(zip(sym.lower_rows, sym.lower_cols)):
+        block = rng.normal(size=(6, 6)) if i != j else np.zeros((6, 6))
+        values[k] = block
+        dense[6 * i:6 * i + 6, 6 * j:6 * j + 6] = block
+        dense[6 * j:6 * j + 6, 6 * i:6 * i + 6] = block.T
+    # diagonally dominant: positive definite
+    strength = np.abs(dense).sum(axis=1) + 1.0
+    diagonal = sym.block_index(np.arange(n), np.arange(n))
+    for i in range(n):
+        values[diagonal[i]] += np.diag(strength[6 * i:6 * i + 6])
+    dense += np.diag(strength)
+    rhs = rng.normal(size=(6 * n, 2))
+    x = sym.factor(values).solve(rhs)
+    np.testing.assert_allclose(dense @ x, rhs, atol=1e-10 * np.abs(rhs).max())
+    values[diagonal[0]] = -np.eye(6)
+    with pytest.raises(np.linalg.LinAlgError):
+        sym.factor(values)
+
+
+def test_newton_matrices_equal_the_sparse_products():
+    m = small("cyclic")
+    system = assemble(m.blocks, m.interfaces, side_block=m.side_block,
+                      side_rotation=m.side_rotation)
+    rng = np.random.default_rng(1)
+    for method in ("net", "plus"):
+        ns = NewtonSystem(system, method)
+        jacobian = rng.normal(size=(len(ns.coefficients), ns.width, ns.width))
+        blocks = ns.newton_blocks(jacobian, 0.0)
+        per_vertex = np.zeros((ns.A.shape[1],) * 2)
+        for v, block in enumerate(jacobian):
+            per_vertex[v * ns.width:(v + 1) * ns.width, v * ns.width:(v + 1) * ns.width] = block
+        full = ns.A.toarray() @ per_vertex @ ns.A.toarray().T
+        sym = ns.symbolic
+        for k, (i, j) in enumerate(zip(sym.lower_rows, sym.lower_cols)):
+            np.testing.assert_allclose(blocks[k], full[6 * i:6 * i + 6, 6 * j:6 * j + 6],
+                                       atol=1e-10 * np.abs(full).max())
+
+
+def test_standard_form_is_the_equilibrium_system():
+    m = small("free")
+    system = assemble(m.blocks, m.interfaces, mu=0.45)
+    form = standard_form(system)
+    for method in ("net", "plus"):
+        rows = form.matrix(method, 0.45).toarray()
+        n_eq, n_fr = form.n_eq, form.n_friction
+        np.testing.assert_array_equal(rows[:n_eq], system.A_eq.toarray())
+        np.testing.assert_array_equal(rows[n_eq:n_eq + n_fr], system.A_fr[method].toarray())
+        tension = rows[n_eq + n_fr:]
+        assert tension.sum() == system.layout.n_vertices
+        np.testing.assert_array_equal(np.flatnonzero(tension.sum(axis=0)),
+                                      system.layout.columns("t"))
+    # one pattern for both models: solvers update values in place
+    assert form.matrix("net", 0.3).nnz == form.matrix("plus", 0.7).nnz
+
+
+# ---------------------------------------------------------------------- agreement
+@functools.lru_cache(maxsize=None)
+def solved(boundary, solver, accuracy="accurate"):
+    return problem(small(boundary)).solve(solver=solver, accuracy=accuracy, lp_check=False)
+
+
+@pytest.mark.parametrize("solver", ["clarabel", "clarabel-cvxpy", "osqp", "osqp-cvxpy",
+                                    "newton"])
+def test_every_solver_finds_the_same_feasible_optimum(solver):
+    # H is positive definite: the minimiser is unique, every path must find it
+    reference = solved("cyclic", "clarabel")
+    result = solved("cyclic", solver)
+    assert result.feasible and result.friction == "net"
+    tolerance = 1e-4 if solver.startswith("osqp") else 1e-6
+    np.testing.assert_allclose(result.x, reference.x, rtol=0,
+                               atol=tolerance * scale(reference))
+    assert result.objective == pytest.approx(reference.objective, rel=tolerance)
+
+
+@pytest.mark.parametrize("solver", ["clarabel", "clarabel-cvxpy", None])
+def test_solvers_agree_on_an_infeasible_section(solver):
+    reference = solved("free", "clarabel")
+    result = solved("free", solver, "balanced")
+    assert not result.feasible and result.friction == "plus"
+    # the cvxpy path returns no multipliers, so it is not polished: an interior point
+    # at gap 1e-8, whose vertex forces were measured 1.8e-5 of the largest from the optimum
+    tolerance = 1e-4 if solver == "clarabel-cvxpy" else 1e-8
+    assert result.moi_factor == pytest.approx(reference.moi_factor, rel=tolerance / 10)
+    np.testing.assert_allclose(result.x, reference.x, rtol=0,
+                               atol=tolerance * scale(reference))
+
+
+def test_direct_and_cvxpy_paths_agree_without_polish():
+    # the fast preset does not polish: the raw interior-point points are compared
+    direct = solved("cyclic", "clarabel", "fast")
+    reference = solved("cyclic", "clarabel-cvxpy", "fast")
+    assert [a["solver"] for a in direct.attempts] == ["clarabel"]
+    np.testing.assert_allclose(direct.x, reference.x, rtol=0, atol=1e-4 * scale(reference))
+
+
+def test_newton_certifies_infeasibility_and_the_lp_agrees():
+    m = small("free")
+    result = solve_rbe(m.blocks, m.interfaces, friction="net", solver="newton", lp_check=True)
+    assert result.status == "infeasible" and result.x is None and not result.feasible
+    assert result.lp_feasible is False
+
+
+@pytest.mark.parametrize("accuracy", ACCURACIES)
+@pytest.mark.parametrize("boundary", ["free", "cyclic"])
+def test_presets_meet_their_residuals(accuracy, boundary):
+    result = solved(boundary, None, accuracy)
+    limit = ACCURACY[accuracy].residual
+    assert result.x is not None and result.accuracy == accuracy
+    assert result.residual_eq <= limit and result.friction_violation <= limit
+    assert result.feasible is (boundary == "cyclic")
+
+
+def test_polish_finds_the_exact_optimum():
+    # Clarabel stops in the interior: tension residue on a feasible structure; the
+    # Newton polish lands on the vertex solution with none
+    raw = solved("cyclic", "clarabel", "fast")
+    polished = solved("cyclic", "clarabel", "accurate")
+    assert raw.moi > 0 and polished.moi == 0.0
+    assert polished.attempts[-1]["solver"] == "newton-polish"
+    assert polished.residual_eq < 1e-12
+
+
+# ---------------------------------------------------------------------- reuse
+@pytest.mark.parametrize("solver", ["newton", "osqp", "clarabel"])
+def test_reuse_between_friction_coefficients_changes_nothing(solver):
+    m = small("free")
+    prepared = problem(m)
+    for mu in (1.5, 0.4, 5.0):
+        again = prepared.solve(mu=mu, friction="plus" if solver != "newton" else "net",
+                               solver=solver, lp_check=False)
+        fresh = solve_rbe(m.blocks, m.interfaces, mu=mu, solver=solver,
+                          friction="plus" if solver != "newton" else "net")
+        assert again.feasible == fresh.feasible and again.status == fresh.status
+        if fresh.x is not None:
+            np.testing.assert_allclose(again.x, fresh.x, rtol=0, atol=1e-5 * scale(fresh))
+
+
+def test_a_second_solve_starts_from_the_first():
+    prepared = problem(small("cyclic"))
+    first = prepared.solve()
+    second = prepared.solve()
+    assert first.iterations > 0 and second.iterations == 0
+    np.testing.assert_allclose(first.x, second.x, rtol=0, atol=1e-12 * scale(first))
+
+
+def test_density_only_scales_the_forces():
+    prepared = problem(small("cyclic"))
+    light = prepared.solve(density=20.0)
+    heavy = prepared.solve(density=2.0e6)
+    np.testing.assert_allclose(heavy.x, light.x * 1e5, rtol=0, atol=1e-9 * scale(heavy))
+    assert heavy.weight_N == pytest.approx(light.weight_N * 1e5)
+
+
+# ---------------------------------------------------------------------- bench
+def test_bench_rows_tables_and_frontier(tmp_path):
+    rows = bench(presets=("3",), scenes=("cyclic",), accuracies=("fast", "accurate"),
+                 repeats=2, solvers=("clarabel-cvxpy",), overrides={"p": 5})
+    assert [r["accuracy"] for r in rows] == ["accurate", "fast", "balanced"]
+    for row in rows:
+        assert set(COLUMNS) <= set(row)
+        assert row["total_s"] >= row["solve_s"] >= row["lp_s"] >= 0
+        assert row["residual_eq"] <= 1e-5 and row["feasible"]
+    reference, fast, cvxpy = rows
+    assert reference["force_deviation"] == 0.0 and reference["lp_s"] > 0
+    assert fast["force_deviation"] < 1e-9  # Newton's exact optimum
+    assert 0 < cvxpy["force_deviation"] < 1e-4  # an unpolished interior point
+    markdown = table_markdown(rows)
+    assert markdown.count("\n") == len(rows) + 2
+    assert table_csv(rows).decode().splitlines()[0].split(",") == list(COLUMNS)
+    assert frontier_png(rows)[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_bench_command_writes_its_files(tmp_path, capsys):
+    code = main(["bench", "--presets", "3", "--p", "5", "--scenes", "section",
+                 "--accuracy", "balanced", "--repeats", "1", "--out", str(tmp_path), "-q"])
+    assert code == 0
+    for name in ("bench.csv", "bench.md", "frontier.png"):
+        assert (tmp_path / "bench" / name).is_file()
+    assert "| 3 | section |" in capsys.readouterr().out
