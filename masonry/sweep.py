@@ -12,6 +12,7 @@ serially.
 
 import dataclasses
 import itertools
+import json
 import logging
 import time
 import traceback
@@ -118,6 +119,20 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     return row
 
 
+def run_after(previous, inputs: dict, out_root, **options) -> dict:
+    """:func:`run_variant` once ``previous`` (the row of the variant that built the shared
+    geometry) is done: Dask passes the finished result in, which orders the two."""
+    return run_variant(inputs, out_root, **options)
+
+
+def geometry_group(inputs: dict) -> str:
+    """Variants with the same group share their geometry and interfaces (the cache key)."""
+    try:
+        return json.dumps(Params(**inputs).geometry_key, sort_keys=True, default=str)
+    except (TypeError, ValueError):  # an invalid variant: alone, to fail on its own
+        return json.dumps(inputs, sort_keys=True, default=str)
+
+
 def execute(study: Study, out_root, workers=1, scheduler=None):
     """Run every variant; yield ``(index, inputs, row)`` as each finishes.
 
@@ -139,9 +154,18 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
                                host="127.0.0.1", dashboard_address=None)
     client = Client(cluster if cluster is not None else scheduler)
     try:
-        futures = {client.submit(run_variant, inputs, str(out_root), **options,
-                                 key=f"variant-{i}-{time.time_ns()}", pure=False): i
-                   for i, inputs in enumerate(variants)}
+        # the first variant of each geometry builds it; the others of its group wait for
+        # it and reuse the cached geometry instead of building it again in parallel
+        first, futures = {}, {}
+        for i, inputs in enumerate(variants):
+            key, group = f"variant-{i}-{time.time_ns()}", geometry_group(inputs)
+            if group in first:
+                future = client.submit(run_after, first[group], inputs, str(out_root),
+                                       **options, key=key, pure=False)
+            else:
+                future = first[group] = client.submit(run_variant, inputs, str(out_root),
+                                                      **options, key=key, pure=False)
+            futures[future] = i
         for future in as_completed(futures):
             i = futures[future]
             try:
