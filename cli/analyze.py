@@ -1,12 +1,12 @@
 """``masonry analyze``: interfaces and rigid block equilibrium of blocks read from files."""
 
 from masonry.assembly import load_assembly
-from masonry.params import FRICTIONS, SOLVERS, Params, validate
+from masonry.params import Params, validate
 from masonry.pipeline import run
 
-from .options import add_output_options, rbe_summary, summary
+from .options import add_analysis_options, add_output_options, rbe_summary, summary
 
-ANALYSIS = ("mu", "density", "friction", "solver", "fast")
+ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast")
 
 
 def register(subparsers):
@@ -24,14 +24,8 @@ def register(subparsers):
                    help="every block reaching down to z <= Z (metres) is a support")
     g.add_argument("--ground", action="store_true",
                    help="add a ground slab (a support) under the lowest blocks")
-    g = parser.add_argument_group("analysis")
-    g.add_argument("--mu", type=float, help="friction coefficient (default 0.7)")
-    g.add_argument("--density", type=float, help="kg/m^3 (default 2000)")
-    g.add_argument("--friction", choices=FRICTIONS,
-                   help="net, plus, or auto (net, then plus if infeasible; default)")
-    g.add_argument("--solver", choices=SOLVERS,
-                   help="QP solver: clarabel (interior point, default) or osqp")
-    g.add_argument("--fast", action="store_true", default=None,
+    add_analysis_options(parser, boundary=False)
+    parser.add_argument("--fast", action="store_true", default=None,
                    help="reduced output: one view, lower resolution")
     add_output_options(parser)
     parser.set_defaults(handler=handle)

@@ -59,7 +59,8 @@ def add_arch_options(parser, thickness=True):
                    help="depth along y (default 1)")
 
 
-def add_analysis_options(parser):
+def add_analysis_options(parser, boundary=True):
+    """Friction, density and solver options; ``boundary`` adds a section's boundary."""
     g = parser.add_argument_group("analysis")
     g.add_argument("--mu", type=float, help="friction coefficient (default 0.7)")
     g.add_argument("--density", type=float, help="kg/m^3 (default 2000)")
@@ -73,6 +74,8 @@ def add_analysis_options(parser):
                    help="override the preset's QP solver: newton (semismooth Newton, "
                         "friction-net), clarabel (interior point), osqp (ADMM), or "
                         "clarabel-cvxpy / osqp-cvxpy (through cvxpy, the reference)")
+    if not boundary:
+        return
     g.add_argument("--boundary", choices=BOUNDARIES,
                    help="boundary of a section: free (free-standing, default), rigid "
                         "(immovable neighbouring webs) or cyclic (exact rotational symmetry)")

@@ -134,6 +134,17 @@ def _choose(candidates, start, below):
     return min(candidates, key=key)
 
 
+def _lay(rows, course, start, pieces, miter_first, miter_last) -> list:
+    """Append the bricks of ``pieces`` (lengths from ``start``) to ``rows``; return the
+    joints between them."""
+    edges = start + np.concatenate([[0.0], np.cumsum(pieces)])
+    for i, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
+        klass = REG if abs(b - a - REGULAR) < 1e-6 else FILL
+        rows.append((course, a, b, klass, miter_first and i == 0,
+                     miter_last and i == len(pieces) - 1))
+    return list(edges[1:-1])
+
+
 def fill_courses(half_width, pattern: Pattern, min_fill: float = 1.0,
                  miter: bool = True) -> Layout:
     """Lay every course: pattern bricks, then regular and fill-in bricks between them.
@@ -196,29 +207,17 @@ def fill_courses(half_width, pattern: Pattern, min_fill: float = 1.0,
                     short += 2
                 else:
                     pieces = _choose(_side_candidates(v - u, min_fill), u, below)
-                mirrored = u < -_EPS or v < -_EPS
-                for start, parts, lb, rb in (
-                        (u, pieces, u_bound, v_bound),
-                        (-v, pieces[::-1], v_bound, u_bound)) if mirrored else (
-                        (u, pieces, u_bound, v_bound),):
-                    edges_s = start + np.concatenate([[0.0], np.cumsum(parts)])
-                    for i, (a, b) in enumerate(zip(edges_s[:-1], edges_s[1:])):
-                        klass = REG if abs(b - a - REGULAR) < 1e-6 else FILL
-                        rows.append((k, a, b, klass, miter and lb and i == 0,
-                                     miter and rb and i == len(parts) - 1))
-                    joints.extend(edges_s[1:-1])
+                joints += _lay(rows, k, u, pieces, miter and u_bound, miter and v_bound)
+                if u < -_EPS or v < -_EPS:  # its mirror image on the right
+                    joints += _lay(rows, k, -v, pieces[::-1], miter and v_bound,
+                                   miter and u_bound)
             elif u < -_EPS:  # the centre sequence
                 if v - u < min_fill - _EPS:
                     pieces = [v - u]
                     short += 1
                 else:
                     pieces = _choose(_centre_candidates(v - u, min_fill), u, below)
-                edges_s = u + np.concatenate([[0.0], np.cumsum(pieces)])
-                for i, (a, b) in enumerate(zip(edges_s[:-1], edges_s[1:])):
-                    klass = REG if abs(b - a - REGULAR) < 1e-6 else FILL
-                    rows.append((k, a, b, klass, miter and u_bound and i == 0,
-                                 miter and v_bound and i == len(pieces) - 1))
-                joints.extend(edges_s[1:-1])
+                joints += _lay(rows, k, u, pieces, miter and u_bound, miter and v_bound)
         joints = np.sort(np.array(joints))
         repeated[k - 1] = _score(joints, below)[0]
         below = joints

@@ -4,7 +4,7 @@ import functools
 
 import numpy as np
 import pytest
-from conftest import PRESETS
+from conftest import PRESETS, support_force
 
 from masonry.boundary import analysis_model
 from masonry.interfaces import INTERFACE_KINDS
@@ -98,9 +98,7 @@ def test_full_dome_support_reaction_equals_weight():
     itf = model.interfaces
     forces = result.per_interface()
     ground = itf.kind == SUPPORT
-    n, t1, t2 = itf.normal[ground], itf.t1[ground], itf.t2[ground]
-    total = (-forces["normal"][ground, None] * n + forces["t1"][ground, None] * t1
-             + forces["t2"][ground, None] * t2).sum(axis=0)
+    total = support_force(itf, forces, ground)
     np.testing.assert_allclose(total, [0, 0, result.weight_N], atol=1e-6 * result.weight_N)
     assert result.residual_eq <= 1e-5
 

@@ -4,7 +4,7 @@ import functools
 
 import numpy as np
 import pytest
-from conftest import PRESETS, scene_of
+from conftest import PRESETS, scene_of, support_force
 
 from masonry.interfaces import INTERFACE_KINDS, detect
 from masonry.solve import solve_rbe
@@ -82,8 +82,5 @@ def test_support_reactions_balance_the_weight_on_a_section():
     result = solved("3")
     forces = result.per_interface()
     ground = interfaces.kind == SUPPORT
-    # the total force the ground exerts on the bricks: normal and friction components
-    n, t1, t2 = interfaces.normal[ground], interfaces.t1[ground], interfaces.t2[ground]
-    total = (-forces["normal"][ground, None] * n + forces["t1"][ground, None] * t1
-             + forces["t2"][ground, None] * t2).sum(axis=0)
+    total = support_force(interfaces, forces, ground)
     np.testing.assert_allclose(total, [0, 0, result.weight_N], atol=1e-6 * result.weight_N)
