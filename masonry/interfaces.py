@@ -328,7 +328,14 @@ def _intersect(blocks, main, comp, tol, up):
     row_m, xyz_m, _, count_m = _face_vertex_rows(blocks, main)
     main_poly = _polygons_2d(xyz_m, row_m, count_m, origin, t1[main], t2[main])
 
-    overlap = _polygon_part(shapely.intersection(main_poly, comp_poly, grid_size=tol.grid))
+    overlap = shapely.intersection(main_poly, comp_poly)
+    # GEOS's plain overlay can fail on coincident polygons (points instead of the
+    # polygon); snap rounding on a fine grid is robust but twice as slow, so only the
+    # pairs that did not come back as one polygon are redone with it
+    retry = shapely.get_type_id(overlap) != shapely.GeometryType.POLYGON
+    overlap[retry] = shapely.intersection(main_poly[retry], comp_poly[retry],
+                                          grid_size=tol.grid)
+    overlap = _polygon_part(overlap)
     keep = (shapely.get_type_id(overlap) == shapely.GeometryType.POLYGON) & (
         shapely.area(overlap) > tol.min_area_rel * np.minimum(area[main], area[comp]))
     # drop collinear and duplicate vertices, then make every ring counter-clockwise
