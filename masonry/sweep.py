@@ -233,7 +233,6 @@ def summary_pngs(study: Study, rows) -> dict:
         labels = sorted({str(v) for v in x}) if not numeric else None
         xs = x if numeric else [labels.index(str(v)) for v in x]
         top.scatter(xs, [r["moi_factor"] for r in done], c="C3", s=18)
-        top.set_yscale("symlog", linthresh=1e-3)
         top.set_ylabel("MoI factor")
         bottom.scatter(xs, [1 if r["feasible"] else 0 for r in done], c="C0", s=18)
         bottom.set_yticks([0, 1], ["infeasible", "feasible"])
