@@ -38,6 +38,7 @@ from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
+from .meshing import merge_vertices
 from .blocks import BLOCK_CLASSES, Blocks, concatenate, tangent_basis
 from .tolerances import Tolerances
 
@@ -282,17 +283,9 @@ class _Soup:
         # coincident vertices of one block: a k-d tree over all, pairs kept within a block
         pairs = cKDTree(vertices).query_pairs(distance, output_type="ndarray")
         pairs = pairs[owner[pairs[:, 0]] == owner[pairs[:, 1]]]
-        if len(pairs):
-            n = len(vertices)
-            graph = coo_array((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
-            _, label = connected_components(graph, directed=False)
-            # the smallest index of each cluster stands for it (same block: same range)
-            first = np.full(label.max() + 1, n)
-            np.minimum.at(first, label, np.arange(n))
-            triangles = first[label][triangles]
-        keep = ((triangles[:, 0] != triangles[:, 1]) & (triangles[:, 1] != triangles[:, 2])
-                & (triangles[:, 2] != triangles[:, 0]))
-        used, triangles = np.unique(triangles[keep], return_inverse=True)
+        # the smallest index of each cluster stands for it (same block: same range)
+        triangles, keep = merge_vertices(triangles, pairs, len(vertices))
+        used, triangles = np.unique(triangles, return_inverse=True)
         return _Soup(self.names, vertices[used], triangles.reshape(-1, 3),
                      self.triangle_block[keep], self.split_bodies)
 

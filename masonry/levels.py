@@ -131,7 +131,7 @@ def level_table(params: Params, dims: Dimensions | None = None) -> LevelTable:
         theta1 = _next_theta(a, c, theta0, h)
         if theta1 is None:
             break
-        p0, p1 = _ellipse(a, c, theta0), _ellipse(a, c, theta1)
+        p1 = _ellipse(a, c, theta1)
         if p1[1] > z_limit or 2 * p1[0] * tan < params.min_fill * h:
             break
         thetas.append(theta1)

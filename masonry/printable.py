@@ -35,6 +35,7 @@ import time
 import numpy as np
 
 from .blocks import Blocks
+from .meshing import merge_vertices
 from .tolerances import Tolerances
 
 log = logging.getLogger(__name__)
@@ -331,25 +332,15 @@ def _collapse_short_edges(vertices, faces, distance):
     -------
     vertices : (V', 3) float, faces : (T', 3) int, collapsed : int
     """
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
     edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
     edges = edges[edges[:, 0] < edges[:, 1]]  # each interior edge once
     short = edges[np.linalg.norm(vertices[edges[:, 0]] - vertices[edges[:, 1]], axis=1)
                   < distance]
     if len(short) == 0:
         return vertices, faces, 0
-    n = len(vertices)
-    graph = coo_matrix((np.ones(len(short)), (short[:, 0], short[:, 1])), shape=(n, n))
-    _, label = connected_components(graph, directed=False)
-    keeper = np.full(label.max() + 1, n)
-    np.minimum.at(keeper, label, np.arange(n))
-    faces = keeper[label][faces]
-    faces = faces[(faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2])
-                  & (faces[:, 2] != faces[:, 0])]
+    faces, _ = merge_vertices(faces, short, len(vertices))
     used = np.unique(faces)
-    index = np.full(n, -1)
+    index = np.full(len(vertices), -1)
     index[used] = np.arange(len(used))
     return np.ascontiguousarray(vertices[used]), index[faces], len(short)
 

@@ -29,8 +29,6 @@ def fixtures_dir():
 def support_force(interfaces, forces, mask):
     """(3,) newtons: the total force the main blocks of ``mask``'s interfaces (the
     supports) exert on the blocks they carry: normal and friction components."""
-    import numpy as np
-
     n, t1, t2 = interfaces.normal[mask], interfaces.t1[mask], interfaces.t2[mask]
     return (-forces["normal"][mask, None] * n + forces["t1"][mask, None] * t1
             + forces["t2"][mask, None] * t2).sum(axis=0)
