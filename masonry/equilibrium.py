@@ -145,9 +145,6 @@ class EquilibriumSystem:
     f_ext : (6 F,) float, dimensionless
         Self weight in the same units (moment rows are zero: the weight acts at the
         centroid).
-    A_fr : dict str -> (4 IV, n) scipy.sparse.csr_array
-        ``'net'`` and ``'plus'`` friction pyramids (thesis eq. 3.26, 3.25). Rows of
-        vertex ``i``: ``4 i + (0, 1, 2, 3)`` bound ``+f1, -f1, +f2, -f2``.
     lower : (n,) float
         0 for c and t, ``-inf`` for f1 and f2.
     h : (n,) float
@@ -169,13 +166,18 @@ class EquilibriumSystem:
         ``A_eq D A_eq^T`` with block-diagonal ``D`` can be formed interface by interface
         (:mod:`masonry.solvers.newton`) instead of by sparse products.
     density : float, kg/m^3
+
+    Attributes
+    ----------
+    A_fr : dict str -> (4 IV, n) scipy.sparse.csr_array
+        ``'net'`` and ``'plus'`` friction pyramids (thesis eq. 3.26, 3.25), for ``mu``.
+        Rows of vertex ``i``: ``4 i + (0, 1, 2, 3)`` bound ``+f1, -f1, +f2, -f2``.
     """
 
     layout: VariableLayout
     free_block: np.ndarray
     A_eq: sp.csr_array
     f_ext: np.ndarray
-    A_fr: dict
     lower: np.ndarray
     h: np.ndarray
     mu: float
@@ -194,14 +196,19 @@ class EquilibriumSystem:
         since the reference weight grows with the density)."""
         out = self
         if mu is not None and float(mu) != self.mu:
-            out = dataclasses.replace(out, A_fr=friction_pyramids(self.layout.n_vertices, mu),
-                                      mu=float(mu))
+            out = dataclasses.replace(out, mu=float(mu))
         if density is not None and float(density) != self.density:
             ratio = float(density) / self.density
             out = dataclasses.replace(out, block_weight=self.block_weight * ratio,
                                       weight_ref=self.weight_ref * ratio,
                                       density=float(density))
         return out
+
+    @cached_property
+    def A_fr(self) -> dict:
+        """The friction pyramids (see :func:`friction_pyramids`), built on first use: the
+        solvers other than the cvxpy reference do not need them as matrices."""
+        return friction_pyramids(self.layout.n_vertices, self.mu)
 
     @property
     def total_weight(self) -> float:
@@ -323,7 +330,7 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     lower = np.tile([0.0, 0.0, -np.inf, -np.inf], n_vertices)
     h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], n_vertices)
     return EquilibriumSystem(layout=layout, free_block=free_block, A_eq=A_eq,
-                             f_ext=f_ext.ravel(), A_fr=friction_pyramids(n_vertices, mu),
+                             f_ext=f_ext.ravel(),
                              lower=lower, h=h, mu=float(mu), block_weight=block_weight,
                              weight_ref=weight_ref, length_ref=length_ref,
                              side_row=block_row[side_block],

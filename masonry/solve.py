@@ -447,9 +447,14 @@ def _check(system: EquilibriumSystem, x_scaled, method: str):
     residual_eq = (np.abs(system.A_eq @ x_scaled + system.f_ext).max()
                    / np.abs(system.f_ext).max())
     bound = max(0.0, float((system.lower - x_scaled).max()))
+    # the rows of A_fr, vertex by vertex: max(|f1|, |f2|) - mu (c - t) (friction-net) or
+    # - mu c (friction+), without building the matrices
+    c, t, f1, f2 = np.asarray(x_scaled).reshape(-1, 4).T
+    friction = np.maximum(np.abs(f1), np.abs(f2))
 
     def violation(name):
-        return max(bound, float((system.A_fr[name] @ x_scaled).max(initial=0.0)))
+        load = c - t if name == "net" else c
+        return max(bound, float((friction - system.mu * load).max(initial=0.0)))
 
     return float(residual_eq), violation(method), violation("net")
 
