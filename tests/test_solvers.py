@@ -203,6 +203,17 @@ def test_presets_meet_their_residuals(accuracy, boundary):
     assert result.feasible is (boundary == "cyclic")
 
 
+@pytest.mark.parametrize("boundary", ["free", "cyclic"])
+def test_the_accurate_preset_has_the_lp_confirm_infeasible_verdicts(boundary):
+    result = problem(small(boundary)).solve(accuracy="accurate")
+    if result.feasible:
+        assert result.lp_feasible is None and result.lp_time_s == 0.0
+    else:
+        assert result.lp_feasible is False and result.lp_time_s > 0.0
+    with pytest.raises(ValueError, match="lp_check"):
+        problem(small(boundary)).solve(lp_check="always")
+
+
 def test_polish_finds_the_exact_optimum():
     # Clarabel stops in the interior: tension residue on a feasible structure; the
     # Newton polish lands on the vertex solution with none
@@ -254,7 +265,8 @@ def test_bench_rows_tables_and_frontier(tmp_path):
         assert row["total_s"] >= row["solve_s"] >= row["lp_s"] >= 0
         assert row["residual_eq"] <= 1e-5 and row["feasible"]
     reference, fast, cvxpy = rows
-    assert reference["force_deviation"] == 0.0 and reference["lp_s"] > 0
+    # a feasible verdict rests on its verified point: no LP
+    assert reference["force_deviation"] == 0.0 and reference["lp_s"] == 0.0
     assert fast["force_deviation"] < 1e-9  # Newton's exact optimum
     assert 0 < cvxpy["force_deviation"] < 1e-4  # an unpolished interior point
     markdown = table_markdown(rows)
