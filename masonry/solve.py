@@ -304,8 +304,10 @@ class RBEProblem:
                 if accepted or outcome.status == INFEASIBLE:
                     break
                 if name != names[-1]:
-                    log.warning("%s found no %s solution (%s); trying %s", name, method,
-                                outcome.status, names[-1])
+                    # the presets' planned fallback (Newton neither converged nor
+                    # certified infeasibility, as on most infeasible structures)
+                    log.info("%s found no %s solution (%s); trying %s", name, method,
+                             outcome.status, names[-1])
             if method == "net":
                 net_status = outcome.status
             if accepted:

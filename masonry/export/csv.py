@@ -1,10 +1,32 @@
-"""CSV tables: brick vertex locations (SPEC 7)."""
-
-import io
+"""CSV tables: brick vertex locations, interfaces and their forces (SPEC 5, 7)."""
 
 import numpy as np
 
 from ..blocks import BLOCK_CLASSES, Blocks
+from ._text import format_floats
+
+
+def _table(columns) -> bytes:
+    """CSV bytes: a header line, then one line per row.
+
+    Parameters
+    ----------
+    columns : sequence of (str, (n,) array)
+        Every column's name and values: int, str or float (printed by
+        :func:`~masonry.export._text.format_floats`).
+
+    Notes
+    -----
+    Columns are printed whole and joined once: formatting row by row in Python took
+    about 1 s for the dome of preset 1 (17,728 interfaces, 50,624 vertices).
+    """
+    names, texts = [], []
+    for name, value in columns:
+        value = np.asarray(value)
+        names.append(name)
+        texts.append(format_floats(value).tolist() if value.dtype.kind == "f"
+                     else list(map(str, value.tolist())))
+    return "\n".join([",".join(names), *map(",".join, zip(*texts)), ""]).encode()
 
 
 def locations_csv(blocks: Blocks, vertices=None) -> bytes:
@@ -21,48 +43,35 @@ def locations_csv(blocks: Blocks, vertices=None) -> bytes:
     owner = np.repeat(np.arange(blocks.n_blocks), counts)
     local = np.arange(len(owner)) - np.repeat(blocks.vertex_offsets[:-1], counts)
     classes = np.array(BLOCK_CLASSES, dtype=object)[blocks.block_class][owner]
-    out = io.StringIO()
-    out.write("brick,name,class,course,vertex,x,y,z\n")
-    for b, name, klass, course, v, (x, y, z) in zip(
-            owner, blocks.block_name[owner], classes, blocks.block_course[owner], local,
-            vertices):
-        out.write(f"{b},{name},{klass},{course},{v},{x:.12g},{y:.12g},{z:.12g}\n")
-    return out.getvalue().encode()
+    x, y, z = np.asarray(vertices, dtype=float).T
+    return _table([("brick", owner), ("name", blocks.block_name[owner]), ("class", classes),
+                   ("course", blocks.block_course[owner]), ("vertex", local), ("x", x),
+                   ("y", y), ("z", z)])
 
 
-def _table(header, columns) -> bytes:
-    out = io.StringIO()
-    out.write(",".join(header) + "\n")
-    for row in zip(*columns):
-        out.write(",".join(v if isinstance(v, str) else f"{v:.12g}" for v in row) + "\n")
-    return out.getvalue().encode()
-
-
-def _interface_columns(blocks: Blocks, interfaces):
+def _interface_columns(blocks: Blocks, interfaces) -> list:
     from ..interfaces import INTERFACE_KINDS
 
-    kind = np.array(INTERFACE_KINDS, dtype=object)[interfaces.kind]
-    header = ["id", "block_a", "block_b", "name_a", "name_b", "kind", "area_m2",
-              "centre_x", "centre_y", "centre_z", "normal_x", "normal_y", "normal_z"]
     a, b = interfaces.pair[:, 0], interfaces.pair[:, 1]
-    columns = [[str(i) for i in range(len(interfaces))], [str(i) for i in a],
-               [str(i) for i in b], list(blocks.block_name[a]), list(blocks.block_name[b]),
-               list(kind), interfaces.area, *interfaces.centre.T, *interfaces.normal.T]
-    return header, columns
+    kind = np.array(INTERFACE_KINDS, dtype=object)[interfaces.kind]
+    return [("id", np.arange(len(interfaces))), ("block_a", a), ("block_b", b),
+            ("name_a", blocks.block_name[a]), ("name_b", blocks.block_name[b]),
+            ("kind", kind), ("area_m2", interfaces.area),
+            *((f"centre_{axis}", v) for axis, v in zip("xyz", interfaces.centre.T)),
+            *((f"normal_{axis}", v) for axis, v in zip("xyz", interfaces.normal.T))]
 
 
 def interfaces_csv(blocks: Blocks, interfaces) -> bytes:
     """``interfaces.csv``: one row per interface (SPEC 5): blocks (main first), kind,
     area, centre, normal (from the main block into the other), vertex count."""
-    header, columns = _interface_columns(blocks, interfaces)
-    return _table(header + ["vertices"],
-                  columns + [[str(c) for c in interfaces.vertex_count]])
+    return _table(_interface_columns(blocks, interfaces)
+                  + [("vertices", interfaces.vertex_count)])
 
 
 def forces_csv(blocks: Blocks, interfaces, forces: dict) -> bytes:
     """``RBE/forces.csv``: one row per interface (SPEC 7): blocks, kind, area, centre,
     normal and the interface's resultants in newtons (compression, tension, normal force
     = tension - compression, t1, t2, friction)."""
-    header, columns = _interface_columns(blocks, interfaces)
     names = ("compression", "tension", "normal", "t1", "t2", "friction")
-    return _table(header + [f"{n}_N" for n in names], columns + [forces[n] for n in names])
+    return _table(_interface_columns(blocks, interfaces)
+                  + [(f"{n}_N", np.asarray(forces[n], dtype=float)) for n in names])

@@ -1,10 +1,9 @@
 """Wavefront OBJ of blocks: one named object per block (Rhino, trimesh, Blender)."""
 
-import io
-
 import numpy as np
 
 from ..blocks import Blocks
+from ._text import format_floats
 
 
 def blocks_obj(blocks: Blocks, vertices=None) -> bytes:
@@ -13,21 +12,30 @@ def blocks_obj(blocks: Blocks, vertices=None) -> bytes:
     Parameters
     ----------
     blocks : Blocks
+        Faces sorted by block (``face_block`` ascending).
     vertices : (V, 3) float, optional
         Vertex positions to write instead of ``blocks.vertices`` (e.g. CAD-offset ones).
     """
     vertices = blocks.vertices if vertices is None else vertices
-    out = io.StringIO()
-    out.write("# masonry blocks: one object per block, metres, z up\n")
+    # block i's lines: its "o" line, its vertices, its faces; every line's row in the
+    # file follows from the counts of the blocks before it
+    first_face = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks))
+    block_row = np.arange(blocks.n_blocks) + blocks.vertex_offsets[:-1] + first_face
+    vertex_block = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
+    vertex_row = np.arange(len(vertex_block)) + vertex_block + 1 + first_face[vertex_block]
+    face_row = (np.arange(blocks.n_faces) + blocks.face_block + 1
+                + blocks.vertex_offsets[blocks.face_block + 1])
+
+    lines = np.empty(blocks.n_blocks + len(vertex_block) + blocks.n_faces, dtype=object)
+    lines[block_row] = ["o " + name for name in blocks.block_name.tolist()]
+    xyz = format_floats(vertices).ravel().tolist()
+    lines[vertex_row] = ("v %s %s %s\n" * len(vertex_block) % tuple(xyz)).split("\n")[:-1]
+    # faces by vertex count, each count's faces as one (faces, count) array
     counts = blocks.face_polygon_count
-    face_starts = blocks.face_offsets[:-1]
-    faces_of = np.split(np.arange(blocks.n_faces), np.searchsorted(
-        blocks.face_block, np.arange(1, blocks.n_blocks)))
-    for i in range(blocks.n_blocks):
-        lo, hi = blocks.vertex_offsets[i], blocks.vertex_offsets[i + 1]
-        out.write(f"o {blocks.block_name[i]}\n")
-        np.savetxt(out, vertices[lo:hi], fmt="v %.12g %.12g %.12g")
-        for f in faces_of[i]:
-            ids = blocks.face_vertices[face_starts[f]:face_starts[f] + counts[f]] + 1
-            out.write("f " + " ".join(map(str, ids)) + "\n")
-    return out.getvalue().encode()
+    for count in np.unique(counts):
+        faces = np.flatnonzero(counts == count)
+        ids = blocks.face_vertices[blocks.face_offsets[faces][:, None] + np.arange(count)]
+        text = ("f" + " %d" * count + "\n") * len(faces) % tuple((ids + 1).ravel().tolist())
+        lines[face_row[faces]] = text.split("\n")[:-1]
+    header = "# masonry blocks: one object per block, metres, z up"
+    return "\n".join([header, *lines.tolist(), ""]).encode()

@@ -35,8 +35,8 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
     Returns
     -------
     bytes
-        zlib-compressed binary VTU. Cell data: every entry of ``forces`` (float64),
-        ``interface`` (int64, row in ``forces.csv``), ``kind`` (int8 code),
+        Binary VTU (base64, not compressed). Cell data: every entry of ``forces``
+        (float64), ``interface`` (int64, row in ``forces.csv``), ``kind`` (int8 code),
         ``area`` (m^2), ``frame_normal``, ``frame_t1``, ``frame_t2`` ((K, 3) unit
         vectors: the directions of the normal, t1 and t2 forces).
 
@@ -76,10 +76,12 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
                        cell_data=cell_data)
 
     # meshio writes to paths only (and drops field data in VTU), so the file is
-    # written to a temporary folder and the kind legend goes into a comment
+    # written to a temporary folder and the kind legend goes into a comment. Not
+    # compressed: zlib took 0.2 s of a dome's 0.25 s (17,728 interfaces), for a file
+    # 4 times smaller (1.8 MB against 6.8 MB)
     with tempfile.TemporaryDirectory() as folder:
         path = os.path.join(folder, "interfaces.vtu")
-        meshio.write(path, mesh, file_format="vtu", binary=True, compression="zlib")
+        meshio.write(path, mesh, file_format="vtu", binary=True, compression=None)
         with open(path, "rb") as f:
             data = f.read()
     legend = ", ".join(f"{code} {name}" for code, name in enumerate(kind_names))
