@@ -45,7 +45,7 @@ preset 1's full dome: 0.38 s per factorization against 0.50 s for fundamental
 supernodes only (1,888 against 4,438 supernodes; 2.9 against 2.1 GFlop)."""
 
 
-SMALL_UPDATE = 60
+SMALL_UPDATE = 120
 """Update matrices up to this size are added to their parent's front by one fancy
 index, larger ones run by run (measured: 0.077 s of 0.28 s per factorization of preset
 1's full dome went to run-by-run adds)."""
@@ -177,16 +177,7 @@ class BlockCholesky:
                              for sn in self.supernodes]
         self._scalar_order = (bs * order[:, None] + np.arange(bs)).ravel()
         self._front_buffer = None
-        # extend-add of a small update in one fancy-indexed add, of a large one by the
-        # slices of its runs of consecutive rows (fewer bytes of indices to read)
-        self._extend_positions = []
-        for sn in self.supernodes:
-            size = bs * len(sn.rows)
-            if sn.parent < 0 or size > SMALL_UPDATE or len(sn.runs) == 1:
-                self._extend_positions.append(None)
-                continue
-            rows = np.concatenate([np.arange(pa, pa + la) for _, pa, la in sn.runs])
-            self._extend_positions.append(np.ix_(rows, rows))
+        self._steps = self._numeric_plan()
 
         self.flops = 0.0
         self.nnz = 0
@@ -299,6 +290,32 @@ class BlockCholesky:
         self._local_row = local_row
         self._local_col = col - np.array([sn.first for sn in self.supernodes])[supernode]
 
+    def _numeric_plan(self):
+        """Everything :meth:`factor` needs per supernode, precomputed as one tuple:
+        (front size, pivot columns, slice of its stored blocks in :attr:`_entry_order`,
+        flat positions of their entries in the front, children, extend-add into the
+        parent). The extend-add of a small update is one add at flat positions of the
+        parent's front; a large one goes by the slices of its runs of consecutive rows
+        (fewer bytes of indices to read)."""
+        bs = self.block_size
+        inner = np.arange(bs)
+        steps = []
+        for s, sn in enumerate(self.supernodes):
+            size = bs * (sn.last - sn.first + 1 + len(sn.rows))
+            entries = slice(self._entry_split[s], self._entry_split[s + 1])
+            chosen = self._entry_order[entries]
+            row = self._local_row[chosen][:, None, None] * bs + inner[:, None]
+            col = self._local_col[chosen][:, None, None] * bs + inner[None, :]
+            extend = sn.runs
+            if sn.parent >= 0 and (bs * len(sn.rows) <= SMALL_UPDATE or len(sn.runs) == 1):
+                parent = self.supernodes[sn.parent]
+                parent_size = bs * (parent.last - parent.first + 1 + len(parent.rows))
+                rows = np.concatenate([np.arange(pa, pa + la) for _, pa, la in sn.runs])
+                extend = (rows[:, None] * parent_size + rows[None, :]).ravel()
+            steps.append((size, bs * (sn.last - sn.first + 1), entries,
+                          (row * size + col).ravel(), self._children[s], extend))
+        return steps
+
     def block_index(self, i, j) -> np.ndarray:
         """Index into :attr:`lower_rows` of the stored block holding ``(i, j)``.
 
@@ -333,44 +350,37 @@ class BlockCholesky:
         numpy.linalg.LinAlgError
             If the matrix is not (numerically) positive definite.
         """
-        bs = self.block_size
-        values = np.asarray(values, dtype=float)
-        updates = [None] * len(self.supernodes)
-        pivots, below = [], []
+        values = np.asarray(values, dtype=float)[self._entry_order].reshape(-1)
+        steps = self._steps
+        updates = [None] * len(steps)
+        pivots, below = [None] * len(steps), [None] * len(steps)
         # one buffer for every front (LAPACK and BLAS return new arrays, nothing keeps a
         # view of it): fresh fronts cost 10% of a factorization in page faults
         if self._front_buffer is None:
-            largest = max(bs * (sn.last - sn.first + 1 + len(sn.rows))
-                          for sn in self.supernodes)
-            self._front_buffer = np.empty(largest * largest)
-        for s, sn in enumerate(self.supernodes):
-            n_index = sn.last - sn.first + 1 + len(sn.rows)
-            k = bs * (sn.last - sn.first + 1)
-            front = self._front_buffer[:(bs * n_index) ** 2].reshape(bs * n_index, -1)
-            front.fill(0.0)
-            sel = self._entry_order[self._entry_split[s]:self._entry_split[s + 1]]
-            front.reshape(n_index, bs, n_index, bs)[
-                self._local_row[sel], :, self._local_col[sel], :] = values[sel]
-            pivots.append(None)
-            below.append(None)
-            for child in self._children[s]:
-                update = updates[child]
+            self._front_buffer = np.empty(max(step[0] for step in steps) ** 2)
+        buffer = self._front_buffer
+        entry = self.block_size ** 2
+        for s, (size, k, entries, positions, children, _) in enumerate(steps):
+            flat = buffer[:size * size]
+            flat.fill(0.0)
+            flat[positions] = values[entry * entries.start:entry * entries.stop]
+            front = flat.reshape(size, size)
+            for child in children:
+                update, extend = updates[child], steps[child][5]
                 updates[child] = None
-                positions = self._extend_positions[child]
-                if positions is not None:
-                    front[positions] += update
+                if isinstance(extend, np.ndarray):
+                    flat[extend] += update.reshape(-1)
                     continue
-                runs = self.supernodes[child].runs
                 # lower triangle only: the update is valid there (dsyrk)
-                for a, (ca, pa, la) in enumerate(runs):
-                    for cb, pb, lb in runs[:a + 1]:
+                for a, (ca, pa, la) in enumerate(extend):
+                    for cb, pb, lb in extend[:a + 1]:
                         front[pa:pa + la, pb:pb + lb] += update[ca:ca + la, cb:cb + lb]
             l11, info = lapack.dpotrf(front[:k, :k], lower=1, clean=1)
             if info != 0:
                 raise np.linalg.LinAlgError(
                     f"matrix not positive definite (supernode {s}, pivot {info})")
             pivots[s] = l11
-            if len(sn.rows):
+            if size > k:
                 l21 = blas.dtrsm(1.0, l11, front[k:, :k], side=1, lower=1, trans_a=1)
                 below[s] = l21
                 updates[s] = blas.dsyrk(-1.0, l21, beta=1.0, c=front[k:, k:], lower=1)
