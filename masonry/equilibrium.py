@@ -299,7 +299,9 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
                           interfaces.t2[vertex_interface]], axis=1)
     columns = (layout.WIDTH * np.arange(n_vertices))[:, None] + np.arange(layout.WIDTH)
 
-    rows, cols, vals, side_coefficients = [], [], [], []
+    # every column (a vertex's c, t, f1 or f2) has six rows on each side's block: build
+    # A_eq column by column in CSC form, no triplet sort (0.1 s on preset 1's full dome)
+    side_rows, side_coefficients = [], []
     for side, sign in ((0, -1.0), (1, 1.0)):
         block = side_block[vertex_interface, side]
         side_direction, side_point = sign * direction, point
@@ -310,19 +312,30 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
         arm = (side_point - blocks.block_centroid[block]) / length_ref
         moment = np.cross(arm[:, None, :], side_direction)
         coeff = np.concatenate([side_direction, moment], axis=2)  # (IV, 4, 6)
-        row = 6 * block_row[block][:, None, None] + np.arange(6)[None, None, :]
         # drop rows of supports, and the zeros and rounding noise of axis-aligned frames
         # (about 40% of the triplets of a wall; HiGHS warns about them and every solver
         # would carry them)
         keep = (block_row[block] >= 0)[:, None, None] & (np.abs(coeff) > COEFFICIENT_NOISE)
         side_coefficients.append(np.where(keep, coeff, 0.0).transpose(0, 2, 1))
-        rows.append(np.broadcast_to(row, coeff.shape)[keep])
-        cols.append(np.broadcast_to(columns[:, :, None], coeff.shape)[keep])
-        vals.append(coeff[keep])
+        side_rows.append(np.maximum(block_row[block], 0))
+    # rows of a column in increasing order: the side on the lower block first
+    swap = side_rows[0] > side_rows[1]
+    first = np.where(swap, side_rows[1], side_rows[0])
+    second = np.where(swap, side_rows[0], side_rows[1])
+    offsets = np.arange(6)
+    indices = np.concatenate([6 * first[:, None] + offsets, 6 * second[:, None] + offsets],
+                             axis=1)                                     # (IV, 12)
+    low = np.where(swap[:, None, None], side_coefficients[1], side_coefficients[0])
+    high = np.where(swap[:, None, None], side_coefficients[0], side_coefficients[1])
+    data = np.concatenate([low, high], axis=1).transpose(0, 2, 1)       # (IV, 4, 12)
     shape = (6 * len(free_block), layout.n_columns)
-    # COO -> CSR sums duplicates: a vertex routed twice to one block adds up
-    A_eq = sp.coo_array((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                        shape=shape).tocsr()
+    # both sides on one block (cyclic symmetry routes an image onto the brick it copies)
+    # add up; then the dropped coefficients go
+    A_eq = sp.csc_array((data.ravel(), np.repeat(indices[:, None, :], layout.WIDTH, axis=1)
+                         .ravel(), np.arange(0, 12 * layout.n_columns + 1, 12)), shape=shape)
+    A_eq.sum_duplicates()
+    A_eq.eliminate_zeros()
+    A_eq = A_eq.tocsr()
 
     f_ext = np.zeros((len(free_block), 6))
     f_ext[:, 2] = -block_weight[free_block] / weight_ref
