@@ -30,7 +30,7 @@ log = logging.getLogger(__name__)
 
 G = 9.81  # m/s^2, SPEC 2
 
-PACKAGES = ("numpy", "scipy", "trimesh", "manifold3d", "shapely", "cvxpy", "osqp",
+PACKAGES = ("numpy", "scipy", "trimesh", "manifold3d", "cvxpy", "osqp", "highspy",
             "clarabel", "meshio", "matplotlib")
 
 

@@ -34,12 +34,6 @@ class Tolerances:
     residual : float
         Largest accepted relative equilibrium residual ``||A x + f||_inf / ||f||_inf``
         and relative friction violation for a result to count as solved.
-    grid_rel : float
-        Precision grid of the polygon overlay (shapely's ``grid_size``), relative to
-        ``scale``. Snap rounding makes intersections of coincident polygons robust: without
-        it GEOS returned two points for two identical quadrilaterals 3e-17 m apart (the
-        mitered end faces of neighbouring webs). Used where the plain overlay does not give
-        one polygon (it doubles the overlay's time).
     """
 
     scale: float = 1.0
@@ -48,17 +42,11 @@ class Tolerances:
     min_area_rel: float = 1e-4
     length_rel: float = 1e-9
     residual: float = 1e-5
-    grid_rel: float = 1e-12
 
     @property
     def contact(self) -> float:
         """Contact distance in metres."""
         return self.contact_rel * self.scale
-
-    @property
-    def grid(self) -> float:
-        """Polygon overlay grid in metres."""
-        return self.grid_rel * self.scale
 
     @property
     def length(self) -> float:

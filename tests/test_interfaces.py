@@ -4,9 +4,17 @@ import itertools
 
 import numpy as np
 import pytest
+import shapely
 
 from masonry.blocks import Blocks
-from masonry.interfaces import INTERFACE_KINDS, candidate_pairs, detect
+from masonry.interfaces import (
+    INTERFACE_KINDS,
+    _area_centroid,
+    _clean,
+    _clip_convex,
+    candidate_pairs,
+    detect,
+)
 from masonry.tolerances import Tolerances
 
 KIND = {name: code for code, name in enumerate(INTERFACE_KINDS)}
@@ -44,7 +52,7 @@ def running_bond_wall(courses=WALL_COURSES, n_full=WALL_FULL):
         else:
             joints = np.concatenate([[0.0], np.arange(2.0, length, 4.0), [length]])
         boxes += [([0.0, y0, course], [2.0, y1, course + 1.0])
-                  for y0, y1 in zip(joints[:-1], joints[1:])]
+                  for y0, y1 in itertools.pairwise(joints)]
     boxes = np.array(boxes)
     corners = np.array([box_corners(lo, hi) for lo, hi in boxes])
     block_class = ["ground"] + ["regular"] * (len(boxes) - 1)
@@ -346,3 +354,56 @@ def test_candidate_pairs_grow_linearly(n_full):
     pairs = candidate_pairs(blocks, Tolerances.for_points(blocks.vertices))
     assert len(pairs) <= 3 * blocks.n_blocks
     assert len(detect(blocks)) == len(pairs)
+
+
+# ---------------------------------------------------------------------- polygon clipping
+def convex_polygon(rng, centre, count):
+    """A random convex polygon: the hull of ``count`` points, (m, 2) counter-clockwise."""
+    points = centre + rng.normal(size=(count, 2))
+    return shapely.get_coordinates(shapely.convex_hull(shapely.multipoints(points)))[:-1][::-1]
+
+
+def padded(polygons):
+    """(2, W, S) float from a list of (m, 2) polygons, each padded with its last vertex."""
+    width = max(len(p) for p in polygons)
+    return np.stack([np.concatenate([p, np.repeat(p[-1:], width - len(p), axis=0)])
+                     for p in polygons], axis=-1).transpose(1, 0, 2)
+
+
+def clipping_cases():
+    """Pairs of convex polygons: random ones, and the degenerate ones masonry is full of
+    (identical faces, shared edges and corners, containment, touching corners, collinear
+    vertices)."""
+    rng = np.random.default_rng(11)
+    square = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0]])
+    pairs = [(convex_polygon(rng, [0, 0], int(rng.integers(3, 8))),
+              convex_polygon(rng, rng.uniform(-2, 2, 2), int(rng.integers(3, 8))))
+             for _ in range(300)]
+    pairs += [(square, square), (square, square + [1.0, 0.0]), (square, square + [2.0, 0.0]),
+              (square, square + [2.0, 1.0]), (square, 0.5 * square + [0.5, 0.25]),
+              (0.5 * square + [0.5, 0.25], square), (square, square[[1, 2, 3, 0]] + [0, 0.5]),
+              (square, np.array([[1.0, 0.0], [3.0, 1.0], [1.0, 1.0]])),
+              # a face with a vertex in the middle of an edge (an imported mesh's)
+              (np.insert(square, 1, [1.0, 0.0], axis=0), 2 * square - 0.5)]
+    return pairs
+
+
+def test_convex_clipping_matches_shapely():
+    pairs = clipping_cases()
+    subject, clip = padded([p for p, _ in pairs]), padded([q for _, q in pairs])
+    xy = _clip_convex(subject, clip, 1e-12)
+    area, centroid = _area_centroid(xy)
+    expected = shapely.intersection([shapely.Polygon(p) for p, _ in pairs],
+                                    [shapely.Polygon(q) for _, q in pairs])
+    np.testing.assert_allclose(area, shapely.area(expected), rtol=1e-9, atol=1e-12)
+    overlap = area > 1e-9
+    assert overlap.sum() > 100
+    np.testing.assert_allclose(centroid[:, overlap].T,
+                               shapely.get_coordinates(shapely.centroid(expected[overlap])),
+                               atol=1e-9)
+    # after cleaning: the vertices of the exact intersection, without repeats
+    xy, count = _clean(xy[..., overlap], 1e-12)
+    simplified = shapely.simplify(expected[overlap], 1e-12)
+    assert count.tolist() == (shapely.get_num_coordinates(simplified) - 1).tolist()
+    np.testing.assert_allclose(_area_centroid(xy)[0], shapely.area(expected[overlap]),
+                               rtol=1e-9)
