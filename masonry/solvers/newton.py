@@ -113,41 +113,39 @@ def project_pyramid(p, mu):
         face or the edge where the projection lands, zero at the apex.
     """
     c = p[:, 0]
-    sign1 = np.where(p[:, 1] >= 0, 1.0, -1.0)
-    sign2 = np.where(p[:, 2] >= 0, 1.0, -1.0)
-    # by symmetry work with |f1|, |f2| (the projection keeps the signs)
+    sign = np.where(p[:, 1:] >= 0, 1.0, -1.0)
+    # by symmetry work with |f1|, |f2|; the signs are put back on the faces' normals
     a, b = np.abs(p[:, 1]), np.abs(p[:, 2])
     norm = 1.0 + mu * mu
     x = np.zeros_like(p)
     jacobian = np.zeros((len(p), 3, 3))
 
-    inside = (a <= mu * c) & (b <= mu * c)
-    x[inside] = np.stack([c, a, b], axis=1)[inside]
+    inside = np.flatnonzero((a <= mu * c) & (b <= mu * c))
+    x[inside] = p[inside]
     jacobian[inside] = np.eye(3)
-    todo = ~inside
-    # one face active (|f1| = mu c): move along its normal (-mu, 1, 0)
+    todo = np.ones(len(p), bool)
+    todo[inside] = False
+    # one face active (|f1| = mu c): move along its normal (-mu, +-1, 0)
     for axis, (u, v) in ((1, (a, b)), (2, (b, a))):
         k = (u - mu * c) / norm
         c_face = c + mu * k
-        face = todo & (k > 0) & (c_face > 0) & (v <= mu * c_face)
-        normal = np.zeros(3)
-        normal[0], normal[axis] = -mu, 1.0
+        face = np.flatnonzero(todo & (k > 0) & (c_face > 0) & (v <= mu * c_face))
         x[face, 0] = c_face[face]
-        x[face, axis] = mu * c_face[face]
-        x[face, 3 - axis] = v[face]
-        jacobian[face] = np.eye(3) - np.outer(normal, normal) / norm
-        todo &= ~face
-    # both faces active: the edge (1, mu, mu), if the multipliers are nonnegative
+        x[face, axis] = mu * c_face[face] * sign[face, axis - 1]
+        x[face, 3 - axis] = p[face, 3 - axis]
+        normal = np.zeros((len(face), 3))
+        normal[:, 0], normal[:, axis] = -mu, sign[face, axis - 1]
+        jacobian[face] = np.eye(3) - normal[:, :, None] * normal[:, None, :] / norm
+        todo[face] = False
+    # both faces active: the edge (1, +-mu, +-mu), if the multipliers are nonnegative
     s = (c + mu * a + mu * b) / (1.0 + 2.0 * mu * mu)
-    edge = todo & (s > 0) & (a >= mu * s) & (b >= mu * s)
-    direction = np.array([1.0, mu, mu]) / np.sqrt(1.0 + 2.0 * mu * mu)
-    x[edge] = s[edge, None] * np.array([1.0, mu, mu])
-    jacobian[edge] = np.outer(direction, direction)
+    edge = np.flatnonzero(todo & (s > 0) & (a >= mu * s) & (b >= mu * s))
+    direction = np.ones((len(edge), 3))
+    direction[:, 1:] = mu * sign[edge]
+    x[edge] = s[edge, None] * direction
+    direction /= np.sqrt(1.0 + 2.0 * mu * mu)
+    jacobian[edge] = direction[:, :, None] * direction[:, None, :]
     # the rest is in the polar cone: projects to the apex, x = 0, J = 0
-    x[:, 1] *= sign1
-    x[:, 2] *= sign2
-    flip = np.stack([np.ones_like(sign1), sign1, sign2], axis=1)
-    jacobian *= flip[:, :, None] * flip[:, None, :]
     return x, jacobian
 
 
@@ -222,12 +220,15 @@ class NewtonSystem:
     # ------------------------------------------------------------------ kernels
     def project(self, w):
         """``x(y)`` for ``w = A^T y`` ((IV, width)) and the projection's Jacobian."""
-        x = np.zeros_like(w)
-        jacobian = np.zeros((len(w), self.width, self.width))
         p = self.pyramid
         x_p, j_p = project_pyramid(w[:, p] / self.h[:, p[:1]], self.mu)
+        j_p /= self.h[:, p[:1], None]
+        if not self.tension:  # friction-net: the pyramid is every column
+            return x_p, j_p
+        x = np.zeros_like(w)
+        jacobian = np.zeros((len(w), self.width, self.width))
         x[:, p] = x_p
-        jacobian[:, p[:, None], p[None, :]] = j_p / self.h[:, p[:1], None]
+        jacobian[:, p[:, None], p[None, :]] = j_p
         for t in self.tension:
             active = w[:, t] > 0
             x[:, t] = np.where(active, w[:, t], 0.0) / self.h[:, t]
