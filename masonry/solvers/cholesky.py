@@ -158,10 +158,15 @@ class BlockCholesky:
 
         order = _amd_order(graph) if self.n_nodes > 1 else np.arange(self.n_nodes)
         permuted = sp.csr_array(graph[order][:, order])
-        order = order[_postorder(_etree(permuted.indptr, permuted.indices))]
+        parent = _etree(permuted.indptr, permuted.indices)
+        # a postorder is an equivalent order: same fill, the tree relabelled
+        post = _postorder(parent)
+        label = np.empty_like(post)
+        label[post] = np.arange(len(post))
+        parent = np.where(parent[post] >= 0, label[np.maximum(parent[post], 0)], -1)
+        order = order[post]
         permuted = sp.csr_array(graph[order][:, order])
         permuted.sort_indices()
-        parent = _etree(permuted.indptr, permuted.indices)
         self.order = order                      # factor position -> caller's node
         self.position = np.empty_like(order)    # caller's node -> factor position
         self.position[order] = np.arange(self.n_nodes)
