@@ -115,8 +115,7 @@ class _Supernode:
     last: int           # last block column, inclusive
     rows: np.ndarray    # (R,) block rows below the supernode's columns, sorted
     parent: int         # parent supernode, -1 for a root
-    runs: tuple         # extend-add into the parent: (child start, parent start, length),
-                        # scalar units, one triple per run of consecutive rows
+    position: np.ndarray  # where each of ``rows`` is in the parent's front (block units)
 
 
 class BlockCholesky:
@@ -257,14 +256,11 @@ class BlockCholesky:
         for s, (first, last, _) in enumerate(merged):
             rows = rows_of[s]
             if len(rows) == 0:
-                supernodes.append(_Supernode(first, last, rows, -1, ()))
+                supernodes.append(_Supernode(first, last, rows, -1, position=rows))
                 continue
             p = int(column_supernode[rows[0]])
             position = np.searchsorted(index_of[p], rows)
-            start, value, length = _runs(position)
-            runs = tuple(zip((bs * start).tolist(), (bs * value).tolist(),
-                             (bs * length).tolist()))
-            supernodes.append(_Supernode(first, last, rows, p, runs))
+            supernodes.append(_Supernode(first, last, rows, p, position))
         return supernodes
 
     def _map_original_blocks(self, permuted):
@@ -311,12 +307,17 @@ class BlockCholesky:
             chosen = self._entry_order[entries]
             row = self._local_row[chosen][:, None, None] * bs + inner[:, None]
             col = self._local_col[chosen][:, None, None] * bs + inner[None, :]
-            extend = sn.runs
-            if sn.parent >= 0 and (bs * len(sn.rows) <= SMALL_UPDATE or len(sn.runs) == 1):
+            extend = None
+            if sn.parent >= 0:
                 parent = self.supernodes[sn.parent]
                 parent_size = bs * (parent.last - parent.first + 1 + len(parent.rows))
-                rows = np.concatenate([np.arange(pa, pa + la) for _, pa, la in sn.runs])
-                extend = (rows[:, None] * parent_size + rows[None, :]).ravel()
+                if bs * len(sn.rows) <= SMALL_UPDATE:
+                    rows = (bs * sn.position[:, None] + inner).ravel()
+                    extend = (rows[:, None] * parent_size + rows[None, :]).ravel()
+                else:
+                    start, value, length = _runs(sn.position)
+                    extend = tuple(zip((bs * start).tolist(), (bs * value).tolist(),
+                                       (bs * length).tolist()))
             steps.append((size, bs * (sn.last - sn.first + 1), entries,
                           (row * size + col).ravel(), self._children[s], extend))
         return steps
