@@ -5,6 +5,7 @@ import sys
 
 from masonry.assembly import AssemblyError
 from masonry.params import ParameterError
+from masonry.solvers.newton import use_one_blas_thread
 
 from . import analyze, arch_thickness, bench, build, run, structures, sweep
 from .options import Parser
@@ -29,6 +30,7 @@ def main(argv=None) -> int:
     logging.basicConfig(level=logging.INFO if verbose else logging.WARNING,
                         format="masonry: %(message)s", stream=sys.stderr)
     logging.getLogger("matplotlib").setLevel(logging.WARNING)
+    use_one_blas_thread()
 
     def report(line):
         print(line)

@@ -96,7 +96,9 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     """Run one variant; never raises: a failure becomes a row with its error."""
     from .params import validate
     from .pipeline import run
+    from .solvers.newton import use_one_blas_thread
 
+    use_one_blas_thread()  # in a Dask worker process too
     start = time.perf_counter()
     row = {"status": "failed", "error": ""}
     try:

@@ -281,12 +281,25 @@ def _blas_controller() -> ThreadpoolController:
     return ThreadpoolController()
 
 
+def use_one_blas_thread():
+    """Run BLAS on one thread for the rest of the process (the command line and sweep
+    workers call this first).
+
+    A factorization makes thousands of small BLAS calls; with a BLAS thread per core
+    every call waits for its threads, and while another process kept one of this
+    machine's two cores busy, one factorization of preset 1's full dome took 5 to 10 s
+    instead of 0.35 s (21,648 blocks: 15 to 38 s instead of 1.8 s). On an idle machine
+    the full dome from parameters to forces took 5.7 s with a BLAS thread per core and
+    4.4 s with one (``masonry bench --presets 1 --scenes dome``, median of 5): idle
+    BLAS threads spin on the other core. Nothing here does dense algebra large enough
+    to gain from more (Clarabel, OSQP and HiGHS have their own threads).
+    """
+    _blas_controller().limit(limits=1, user_api="blas")
+
+
 def _one_blas_thread(function):
-    """Run ``function`` with BLAS on one thread. A factorization makes thousands of
-    small BLAS calls; with a BLAS thread per core every call waits for its threads, and
-    while another process kept one of this machine's two cores busy, one factorization
-    of preset 1's full dome took 5 to 10 s instead of 0.35 s (21,648 blocks: 15 to 38 s
-    instead of 1.8 s)."""
+    """Run ``function`` with BLAS on one thread (see :func:`use_one_blas_thread`): the
+    Newton method's factorizations, when the library is used without the command line."""
     @functools.wraps(function)
     def limited(*args, **kwargs):
         with _blas_controller().limit(limits=1, user_api="blas"):
