@@ -237,7 +237,7 @@ def frontier_png(rows) -> bytes:
             ax.plot(xi, yi, markers.get(r["accuracy"], "x"), color=colour,
                     label=f"{preset} {scene}" if r is own[0] else None)
     for name, marker in markers.items():
-        ax.plot([], [], marker, color="grey", label=name)
+        ax.plot([], [], marker, color="black", label=name)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("solve time, s (median)")
