@@ -308,7 +308,8 @@ class Blocks:
 
     def face_polygon(self, face: int) -> np.ndarray:
         """(k, 3) float: vertices of one face, counter-clockwise seen from outside."""
-        return self.vertices[self.face_vertices[self.face_offsets[face]:self.face_offsets[face + 1]]]
+        start, stop = self.face_offsets[face], self.face_offsets[face + 1]
+        return self.vertices[self.face_vertices[start:stop]]
 
     def block_faces(self, block: int) -> np.ndarray:
         """Face indices of one block (faces are stored block after block)."""

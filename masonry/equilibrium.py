@@ -250,7 +250,7 @@ class EquilibriumSystem:
 
 def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
              side_rotation=None) -> EquilibriumSystem:
-    """Assemble the scaled RBE matrices (vectorized: COO triplets built with numpy).
+    """Assemble the scaled RBE matrices (vectorized: ``A_eq`` built column by column in CSC form).
 
     Parameters
     ----------
@@ -297,7 +297,6 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     normal = interfaces.normal[vertex_interface]
     direction = np.stack([normal, -normal, interfaces.t1[vertex_interface],
                           interfaces.t2[vertex_interface]], axis=1)
-    columns = (layout.WIDTH * np.arange(n_vertices))[:, None] + np.arange(layout.WIDTH)
 
     # every column (a vertex's c, t, f1 or f2) has six rows on each side's block: build
     # A_eq column by column in CSC form, no triplet sort (0.1 s on preset 1's full dome)

@@ -149,6 +149,8 @@ def detect(blocks: Blocks, tol: Tolerances | None = None, up=None) -> Interfaces
     if tol is None:
         tol = Tolerances.for_points(blocks.vertices)
     pairs = candidate_pairs(blocks, tol)
+    if len(pairs) == 0:
+        return Interfaces.empty()
     faces = _face_table(blocks)
     face_a, face_b = _touching_face_pairs(blocks, pairs, faces, tol)
     if len(face_a) == 0:

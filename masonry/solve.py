@@ -18,6 +18,7 @@ import logging
 import time
 from dataclasses import dataclass, field
 
+import highspy
 import numpy as np
 import scipy.sparse as sp
 
@@ -304,10 +305,10 @@ class RBEProblem:
                 if accepted or outcome.status == INFEASIBLE:
                     break
                 if name != names[-1]:
-                    # the presets' planned fallback (Newton neither converged nor
-                    # certified infeasibility, as on most infeasible structures)
-                    log.info("%s found no %s solution (%s); trying %s", name, method,
-                             outcome.status, names[-1])
+                    # Newton neither converged nor certified infeasibility (it certifies
+                    # the thesis's infeasible sections in one step): a fallback warns
+                    log.warning("%s found no %s solution (%s); trying %s", name, method,
+                                outcome.status, names[-1])
             if method == "net":
                 net_status = outcome.status
             if accepted:
@@ -488,8 +489,6 @@ def _lp_feasible(system: EquilibriumSystem, time_limit: float):
 
     Returns True, False, or None when HiGHS ends without a verdict (time limit).
     """
-    import highspy
-
     mu = system.mu
     edges = np.array([[1.0, 1.0, 1.0, 1.0],    # c
                       [0.0, 0.0, 0.0, 0.0],    # t
@@ -509,13 +508,16 @@ def _lp_feasible(system: EquilibriumSystem, time_limit: float):
     solver = highspy.Highs()
     for name, value in (("output_flag", False), ("solver", "ipm"), ("run_crossover", "off"),
                         ("time_limit", float(time_limit))):
-        solver.setOptionValue(name, value)
+        if solver.setOptionValue(name, value) != highspy.HighsStatus.kOk:
+            raise ValueError(f"HiGHS refused option {name}={value!r}")
     solver.passModel(lp)
     solver.run()
     status = solver.getModelStatus()
     if status == highspy.HighsModelStatus.kOptimal:
         return True
-    if status == highspy.HighsModelStatus.kInfeasible:
+    # with a zero objective nothing is unbounded: either verdict means infeasible
+    if status in (highspy.HighsModelStatus.kInfeasible,
+                  highspy.HighsModelStatus.kUnboundedOrInfeasible):
         return False
     log.warning("friction-net LP inconclusive: %s", solver.modelStatusToString(status))
     return None

@@ -22,8 +22,9 @@ Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1
    when that adds few explicit zeros), which trades a little arithmetic for far fewer
    Python-level steps.
 3. Numeric factorization, one dense frontal matrix per supernode: assemble the original
-   blocks and the children's update matrices (extend-add by contiguous runs of rows),
-   factor the pivot block, form the update for the parent.
+   blocks and the children's update matrices (extend-add: a small update by one add at
+   precomputed flat positions, a large one by contiguous runs of rows), factor the
+   pivot block, form the update for the parent.
 """
 
 import logging
@@ -46,9 +47,10 @@ supernodes only (1,888 against 4,438 supernodes; 2.9 against 2.1 GFlop)."""
 
 
 SMALL_UPDATE = 120
-"""Update matrices up to this size are added to their parent's front by one fancy
-index, larger ones run by run (measured: 0.077 s of 0.28 s per factorization of preset
-1's full dome went to run-by-run adds)."""
+"""Update matrices up to this size are added to their parent's front by one add at
+precomputed flat positions, larger ones run by run (run-by-run adds took 0.077 s of
+0.28 s per factorization of preset 1's full dome with all updates run by run; 60, 120,
+240 and 480 measured 0.25, 0.235, 0.24 and 0.265 s)."""
 
 
 def _amd_order(graph: sp.csr_array) -> np.ndarray:
@@ -243,7 +245,6 @@ class BlockCholesky:
         column_supernode = np.empty(n, dtype=np.int64)
         for s, (first, last, _) in enumerate(merged):
             column_supernode[first:last + 1] = s
-        bs = self.block_size
         rows_of, index_of = [], []
         for first, last, _ in merged:
             below = set()
