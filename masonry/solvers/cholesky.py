@@ -179,8 +179,10 @@ class BlockCholesky:
         for s, sn in enumerate(self.supernodes):
             if sn.parent >= 0:
                 self._children[sn.parent].append(s)
-        self._scalar_rows = [(bs * sn.rows[:, None] + np.arange(bs)).ravel()
-                             for sn in self.supernodes]
+        # per supernode: its scalar columns and the scalar rows below them
+        self._solve_slices = [(slice(bs * sn.first, bs * (sn.last + 1)),
+                               (bs * sn.rows[:, None] + np.arange(bs)).ravel())
+                              for sn in self.supernodes]
         self._scalar_order = (bs * order[:, None] + np.arange(bs)).ravel()
         self._front_buffer = None
         self._steps = self._numeric_plan()
@@ -405,27 +407,24 @@ class BlockFactor:
     def solve(self, rhs) -> np.ndarray:
         """``M^-1 rhs`` for ``rhs`` of shape (n,) or (n, k), n = nodes x block size."""
         sym = self.symbolic
-        bs = sym.block_size
         order = sym._scalar_order
-        rhs = np.asarray(rhs, dtype=float)
-        x = rhs[order].copy()
+        x = np.asarray(rhs, dtype=float)[order]
         vector = x.ndim == 1
         if vector:
             x = x[:, None]
-        rows = sym._scalar_rows
-        for s, sn in enumerate(sym.supernodes):
-            c0, c1 = bs * sn.first, bs * (sn.last + 1)
-            xs = blas.dtrsm(1.0, self._pivots[s], x[c0:c1], lower=1)
-            x[c0:c1] = xs
-            if self._below[s] is not None:
-                x[rows[s]] -= self._below[s] @ xs
-        for s in range(len(sym.supernodes) - 1, -1, -1):
-            sn = sym.supernodes[s]
-            c0, c1 = bs * sn.first, bs * (sn.last + 1)
-            v = x[c0:c1]
-            if self._below[s] is not None:
-                v = v - self._below[s].T @ x[rows[s]]
-            x[c0:c1] = blas.dtrsm(1.0, self._pivots[s], v, lower=1, trans_a=1)
+        # one tuple per supernode: its columns, the rows below them, L11, L21
+        plan = [(c, r, p, b) for (c, r), p, b in zip(sym._solve_slices, self._pivots,
+                                                    self._below)]
+        for columns, rows, pivot, below in plan:
+            xs = blas.dtrsm(1.0, pivot, x[columns], lower=1)
+            x[columns] = xs
+            if below is not None:
+                x[rows] -= below @ xs
+        for columns, rows, pivot, below in reversed(plan):
+            v = x[columns]
+            if below is not None:
+                v = v - below.T @ x[rows]
+            x[columns] = blas.dtrsm(1.0, pivot, v, lower=1, trans_a=1)
         out = np.empty_like(x)
         out[order] = x
         return out[:, 0] if vector else out
