@@ -13,7 +13,7 @@ import numpy as np
 
 from .base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL, OPTIMAL_INACCURATE,
                    SOLVER_ERROR, USER_LIMIT, QPOutcome)
-from .standard_form import standard_form
+from .standard_form import kept_form
 
 STATUS = {
     "Solved": OPTIMAL,
@@ -39,9 +39,7 @@ def solve(system, method, options, workspace) -> QPOutcome:
     import clarabel
 
     start = time.perf_counter()
-    form = workspace.get("form")
-    if form is None:
-        form = workspace["form"] = standard_form(system)
+    form = kept_form(system, workspace)
     values = form.values(method, system.mu)
     # Clarabel's rows are A x + s = b: the t rows enter negated
     values[_tension_rows(form)] *= -1.0

@@ -12,7 +12,7 @@ import scipy.sparse as sp
 
 from .base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL, OPTIMAL_INACCURATE,
                    SOLVER_ERROR, USER_LIMIT, QPOutcome)
-from .standard_form import standard_form
+from .standard_form import kept_form
 
 STATUS = {
     "solved": OPTIMAL,
@@ -36,9 +36,7 @@ def solve(system, method, options, workspace) -> QPOutcome:
     import osqp
 
     start = time.perf_counter()
-    form = workspace.get("form")
-    if form is None:
-        form = workspace["form"] = standard_form(system)
+    form = kept_form(system, workspace)
     values = form.values(method, system.mu)
     solver = workspace.get("solver")
     if solver is None or workspace.get("options") != options:

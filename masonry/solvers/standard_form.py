@@ -96,3 +96,11 @@ def standard_form(system) -> StandardForm:
         rows=rows, n_eq=n_eq, n_friction=4 * n_vertices, n_tension=n_vertices,
         b=-system.f_ext, _tension_slot=np.flatnonzero(kind == 1),
         _mu_slot=np.flatnonzero(kind == 0))
+
+
+def kept_form(system, workspace: dict) -> StandardForm:
+    """The standard form of ``system`` kept in a solver's ``workspace`` (one per scene,
+    built on first use: friction+ and other friction coefficients change only values)."""
+    if "form" not in workspace:
+        workspace["form"] = standard_form(system)
+    return workspace["form"]
