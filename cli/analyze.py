@@ -1,6 +1,6 @@
 """``masonry analyze``: interfaces and rigid block equilibrium of blocks read from files."""
 
-from masonry.assembly import load_assembly
+from masonry.scenes.imported import load_assembly
 from masonry.params import Params, validate
 from masonry.pipeline import run
 

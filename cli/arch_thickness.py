@@ -1,9 +1,9 @@
 """``masonry arch-thickness``: the minimum thickness t/R of an arch, by bisection on RBE
 feasibility, beside the thrust line's value."""
 
-from masonry.arch import thrust_line_minimum_thickness
+from masonry.studies.thrust_line import thrust_line_minimum_thickness
 from masonry.params import SOLVERS, Params, validate
-from masonry.thickness import minimum_thickness
+from masonry.studies.thickness import minimum_thickness
 
 from .options import add_arch_options
 

@@ -2,7 +2,7 @@
 
 import resource
 
-from masonry.bench import SCENES, bench, frontier_png, table_csv, table_markdown
+from masonry.studies.bench import SCENES, bench, frontier_png, table_csv, table_markdown
 from masonry.params import ACCURACIES, SOLVERS
 from masonry.runfolder import RunFolder
 
@@ -55,4 +55,4 @@ def handle(args, report):
 def _progress(message):
     import logging
 
-    logging.getLogger("masonry.bench").info(message)
+    logging.getLogger("masonry.studies.bench").info(message)

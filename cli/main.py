@@ -3,9 +3,9 @@
 import logging
 import sys
 
-from masonry.assembly import AssemblyError
+from masonry.scenes.imported import AssemblyError
 from masonry.params import ParameterError
-from masonry.solvers.newton import use_one_blas_thread
+from masonry.rbe.solvers.newton import use_one_blas_thread
 
 from . import analyze, arch_thickness, bench, build, run, structures, sweep
 from .options import Parser

@@ -2,7 +2,7 @@
 side by side."""
 
 from masonry.runfolder import RunFolder
-from masonry.structures import structures_table, table_csv, table_markdown
+from masonry.studies.structures import structures_table, table_csv, table_markdown
 
 
 def register(subparsers):

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from masonry.params import PRESETS, ParameterError
 from masonry.runfolder import RunFolder
-from masonry.sweep import (Study, execute, summary_csv, summary_parquet, summary_pngs,
+from masonry.studies.sweep import (Study, execute, summary_csv, summary_parquet, summary_pngs,
                            summary_rows)
 
 from . import run as run_command

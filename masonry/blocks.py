@@ -20,6 +20,9 @@ import numpy as np
 BLOCK_CLASSES = ("ground", "regular", "pattern", "fill_in", "block")
 """Names of the ``block_class`` codes. ``block`` is an imported or scene block (arch)."""
 
+GROUND = BLOCK_CLASSES.index("ground")
+"""``block_class`` code of a ground slab or support block."""
+
 # Corner order of a hexahedral brick: index = ix + 2 * iy + 4 * iz, with local axes
 # x = through the wall (0 inner, 1 outer), y = along the wall, z = up the course.
 HEX_FACES = np.array(
@@ -387,6 +390,25 @@ def concatenate(parts) -> Blocks:
         block_name=np.concatenate([p.block_name for p in parts]),
         block_web=np.concatenate([p.block_web for p in parts]),
     )
+
+
+def rotation_z(angle) -> np.ndarray:
+    """(3, 3) rotation by ``angle`` radians about the dome axis (z)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rotated_web(blocks: Blocks, web: int, n: int, mask=None) -> Blocks:
+    """Blocks (or those selected by ``mask``, (B,) bool) rotated by ``2 pi web / n`` about
+    z, named ``w<web>_<name>`` and marked as web ``web % n``."""
+    part = blocks if mask is None else blocks.subset(mask)
+    motion = np.eye(4)
+    motion[:3, :3] = rotation_z(2 * np.pi * web / n)
+    part = part.transformed(motion)
+    return dataclasses.replace(
+        part,
+        block_name=np.array([f"w{web % n}_{name}" for name in part.block_name], dtype=object),
+        block_web=np.full(part.n_blocks, web % n))
 
 
 def _newell(polygons):

@@ -16,7 +16,7 @@ log = logging.getLogger(__name__)
 SCENES = ("section", "wall", "dome", "assembly", "arch")
 FRICTIONS = ("net", "plus", "auto")
 BOUNDARIES = ("free", "rigid", "cyclic")
-# QP solvers (masonry.solvers.BACKENDS) and accuracy presets (masonry.solve.ACCURACY)
+# QP solvers (masonry.rbe.solvers.BACKENDS) and accuracy presets (masonry.rbe.solve.ACCURACY)
 SOLVERS = ("newton", "clarabel", "osqp", "clarabel-cvxpy", "osqp-cvxpy")
 ACCURACIES = ("fast", "balanced", "accurate")
 ARCH_SHAPES = ("semicircular", "pointed", "segmental")
@@ -51,7 +51,7 @@ class Params:
     top; ``unit`` brick unit in metres; ``min_fill`` shortest fill-in brick (units).
     Scene: ``scene`` (section, wall, dome, ...), ``boundary`` of a section (free, rigid,
     cyclic), ``wall_length`` (units) and ``wall_courses`` for the wall scene.
-    Arch scene (metres, :mod:`masonry.arch`): ``arch_blocks`` voussoirs, ``arch_span`` and
+    Arch scene (metres, :mod:`masonry.scenes.arch`): ``arch_blocks`` voussoirs, ``arch_span`` and
     ``arch_rise`` (None: the shape's default) of the centre line, ``arch_thickness``,
     ``arch_depth`` (along y), ``arch_shape``. Assembly scene: ``assembly``, the name of
     the imported model (``<file stem>_<content hash>``, set by ``masonry analyze``).
@@ -180,8 +180,6 @@ def validate(params: Params) -> Params:
         _check("arch_rise", p.arch_rise, _number("arch_rise", p.arch_rise) > 0,
                "> 0 (metres) or none")
     if p.scene == "arch":
-        from .arch import check_arch  # the checks that depend on the arch's shape
-
         check_arch(p)
     if p.scene == "assembly":
         _check("assembly", p.assembly, bool(p.assembly),
@@ -190,6 +188,52 @@ def validate(params: Params) -> Params:
         log.warning("stretch=%g is outside 0.2..5: the dome is unusually flat or tall",
                     p.stretch)
     return p
+
+
+def arch_radius(shape: str, span: float, rise=None) -> tuple:
+    """``(R, h)``: centre-line radius and rise of an arch of ``span`` (metres).
+
+    ``rise`` None takes the shape's default: ``span / 2`` (semicircular), ``span / 4``
+    (segmental), ``span * sqrt(3) / 2`` (pointed, equilateral).
+    """
+    if shape == "semicircular":
+        return span / 2, span / 2
+    if shape == "segmental":
+        h = span / 4 if rise is None else rise
+        return (span**2 / 4 + h**2) / (2 * h), h
+    h = span * math.sqrt(3) / 2 if rise is None else rise
+    return (span**2 / 4 + h**2) / span, h
+
+
+def check_arch(params: Params) -> None:
+    """Refuse arch parameters that make no arch (:class:`ParameterError`).
+
+    The ranges that do not depend on the shape are checked by
+    :func:`masonry.params.validate`; here: the rise against the shape, an even number of
+    voussoirs for a pointed arch, and a thickness that leaves an intrados.
+    """
+    p = params
+    span, rise, t = p.arch_span, p.arch_rise, p.arch_thickness
+    if p.arch_shape == "semicircular" and rise is not None and rise != span / 2:
+        raise ParameterError("arch_rise", rise, f"none for a semicircular arch (its rise is "
+                                                f"span / 2 = {span / 2:g} m)")
+    if p.arch_shape == "segmental" and rise is not None and not 0 < rise < span / 2:
+        raise ParameterError("arch_rise", rise, f"0 < rise < span / 2 = {span / 2:g} m for "
+                                                "a segmental arch")
+    if p.arch_shape == "pointed":
+        if rise is not None and not rise > span / 2:
+            raise ParameterError("arch_rise", rise, f"> span / 2 = {span / 2:g} m for a "
+                                                    "pointed arch")
+        if p.arch_blocks % 2:
+            raise ParameterError("arch_blocks", p.arch_blocks, "an even number for a "
+                                                               "pointed arch")
+    radius, _ = arch_radius(p.arch_shape, span, rise)
+    # the intrados must exist: radius R - t/2 > 0, and for a pointed arch it must still
+    # reach the crown, R - t/2 > R - span/2
+    limit = span if p.arch_shape == "pointed" else 2 * radius
+    if not t < limit:
+        raise ParameterError("arch_thickness", t, f"< {limit:g} m (the intrados of this "
+                                                  f"arch vanishes at t = {limit:g} m)")
 
 
 def structure_id(params: Params) -> str:

@@ -1,8 +1,9 @@
 """A whole run: parameters to bricks, interfaces, forces and exports in a run folder.
 
 The library logs progress; it never prints. Timings of every stage go into ``run.json``.
-Geometry and interfaces are cached under ``<out>/.cache`` keyed by the geometric inputs,
-so a run that changes only ``mu``, ``friction``, ``density`` or the solver reuses them.
+Geometry and interfaces are cached under ``<out>/.cache`` keyed by the geometric inputs
+and the source of the code that builds them, so a run that changes only ``mu``,
+``friction``, ``density`` or the solver reuses them, and an edited geometry stage does not.
 """
 
 import dataclasses
@@ -11,24 +12,23 @@ import json
 import logging
 import pickle
 import time
+from functools import cache
 from contextlib import contextmanager
 from importlib import metadata
 from pathlib import Path
 
-import numpy as np
-
-from . import __version__, plots
-from .blocks import BLOCK_CLASSES
-from .export.csv import forces_csv, interfaces_csv, locations_csv
-from .export.obj import blocks_obj
-from .boundary import analysis_model
-from .params import Params, structure_id, validate
-from .runfolder import RunFolder
-from .scenes import build
+import masonry
+from masonry import __version__
+from masonry.blocks import BLOCK_CLASSES
+from masonry.export import EXPORTERS, RunOutputs
+from masonry.params import Params, structure_id, validate
+from masonry.rbe.boundary import Model, analysis_model
+from masonry.rbe.solve import RBEProblem, RBEResult
+from masonry.runfolder import RunFolder, write_file_atomically
+from masonry.scenes import Scene, build
+from masonry.tolerances import G
 
 log = logging.getLogger(__name__)
-
-G = 9.81  # m/s^2, SPEC 2
 
 PACKAGES = ("numpy", "scipy", "trimesh", "manifold3d", "cvxpy", "osqp", "highspy",
             "clarabel", "meshio", "matplotlib")
@@ -52,22 +52,14 @@ class Timer:
 
     @contextmanager
     def stage(self, name):
+        """Time a stage; a stage entered again (several exporters) adds up."""
         log.info("%s ...", name)
         start = time.perf_counter()
         try:
             yield
         finally:
-            self.seconds[name] = round(time.perf_counter() - start, 4)
-
-
-def cad_vertices(scene) -> np.ndarray:
-    """Vertices moved inward by ``cad_offset`` units along each brick's inward normal
-    (``scene.block_inward``; thesis 3.4.1). Scenes without one are not moved."""
-    blocks = scene.blocks
-    if scene.block_inward is None:
-        return blocks.vertices
-    shift = scene.params.cad_offset * scene.params.unit * scene.block_inward
-    return blocks.vertices + np.repeat(shift, np.diff(blocks.vertex_offsets), axis=0)
+            total = self.seconds.get(name, 0.0) + time.perf_counter() - start
+            self.seconds[name] = round(total, 4)
 
 
 def model_record(scene) -> dict:
@@ -103,41 +95,35 @@ def model_record(scene) -> dict:
     return record
 
 
-def parameters_text(params: Params, sid: str) -> str:
-    lines = [f"structure id: {sid}", ""]
-    lines += [f"{f.name:>12} = {getattr(params, f.name)}" for f in dataclasses.fields(params)]
-    return "\n".join(lines) + "\n"
-
-
-def objective_text(result) -> str:
-    """``RBE/00_objective.txt``: the thesis's summary of a solve, readable."""
-    d = result.to_dict()
-    verdict = "feasible" if d["feasible"] else "infeasible"
-    lines = [
-        f"feasibility:        {verdict}",
-        f"friction method:    friction-{d['friction']} (mu = {d['mu']:g})",
-        f"objective:          {d['objective']:.6g} N^2",
-        f"MoI:                {d['moi']:.6g} N",
-        f"MoI factor:         {d['moi_factor']:.6g}",
-        f"weight:             {d['weight_N']:.6g} N",
-        f"solver:             {d['solver']} ({d['status']}, {d['iterations']} iterations)",
-        f"residual (eq):      {d['residual_eq']:.3g}",
-        f"friction violation: {d['friction_violation']:.3g}",
-        f"LP check (HiGHS):   {d['lp_feasible']}",
-        f"time:               {d['time_s']:.3g} s",
-    ]
-    return "\n".join(lines) + "\n"
-
-
 # ---------------------------------------------------------------------------- cache
+GEOMETRY_SOURCES = ("params.py", "tolerances.py", "blocks.py", "meshing.py", "interfaces.py",
+                    "dome", "scenes", "rbe/boundary.py")
+"""The package's files (or folders) whose code decides a cached scene and model."""
+
+
+@cache
+def geometry_code_digest() -> str:
+    """SHA-1 of the source of :data:`GEOMETRY_SOURCES`: part of the cache key, so an edited
+    geometry stage never reuses a stale cache at the same version number."""
+    root = Path(masonry.__file__).parent
+    digest = hashlib.sha1()
+    for name in GEOMETRY_SOURCES:
+        path = root / name
+        for file in sorted(path.rglob("*.py")) if path.is_dir() else [path]:
+            digest.update(file.relative_to(root).as_posix().encode())
+            digest.update(file.read_bytes())
+    return digest.hexdigest()
+
+
 def _geometry_key(params: Params) -> str:
-    key = json.dumps({**params.geometry_key, "version": __version__}, sort_keys=True)
+    key = json.dumps({**params.geometry_key, "version": __version__,
+                      "code": geometry_code_digest()}, sort_keys=True)
     return hashlib.sha1(key.encode()).hexdigest()[:16]
 
 
 def _model(params: Params, out_root, timer: Timer):
     """Scene and analysis model (interfaces, boundary routing), from the geometry cache
-    when present."""
+    when present: ``(scene, model, 'reused' | 'computed')``."""
     cache = Path(out_root) / ".cache" / f"{_geometry_key(params)}.pickle"
     if cache.is_file():
         with timer.stage("model (cached)"):
@@ -150,11 +136,8 @@ def _model(params: Params, out_root, timer: Timer):
         scene = build(params)
     with timer.stage("interfaces"):
         model = analysis_model(scene)
-    cache.parent.mkdir(parents=True, exist_ok=True)
-    tmp = cache.with_suffix(f".tmp{id(scene)}")
-    with open(tmp, "wb") as f:
-        pickle.dump((scene, model), f, protocol=pickle.HIGHEST_PROTOCOL)
-    tmp.replace(cache)
+    write_file_atomically(cache, pickle.dumps((scene, model),
+                                              protocol=pickle.HIGHEST_PROTOCOL))
     return scene, model, "computed"
 
 
@@ -176,13 +159,9 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
 
     Parameters
     ----------
-    scene : Scene, optional
-        An already built scene (``masonry analyze``: blocks read from files, see
-        :func:`masonry.assembly.load_assembly`), used as is instead of building
-        ``params``, and never cached; ``params`` (with its ``assembly`` name) still names
-        the run folder.
-    source : dict, optional
-        Where such a scene came from (files, supports), recorded in run.json.
+    params : Params
+    out_root : str or Path
+        The output root; the run folder is ``out_root/<structure id>``.
     analyse : bool
         Solve the rigid block equilibrium (``masonry run``); False only builds the model
         and its interfaces (``masonry build``).
@@ -190,6 +169,13 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
         Write the plots; unite and write the printable body.
     force : bool
         Recompute even when the folder holds a complete run of the same input.
+    scene : Scene, optional
+        An already built scene (``masonry analyze``: blocks read from files, see
+        :func:`masonry.scenes.imported.load_assembly`), used as is instead of building
+        ``params``, and never cached; ``params`` (with its ``assembly`` name) still names
+        the run folder.
+    source : dict, optional
+        Where such a scene came from (files, supports), recorded in run.json.
 
     Returns
     -------
@@ -198,13 +184,11 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
     """
     params = validate(params)
     sid = structure_id(params)
-    target = Path(out_root) / sid
     outputs = {"analyse": analyse, "plots": plots_wanted, "printable": printable}
-    if not force:
-        previous = _previous(target, params, outputs)
-        if previous is not None:
-            log.info("%s is up to date (use --force to recompute)", sid)
-            return {**previous, "path": str(target), "reused": True}
+    previous = None if force else _previous(Path(out_root) / sid, params, outputs)
+    if previous is not None:
+        log.info("%s is up to date (use --force to recompute)", sid)
+        return {**previous, "path": str(Path(out_root) / sid), "reused": True}
 
     timer = Timer()
     if scene is None:
@@ -213,54 +197,15 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
         scene, cached = dataclasses.replace(scene, params=params), "given"
         with timer.stage("interfaces"):
             model = analysis_model(scene)
-    interfaces = model.interfaces
-    record = {
-        "structure_id": sid,
-        "scene": params.scene,
-        "params": dataclasses.asdict(params),
-        "outputs": outputs,
-        **model_record(scene),
-        "cache": {"geometry": cached},
-    }
-    if source is not None:
-        record["source"] = source
-    record["counts"]["interfaces"] = interfaces.counts()
-    result = forces = None
-    if analyse:
-        from .solve import RBEProblem
-
-        with timer.stage("assembly"):
-            problem = RBEProblem(model.blocks, interfaces, side_block=model.side_block,
-                                 side_rotation=model.side_rotation)
-        with timer.stage("solve"):
-            result = problem.solve(mu=params.mu, density=params.density,
-                                   friction=params.friction, solver=params.solver,
-                                   accuracy=params.solver_accuracy)
+    record = run_record(scene, model, outputs, cached, source)
+    result = _solve(model, params, timer) if analyse else None
+    if result is not None:
         record["rbe"] = {**result.to_dict(), "attempts": list(result.attempts)}
-        forces = result.per_interface() if result.x is not None else None
-
+    made = RunOutputs(scene, model, result,
+                      result.per_interface() if result is not None and result.x is not None
+                      else None, plots=plots_wanted, printable=printable)
     with RunFolder(out_root, sid) as folder:
-        with timer.stage("exports"):
-            folder.write("00_parameters.txt", parameters_text(params, sid))
-            cad = cad_vertices(scene)
-            folder.write("locations.csv", locations_csv(scene.blocks, cad))
-            folder.write("bricks.obj", blocks_obj(scene.blocks))
-            folder.write("interfaces.csv", interfaces_csv(model.blocks, interfaces))
-            _write_rhino(folder, scene.blocks)
-            if result is not None:
-                folder.write("RBE/00_objective.txt", objective_text(result))
-            if forces is not None:
-                from .export.vtu import interfaces_vtu
-
-                folder.write("RBE/forces.csv", forces_csv(model.blocks, interfaces, forces))
-                if len(interfaces):
-                    folder.write("RBE/interfaces.vtu", interfaces_vtu(interfaces, forces))
-        if printable:
-            with timer.stage("printable"):
-                record["printable"] = _write_printable(folder, *printable_blocks(scene))
-        if plots_wanted:
-            with timer.stage("plots"):
-                _write_plots(folder, scene, model, forces)
+        write_exports(folder, made, record, timer)
         record["timings_s"] = timer.seconds
         record["versions"] = versions()
         record["complete"] = True
@@ -269,55 +214,41 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
     return record
 
 
-def printable_blocks(scene):
-    """Blocks and CAD-offset vertices of the printable body: the whole dome in dome mode
-    (a section with a boundary, or the dome scene; SPEC 7), else the scene itself."""
+def run_record(scene: Scene, model: Model, outputs: dict, cached: str, source=None) -> dict:
+    """The run.json record of a built model, before any solve."""
     params = scene.params
-    if params.scene == "section" and params.boundary != "free":
-        from .boundary import rotated_web, rotation_z
-        from .blocks import concatenate
-
-        n = params.n
-        cad = cad_vertices(scene)
-        blocks = concatenate([rotated_web(scene.blocks, k, n) for k in range(n)])
-        vertices = np.concatenate([cad @ rotation_z(2 * np.pi * k / n).T for k in range(n)])
-        return blocks, vertices
-    return scene.blocks, cad_vertices(scene)
-
-
-def _write_printable(folder, blocks, cad) -> dict:
-    from .export.stl import obj_body_bytes, readback_check, stl_bytes
-    from .printable import printable_body
-
-    body, report = printable_body(blocks, cad)
-    stl = stl_bytes(body)
-    report["readback"] = readback_check(stl, report["volume_m3"], rtol=1e-5)
-    folder.write("dome.stl", stl)
-    folder.write("dome.obj", obj_body_bytes(body))
-    return report
+    record = {
+        "structure_id": structure_id(params),
+        "scene": params.scene,
+        "params": dataclasses.asdict(params),
+        "outputs": outputs,
+        **model_record(scene),
+        "cache": {"geometry": cached},
+    }
+    if source is not None:
+        record["source"] = source
+    record["counts"]["interfaces"] = model.interfaces.counts()
+    return record
 
 
-def _write_rhino(folder, blocks):
-    """``bricks.3dm`` when the optional rhino3dm package is installed."""
-    try:
-        import rhino3dm  # noqa: F401
-    except ImportError:
-        log.info("bricks.3dm skipped: pip install 'masonry[rhino]' to write it")
-        return
-    from .export.rhino import blocks_3dm
-
-    folder.write("bricks.3dm", blocks_3dm(blocks))
+def _solve(model: Model, params: Params, timer: Timer) -> RBEResult:
+    with timer.stage("assembly"):
+        problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
+                             side_rotation=model.side_rotation)
+    with timer.stage("solve"):
+        return problem.solve(mu=params.mu, density=params.density, friction=params.friction,
+                             solver=params.solver, accuracy=params.solver_accuracy)
 
 
-def _write_plots(folder, scene, model, forces):
-    fast = scene.params.fast
-    interfaces = model.interfaces
-    if scene.layout is not None:
-        folder.write("00_pattern.png", plots.pattern_png(scene, fast))
-    for name, png in plots.structure_pngs(scene, fast).items():
-        folder.write(name, png)
-    for name, png in plots.interface_pngs(model.blocks, interfaces, fast).items():
-        folder.write(name, png)
-    if forces is not None:
-        for name, png in plots.force_pngs(model.blocks, interfaces, forces, fast).items():
-            folder.write(f"RBE/{name}", png)
+def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer):
+    """Every wanted exporter of :data:`masonry.export.EXPORTERS` into ``folder``; their
+    records go into ``record`` under their names."""
+    for exporter in EXPORTERS:
+        if not exporter.wanted(made):
+            continue
+        with timer.stage(exporter.stage):
+            export = exporter.make(made)
+            for relative, data in export.files.items():
+                folder.write(relative, data)
+        if export.record is not None:
+            record[exporter.name] = export.record

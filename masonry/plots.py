@@ -14,7 +14,7 @@ import numpy as np  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-from .blocks import BLOCK_CLASSES  # noqa: E402
+from masonry.blocks import BLOCK_CLASSES  # noqa: E402
 
 CLASS_COLOURS = {
     "ground": "#9e9e9e",
@@ -153,7 +153,7 @@ def _colour_plot(blocks, interfaces, index, values, title, view, fast, label="N"
 def interface_pngs(blocks, interfaces, fast=False) -> dict:
     """Horizontal and vertical interfaces drawn as polygons (thesis figures 3.12-3.13),
     coloured by area."""
-    from .interfaces import INTERFACE_KINDS
+    from masonry.interfaces import INTERFACE_KINDS
 
     out = {}
     views = ["01_angle"] if fast else list(VIEWS)
@@ -183,7 +183,7 @@ FORCE_PLOTS = (
 
 def force_pngs(blocks, interfaces, forces: dict, fast=False) -> dict:
     """Force plots with colour bars in newtons, per view (``RBE/<view>/<name>.png``)."""
-    from .interfaces import INTERFACE_KINDS
+    from masonry.interfaces import INTERFACE_KINDS
 
     horizontal = np.isin(interfaces.kind, [INTERFACE_KINDS.index("horizontal"),
                                            INTERFACE_KINDS.index("support")])

@@ -34,9 +34,9 @@ import time
 
 import numpy as np
 
-from .blocks import Blocks
-from .meshing import merge_vertices
-from .tolerances import Tolerances
+from masonry.blocks import Blocks, concatenate, rotated_web, rotation_z
+from masonry.meshing import merge_vertices
+from masonry.tolerances import Tolerances
 
 log = logging.getLogger(__name__)
 
@@ -353,3 +353,16 @@ def _require_ok(body, what):
     status = _status_name(body)
     if status != "NoError":
         raise PrintableError(f"manifold3d reported {status} for the {what}")
+
+
+def printable_blocks(scene):
+    """Blocks and CAD-offset vertices of the printable body: the whole dome in dome mode
+    (a section with a boundary, or the dome scene; SPEC 7), else the scene itself."""
+    params = scene.params
+    if params.scene == "section" and params.boundary != "free":
+        n = params.n
+        cad = scene.cad_vertices()
+        blocks = concatenate([rotated_web(scene.blocks, k, n) for k in range(n)])
+        vertices = np.concatenate([cad @ rotation_z(2 * np.pi * k / n).T for k in range(n)])
+        return blocks, vertices
+    return scene.blocks, scene.cad_vertices()

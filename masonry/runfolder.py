@@ -2,7 +2,8 @@
 
 A run writes into a hidden temporary folder beside its target and swaps it into place
 only when everything is written. A failed or interrupted run removes its temporary folder
-and leaves the previous output exactly as it was.
+and leaves the previous output exactly as it was. Single files outside a run folder (the
+geometry cache) are written the same way by :func:`write_file_atomically`.
 """
 
 import json
@@ -10,6 +11,20 @@ import os
 import shutil
 import uuid
 from pathlib import Path
+
+
+def write_file_atomically(path, data: bytes):
+    """Write ``data`` to ``path`` through a hidden temporary file beside it, renamed into
+    place when complete: a reader sees the old file or the whole new one, never a part."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp-{uuid.uuid4().hex[:8]}")
+    try:
+        with open(tmp, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 class RunFolder:
@@ -51,6 +66,7 @@ class RunFolder:
             f.write(data)
 
     def write_json(self, relative, record):
+        """Write ``record`` as indented JSON (numpy scalars and arrays as plain values)."""
         self.write(relative, json.dumps(record, indent=2, sort_keys=False, default=_jsonable)
                    + "\n")
 

@@ -1,4 +1,4 @@
-"""The one place for tolerances.
+"""The one place for tolerances and physical constants.
 
 Every length tolerance is relative to the scene's size (the diagonal of its bounding box),
 so a model built with ``unit=0.001`` and one built with ``unit=100`` are treated alike.
@@ -8,6 +8,9 @@ Pass a :class:`Tolerances` explicitly; never hard-code a tolerance in a stage.
 from dataclasses import dataclass
 
 import numpy as np
+
+G = 9.81
+"""Gravitational acceleration, m/s^2 (SPEC 2)."""
 
 
 @dataclass(frozen=True)

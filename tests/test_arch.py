@@ -7,16 +7,17 @@ import numpy as np
 import pytest
 import shapely
 
-from masonry.arch import arch_profile, build_arch, thrust_line_minimum_thickness
+from masonry.scenes.arch import arch_profile, build_arch
+from masonry.studies.thrust_line import thrust_line_minimum_thickness
 from masonry.interfaces import detect
 from masonry.params import ParameterError, Params, validate
-from masonry.thickness import minimum_thickness
+from masonry.studies.thickness import minimum_thickness
 from masonry_cli.main import main
 
 MILANKOVITCH = 0.1075  # t/R of the continuous semicircular arch under self weight
 
 # Minimum t/R of semicircular arches of N chord voussoirs (mu = 10, sliding never
-# governs), from the thrust line (masonry.arch.thrust_line_minimum_thickness) to 1e-12;
+# governs), from the thrust line (masonry.studies.thrust_line.thrust_line_minimum_thickness) to 1e-12;
 # the RBE bisection brackets the same numbers (test below).
 THRUST_LINE = {16: 0.1070762, 32: 0.1071970, 64: 0.1073832}
 

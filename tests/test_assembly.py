@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from masonry.assembly import AssemblyError, load_assembly, read_blocks, select_supports
+from masonry.scenes.imported import AssemblyError, load_assembly, read_blocks, select_supports
 from masonry.export.obj import blocks_obj
 from masonry.interfaces import detect
 from masonry.params import Params, from_preset, validate

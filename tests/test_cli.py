@@ -89,7 +89,7 @@ def test_failed_run_leaves_previous_output(tmp_path, monkeypatch):
     def broken(*args, **kwargs):
         raise RuntimeError("injected failure")
 
-    monkeypatch.setattr("masonry.pipeline.blocks_obj", broken)
+    monkeypatch.setattr("masonry.export.obj.blocks_obj", broken)
     with pytest.raises(RuntimeError):
         main(["build", "--preset", "wall", "--no-plots", "--force", "--out", str(tmp_path),
               "-q"])
@@ -100,10 +100,9 @@ def test_failed_run_leaves_previous_output(tmp_path, monkeypatch):
 
 def test_cad_offset_moves_bricks_inward(tmp_path):
     from masonry.params import from_preset
-    from masonry.pipeline import cad_vertices
     from masonry.scenes import build
 
     scene = build(from_preset("1"))
-    moved = cad_vertices(scene) - scene.blocks.vertices
+    moved = scene.cad_vertices() - scene.blocks.vertices
     np.testing.assert_allclose(np.linalg.norm(moved, axis=1), 0.1, rtol=1e-12)
     assert np.all(moved[:, 0] < 0)  # the section faces +x: inward is -x

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from conftest import PRESETS, support_force
 
-from masonry.boundary import analysis_model
+from masonry.rbe.boundary import analysis_model
 from masonry.interfaces import INTERFACE_KINDS
 from masonry.params import from_preset
 from masonry.scenes import build
-from masonry.solve import solve_rbe
+from masonry.rbe.solve import solve_rbe
 
 BOUNDARY, SUPPORT = INTERFACE_KINDS.index("boundary"), INTERFACE_KINDS.index("support")
 
@@ -131,7 +131,7 @@ def test_a_dome_too_small_for_its_bricks_is_refused():
 
 
 def test_structures_table_rows_and_formats():
-    from masonry.structures import ROWS, structures_table, table_csv, table_markdown
+    from masonry.studies.structures import ROWS, structures_table, table_csv, table_markdown
 
     rows = structures_table(rows=[r for r in ROWS if r[0] == "3.2 rigid"])
     (row,) = rows

@@ -10,12 +10,12 @@ seconds; the ranges are those of the issue.
 import numpy as np
 import pytest
 
-from masonry.boundary import analysis_model
-from masonry.equilibrium import G
+from masonry.rbe.boundary import analysis_model
+from masonry.tolerances import G
 from masonry.interfaces import INTERFACE_KINDS
 from masonry.params import ParameterError, Params, validate
 from masonry.scenes import build
-from masonry.solve import ACCURACY, RBEProblem
+from masonry.rbe.solve import ACCURACY, RBEProblem
 from masonry_cli.main import main
 
 SUPPORT = INTERFACE_KINDS.index("support")

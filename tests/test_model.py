@@ -9,7 +9,7 @@ import pytest
 from conftest import FIXTURES, PRESETS, scene_of
 
 from masonry.blocks import BLOCK_CLASSES
-from masonry.levels import Dimensions, level_table
+from masonry.dome.levels import Dimensions, level_table
 from masonry.params import PRESETS as LIBRARY_PRESETS
 from masonry.params import Params, from_preset
 

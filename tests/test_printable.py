@@ -11,7 +11,6 @@ from conftest import scene_of
 
 from masonry.blocks import Blocks
 from masonry.export.stl import obj_body_bytes, readback_check, stl_bytes
-from masonry.pipeline import cad_vertices
 from masonry.printable import OVERLAP_REL, PrintableError, grown_blocks, printable_body
 from masonry.tolerances import Tolerances
 
@@ -30,7 +29,7 @@ BRICKS_RTOL = 0.01
 def body_of(name):
     """(mesh, report, stl bytes, read-back report) of a scene's CAD-offset bricks."""
     scene = scene_of(name)
-    mesh, report = printable_body(scene.blocks, cad_vertices(scene))
+    mesh, report = printable_body(scene.blocks, scene.cad_vertices())
     stl = stl_bytes(mesh)
     return mesh, report, stl, readback_check(stl, report["volume_m3"], rtol=READBACK_RTOL)
 
@@ -111,7 +110,7 @@ def test_union_is_one_watertight_body(name):
     assert report["zero_area_faces"] == report["close_vertex_pairs"] == 0
     assert report["halfspace_blocks"] == 0  # hexahedra: all grown by the batched solve
     assert report["overlap_m"] == pytest.approx(
-        OVERLAP_REL * np.linalg.norm(np.ptp(cad_vertices(scene_of(name)), axis=0)))
+        OVERLAP_REL * np.linalg.norm(np.ptp(scene_of(name).cad_vertices(), axis=0)))
 
 
 @pytest.mark.parametrize("name", SCENES)

@@ -14,12 +14,12 @@ from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
 from masonry.blocks import HEX_FACES
-from masonry.boundary import analysis_model
-from masonry.equilibrium import G
+from masonry.rbe.boundary import analysis_model
+from masonry.tolerances import G
 from masonry.interfaces import candidate_pairs
 from masonry.params import ParameterError, Params, validate
 from masonry.scenes import build
-from masonry.solve import ACCURACY, RBEProblem
+from masonry.rbe.solve import ACCURACY, RBEProblem
 from masonry.tolerances import Tolerances
 
 SOLVE_LIMIT = 400

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 from masonry.blocks import Blocks, tangent_basis
-from masonry.equilibrium import G, VariableLayout, assemble
+from masonry.rbe.equilibrium import VariableLayout, assemble
+from masonry.tolerances import G
 from masonry.interfaces import INTERFACE_KINDS, Interfaces
-from masonry.solve import RESULT_KEYS, interface_forces, solve_rbe
+from masonry.rbe.solve import RESULT_KEYS, interface_forces, solve_rbe
 from masonry.tolerances import Tolerances
 
 MU = 0.7

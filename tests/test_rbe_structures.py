@@ -7,7 +7,7 @@ import pytest
 from conftest import PRESETS, scene_of, support_force
 
 from masonry.interfaces import INTERFACE_KINDS, detect
-from masonry.solve import solve_rbe
+from masonry.rbe.solve import solve_rbe
 from masonry.tolerances import Tolerances
 
 HORIZONTAL, SUPPORT = INTERFACE_KINDS.index("horizontal"), INTERFACE_KINDS.index("support")

@@ -93,7 +93,7 @@ def test_run_failing_midway_leaves_the_earlier_folder(wall_run, monkeypatch):
     def broken(*args, **kwargs):
         raise KeyboardInterrupt  # an interrupted run, halfway through its exports
 
-    monkeypatch.setattr("masonry.pipeline.forces_csv", broken)
+    monkeypatch.setattr("masonry.export.csv.forces_csv", broken)
     assert main(["run", "--preset", "wall", "--fast", "--force", "--out", str(out),
                  "-q"]) == 130
     after = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}

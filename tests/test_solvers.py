@@ -11,16 +11,16 @@ import functools
 import numpy as np
 import pytest
 
-from masonry.bench import COLUMNS, bench, frontier_png, table_csv, table_markdown
-from masonry.boundary import analysis_model
-from masonry.equilibrium import assemble
+from masonry.studies.bench import COLUMNS, bench, frontier_png, table_csv, table_markdown
+from masonry.rbe.boundary import analysis_model
+from masonry.rbe.equilibrium import assemble
 from masonry.params import ACCURACIES, SOLVERS, ParameterError, Params, from_preset, structure_id
 from masonry.scenes import build
-from masonry.solve import ACCURACY, RBEProblem, solve_rbe
-from masonry.solvers import BACKENDS
-from masonry.solvers.cholesky import BlockCholesky
-from masonry.solvers.newton import NewtonSystem, project_pyramid
-from masonry.solvers.standard_form import standard_form
+from masonry.rbe.solve import ACCURACY, RBEProblem, solve_rbe
+from masonry.rbe.solvers import BACKENDS
+from masonry.rbe.solvers.cholesky import BlockCholesky
+from masonry.rbe.solvers.newton import NewtonSystem, project_pyramid
+from masonry.rbe.solvers.standard_form import standard_form
 from masonry_cli.main import main
 
 

@@ -62,7 +62,7 @@ def test_a_failing_variant_is_recorded_and_the_rest_complete(tmp_path):
 
 def test_interrupted_study_resumes_with_only_the_missing_variants(tmp_path, study,
                                                                   monkeypatch):
-    import masonry.sweep as sweep
+    import masonry.studies.sweep as sweep
 
     real = sweep.run_variant
     calls = []

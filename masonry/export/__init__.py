@@ -1,2 +1,130 @@
-"""Exporters, one module per format. Each turns arrays into bytes; :mod:`masonry.runfolder`
-is the one place that writes files."""
+"""Exporters, one module per format, and the registry the pipeline iterates.
+
+Each exporter turns what a run made (:class:`RunOutputs`) into files, as bytes or text
+keyed by their path inside the run folder; :mod:`masonry.runfolder` is the one place that
+writes them. An exporter may also return a record for ``run.json`` (the printable body's
+checks). A new format is a module and one :class:`Exporter` row in :data:`EXPORTERS`.
+"""
+
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from masonry import plots
+from masonry.export import csv, obj, rhino, stl, summaries, vtu
+from masonry.printable import printable_blocks, printable_body
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True, eq=False)
+class RunOutputs:
+    """What one run made, handed to every exporter.
+
+    Parameters
+    ----------
+    scene : masonry.scenes.base.Scene
+    model : masonry.rbe.boundary.Model
+        The analysed blocks (the scene's, then any neighbour images) and interfaces.
+    result : masonry.rbe.solve.RBEResult or None
+        The rigid block equilibrium; None when the run only builds.
+    forces : dict str -> (K,) float or None, newtons
+        Per-interface force sums (:func:`masonry.rbe.solve.interface_forces`), None
+        without an accepted solution.
+    plots, printable : bool
+        The outputs the user asked for.
+    """
+
+    scene: object
+    model: object
+    result: object = None
+    forces: dict | None = None
+    plots: bool = True
+    printable: bool = True
+
+
+@dataclass(frozen=True)
+class Export:
+    """Files (path in the run folder -> bytes or text) and an optional run.json record."""
+
+    files: dict
+    record: dict | None = None
+
+
+@dataclass(frozen=True)
+class Exporter:
+    """One row of the registry.
+
+    Parameters
+    ----------
+    name : str
+        Also the run.json key of its record, if it returns one.
+    stage : str
+        The timing stage it counts towards (``exports``, ``printable``, ``plots``).
+    make : callable RunOutputs -> Export
+    wanted : callable RunOutputs -> bool
+        Whether this run writes it.
+    """
+
+    name: str
+    stage: str
+    make: Callable
+    wanted: Callable = field(default=lambda made: True)
+
+
+def _model_files(made: RunOutputs) -> Export:
+    scene, model = made.scene, made.model
+    return Export({
+        "00_parameters.txt": summaries.parameters_text(scene.params),
+        "locations.csv": csv.locations_csv(scene.blocks, scene.cad_vertices()),
+        "bricks.obj": obj.blocks_obj(scene.blocks),
+        "interfaces.csv": csv.interfaces_csv(model.blocks, model.interfaces),
+    })
+
+
+def _rhino_files(made: RunOutputs) -> Export:
+    if not rhino.available():
+        log.info("bricks.3dm skipped: pip install 'masonry[rhino]' to write it")
+        return Export({})
+    return Export({"bricks.3dm": rhino.blocks_3dm(made.scene.blocks)})
+
+
+def _rbe_files(made: RunOutputs) -> Export:
+    files = {"RBE/00_objective.txt": summaries.objective_text(made.result)}
+    if made.forces is not None:
+        blocks, interfaces = made.model.blocks, made.model.interfaces
+        files["RBE/forces.csv"] = csv.forces_csv(blocks, interfaces, made.forces)
+        if len(interfaces):
+            files["RBE/interfaces.vtu"] = vtu.interfaces_vtu(interfaces, made.forces)
+    return Export(files)
+
+
+def _printable_files(made: RunOutputs) -> Export:
+    body, report = printable_body(*printable_blocks(made.scene))
+    data = stl.stl_bytes(body)
+    report["readback"] = stl.readback_check(data, report["volume_m3"], rtol=1e-5)
+    return Export({"dome.stl": data, "dome.obj": stl.obj_body_bytes(body)}, report)
+
+
+def _plot_files(made: RunOutputs) -> Export:
+    scene, model, fast = made.scene, made.model, made.scene.params.fast
+    files = {}
+    if scene.layout is not None:
+        files["00_pattern.png"] = plots.pattern_png(scene, fast)
+    files.update(plots.structure_pngs(scene, fast))
+    files.update(plots.interface_pngs(model.blocks, model.interfaces, fast))
+    if made.forces is not None:
+        pngs = plots.force_pngs(model.blocks, model.interfaces, made.forces, fast)
+        files.update({f"RBE/{name}": png for name, png in pngs.items()})
+    return Export(files)
+
+
+EXPORTERS = (
+    Exporter("model", "exports", _model_files),
+    Exporter("rhino", "exports", _rhino_files),
+    Exporter("rbe", "exports", _rbe_files, wanted=lambda made: made.result is not None),
+    Exporter("printable", "printable", _printable_files,
+             wanted=lambda made: made.printable),
+    Exporter("plots", "plots", _plot_files, wanted=lambda made: made.plots),
+)
+"""Every exporter, in the order a run writes them."""

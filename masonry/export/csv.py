@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ..blocks import BLOCK_CLASSES, Blocks
-from ._text import format_floats
+from masonry.blocks import BLOCK_CLASSES, Blocks
+from masonry.export._text import format_floats
 
 
 def _table(columns) -> bytes:
@@ -50,7 +50,7 @@ def locations_csv(blocks: Blocks, vertices=None) -> bytes:
 
 
 def _interface_columns(blocks: Blocks, interfaces) -> list:
-    from ..interfaces import INTERFACE_KINDS
+    from masonry.interfaces import INTERFACE_KINDS
 
     a, b = interfaces.pair[:, 0], interfaces.pair[:, 1]
     kind = np.array(INTERFACE_KINDS, dtype=object)[interfaces.kind]

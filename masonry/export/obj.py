@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from ..blocks import Blocks
-from ._text import format_floats
+from masonry.blocks import Blocks
+from masonry.export._text import format_floats
 
 
 def blocks_obj(blocks: Blocks, vertices=None) -> bytes:

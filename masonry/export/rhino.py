@@ -10,11 +10,20 @@ import tempfile
 
 import numpy as np
 
-from ..blocks import BLOCK_CLASSES, Blocks
+from masonry.blocks import BLOCK_CLASSES, Blocks
 
 # layer colours (RGBA), one per block class, in BLOCK_CLASSES order
 _LAYER_COLOURS = ((128, 128, 128, 255), (200, 120, 80, 255), (200, 40, 40, 255),
                   (80, 120, 200, 255), (120, 180, 90, 255))
+
+
+def available() -> bool:
+    """Whether the optional rhino3dm package is installed."""
+    try:
+        import rhino3dm  # noqa: F401
+    except ImportError:
+        return False
+    return True
 
 
 def blocks_3dm(blocks: Blocks, vertices=None) -> bytes:

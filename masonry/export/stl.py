@@ -11,7 +11,7 @@ import io
 
 import numpy as np
 
-from ..printable import PrintableError
+from masonry.printable import PrintableError
 
 
 def stl_bytes(mesh) -> bytes:

@@ -13,7 +13,7 @@ import tempfile
 
 import numpy as np
 
-from ..interfaces import INTERFACE_KINDS
+from masonry.interfaces import INTERFACE_KINDS
 
 _CELL_TYPES = {3: "triangle", 4: "quad"}
 _RESERVED = ("interface", "kind", "area", "frame_normal", "frame_t1", "frame_t2")
@@ -28,7 +28,7 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
         ``K`` interfaces; their polygon vertices become the points (metres).
     forces : dict of str to (K,) float
         Per-interface resultants in newtons, e.g. ``compression``, ``tension``,
-        ``normal``, ``t1``, ``t2``, ``friction`` (:func:`masonry.solve.interface_forces`).
+        ``normal``, ``t1``, ``t2``, ``friction`` (:func:`masonry.rbe.solve.interface_forces`).
     kind_names : sequence of str
         Names of the ``kind`` codes, written into the file's header comment.
 

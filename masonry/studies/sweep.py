@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .params import Params, ParameterError
+from masonry.params import Params, ParameterError
 
 log = logging.getLogger(__name__)
 
@@ -94,9 +94,9 @@ class Study:
 
 def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=False) -> dict:
     """Run one variant; never raises: a failure becomes a row with its error."""
-    from .params import validate
-    from .pipeline import run
-    from .solvers.newton import use_one_blas_thread
+    from masonry.params import validate
+    from masonry.pipeline import run
+    from masonry.rbe.solvers.newton import use_one_blas_thread
 
     use_one_blas_thread()  # in a Dask worker process too
     start = time.perf_counter()
@@ -224,7 +224,7 @@ def summary_parquet(study: Study, rows):
 
 def summary_pngs(study: Study, rows) -> dict:
     """MoI factor and feasibility against each swept input (one figure per input)."""
-    from .plots import _png, plt
+    from masonry.plots import _png, plt
 
     out = {}
     done = [r for r in rows if r["status"] != "failed"]

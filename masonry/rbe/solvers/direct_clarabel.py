@@ -11,9 +11,9 @@ import time
 
 import numpy as np
 
-from .base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL, OPTIMAL_INACCURATE,
+from masonry.rbe.solvers.base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL, OPTIMAL_INACCURATE,
                    SOLVER_ERROR, USER_LIMIT, QPOutcome)
-from .standard_form import kept_form
+from masonry.rbe.solvers.standard_form import kept_form
 
 STATUS = {
     "Solved": OPTIMAL,

@@ -12,7 +12,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from .base import SOLVER_ERROR, QPOutcome
+from masonry.rbe.solvers.base import SOLVER_ERROR, QPOutcome
 
 log = logging.getLogger(__name__)
 

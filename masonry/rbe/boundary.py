@@ -24,29 +24,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .blocks import Blocks, concatenate
-from .interfaces import INTERFACE_KINDS, Interfaces, detect
+from masonry.blocks import Blocks, concatenate, rotated_web, rotation_z
+from masonry.interfaces import INTERFACE_KINDS, Interfaces, detect
 
 BOUNDARY = INTERFACE_KINDS.index("boundary")
-
-
-def rotation_z(angle) -> np.ndarray:
-    """(3, 3) rotation by ``angle`` radians about the dome axis (z)."""
-    c, s = np.cos(angle), np.sin(angle)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def rotated_web(blocks: Blocks, web: int, n: int, mask=None) -> Blocks:
-    """Blocks (or those selected by ``mask``) rotated by ``2 pi web / n`` about z, named
-    ``w<web>_<name>`` and marked as web ``web % n``."""
-    part = blocks if mask is None else blocks.subset(mask)
-    motion = np.eye(4)
-    motion[:3, :3] = rotation_z(2 * np.pi * web / n)
-    part = part.transformed(motion)
-    return dataclasses.replace(
-        part,
-        block_name=np.array([f"w{web % n}_{name}" for name in part.block_name], dtype=object),
-        block_web=np.full(part.n_blocks, web % n))
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,7 +41,7 @@ class Model:
         The scene's blocks first (indices unchanged), then the neighbour images.
     interfaces : Interfaces
     side_block : (K, 2) int or None
-        Block that receives each side's force (see :func:`masonry.equilibrium.assemble`).
+        Block that receives each side's force (see :func:`masonry.rbe.equilibrium.assemble`).
     side_rotation : (K, 2, 3, 3) float or None
         Rotation applied to each side's force and lever arm.
     """

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .blocks import BLOCK_CLASSES
-from .pattern import Pattern
+from masonry.blocks import BLOCK_CLASSES
+from masonry.dome.pattern import Pattern
 
 REGULAR = 4.0  # regular brick length, units
 _EPS = 1e-9

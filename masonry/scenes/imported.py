@@ -38,9 +38,11 @@ from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
-from .meshing import merge_vertices
-from .blocks import BLOCK_CLASSES, Blocks, concatenate, tangent_basis
-from .tolerances import Tolerances
+from masonry.blocks import BLOCK_CLASSES, Blocks, concatenate, tangent_basis
+from masonry.meshing import merge_vertices
+from masonry.params import validate
+from masonry.scenes.base import Scene
+from masonry.tolerances import Tolerances
 
 log = logging.getLogger(__name__)
 
@@ -225,9 +227,6 @@ def load_assembly(paths, params, *, supports=(), support_below=None, ground=Fals
         A file or a block is bad (:func:`read_blocks`), a support pattern matches
         nothing, or no block (or every block) is a support.
     """
-    from .params import validate
-    from .scenes import Scene
-
     start = time.perf_counter()
     blocks = read_blocks(paths)
     tol = Tolerances.for_points(blocks.vertices)

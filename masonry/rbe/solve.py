@@ -1,7 +1,7 @@
 """Solve rigid block equilibrium (RBE) as a quadratic program (SPEC 6.5-6.7, thesis 3.3.4).
 
-The matrices come from :mod:`masonry.equilibrium`, the solvers from
-:mod:`masonry.solvers`; this module chooses them by accuracy preset (SPEC 6.6), runs the
+The matrices come from :mod:`masonry.rbe.equilibrium`, the solvers from
+:mod:`masonry.rbe.solvers`; this module chooses them by accuracy preset (SPEC 6.6), runs the
 thesis's friction flow (friction-net, then friction+ when the structure is infeasible),
 checks what every solver returned and packs the result. A solver's status is never
 trusted alone: the equilibrium residual and the friction violation are recomputed from
@@ -22,10 +22,10 @@ import highspy
 import numpy as np
 import scipy.sparse as sp
 
-from .equilibrium import FRICTION_METHODS, EquilibriumSystem, VariableLayout, assemble
-from .solvers import BACKENDS, FAMILY
-from .solvers.base import INFEASIBLE, OPTIMAL
-from .tolerances import Tolerances
+from masonry.rbe.equilibrium import FRICTION_METHODS, EquilibriumSystem, VariableLayout, assemble
+from masonry.rbe.solvers import BACKENDS, FAMILY
+from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL
+from masonry.tolerances import Tolerances
 
 log = logging.getLogger(__name__)
 
@@ -38,7 +38,7 @@ class AccuracyPreset:
     ----------
     name : str
     net_solver, plus_solver : str
-        :data:`masonry.solvers.BACKENDS` names for friction-net and friction+. An
+        :data:`masonry.rbe.solvers.BACKENDS` names for friction-net and friction+. An
         explicit ``solver`` argument replaces both.
     residual : float
         Acceptance: a returned point counts when its relative equilibrium residual and
@@ -49,7 +49,7 @@ class AccuracyPreset:
         a point whose equilibrium and friction residuals were recomputed here.
     polish : bool
         Refine an accepted interior-point or ADMM point with Newton steps started from
-        its multipliers (:mod:`masonry.solvers.newton`): one or two steps find the exact
+        its multipliers (:mod:`masonry.rbe.solvers.newton`): one or two steps find the exact
         active set, which leaves residuals near rounding and no interior-point tension
         (Clarabel at 1e-10 left 1e-6 of the weight as tension on a feasible section).
         Kept only if it converges within :data:`POLISH_STEPS`.
@@ -163,7 +163,7 @@ class RBEResult:
         Verdict of the independent friction-net LP (HiGHS); None when not run or
         inconclusive.
     x : (4 IV,) float or None, N
-        Solution in the :class:`~masonry.equilibrium.VariableLayout` order.
+        Solution in the :class:`~masonry.rbe.equilibrium.VariableLayout` order.
     layout : VariableLayout
     accuracy : str
         The accuracy preset.
@@ -234,7 +234,7 @@ def interface_forces(layout, x) -> dict:
 class RBEProblem:
     """One scene's rigid block equilibrium, prepared for any number of solves.
 
-    Assembles the scaled matrices once (:func:`masonry.equilibrium.assemble`); every
+    Assembles the scaled matrices once (:func:`masonry.rbe.equilibrium.assemble`); every
     :meth:`solve` reuses them with its own ``mu`` and ``density``, and every solver keeps
     its workspace (Newton's symbolic Cholesky factorization and last dual point, the
     OSQP and Clarabel solver objects, updated in place) between friction-net and
@@ -245,7 +245,7 @@ class RBEProblem:
     blocks : masonry.blocks.Blocks
     interfaces : masonry.interfaces.Interfaces
     side_block, side_rotation : optional
-        Force routing for boundary modes, see :func:`masonry.equilibrium.assemble`.
+        Force routing for boundary modes, see :func:`masonry.rbe.equilibrium.assemble`.
     """
 
     def __init__(self, blocks, interfaces, *, side_block=None, side_rotation=None):
@@ -387,7 +387,7 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
     friction-net: ``|f1|, |f2| <= mu (c - t)`` (eq. 3.26, infeasible when the structure
     cannot stand without tension); friction+: ``|f1|, |f2| <= mu c`` (eq. 3.25, always
     feasible; the sum of tension is the measure of infeasibility, eq. 3.28). The problem
-    is solved scaled (:mod:`masonry.equilibrium`), results are in newtons.
+    is solved scaled (:mod:`masonry.rbe.equilibrium`), results are in newtons.
 
     Parameters
     ----------
@@ -400,7 +400,7 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
         ``'auto'`` (thesis 3.3.3): friction-net first; when it has no accepted solution,
         friction+ and report that.
     solver : str, optional
-        A :data:`masonry.solvers.BACKENDS` name (``newton``, ``clarabel``, ``osqp``,
+        A :data:`masonry.rbe.solvers.BACKENDS` name (``newton``, ``clarabel``, ``osqp``,
         ``clarabel-cvxpy``, ``osqp-cvxpy``) for both friction models, with the preset's
         tolerances for its family. Default: the preset's solvers.
     tol : Tolerances, optional
@@ -416,7 +416,7 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
     lp_time_limit : float, s
         HiGHS's time limit; when reached, ``lp_feasible`` is None and a warning is logged.
     side_block, side_rotation : optional
-        Force routing for boundary modes, see :func:`masonry.equilibrium.assemble`.
+        Force routing for boundary modes, see :func:`masonry.rbe.equilibrium.assemble`.
 
     Returns
     -------

@@ -1,4 +1,4 @@
-"""What every QP backend returns (:mod:`masonry.solvers`)."""
+"""What every QP backend returns (:mod:`masonry.rbe.solvers`)."""
 
 from dataclasses import dataclass, field
 
@@ -25,7 +25,7 @@ class QPOutcome:
     status : str
         One of the module's statuses (cvxpy's words).
     x : (n,) float or None
-        The point, in solver units and the :class:`~masonry.equilibrium.VariableLayout`
+        The point, in solver units and the :class:`~masonry.rbe.equilibrium.VariableLayout`
         order; None without one.
     iterations : int
         Solver iterations (Newton steps, interior-point or ADMM iterations); -1 when

@@ -10,7 +10,7 @@ violation, and how far its MoI and forces are from the most accurate solution (t
 :func:`table_csv` and :func:`frontier_png` format them, the ``masonry bench`` command
 prints and writes them.
 
-Every repeat builds everything again (a fresh :class:`~masonry.solve.RBEProblem`), so no
+Every repeat builds everything again (a fresh :class:`~masonry.rbe.solve.RBEProblem`), so no
 solver reuses a factorization or a warm start from an earlier run: the times are what a
 user's first run costs.
 """
@@ -23,12 +23,12 @@ import time
 
 import numpy as np
 
-from .boundary import analysis_model
-from .export.csv import forces_csv, interfaces_csv, locations_csv
-from .export.obj import blocks_obj
-from .params import from_preset
-from .scenes import build
-from .solve import ACCURACY, RBEProblem
+from masonry.rbe.boundary import analysis_model
+from masonry.export.csv import forces_csv, interfaces_csv, locations_csv
+from masonry.export.obj import blocks_obj
+from masonry.params import from_preset
+from masonry.scenes import build
+from masonry.rbe.solve import ACCURACY, RBEProblem
 
 log = logging.getLogger(__name__)
 
@@ -140,7 +140,7 @@ def _run(params, accuracy, solver, exports=True):
         blocks_obj(scene.blocks)
         interfaces_csv(model.blocks, model.interfaces)
         if result.x is not None:
-            from .export.vtu import interfaces_vtu
+            from masonry.export.vtu import interfaces_vtu
 
             forces = result.per_interface()
             forces_csv(model.blocks, model.interfaces, forces)

@@ -1,6 +1,6 @@
 """Rigid block equilibrium (RBE) matrices, without a solver (SPEC 6.1-6.3, thesis 3.3).
 
-This module only assembles; :mod:`masonry.solve` calls a solver. Keeping the two apart
+This module only assembles; :mod:`masonry.rbe.solve` calls a solver. Keeping the two apart
 makes the matrices testable on their own (the peers compas_cra keep ``cra_helper.py``
 apart from ``rbe_pyomo.py`` for the same reason).
 
@@ -46,8 +46,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
-G = 9.81
-"""Gravitational acceleration, m/s^2 (SPEC 2)."""
+from masonry.tolerances import G
 
 TENSION_WEIGHT = 1.0
 """Diagonal of ``H`` for tension (thesis eq. 3.27)."""
@@ -164,7 +163,7 @@ class EquilibriumSystem:
         ``A_eq`` by vertex: the six rows a vertex's ``(c, t, f1, f2)`` give the block of
         each side (zero for a support side). ``A_eq`` is their sum, so Newton matrices
         ``A_eq D A_eq^T`` with block-diagonal ``D`` can be formed interface by interface
-        (:mod:`masonry.solvers.newton`) instead of by sparse products.
+        (:mod:`masonry.rbe.solvers.newton`) instead of by sparse products.
     density : float, kg/m^3
 
     Attributes

@@ -10,9 +10,9 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from .base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL, OPTIMAL_INACCURATE,
+from masonry.rbe.solvers.base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL, OPTIMAL_INACCURATE,
                    SOLVER_ERROR, USER_LIMIT, QPOutcome)
-from .standard_form import kept_form
+from masonry.rbe.solvers.standard_form import kept_form
 
 STATUS = {
     "solved": OPTIMAL,

@@ -3,8 +3,8 @@
 An arch of rigid, no-tension voussoirs stands above a minimum thickness and falls below
 it (Heyman; Milankovitch's t/R = 0.1075 for a semicircle under self weight). Here the
 feasibility of each thickness is decided by the same interface detector and friction-net
-QP as every other scene; :func:`masonry.arch.thrust_line_minimum_thickness` computes
-the same number independently from the thrust line.
+QP as every other scene; :mod:`masonry.studies.thrust_line` computes the same number
+independently from the thrust line.
 """
 
 import logging
@@ -13,9 +13,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .arch import arch_radius, build_arch
-from .interfaces import detect
-from .params import Params, validate
+from masonry.interfaces import detect
+from masonry.params import Params, arch_radius, validate
+from masonry.rbe.solve import solve_rbe
+from masonry.scenes.arch import build_arch
 
 log = logging.getLogger(__name__)
 
@@ -48,8 +49,6 @@ class ThicknessResult:
 
 def is_feasible(params: Params) -> bool:
     """Whether the arch of ``params`` stands: friction-net RBE, no LP check."""
-    from .solve import solve_rbe
-
     scene = build_arch(params)
     interfaces = detect(scene.blocks, up=scene.block_up)
     result = solve_rbe(scene.blocks, interfaces, mu=params.mu, density=params.density,

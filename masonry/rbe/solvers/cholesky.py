@@ -1,6 +1,6 @@
 """Sparse Cholesky factorization of block-structured SPD matrices (multifrontal).
 
-The Newton systems of the rigid block equilibrium (:mod:`masonry.solvers.newton`) are
+The Newton systems of the rigid block equilibrium (:mod:`masonry.rbe.solvers.newton`) are
 ``M = A J A^T + eps I`` over the six equilibrium rows of every free block: a symmetric
 positive definite matrix of dense 6 x 6 blocks whose block pattern is the contact graph
 (block ``i`` couples to block ``j`` when an interface joins them). The pattern is fixed

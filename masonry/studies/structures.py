@@ -11,9 +11,9 @@ the thesis could not compute (its future work, 5.6).
 import logging
 import time
 
-from .boundary import analysis_model
-from .params import from_preset
-from .scenes import build
+from masonry.rbe.boundary import analysis_model
+from masonry.params import from_preset
+from masonry.scenes import build
 
 log = logging.getLogger(__name__)
 
@@ -55,7 +55,7 @@ def structures_table(rows=ROWS, full_dome=True, lp_check=False):
     explicit). The LP check is off by default: the table reports the QP's verdict with its
     recomputed residuals.
     """
-    from .solve import solve_rbe
+    from masonry.rbe.solve import solve_rbe
 
     out = []
     for structure, preset, scene_name, boundary, friction, mu in rows:

@@ -1,6 +1,6 @@
 """Semismooth Newton method on the dual of the RBE quadratic program.
 
-The thesis's QP (eq. 3.27, SPEC 6.5), scaled as in :mod:`masonry.equilibrium`::
+The thesis's QP (eq. 3.27, SPEC 6.5), scaled as in :mod:`masonry.rbe.equilibrium`::
 
     minimize 1/2 x^T H x   subject to   A x = b,   x in K
 
@@ -20,7 +20,7 @@ entry per equilibrium row (six per free block: a virtual displacement and rotati
 ``x(y)`` meets the friction and sign constraints exactly. Newton steps use the
 generalized Hessian ``-(A J A^T + eps I)``, ``J`` the Jacobian of the projection
 (block-diagonal, one 3 x 3 or 4 x 4 block per vertex), factored by
-:class:`masonry.solvers.cholesky.BlockCholesky` on the contact graph; a backtracking
+:class:`masonry.rbe.solvers.cholesky.BlockCholesky` on the contact graph; a backtracking
 (Armijo) line search on ``g`` globalizes them. Once the set of active pyramid faces is
 found the step is exact, so the method ends with residuals near rounding.
 
@@ -32,7 +32,7 @@ took 9 Newton steps on a 38,000-row system of 6 x 6 blocks.
 When friction-net is infeasible the dual is unbounded: the iterates run off along a
 Farkas direction ``d`` with ``b^T d > 0`` and ``A^T d`` in the polar cone of ``K``. The
 method stops when the current step is such a certificate within tolerance, or when it
-stalls, and reports it; :mod:`masonry.solve` then decides what to do.
+stalls, and reports it; :mod:`masonry.rbe.solve` then decides what to do.
 """
 
 import dataclasses
@@ -45,8 +45,8 @@ import numpy as np
 import scipy.sparse as sp
 from threadpoolctl import ThreadpoolController
 
-from .base import QPOutcome
-from .cholesky import BlockCholesky
+from masonry.rbe.solvers.base import QPOutcome
+from masonry.rbe.solvers.cholesky import BlockCholesky
 
 log = logging.getLogger(__name__)
 
@@ -152,7 +152,7 @@ def project_pyramid(p, mu):
 
 
 class NewtonSystem:
-    """What the Newton method keeps for one :class:`~masonry.equilibrium.EquilibriumSystem`
+    """What the Newton method keeps for one :class:`~masonry.rbe.equilibrium.EquilibriumSystem`
     and friction model: the column subset of ``A_eq``, the Cholesky symbolic analysis of
     the contact graph (shared between friction models and friction coefficients), and the
     maps that scatter per-interface 12 x 12 blocks into the Newton matrix."""
@@ -313,7 +313,7 @@ def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOut
 
     Parameters
     ----------
-    system : masonry.equilibrium.EquilibriumSystem
+    system : masonry.rbe.equilibrium.EquilibriumSystem
     method : {'net', 'plus'}
     options : NewtonOptions, optional
     y0 : (6 F,) float, optional
@@ -436,7 +436,7 @@ def _certifies_infeasibility(ns, step, w_step, b_one, tol) -> bool:
 
 
 def backend(system, method, options, workspace, y0=None) -> QPOutcome:
-    """The :mod:`masonry.solvers` interface: ``options`` are :class:`NewtonOptions`
+    """The :mod:`masonry.rbe.solvers` interface: ``options`` are :class:`NewtonOptions`
     fields. The workspace keeps the prepared systems (their symbolic factorization is
     shared by both friction models) and the last dual point per model, which starts the
     next solve of that model (another ``mu``) unless ``y0`` is given (a polish)."""

@@ -1,6 +1,6 @@
 """The scaled RBE QP as the sparse matrices a QP solver takes, without cvxpy.
 
-Variables ``x`` in the :class:`~masonry.equilibrium.VariableLayout` order, solver units::
+Variables ``x`` in the :class:`~masonry.rbe.equilibrium.VariableLayout` order, solver units::
 
     minimize    1/2 x^T P x          P = diag(h_solver)
     subject to  A_eq x = b           b = -f_ext
@@ -65,7 +65,7 @@ class StandardForm:
 
 
 def standard_form(system) -> StandardForm:
-    """:class:`StandardForm` of an :class:`~masonry.equilibrium.EquilibriumSystem`."""
+    """:class:`StandardForm` of an :class:`~masonry.rbe.equilibrium.EquilibriumSystem`."""
     layout = system.layout
     n, n_vertices = layout.n_columns, layout.n_vertices
     A_eq = sp.coo_array(system.A_eq)

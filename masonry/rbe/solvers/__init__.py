@@ -1,10 +1,10 @@
 """QP backends for the rigid block equilibrium (SPEC 6.5, 6.6).
 
 Every backend is ``solve(system, method, options, workspace) -> QPOutcome``: it solves
-the scaled QP of an :class:`~masonry.equilibrium.EquilibriumSystem` for the friction
+the scaled QP of an :class:`~masonry.rbe.equilibrium.EquilibriumSystem` for the friction
 model ``method`` (``'net'`` or ``'plus'``) with solver ``options``, and may keep
 whatever it can reuse (factorizations, solver objects, warm starts) in ``workspace``, a
-dict that :class:`masonry.solve.RBEProblem` keeps per scene and backend. Adding a solver
+dict that :class:`masonry.rbe.solve.RBEProblem` keeps per scene and backend. Adding a solver
 is adding a module and a line here.
 
 - ``newton``: semismooth Newton on the dual (:mod:`.newton`); friction-net only in the
@@ -14,8 +14,8 @@ is adding a module and a line here.
 - ``clarabel-cvxpy``, ``osqp-cvxpy``: the same through cvxpy, the readable reference.
 """
 
-from . import direct_clarabel, direct_osqp, newton, via_cvxpy
-from .base import QPOutcome
+from masonry.rbe.solvers import direct_clarabel, direct_osqp, newton, via_cvxpy
+from masonry.rbe.solvers.base import QPOutcome
 
 BACKENDS = {
     "newton": newton.backend,

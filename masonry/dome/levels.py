@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from .params import Params
+from masonry.params import Params
 
 
 @dataclass(frozen=True)
