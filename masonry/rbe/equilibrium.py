@@ -363,3 +363,25 @@ def friction_pyramids(n_vertices: int, mu: float) -> dict:
         "net": sp.csr_array(sp.kron(eye, pyramid_net, format="csr")),
         "plus": sp.csr_array(sp.kron(eye, pyramid_plus, format="csr")),
     }
+
+
+def friction_pyramid_edges(n_vertices: int, mu: float) -> sp.csr_array:
+    """The friction-net pyramid with ``t = 0`` by its edge rays (SPEC 6.3, 6.8).
+
+    A vertex force with ``|f1|, |f2| <= mu c`` and no tension is a nonnegative
+    combination of the four edge rays ``(c, t, f1, f2) = (1, 0, +-mu, +-mu)``, so
+    ``x = E g`` with ``g >= 0`` states the pyramid without inequality rows. Fixing
+    ``t = 0`` loses nothing: a friction-net point with ``0 < t <= c`` stays one with
+    ``(c - t, 0)``.
+
+    Returns
+    -------
+    E : (4 IV, 4 IV) scipy.sparse.csr_array
+        Column ``4 i + e`` is edge ``e`` of vertex ``i`` in the
+        :class:`VariableLayout` order; edges ``(+f1 +f2, +f1 -f2, -f1 +f2, -f1 -f2)``.
+    """
+    edges = np.array([[1.0, 1.0, 1.0, 1.0],    # c
+                      [0.0, 0.0, 0.0, 0.0],    # t
+                      [mu, mu, -mu, -mu],      # f1
+                      [mu, -mu, mu, -mu]])     # f2
+    return sp.csr_array(sp.kron(sp.identity(n_vertices), edges, format="csr"))

@@ -22,7 +22,8 @@ import highspy
 import numpy as np
 import scipy.sparse as sp
 
-from masonry.rbe.equilibrium import FRICTION_METHODS, EquilibriumSystem, VariableLayout, assemble
+from masonry.rbe.equilibrium import (FRICTION_METHODS, EquilibriumSystem, VariableLayout,
+                                     assemble, friction_pyramid_edges)
 from masonry.rbe.solvers import BACKENDS, FAMILY
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL
 from masonry.tolerances import Tolerances
@@ -490,12 +491,7 @@ def _lp_feasible(system: EquilibriumSystem, time_limit: float):
 
     Returns True, False, or None when HiGHS ends without a verdict (time limit).
     """
-    mu = system.mu
-    edges = np.array([[1.0, 1.0, 1.0, 1.0],    # c
-                      [0.0, 0.0, 0.0, 0.0],    # t
-                      [mu, mu, -mu, -mu],      # f1
-                      [mu, -mu, mu, -mu]])     # f2
-    generators = sp.kron(sp.identity(system.layout.n_vertices), edges, format="csr")
+    generators = friction_pyramid_edges(system.layout.n_vertices, system.mu)
     A = sp.csc_array(system.A_eq @ generators)
     lp = highspy.HighsLp()
     lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
