@@ -4,9 +4,11 @@ from masonry.scenes.imported import load_assembly
 from masonry.params import Params, validate
 from masonry.pipeline import run
 
-from .options import add_analysis_options, add_output_options, rbe_summary, summary
+from .options import (add_analysis_options, add_live_load_options, add_output_options,
+                      collapse_summary, rbe_summary, summary)
 
-ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast")
+ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast", "lateral",
+            "point_loads", "crown_load")
 
 
 def register(subparsers):
@@ -25,6 +27,7 @@ def register(subparsers):
     g.add_argument("--ground", action="store_true",
                    help="add a ground slab (a support) under the lowest blocks")
     add_analysis_options(parser, boundary=False)
+    add_live_load_options(parser)
     parser.add_argument("--fast", action="store_true", default=None,
                    help="reduced output: one view, lower resolution")
     add_output_options(parser)
@@ -42,4 +45,6 @@ def handle(args, report):
            f"{len(source['files'])} file(s) in {source['read_s']:.3g} s")
     summary(record, report)
     rbe_summary(record, report)
+    if "collapse" in record:
+        collapse_summary(record, report)
     return 0

@@ -84,6 +84,40 @@ def add_analysis_options(parser, boundary=True):
                         "--boundary says otherwise")
 
 
+def add_live_load_options(parser):
+    """The live loads of a collapse load factor (SPEC 6.8); at most one per run."""
+    g = parser.add_argument_group(
+        "live load: compute the collapse load factor lambda and its mechanism")
+    g.add_argument("--lateral", metavar="AZIMUTH|all",
+                   help="horizontal body force lambda x each block's weight, at AZIMUTH "
+                        "degrees from +x toward +y; 'all' searches 24 azimuths and the "
+                        "dome's symmetry directions for the worst (not on a cyclic "
+                        "section: use --scene dome)")
+    g.add_argument("--point-load", dest="point_loads", action="append",
+                   metavar="NAME_OR_PATTERN:FX,FY,FZ",
+                   help="force in newtons at the centre of the top face of every block "
+                        "the name or fnmatch pattern matches (repeatable)")
+    g.add_argument("--crown-load", dest="crown_load", type=float, metavar="NEWTONS",
+                   help="domes: a downward load on the top course, shared by brick top "
+                        "area (a lantern; a section carries its 1/n share)")
+
+
+def collapse_summary(record, report):
+    """The line about the collapse load factor of a run record."""
+    c = record["collapse"]
+    live = c["live_load"]
+    what = (f"lateral at {c['azimuth_deg']:g} deg" if live["kind"] == "lateral"
+            else f"{live['kind']} load")
+    if c.get("azimuths"):
+        what += f" (worst of {len(c['azimuths'])} azimuths)"
+    if c["load_factor"] is None:
+        report(f"collapse: no load factor ({c['status']}), {what}")
+        return
+    report(f"collapse: lambda = {c['load_factor']:.4g} for the {what}; mechanism: "
+           f"{c['opening']} interfaces open ({c['hinges']} hinges), {c['sliding']} slide; "
+           f"{c['solver']} {c['time_s']:.3g} s")
+
+
 def add_output_options(parser):
     g = parser.add_argument_group("output")
     g.add_argument("--out", default="exports", metavar="DIR",

@@ -2,8 +2,9 @@
 
 from masonry.pipeline import run
 
-from .options import (add_analysis_options, add_model_options, add_output_options,
-                      params_from_args, rbe_summary, summary)
+from .options import (add_analysis_options, add_live_load_options, add_model_options,
+                      add_output_options, collapse_summary, params_from_args, rbe_summary,
+                      summary)
 
 
 def register(subparsers):
@@ -11,6 +12,7 @@ def register(subparsers):
         "run", help="the full job: model, interfaces, rigid block equilibrium, exports")
     add_model_options(parser)
     add_analysis_options(parser)
+    add_live_load_options(parser)
     add_output_options(parser)
     parser.set_defaults(handler=handle)
 
@@ -20,4 +22,6 @@ def handle(args, report):
                  printable=args.printable, force=args.force)
     summary(record, report)
     rbe_summary(record, report)
+    if "collapse" in record:
+        collapse_summary(record, report)
     return 0

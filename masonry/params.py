@@ -6,6 +6,7 @@ parameter, the value and the valid range.
 """
 
 import dataclasses
+import hashlib
 import logging
 import math
 import tomllib
@@ -59,6 +60,12 @@ class Params:
     auto, ``accuracy`` solver preset (fast | balanced | accurate; None: fast in fast
     mode, else balanced, SPEC 3), ``solver`` (None: the preset's; a name overrides it).
     Output: ``fast`` (one view, low resolution), ``cad_offset`` (units).
+    Live loads (SPEC 6.8, :mod:`masonry.rbe.loads`), each making the run compute a collapse
+    load factor: ``lateral`` azimuth in degrees from +x toward +y of a horizontal body
+    force of each block's weight, or ``'all'`` for the worst azimuth; ``point_loads``
+    ``'NAME_OR_PATTERN:FX,FY,FZ'`` strings (newtons at the centre of each matched block's
+    top face); ``crown_load`` newtons, downward, on the top course by brick top area. At
+    most one kind per run.
     """
 
     stretch: float = 1.0
@@ -86,6 +93,9 @@ class Params:
     arch_shape: str = "semicircular"
     arch_rise: float | None = None
     assembly: str = ""
+    lateral: float | str | None = None
+    point_loads: tuple = ()
+    crown_load: float | None = None
 
     def replace(self, **changes) -> "Params":
         return dataclasses.replace(self, **changes)
@@ -97,6 +107,15 @@ class Params:
         if self.accuracy is not None:
             return self.accuracy
         return "fast" if self.fast else "balanced"
+
+    @property
+    def live_load_kind(self) -> str | None:
+        """``'lateral'``, ``'point'``, ``'crown'`` or None: the run's live load."""
+        if self.lateral is not None:
+            return "lateral"
+        if self.point_loads:
+            return "point"
+        return None if self.crown_load is None else "crown"
 
     @property
     def geometry_key(self) -> dict:
@@ -144,9 +163,59 @@ def _number(name, value, integer=False):
     return value
 
 
+def parse_point_load(spec: str) -> tuple:
+    """``'NAME_OR_PATTERN:FX,FY,FZ'`` -> ``(pattern, (fx, fy, fz))`` in newtons; raises
+    :class:`ParameterError` naming ``--point-load``."""
+    expected = "NAME_OR_PATTERN:FX,FY,FZ (a block name or fnmatch pattern, newtons)"
+    pattern, colon, numbers = str(spec).rpartition(":")
+    parts = numbers.split(",")
+    if not colon or not pattern or len(parts) != 3:
+        raise ParameterError("--point-load", spec, expected)
+    try:
+        force = tuple(float(v) for v in parts)
+    except ValueError:
+        raise ParameterError("--point-load", spec, expected) from None
+    if not all(math.isfinite(v) for v in force) or not any(force):
+        raise ParameterError("--point-load", spec, "finite forces, not all zero")
+    return pattern, force
+
+
+def _live_loads(p: Params) -> Params:
+    """Check the live-load fields (SPEC 6.8); return them normalised (``lateral`` a float
+    or ``'all'``, ``point_loads`` a tuple)."""
+    lateral = p.lateral
+    if isinstance(lateral, str) and lateral != "all":
+        try:
+            lateral = float(lateral)
+        except ValueError:
+            raise ParameterError("--lateral", p.lateral,
+                                 "an azimuth in degrees or 'all'") from None
+    if lateral is not None and lateral != "all":
+        lateral = float(_number("--lateral", lateral)) % 360.0
+    specs = (p.point_loads,) if isinstance(p.point_loads, str) else tuple(p.point_loads)
+    for spec in specs:
+        parse_point_load(spec)
+    if p.crown_load is not None:
+        _check("--crown-load", p.crown_load, _number("--crown-load", p.crown_load) > 0,
+               "> 0 (newtons, downward)")
+        _check("--crown-load", p.crown_load, p.scene in ("section", "dome"),
+               "a dome: --scene section or dome")
+    kinds = sum((lateral is not None, bool(specs), p.crown_load is not None))
+    _check("--lateral", p.lateral, kinds <= 1,
+           "one live load per run: --lateral, --point-load or --crown-load")
+    if p.scene == "section" and p.boundary == "cyclic" and (lateral is not None or specs):
+        # one web with the load repeated in every web is not the asked load case
+        raise ParameterError("--lateral" if lateral is not None else "--point-load",
+                             p.lateral if lateral is not None else specs[0],
+                             "a symmetric load on a cyclic section: this load breaks the "
+                             "dome's rotational symmetry; use --scene dome")
+    return dataclasses.replace(p, lateral=lateral, point_loads=specs)
+
+
 def validate(params: Params) -> Params:
-    """Check every parameter; return ``params`` or raise :class:`ParameterError`."""
-    p = params
+    """Check every parameter; return ``params`` (live loads normalised) or raise
+    :class:`ParameterError`."""
+    p = _live_loads(params)
     _check("scene", p.scene, p.scene in SCENES, f"one of {', '.join(SCENES)}")
     _check("boundary", p.boundary, p.boundary in BOUNDARIES, f"one of {', '.join(BOUNDARIES)}")
     _check("friction", p.friction, p.friction in FRICTIONS, f"one of {', '.join(FRICTIONS)}")
@@ -267,4 +336,17 @@ def structure_id(params: Params) -> str:
             continue  # dome0 / dome1 already say free / cyclic
         if value != getattr(default, name):
             head += f"_{tag}{value:g}" if isinstance(value, float) else f"_{tag}{value}"
-    return head
+    return head + _live_load_tag(p)
+
+
+def _live_load_tag(p: Params) -> str:
+    """Structure id suffix of the live load: ``_latall``, ``_lat30``, ``_crown500``, or
+    ``_pl`` and a digest of the point loads (they can be long)."""
+    if p.lateral is not None:
+        return "_latall" if p.lateral == "all" else f"_lat{p.lateral:g}"
+    if p.crown_load is not None:
+        return f"_crown{p.crown_load:g}"
+    if p.point_loads:
+        digest = hashlib.sha1("\n".join(p.point_loads).encode()).hexdigest()[:8]
+        return f"_pl{digest}"
+    return ""

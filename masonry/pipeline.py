@@ -23,6 +23,8 @@ from masonry.blocks import BLOCK_CLASSES
 from masonry.export import EXPORTERS, RunOutputs
 from masonry.params import Params, structure_id, validate
 from masonry.rbe.boundary import Model, analysis_model
+from masonry.rbe.collapse import CollapseResult, collapse_load, worst_lateral
+from masonry.rbe.loads import crown_load, lateral, point_loads
 from masonry.rbe.solve import RBEProblem, RBEResult
 from masonry.runfolder import RunFolder, write_file_atomically
 from masonry.scenes import Scene, build
@@ -201,9 +203,15 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
     result = _solve(model, params, timer) if analyse else None
     if result is not None:
         record["rbe"] = {**result.to_dict(), "attempts": list(result.attempts)}
+    collapse = None
+    if analyse and params.live_load_kind is not None:
+        with timer.stage("collapse"):
+            collapse = collapse_of(model, params, result)
+        record["collapse"] = collapse.to_dict()
     made = RunOutputs(scene, model, result,
                       result.per_interface() if result is not None and result.x is not None
-                      else None, plots=plots_wanted, printable=printable)
+                      else None, plots=plots_wanted, printable=printable,
+                      collapse=collapse)
     with RunFolder(out_root, sid) as folder:
         write_exports(folder, made, record, timer)
         record["timings_s"] = timer.seconds
@@ -238,6 +246,28 @@ def _solve(model: Model, params: Params, timer: Timer) -> RBEResult:
     with timer.stage("solve"):
         return problem.solve(mu=params.mu, density=params.density, friction=params.friction,
                              solver=params.solver, accuracy=params.solver_accuracy)
+
+
+def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> CollapseResult:
+    """The collapse load factor of the run's live load (SPEC 6.8). A feasible RBE verdict
+    stands for the dead load; otherwise the LP decides it. ``--crown-load`` is the load on
+    the whole dome: a section carries its ``1/n`` share."""
+    known = True if rbe is not None and rbe.feasible else None
+    options = dict(mu=params.mu, density=params.density)
+    if params.lateral == "all":
+        webs = params.n if params.scene in ("section", "dome") else None
+        return worst_lateral(model, n_webs=webs, dead_load_feasible=known, **options)
+    if params.lateral is not None:
+        live = lateral(model, params.lateral, params.density)
+    elif params.point_loads:
+        live = point_loads(model.blocks, params.point_loads)
+    else:
+        live = crown_load(model.blocks, params.crown_load,
+                          copies=params.n if params.scene == "section" else 1)
+    result = collapse_load(model, live, dead_load_feasible=known, **options)
+    if params.lateral is not None:
+        result = dataclasses.replace(result, azimuth_deg=float(params.lateral))
+    return result
 
 
 def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer):

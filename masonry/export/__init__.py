@@ -33,6 +33,8 @@ class RunOutputs:
         without an accepted solution.
     plots, printable : bool
         The outputs the user asked for.
+    collapse : masonry.rbe.collapse.CollapseResult or None
+        The collapse load factor of the run's live load (SPEC 6.8), if it has one.
     """
 
     scene: object
@@ -41,6 +43,7 @@ class RunOutputs:
     forces: dict | None = None
     plots: bool = True
     printable: bool = True
+    collapse: object = None
 
 
 @dataclass(frozen=True)
@@ -99,6 +102,23 @@ def _rbe_files(made: RunOutputs) -> Export:
     return Export(files)
 
 
+def _collapse_files(made: RunOutputs) -> Export:
+    result = made.collapse
+    files = {"collapse/00_collapse.txt": summaries.collapse_text(result)}
+    if result.azimuths:
+        files["collapse/azimuths.csv"] = csv.azimuths_csv(result.azimuths)
+    if result.forces is not None and result.load_factor is not None:
+        blocks, interfaces = made.model.blocks, made.model.interfaces
+        files["collapse/forces.csv"] = csv.forces_csv(blocks, interfaces, result.forces)
+        flags = {name: getattr(result, name).astype(float)
+                 for name in ("opens", "slides", "hinge")}
+        files["collapse/interfaces.vtu"] = vtu.interfaces_vtu(
+            interfaces, {**result.forces, **flags})
+        files["collapse/mechanism.csv"] = csv.mechanism_csv(blocks, result.mechanism)
+        files["collapse/mechanism.vtu"] = vtu.mechanism_vtu(blocks, result.mechanism)
+    return Export(files)
+
+
 def _printable_files(made: RunOutputs) -> Export:
     body, report = printable_body(*printable_blocks(made.scene))
     data = stl.stl_bytes(body)
@@ -123,6 +143,8 @@ EXPORTERS = (
     Exporter("model", "exports", _model_files),
     Exporter("rhino", "exports", _rhino_files),
     Exporter("rbe", "exports", _rbe_files, wanted=lambda made: made.result is not None),
+    Exporter("collapse", "exports", _collapse_files,
+             wanted=lambda made: made.collapse is not None),
     Exporter("printable", "printable", _printable_files,
              wanted=lambda made: made.printable),
     Exporter("plots", "plots", _plot_files, wanted=lambda made: made.plots),

@@ -75,3 +75,26 @@ def forces_csv(blocks: Blocks, interfaces, forces: dict) -> bytes:
     names = ("compression", "tension", "normal", "t1", "t2", "friction")
     return _table(_interface_columns(blocks, interfaces)
                   + [(f"{n}_N", np.asarray(forces[n], dtype=float)) for n in names])
+
+
+def mechanism_csv(blocks: Blocks, mechanism) -> bytes:
+    """``collapse/mechanism.csv``: one row per block (SPEC 6.9): block, name, virtual
+    translation of the centroid ``ux, uy, uz`` and rotation ``rx, ry, rz`` (radians per
+    unit), normalised so the largest block displacement is 1.
+
+    Parameters
+    ----------
+    mechanism : (B, 6) float
+    """
+    mechanism = np.asarray(mechanism, dtype=float)
+    names = ("ux", "uy", "uz", "rx", "ry", "rz")
+    return _table([("block", np.arange(blocks.n_blocks)), ("name", blocks.block_name)]
+                  + [(name, mechanism[:, i]) for i, name in enumerate(names)])
+
+
+def azimuths_csv(azimuths) -> bytes:
+    """``collapse/azimuths.csv``: the lateral load factor of every azimuth searched
+    (empty factor: none)."""
+    lines = ["azimuth_deg,load_factor"]
+    lines += [f"{a:.10g}," + ("" if f is None else f"{f:.10g}") for a, f in azimuths]
+    return ("\n".join(lines) + "\n").encode()

@@ -30,3 +30,28 @@ def objective_text(result) -> str:
         f"time:               {d['time_s']:.3g} s",
     ]
     return "\n".join(lines) + "\n"
+
+
+def collapse_text(result) -> str:
+    """``collapse/00_collapse.txt``: the collapse load factor and its mechanism, readable
+    (SPEC 6.8-6.9), with the friction-law note when sliding takes part."""
+    d = result.to_dict()
+    factor = "none" if d["load_factor"] is None else f"{d['load_factor']:.6g}"
+    live = d["live_load"]
+    lines = [
+        f"load factor:        {factor} ({d['status']})",
+        f"dead load stands:   {d['dead_load_feasible']}",
+        f"live load:          {live['kind']}, "
+        + ", ".join(f"{k} {v}" for k, v in live.items() if k != "kind"),
+        f"azimuth:            {d['azimuth_deg']}",
+        f"mu:                 {d['mu']:g}",
+        f"mechanism:          {d['opening']} interfaces open ({d['hinges']} hinges), "
+        f"{d['sliding']} slide",
+        f"solver:             {d['solver']} ({d['iterations']} iterations)",
+        f"residual (eq):      {d['residual']:.3g}",
+        f"work balance:       {d['work_balance']:.3g}",
+        f"time:               {d['time_s']:.3g} s",
+    ]
+    if d["note"]:
+        lines.append(f"note:               {d['note']}")
+    return "\n".join(lines) + "\n"

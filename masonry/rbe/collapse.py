@@ -1,0 +1,435 @@
+"""The collapse load factor and mechanism: one linear program (SPEC 6.8, 6.9).
+
+With the scaled matrices of :mod:`masonry.rbe.equilibrium` (``A_eq``, the dead load
+``f_dead`` = the RBE's ``f_ext``) and a live load ``l`` (:mod:`masonry.rbe.loads`, in the
+same row scaling)::
+
+    maximize    lambda
+    subject to  A_eq E g + lambda l = -f_dead        6 rows per free block
+                g >= 0                                 edge rays of the pyramid
+
+``x = E g`` are the vertex forces ``(c, 0, f1, f2)`` with no tension and
+``|f1|, |f2| <= mu c`` (:func:`~masonry.rbe.equilibrium.friction_pyramid_edges`, the
+friction-net pyramid of SPEC 6.3 with ``t = 0``). HiGHS solves it by the dual simplex, whose
+basis warm-starts the next load case (:class:`CollapseLP`: a lateral load at another
+azimuth changes two coefficients and two costs, SPEC 6.8's "reuse work").
+
+The dual of the equilibrium rows is the collapse mechanism (SPEC 6.9): per free block a
+virtual translation ``u`` and rotation ``theta`` about the centroid. The dual constraints
+``E^T A_eq^T y >= 0`` say that every edge ray does non-negative work on the relative motion
+at its vertex: the motion opens the joint at least ``mu`` times its slip (associated
+flow), so no interface penetrates; and at the optimum ``lambda l^T y = -f_dead^T y``: the
+live load's virtual work balances the dead load's (the kinematic theorem).
+
+Glossary: ``lambda`` -> ``load_factor``; ``y`` -> the dual of the equilibrium rows, in
+scaled units (force rows: a translation; moment rows: a rotation times ``length_ref``).
+"""
+
+import dataclasses
+import logging
+import time
+from dataclasses import dataclass, field
+
+import highspy
+import numpy as np
+import scipy.sparse as sp
+
+from masonry.rbe.equilibrium import assemble, friction_pyramid_edges
+from masonry.rbe.loads import LiveLoad, lateral
+from masonry.rbe.solve import interface_forces
+
+log = logging.getLogger(__name__)
+
+MOTION_TOL = 1e-6
+"""Relative motion at a vertex, per largest block displacement (1 after normalising),
+above which an interface counts as opening or sliding in the mechanism."""
+
+FEASIBILITY_TOL = 1e-7
+"""HiGHS's primal and dual feasibility tolerance (scaled rows: of order one)."""
+
+HIGHS_METHODS = {
+    "ipm": {"solver": "ipm", "run_crossover": "off"},
+    "ipm-crossover": {"solver": "ipm", "run_crossover": "on"},
+    "simplex": {"solver": "simplex"},
+}
+"""HiGHS settings by name."""
+
+METHOD = "ipm-crossover"
+"""The default :data:`HIGHS_METHODS` entry."""
+
+ASSOCIATED_NOTE = (
+    "sliding interfaces take part in this mechanism: the load factor assumes associated "
+    "friction (the pyramid's normal as flow rule, joints that dilate as they slide) and "
+    "can overestimate the collapse load of real, non-dilatant joints (SPEC 6.8)")
+
+RESULT_KEYS = ("load_factor", "dead_load_feasible", "status", "solver", "iterations",
+               "time_s", "residual", "work_balance", "mu", "azimuth_deg", "opening",
+               "sliding", "hinges", "note")
+"""Scalar fields of :class:`CollapseResult` in run.json, in order (plus ``live_load``)."""
+
+
+@dataclass(frozen=True, eq=False)
+class CollapseResult:
+    """Outcome of a collapse load factor LP. Forces in newtons, lengths in metres.
+
+    Parameters
+    ----------
+    load_factor : float or None
+        The largest ``lambda``; None when the dead load alone cannot stand, when the live
+        load is carried at any factor (``status`` says which) or without a verdict.
+    dead_load_feasible : bool or None
+        Whether ``lambda = 0`` has an equilibrium (None: unknown, e.g. time limit).
+    status : str
+        ``optimal``, ``dead load infeasible``, ``unbounded`` or HiGHS's words.
+    solver : str
+    iterations : int
+        Simplex iterations of this solve.
+    time_s : float, s
+    residual : float
+        ``||A_eq x + f_dead + lambda l||_inf / ||f_dead + lambda l||_inf``, recomputed.
+    work_balance : float
+        ``|lambda W_live + W_dead| / |W_dead|`` on the normalised mechanism (the
+        kinematic theorem; 0 up to rounding).
+    mu : float
+    live : LiveLoad
+    azimuth_deg : float or None
+        Of a lateral load.
+    x : (4 IV,) float or None
+        Vertex forces at collapse in the :class:`~masonry.rbe.equilibrium.VariableLayout`
+        order, newtons.
+    forces : dict str -> (K,) float or None
+        Per-interface sums (:func:`masonry.rbe.solve.interface_forces`).
+    mechanism : (B, 6) float or None
+        ``(ux, uy, uz, rx, ry, rz)`` per block: translation of the centroid and rotation
+        (radians per unit), normalised so the largest displacement of any block vertex is
+        1; zero on supports.
+    opens, slides, hinge : (K,) bool or None
+        Per interface: some vertex separates (relative normal motion > :data:`MOTION_TOL`);
+        some vertex slips; opens with some vertex still closed (a hinge, not a separation).
+    """
+
+    load_factor: float | None
+    dead_load_feasible: bool | None
+    status: str
+    solver: str
+    iterations: int
+    time_s: float
+    residual: float
+    work_balance: float
+    mu: float
+    live: LiveLoad
+    azimuth_deg: float | None = None
+    x: np.ndarray | None = None
+    forces: dict | None = None
+    mechanism: np.ndarray | None = None
+    opens: np.ndarray | None = None
+    slides: np.ndarray | None = None
+    hinge: np.ndarray | None = None
+    azimuths: tuple = field(default=())
+
+    @property
+    def opening(self) -> int:
+        return -1 if self.opens is None else int(self.opens.sum())
+
+    @property
+    def sliding(self) -> int:
+        return -1 if self.slides is None else int(self.slides.sum())
+
+    @property
+    def hinges(self) -> int:
+        return -1 if self.hinge is None else int(self.hinge.sum())
+
+    @property
+    def note(self) -> str | None:
+        """:data:`ASSOCIATED_NOTE` when sliding takes part in the mechanism."""
+        return ASSOCIATED_NOTE if self.sliding > 0 else None
+
+    def to_dict(self) -> dict:
+        """Plain values for run.json: :data:`RESULT_KEYS`, ``live_load`` and, after a
+        search, every azimuth's factor."""
+        out = {}
+        for key in RESULT_KEYS:
+            value = getattr(self, key)
+            out[key] = value.item() if isinstance(value, np.generic) else value
+        out["live_load"] = self.live.description
+        if self.azimuths:
+            out["azimuths"] = [{"azimuth_deg": a, "load_factor": f} for a, f in self.azimuths]
+        return out
+
+
+class CollapseLP:
+    """One model's collapse LP, kept in HiGHS between load cases.
+
+    The matrix ``A_eq E`` is built once. :meth:`solve` takes any live load;
+    :meth:`solve_lateral` keeps a second HiGHS model whose two load columns are the
+    lateral loads along x and y, tied by one row ``-sin a lambda_x + cos a lambda_y = 0``
+    and maximising ``cos a lambda_x + sin a lambda_y``: another azimuth changes two
+    coefficients and two costs, and the dual simplex restarts from the last basis.
+
+    Parameters
+    ----------
+    model : masonry.rbe.boundary.Model
+    mu : float
+    density : float, kg/m^3
+    time_limit : float, s
+        HiGHS's limit per solve.
+    """
+
+    def __init__(self, model, *, mu=0.7, density=2000.0, time_limit=600.0, method=None):
+        self.model = model
+        self.system = assemble(model.blocks, model.interfaces, mu=mu, density=density,
+                               side_block=model.side_block,
+                               side_rotation=model.side_rotation)
+        self.edges = friction_pyramid_edges(self.system.layout.n_vertices, float(mu))
+        self.matrix = sp.csc_array(self.system.A_eq @ self.edges)
+        self.mu, self.density, self.time_limit = float(mu), float(density), time_limit
+        self._lateral = None
+        self.method = METHOD if method is None else method
+
+    def scaled(self, live: LiveLoad) -> np.ndarray:
+        """(6 F,) float: a live load in the rows' scaling (free blocks only)."""
+        wrench = live.wrench[self.system.free_block].ravel()
+        return wrench / self.system.row_scale
+
+    def solve(self, live: LiveLoad, *, dead_load_feasible=None) -> CollapseResult:
+        """The largest factor of ``live``; ``dead_load_feasible`` (e.g. the RBE's verdict)
+        saves the check of ``lambda = 0`` when the optimum is positive."""
+        start = time.perf_counter()
+        highs = self._highs(self.scaled(live)[:, None], np.ones(1))
+        return self._result(highs, live, None, start, dead_load_feasible)
+
+    def solve_lateral(self, azimuth_deg: float, *, dead_load_feasible=None) -> CollapseResult:
+        """The factor of :func:`masonry.rbe.loads.lateral` at ``azimuth_deg``, warm-started
+        from the previous azimuth's basis."""
+        start = time.perf_counter()
+        angle = np.radians(azimuth_deg)
+        cos, sin = np.cos(angle), np.sin(angle)
+        n = self.matrix.shape[1]
+        if self._lateral is None:
+            loads = np.stack([self.scaled(lateral(self.model, 0.0, self.density)),
+                              self.scaled(lateral(self.model, 90.0, self.density))], axis=1)
+            self._lateral = self._highs(loads, np.array([cos, sin]), tie=(-sin, cos))
+        else:
+            highs, row = self._lateral, self.system.A_eq.shape[0]
+            highs.changeCoeff(row, n, -sin)
+            highs.changeCoeff(row, n + 1, cos)
+            highs.changeColsCost(2, np.array([n, n + 1], dtype=np.int32),
+                                 np.array([cos, sin]))
+        live = lateral(self.model, azimuth_deg, self.density)
+        return self._result(self._lateral, live, float(azimuth_deg) % 360.0, start,
+                            dead_load_feasible)
+
+    def _highs(self, loads, cost, tie=None) -> highspy.Highs:
+        """A HiGHS model: columns ``g`` (>= 0) then one free ``lambda`` per load column;
+        equilibrium rows, and the row tying two load columns to one direction."""
+        system = self.system
+        rows, m = system.A_eq.shape[0], loads.shape[1]
+        A = sp.hstack([self.matrix, sp.csc_array(loads)], format="csc")
+        lower, upper = -system.f_ext, -system.f_ext
+        if tie is not None:
+            tie_row = sp.csc_array((np.asarray(tie), ([0, 0], [A.shape[1] - 2,
+                                                             A.shape[1] - 1])),
+                                   shape=(1, A.shape[1]))
+            A = sp.vstack([A, tie_row], format="csc")
+            lower, upper = np.append(lower, 0.0), np.append(upper, 0.0)
+        lp = highspy.HighsLp()
+        lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
+        lp.col_cost_ = np.concatenate([np.zeros(self.matrix.shape[1]), cost])
+        lp.col_lower_ = np.concatenate([np.zeros(self.matrix.shape[1]),
+                                        np.full(m, -highspy.kHighsInf)])
+        lp.col_upper_ = np.full(A.shape[1], highspy.kHighsInf)
+        lp.row_lower_, lp.row_upper_ = lower, upper
+        lp.sense_ = highspy.ObjSense.kMaximize
+        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
+        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
+            A.indptr, A.indices, A.data)
+        highs = highspy.Highs()
+        for name, value in (("output_flag", False), *HIGHS_METHODS[self.method].items(),
+                            ("time_limit", float(self.time_limit)),
+                            ("primal_feasibility_tolerance", FEASIBILITY_TOL),
+                            ("dual_feasibility_tolerance", FEASIBILITY_TOL)):
+            if highs.setOptionValue(name, value) != highspy.HighsStatus.kOk:
+                raise ValueError(f"HiGHS refused option {name}={value!r}")
+        highs.passModel(lp)
+        return highs
+
+    def _run(self, highs) -> highspy.HighsModelStatus:
+        highs.run()
+        status = highs.getModelStatus()
+        if status == highspy.HighsModelStatus.kUnboundedOrInfeasible:
+            # presolve's verdict does not say which; the simplex without it does
+            highs.setOptionValue("presolve", "off")
+            highs.run()
+            highs.setOptionValue("presolve", "choose")
+            status = highs.getModelStatus()
+        return status
+
+    def _stands_unloaded(self, highs) -> bool | None:
+        """Whether ``lambda = 0`` is feasible: the load columns fixed at 0, solved from
+        the current basis, then freed again."""
+        count = highs.getNumCol()
+        columns = np.arange(count - (2 if highs is self._lateral else 1), count,
+                            dtype=np.int32)
+        zeros = np.zeros(len(columns))
+        highs.changeColsBounds(len(columns), columns, zeros, zeros)
+        status = self._run(highs)
+        highs.changeColsBounds(len(columns), columns, zeros - highspy.kHighsInf,
+                               zeros + highspy.kHighsInf)
+        if status == highspy.HighsModelStatus.kOptimal:
+            return True
+        return False if status == highspy.HighsModelStatus.kInfeasible else None
+
+    def _result(self, highs, live, azimuth, start, dead_load_feasible) -> CollapseResult:
+        status = self._run(highs)
+        info = highs.getInfo()
+        iterations = int(info.simplex_iteration_count + info.ipm_iteration_count)
+        common = dict(solver=f"highs-{self.method}", mu=self.mu, live=live, azimuth_deg=azimuth)
+        Status = highspy.HighsModelStatus
+        if status != Status.kOptimal:
+            if status == Status.kInfeasible:
+                feasible, words = False, "dead load infeasible"
+            elif status == Status.kUnbounded:
+                feasible, words = dead_load_feasible, "unbounded"
+                if feasible is None:
+                    feasible = self._stands_unloaded(highs)
+            else:
+                feasible, words = dead_load_feasible, highs.modelStatusToString(status)
+                log.warning("collapse LP without a verdict: %s", words)
+            return CollapseResult(None, feasible, words, iterations=iterations,
+                                  time_s=time.perf_counter() - start, residual=np.nan,
+                                  work_balance=np.nan, **common)
+        solution = highs.getSolution()
+        n = self.matrix.shape[1]
+        values = np.array(solution.col_value)
+        dual = np.array(solution.row_dual)[: self.system.A_eq.shape[0]]
+        factor = float(highs.getInfo().objective_function_value)
+        loads = values[n:]
+        x_scaled = self.edges @ values[:n]
+        load = self.scaled(live)
+        total = self.system.f_ext + factor * load
+        residual = float(np.abs(self.system.A_eq @ x_scaled + total).max()
+                         / np.abs(total).max())
+        if factor < 0:
+            # the largest factor is negative: lambda = 0 is past it
+            dead_load_feasible = False
+        elif dead_load_feasible is None:
+            dead_load_feasible = self._stands_unloaded(highs)
+        motion = self._mechanism(dual, load, factor)
+        x = self.system.to_newtons(x_scaled)
+        log.debug("collapse LP: lambda %.6g (load columns %s), %d iterations", factor,
+                  loads, iterations)
+        return CollapseResult(
+            factor if dead_load_feasible else None, dead_load_feasible,
+            "optimal" if dead_load_feasible else "dead load infeasible",
+            iterations=iterations, time_s=time.perf_counter() - start, residual=residual,
+            x=x, forces=interface_forces(self.system.layout, x), **motion, **common)
+
+    def _mechanism(self, dual, load, factor) -> dict:
+        """Mechanism, per-interface flags and the work balance from the equilibrium rows'
+        dual ``y`` ((6 F,) float, scaled) and the scaled live load."""
+        system, blocks = self.system, self.model.blocks
+        if dual @ load < 0:  # HiGHS's sign convention: make the live load do positive work
+            dual = -dual
+        per_block = dual.reshape(-1, 6).copy()
+        per_block[:, 3:] /= system.length_ref  # moment rows: rotation times length_ref
+        mechanism = np.zeros((blocks.n_blocks, 6))
+        mechanism[system.free_block] = per_block
+        # the largest displacement of any vertex: u + theta x (p - c)
+        owner = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
+        arm = blocks.vertices - blocks.block_centroid[owner]
+        motion = mechanism[owner, :3] + np.cross(mechanism[owner, 3:], arm)
+        largest = float(np.linalg.norm(motion, axis=1).max())
+        if largest == 0:
+            return dict(work_balance=np.nan)
+        mechanism /= largest
+        # relative motion at every vertex, per column (c: opening along n; f1, f2: slip
+        # along t1, t2); A_eq^T y routes the cyclic images like the forces
+        relative = (system.A_eq.T @ dual).reshape(-1, 4) / largest
+        layout = system.layout
+        opening, slip = relative[:, 0], np.hypot(relative[:, 2], relative[:, 3])
+        vertex_opens = opening > MOTION_TOL
+        opens = np.bincount(layout.vertex_interface, vertex_opens,
+                            minlength=layout.n_interfaces) > 0
+        closed = np.bincount(layout.vertex_interface, ~vertex_opens,
+                             minlength=layout.n_interfaces) > 0
+        slides = np.bincount(layout.vertex_interface, slip > MOTION_TOL,
+                             minlength=layout.n_interfaces) > 0
+        # kinematic theorem on the normalised mechanism, in physical units
+        free = system.free_block
+        work_live = float(np.sum(load.reshape(-1, 6) * system.row_scale.reshape(-1, 6)
+                                 * mechanism[free]))
+        dead = (system.f_ext * system.row_scale).reshape(-1, 6)
+        work_dead = float(np.sum(dead * mechanism[free]))
+        balance = abs(factor * work_live + work_dead) / max(abs(work_dead), abs(work_live))
+        return dict(mechanism=mechanism, opens=opens, slides=slides, hinge=opens & closed,
+                    work_balance=balance)
+
+
+def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=None,
+                  dead_load_feasible=None, time_limit=600.0) -> CollapseResult:
+    """The collapse load factor of ``live`` on ``model``, and its mechanism (SPEC 6.8-6.9).
+
+    Parameters
+    ----------
+    model : masonry.rbe.boundary.Model
+    live : LiveLoad
+        Built on ``model.blocks`` (:mod:`masonry.rbe.loads`).
+    mu : float
+    density : float, kg/m^3
+        Of the dead load (and of a lateral load built with the same density).
+    friction : None or 'fixed-directions'
+        None: associated friction, the LP above. ``'fixed-directions'``: the
+        non-associative estimate of :func:`fixed_direction_factor` (sliding interfaces
+        keep the slip direction of the associated mechanism and may not dilate).
+    dead_load_feasible : bool, optional
+        Known verdict on the dead load alone (e.g. the RBE's); otherwise the LP decides it
+        with ``lambda`` fixed at 0.
+    time_limit : float, s
+
+    Returns
+    -------
+    CollapseResult
+    """
+    if live.wrench.shape != (model.blocks.n_blocks, 6):
+        raise ValueError(f"live load of shape {live.wrench.shape} for "
+                         f"{model.blocks.n_blocks} blocks")
+    problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit)
+    if friction is None:
+        return problem.solve(live, dead_load_feasible=dead_load_feasible)
+    raise ValueError(f"friction must be None or 'fixed-directions', not {friction!r}")
+
+
+def lateral_azimuths(n_webs=None, count=24) -> np.ndarray:
+    """Azimuths in degrees for :func:`worst_lateral`: ``count`` equally spaced, plus the
+    directions a dome's symmetry makes special (the mid-planes of the webs and the corners,
+    every ``180 / n`` degrees), sorted and unique."""
+    angles = np.arange(count) * 360.0 / count
+    if n_webs is not None:
+        angles = np.concatenate([angles, np.arange(2 * n_webs) * 180.0 / n_webs])
+    return np.unique(np.round(angles % 360.0, 9))
+
+
+def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
+                  dead_load_feasible=None, time_limit=600.0) -> CollapseResult:
+    """The smallest lateral load factor over ``azimuths`` (``--lateral all``).
+
+    One HiGHS model serves every azimuth (:meth:`CollapseLP.solve_lateral`: two
+    coefficients and two costs change, the dual simplex restarts from the last basis),
+    and the dead load is checked once (unless ``dead_load_feasible`` is given). Returns the worst azimuth's result with every
+    azimuth's factor in ``azimuths`` ((azimuth, factor or None) pairs).
+    """
+    azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
+    problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit)
+    start = time.perf_counter()
+    results, known = [], dead_load_feasible
+    for azimuth in azimuths:
+        result = problem.solve_lateral(float(azimuth), dead_load_feasible=known)
+        known = result.dead_load_feasible
+        results.append(result)
+        if known is False:
+            break
+    factors = [(float(a), r.load_factor) for a, r in zip(azimuths, results)]
+    found = [r for r in results if r.load_factor is not None]
+    worst = min(found, key=lambda r: r.load_factor) if found else results[-1]
+    return dataclasses.replace(worst, azimuths=tuple(factors),
+                               time_s=time.perf_counter() - start)

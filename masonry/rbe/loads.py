@@ -1,0 +1,172 @@
+"""Live loads as arrays: the load cases of the collapse load factor (SPEC 6.8).
+
+A :class:`LiveLoad` is one wrench per block: the applied force (N) and its moment about the
+block's centroid (N m), the same reduction as the equilibrium rows of
+:mod:`masonry.rbe.equilibrium` (moments about centroids, SPEC 6.2). Support blocks carry no
+load (they have no rows). The builders are the three load cases of the command line:
+
+- :func:`lateral`: a horizontal body force of each block's weight, at its centroid (the
+  static seismic load, the tilting table); no moment.
+- :func:`point_loads`: forces at the centre of the top face of named blocks.
+- :func:`crown_load`: a downward load on the top course, shared by top-face area (a
+  lantern on the oculus ring).
+"""
+
+import fnmatch
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from masonry.blocks import BLOCK_CLASSES
+from masonry.params import ParameterError, parse_point_load
+from masonry.tolerances import G
+
+PATTERN = BLOCK_CLASSES.index("pattern")
+
+
+@dataclass(frozen=True, eq=False)
+class LiveLoad:
+    """A live load, per block.
+
+    Parameters
+    ----------
+    wrench : (B, 6) float
+        Force ``(Fx, Fy, Fz)`` in newtons and moment ``(Mx, My, Mz)`` about the block's
+        centroid in newton-metres, per block of the model (zero on supports).
+    description : dict
+        What was applied, for run.json: ``kind`` and the load's inputs, and
+        ``total_force_N`` (the resultant force, (3,) list).
+    symmetric : bool
+        The load is the same in every web of a dome (a cyclic section may carry it).
+    """
+
+    wrench: np.ndarray
+    description: dict = field(default_factory=dict)
+    symmetric: bool = False
+
+    @property
+    def total_force(self) -> np.ndarray:
+        """(3,) float, N: the resultant force."""
+        return self.wrench[:, :3].sum(axis=0)
+
+
+def _blocks(model_or_blocks):
+    return getattr(model_or_blocks, "blocks", model_or_blocks)
+
+
+def _describe(kind, wrench, **inputs) -> dict:
+    return {"kind": kind, **inputs,
+            "total_force_N": [float(v) for v in wrench[:, :3].sum(axis=0)]}
+
+
+def lateral(model_or_blocks, azimuth_deg: float, density: float = 2000.0) -> LiveLoad:
+    """Horizontal body force: each free block's weight times ``(cos a, sin a, 0)``.
+
+    Parameters
+    ----------
+    model_or_blocks : masonry.rbe.boundary.Model or masonry.blocks.Blocks
+    azimuth_deg : float
+        Direction in degrees from +x toward +y.
+    density : float, kg/m^3
+
+    Returns
+    -------
+    LiveLoad
+        Forces at the centroids, so no moments (SPEC 6.8).
+    """
+    blocks = _blocks(model_or_blocks)
+    weight = density * G * blocks.block_volume * ~np.asarray(blocks.block_is_support)
+    angle = np.radians(azimuth_deg)
+    wrench = np.zeros((blocks.n_blocks, 6))
+    wrench[:, 0], wrench[:, 1] = weight * np.cos(angle), weight * np.sin(angle)
+    return LiveLoad(wrench, _describe("lateral", wrench, azimuth_deg=float(azimuth_deg),
+                                      per_block="weight"))
+
+
+def top_faces(blocks) -> np.ndarray:
+    """(B,) int: every block's top face, the one whose outward normal points most up."""
+    score = blocks.face_normal[:, 2]
+    order = np.lexsort((-score, blocks.face_block))  # by block, best score first
+    first = np.searchsorted(blocks.face_block[order], np.arange(blocks.n_blocks))
+    return order[first]
+
+
+def _at_points(blocks, block, point, force) -> np.ndarray:
+    """(B, 6) wrench of forces ``force`` ((m, 3) N) at ``point`` ((m, 3) m) on ``block``."""
+    wrench = np.zeros((blocks.n_blocks, 6))
+    moment = np.cross(point - blocks.block_centroid[block], force)
+    np.add.at(wrench, block, np.concatenate([force, moment], axis=1))
+    return wrench
+
+
+def point_loads(blocks, specs) -> LiveLoad:
+    """Forces at the centre of the top face of the blocks each spec names.
+
+    Parameters
+    ----------
+    blocks : masonry.blocks.Blocks (or a Model)
+    specs : sequence of str
+        ``'NAME_OR_PATTERN:FX,FY,FZ'``: a block name or an :mod:`fnmatch` pattern (e.g.
+        ``b00*_pattern_c3*``) and a force in newtons applied to *every* matched free block.
+
+    Raises
+    ------
+    ParameterError
+        A spec that is malformed or matches no free block (named ``--point-load``).
+    """
+    blocks = _blocks(blocks)
+    free = ~np.asarray(blocks.block_is_support)
+    names = [str(name) for name in blocks.block_name]
+    top = top_faces(blocks)
+    chosen, forces = [], []
+    for spec in specs:
+        pattern, force = parse_point_load(spec)
+        matched = [i for i in np.flatnonzero(free) if fnmatch.fnmatchcase(names[i], pattern)]
+        if not matched:
+            raise ParameterError("--point-load", spec, "a name or pattern that matches a "
+                                 "free block (see bricks.obj or locations.csv)")
+        chosen += matched
+        forces += [force] * len(matched)
+    chosen = np.asarray(chosen, dtype=np.int64)
+    wrench = _at_points(blocks, chosen, blocks.face_centre[top[chosen]],
+                        np.asarray(forces, dtype=float))
+    return LiveLoad(wrench, _describe("point", wrench, specs=list(specs),
+                                      blocks=len(chosen)))
+
+
+def top_course(blocks) -> np.ndarray:
+    """(m,) int: the free blocks whose top lies in the highest course (a pattern brick
+    spans its course and the next, SPEC 2)."""
+    free = ~np.asarray(blocks.block_is_support)
+    reach = blocks.block_course + (blocks.block_class == PATTERN)
+    if not (free & (blocks.block_course > 0)).any():
+        raise ValueError("a crown load needs courses: this scene has none")
+    return np.flatnonzero(free & (reach == reach[free].max()))
+
+
+def crown_load(blocks, newtons: float, copies: int = 1) -> LiveLoad:
+    """A downward load of ``newtons`` on the top course of a dome, shared by top-face area.
+
+    Each top-course brick carries ``newtons / copies * A_j / sum A`` at the centre of its
+    top face (``A_j`` that face's area): a lantern on the oculus ring. The same load in
+    every web, so a cyclic section may carry it.
+
+    Parameters
+    ----------
+    blocks : masonry.blocks.Blocks (or a Model)
+    newtons : float, N
+        The whole load (the lantern's weight on the whole dome).
+    copies : int
+        How many copies of these blocks the dome is made of: ``n`` for a section (it
+        carries its ``1/n`` share), 1 for the full dome.
+    """
+    blocks = _blocks(blocks)
+    chosen = top_course(blocks)
+    face = top_faces(blocks)[chosen]
+    share = blocks.face_area[face] / blocks.face_area[face].sum()
+    force = np.zeros((len(chosen), 3))
+    force[:, 2] = -newtons / copies * share
+    wrench = _at_points(blocks, chosen, blocks.face_centre[face], force)
+    return LiveLoad(wrench, _describe("crown", wrench, newtons=float(newtons),
+                                      copies=int(copies), blocks=len(chosen)),
+                    symmetric=True)

@@ -1,0 +1,272 @@
+"""Collapse load factors and mechanisms (SPEC 6.8-6.9) against analytic limit states and
+an independent 2D linear program on the arch's voussoirs."""
+
+import json
+
+import numpy as np
+import pytest
+from scipy.optimize import linprog
+
+from masonry.blocks import Blocks
+from masonry.params import ParameterError, Params, from_preset, validate
+from masonry.rbe.boundary import Model, analysis_model
+from masonry.rbe.collapse import collapse_load, lateral_azimuths, worst_lateral
+from masonry.rbe.loads import crown_load, lateral, point_loads
+from masonry.scenes import build
+from masonry.scenes.arch import arch_profile
+from masonry.studies.thrust_line import thrust_line_minimum_thickness
+from masonry.tolerances import G
+from masonry_cli.main import main
+from test_rbe import HORIZONTAL, SUPPORT, box, make_interfaces
+
+DENSITY = 2000.0
+SMALL_DOME = dict(stretch=1.0, n=6, r=0, p=3, cut=0.5)  # 78 bricks in 6 webs
+
+
+def column(count, size):
+    """``count`` boxes ``size = (bx, by, h)`` stacked on a ground slab, bed joints
+    whole rectangles with the lower block as main (normals up)."""
+    bx, by, h = size
+    corners = [box((-1, -1, -0.1), (1, 1, 0))]
+    corners += [box((0, 0, i * h), (bx, by, (i + 1) * h)) for i in range(count)]
+    blocks = Blocks.from_hexahedra(corners, block_class=["ground"] + ["block"] * count,
+                                   block_name=["ground"] + [f"b{i}" for i in range(count)])
+    polygons = [box((0, 0, i * h), (bx, by, i * h))[[0, 1, 3, 2]] for i in range(count)]
+    kinds = [SUPPORT] + [HORIZONTAL] * (count - 1)
+    interfaces = make_interfaces([(i, i + 1) for i in range(count)], polygons,
+                                 [(0, 0, 1)] * count, kinds)
+    return Model(blocks, interfaces)
+
+
+def check_mechanism(model, live, result):
+    """Independently of the LP: the mechanism's virtual work balances (lambda W_live +
+    W_dead = 0) and no interface vertex penetrates."""
+    blocks, interfaces, motion = model.blocks, model.interfaces, result.mechanism
+    weight = DENSITY * G * blocks.block_volume * ~blocks.block_is_support
+    work_dead = -(weight * motion[:, 2]).sum()
+    work_live = (live.wrench * motion).sum()
+    assert abs(result.load_factor * work_live + work_dead) <= 1e-7 * abs(work_dead)
+    vertex = interfaces.vertices
+    k = np.repeat(np.arange(len(interfaces)), interfaces.vertex_count)
+    main_block, other = interfaces.pair[k, 0], interfaces.pair[k, 1]
+
+    def moved(block):
+        arm = vertex - blocks.block_centroid[block]
+        return motion[block, :3] + np.cross(motion[block, 3:], arm)
+
+    opening = np.einsum("ij,ij->i", moved(other) - moved(main_block), interfaces.normal[k])
+    assert opening.min() >= -1e-7
+    # normalised: the largest vertex displacement of any block is 1
+    owner = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
+    arm = blocks.vertices - blocks.block_centroid[owner]
+    largest = np.linalg.norm(motion[owner, :3] + np.cross(motion[owner, 3:], arm), axis=1)
+    assert largest.max() == pytest.approx(1.0, rel=1e-12)
+
+
+# ---------------------------------------------------------------------- analytic blocks
+@pytest.mark.parametrize("azimuth, expected, mode", [
+    (0.0, 0.2 / 0.5, "tips"),       # b = 0.2 along x: tips at b/h = 0.4 < mu
+    (180.0, 0.2 / 0.5, "tips"),
+    (90.0, 0.7, "slides"),          # b = 0.4 along y: b/h = 0.8 > mu = 0.7, slides
+    (270.0, 0.7, "slides"),
+])
+def test_single_block_tips_at_b_over_h_or_slides_at_mu(azimuth, expected, mode):
+    model = column(1, (0.2, 0.4, 0.5))
+    live = lateral(model, azimuth, DENSITY)
+    result = collapse_load(model, live, mu=0.7, density=DENSITY)
+    assert result.load_factor == pytest.approx(expected, rel=1e-9)
+    assert result.dead_load_feasible and result.residual < 1e-9
+    assert result.hinge.all() == (mode == "tips")
+    assert result.slides.all() == (mode == "slides")
+    assert (result.note is not None) == (mode == "slides")
+    check_mechanism(model, live, result)
+
+
+@pytest.mark.parametrize("count", [2, 4])
+def test_column_tips_at_b_over_its_whole_height(count):
+    model = column(count, (0.1, 0.3, 0.15))
+    live = lateral(model, 0.0, DENSITY)
+    result = collapse_load(model, live, mu=0.9, density=DENSITY)
+    assert result.load_factor == pytest.approx(0.1 / (0.15 * count), rel=1e-9)
+    # the whole column rotates as one about its base: only the base joint opens
+    assert result.opens.tolist() == [True] + [False] * (count - 1)
+    check_mechanism(model, live, result)
+
+
+def test_point_load_at_the_top_face_tips_a_block_at_the_lever_ratio():
+    """A horizontal point force P at the top of a block of weight W tips it when
+    P h = W b / 2, i.e. lambda = W b / (2 P h)."""
+    model = column(1, (0.2, 0.4, 0.5))
+    live = point_loads(model.blocks, ["b*:100,0,0"])
+    weight = DENSITY * G * 0.2 * 0.4 * 0.5
+    result = collapse_load(model, live, mu=0.9, density=DENSITY)
+    assert result.load_factor == pytest.approx(weight * 0.1 / (100 * 0.5), rel=1e-9)
+    check_mechanism(model, live, result)
+    with pytest.raises(ParameterError, match="--point-load"):
+        point_loads(model.blocks, ["nothing*:1,0,0"])
+
+
+def test_free_wall_overturns_out_of_plane_at_t_over_h():
+    params = from_preset("wall")
+    model = analysis_model(build(params))
+    free = ~model.blocks.block_is_support
+    bounds = model.blocks.block_bounds[free]
+    thickness = bounds[:, 1, 0].max() - bounds[:, 0, 0].min()
+    height = bounds[:, 1, 2].max() - bounds[:, 0, 2].min()
+    length = bounds[:, 1, 1].max() - bounds[:, 0, 1].min()
+    assert length > 10 * thickness  # the wall runs along y: x is out of plane
+    live = lateral(model, 0.0, DENSITY)
+    result = collapse_load(model, live, mu=0.7, density=DENSITY)
+    assert result.load_factor == pytest.approx(thickness / height, rel=1e-7)
+    check_mechanism(model, live, result)
+
+
+# ---------------------------------------------------------------------- the arch
+def arch_lp(profile, depth, mu, density=DENSITY):
+    """The largest horizontal load factor of an arch by a 2D LP written here, apart from
+    the RBE matrices: per joint, compressive forces at its intrados and extrados ends and
+    one shear with |shear| <= mu (sum of the normal forces); per voussoir, force and
+    moment balance in the xz-plane under its weight and lambda times its weight along
+    +x. Joints 0 and N bear on the supports."""
+    joints = len(profile.intrados)
+    voussoirs = profile.voussoirs
+    x, z = voussoirs[..., 0], voussoirs[..., 1]
+    cross = x * np.roll(z, -1, axis=1) - np.roll(x, -1, axis=1) * z
+    area = cross.sum(axis=1) / 2
+    centroid = np.stack([((x + np.roll(x, -1, axis=1)) * cross).sum(axis=1),
+                         ((z + np.roll(z, -1, axis=1)) * cross).sum(axis=1)], axis=1)
+    centroid /= 6 * area[:, None]
+    weight = density * G * np.abs(area) * depth
+    # joint j: unit normal from voussoir j-1 into voussoir j (towards the left springing)
+    along = profile.extrados - profile.intrados
+    normal = np.stack([-along[:, 1], along[:, 0]], axis=1)
+    normal /= np.linalg.norm(normal, axis=1)[:, None]
+    # orient: joint 0's normal points into voussoir 0, every next one the same way round
+    middle = (profile.intrados + profile.extrados) / 2
+    for j in range(joints):
+        inside = centroid[min(j, len(centroid) - 1)] - middle[j]
+        sign = 1 if j < len(centroid) else -1
+        if sign * (normal[j] @ inside) < 0:
+            normal[j] *= -1
+    tangent = np.stack([-normal[:, 1], normal[:, 0]], axis=1)
+    # unknowns per joint: n_intrados, n_extrados, shear; then lambda
+    count = 3 * joints + 1
+    A, b = np.zeros((3 * len(voussoirs), count)), np.zeros(3 * len(voussoirs))
+    for i in range(len(voussoirs)):
+        for j, sign in ((i, 1.0), (i + 1, -1.0)):  # joint i pushes on i, joint i+1 back
+            for col, (point, direction) in enumerate((
+                    (profile.intrados[j], normal[j]), (profile.extrados[j], normal[j]),
+                    (middle[j], tangent[j]))):
+                arm = point - centroid[i]
+                A[3 * i: 3 * i + 3, 3 * j + col] += sign * np.array(
+                    [direction[0], direction[1], arm[0] * direction[1] - arm[1] * direction[0]])
+        A[3 * i, -1] = weight[i]
+        b[3 * i + 1] = weight[i]
+    friction = np.zeros((2 * joints, count))
+    for j in range(joints):
+        friction[2 * j, [3 * j, 3 * j + 1, 3 * j + 2]] = (-mu, -mu, 1.0)
+        friction[2 * j + 1, [3 * j, 3 * j + 1, 3 * j + 2]] = (-mu, -mu, -1.0)
+    bounds = [(0, None), (0, None), (None, None)] * joints + [(None, None)]
+    cost = np.zeros(count)
+    cost[-1] = -1.0
+    solution = linprog(cost, A_ub=friction, b_ub=np.zeros(2 * joints), A_eq=A, b_eq=b,
+                       bounds=bounds, method="highs")
+    assert solution.status == 0
+    return solution.x[-1]
+
+
+def arch_model(thickness, blocks=12):
+    params = validate(Params(scene="arch", arch_blocks=blocks, arch_thickness=thickness))
+    return params, analysis_model(build(params))
+
+
+@pytest.mark.parametrize("thickness, mu", [(1.0, 0.9), (1.6, 0.5)])
+def test_arch_under_horizontal_load_matches_an_independent_2d_lp(thickness, mu):
+    params, model = arch_model(thickness)
+    live = lateral(model, 0.0, DENSITY)
+    result = collapse_load(model, live, mu=mu, density=DENSITY)
+    profile = arch_profile("semicircular", 12, params.arch_span, thickness)
+    assert result.load_factor == pytest.approx(arch_lp(profile, params.arch_depth, mu),
+                                               rel=1e-6)
+    assert result.hinges >= 3  # a hinge mechanism: four hinges, or sliding with fewer
+    check_mechanism(model, live, result)
+
+
+def test_lateral_factor_vanishes_at_the_minimum_thickness_and_below_it_none():
+    """lambda falls to 0 as the thickness approaches the minimum of the thrust line
+    (:mod:`masonry.studies.thrust_line`, independent of the RBE); below it, no factor."""
+    minimum = thrust_line_minimum_thickness("semicircular", 12, 10.0).thickness
+    factors = []
+    for ratio in (1.5, 1.2, 1.05, 1.01, 1.001):
+        _, model = arch_model(ratio * minimum)
+        result = collapse_load(model, lateral(model, 0.0, DENSITY), mu=10.0, density=DENSITY)
+        factors.append(result.load_factor)
+    assert all(a > b for a, b in zip(factors, factors[1:]))
+    assert 0 < factors[-1] < 5e-3 * factors[0]  # about linear in t - t_min
+    _, model = arch_model(0.99 * minimum)
+    below = collapse_load(model, lateral(model, 0.0, DENSITY), mu=10.0, density=DENSITY)
+    assert below.load_factor is None and below.dead_load_feasible is False
+    assert below.status == "dead load infeasible"
+
+
+# ---------------------------------------------------------------------- domes
+def test_crown_load_on_the_cyclic_section_equals_the_full_dome():
+    section = analysis_model(build(validate(Params(scene="section", boundary="cyclic",
+                                                   **SMALL_DOME))))
+    dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
+    newtons = 2000.0
+    on_section = collapse_load(section, crown_load(section, newtons, copies=6))
+    on_dome = collapse_load(dome, crown_load(dome, newtons))
+    assert on_dome.load_factor == pytest.approx(on_section.load_factor, rel=1e-6)
+    total = crown_load(dome, newtons).total_force
+    np.testing.assert_allclose(total, [0, 0, -newtons], atol=1e-9 * newtons)
+
+
+def test_worst_lateral_searches_the_symmetry_directions_with_one_model():
+    dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
+    azimuths = lateral_azimuths(6)
+    assert len(azimuths) >= 24 and {30.0, 90.0, 150.0} <= set(azimuths)
+    worst = worst_lateral(dome, azimuths, n_webs=6)
+    factors = np.array([f for _, f in worst.azimuths])
+    assert len(factors) == len(azimuths) and worst.load_factor == factors.min()
+    # six-fold symmetry: the factor repeats every 60 degrees
+    by_angle = dict(worst.azimuths)
+    for a in azimuths:
+        assert by_angle[a] == pytest.approx(by_angle[(a + 60.0) % 360.0], rel=1e-6)
+    # the same factor as an independent solve at that azimuth
+    alone = collapse_load(dome, lateral(dome, worst.azimuth_deg))
+    assert alone.load_factor == pytest.approx(worst.load_factor, rel=1e-7)
+    check_mechanism(dome, lateral(dome, worst.azimuth_deg), worst)
+
+
+# ---------------------------------------------------------------------- inputs, CLI
+@pytest.mark.parametrize("argv, option", [
+    (["--lateral", "north"], "--lateral"),
+    (["--point-load", "b1:1,2"], "--point-load"),
+    (["--crown-load", "-5"], "--crown-load"),
+    (["--dome", "--lateral", "30"], "--scene dome"),
+    (["--lateral", "30", "--crown-load", "5"], "one live load"),
+])
+def test_bad_live_loads_are_refused_in_one_line(argv, option, tmp_path, capsys):
+    code = main(["run", "--preset", "1", "--out", str(tmp_path), "--no-plots",
+                 "--no-printable", *argv])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and option in err
+    assert not any(tmp_path.iterdir())
+
+
+def test_run_writes_the_collapse_record_and_files(tmp_path, capsys):
+    code = main(["run", "--preset", "wall", "--lateral", "0", "--out", str(tmp_path),
+                 "--no-plots", "--no-printable"])
+    assert code == 0
+    line = [ln for ln in capsys.readouterr().out.splitlines() if "lambda" in ln]
+    assert len(line) == 1 and "lambda = 0.2" in line[0]
+    folder = next(tmp_path.glob("wall_*_lat0"))
+    record = json.loads((folder / "run.json").read_text())["collapse"]
+    assert record["load_factor"] == pytest.approx(0.2, rel=1e-7)
+    assert record["dead_load_feasible"] is True and record["azimuth_deg"] == 0.0
+    assert record["live_load"]["kind"] == "lateral" and record["residual"] < 1e-9
+    for name in ("forces.csv", "interfaces.vtu", "mechanism.csv", "mechanism.vtu"):
+        assert (folder / "collapse" / name).stat().st_size > 0
+    rows = (folder / "collapse" / "mechanism.csv").read_text().splitlines()
+    assert rows[0] == "block,name,ux,uy,uz,rx,ry,rz" and len(rows) == 1 + 86
