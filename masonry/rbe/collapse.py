@@ -195,8 +195,8 @@ class CollapseLP:
         """The largest factor of ``live``; ``dead_load_feasible`` (e.g. the RBE's verdict)
         saves the check of ``lambda = 0`` when the optimum is positive."""
         start = time.perf_counter()
-        highs = self._highs(self.scaled(live)[:, None], np.ones(1))
-        return self._result(highs, live, None, start, dead_load_feasible)
+        highs, heads, _ = self._highs(self.scaled(live)[:, None], np.ones(1))
+        return self._result(highs, heads, live, None, start, dead_load_feasible)
 
     def solve_lateral(self, azimuth_deg: float, *, dead_load_feasible=None) -> CollapseResult:
         """The factor of :func:`masonry.rbe.loads.lateral` at ``azimuth_deg``, warm-started
@@ -204,41 +204,69 @@ class CollapseLP:
         start = time.perf_counter()
         angle = np.radians(azimuth_deg)
         cos, sin = np.cos(angle), np.sin(angle)
-        n = self.matrix.shape[1]
         if self._lateral is None:
             loads = np.stack([self.scaled(lateral(self.model, 0.0, self.density)),
                               self.scaled(lateral(self.model, 90.0, self.density))], axis=1)
             self._lateral = self._highs(loads, np.array([cos, sin]), tie=(-sin, cos))
         else:
-            highs, row = self._lateral, self.system.A_eq.shape[0]
-            highs.changeCoeff(row, n, -sin)
-            highs.changeCoeff(row, n + 1, cos)
-            highs.changeColsCost(2, np.array([n, n + 1], dtype=np.int32),
-                                 np.array([cos, sin]))
+            highs, heads, row = self._lateral
+            highs.changeCoeff(row, heads[0], -sin)
+            highs.changeCoeff(row, heads[1], cos)
+            highs.changeColsCost(2, heads, np.array([cos, sin]))
         live = lateral(self.model, azimuth_deg, self.density)
-        return self._result(self._lateral, live, float(azimuth_deg) % 360.0, start,
+        highs, heads, _ = self._lateral
+        return self._result(highs, heads, live, float(azimuth_deg) % 360.0, start,
                             dead_load_feasible)
 
-    def _highs(self, loads, cost, tie=None) -> highspy.Highs:
-        """A HiGHS model: columns ``g`` (>= 0) then one free ``lambda`` per load column;
-        equilibrium rows, and the row tying two load columns to one direction."""
-        system = self.system
-        rows, m = system.A_eq.shape[0], loads.shape[1]
-        A = sp.hstack([self.matrix, sp.csc_array(loads)], format="csc")
-        lower, upper = -system.f_ext, -system.f_ext
+    def _load_columns(self, loads):
+        """Columns and link rows for ``loads`` ((6 F, m) float), one chain per load.
+
+        A load column touches every loaded row, and one dense column makes an interior
+        point method's normal equations dense. So each load gets one factor column per
+        loaded block (its six rows), chained equal by link rows ``lambda_i - lambda_i+1
+        = 0``: every column stays sparse. Returns the sparse columns ((6 F, c)), the link
+        rows ((r, c)) and the first column of each chain, the one that stands for its
+        ``lambda``."""
+        columns, links, heads, start = [], [], [], 0
+        for load in loads.T:
+            per_block = load.reshape(-1, 6)
+            blocks = np.flatnonzero(np.abs(per_block).max(axis=1) > 0)
+            if len(blocks) == 0:
+                raise ValueError("the live load is zero on every free block")
+            rows = (6 * blocks[:, None] + np.arange(6)).ravel()
+            chain = np.repeat(np.arange(len(blocks)), 6)
+            columns.append(sp.csc_array((load[rows], (rows, chain)),
+                                        shape=(len(load), len(blocks))))
+            link = np.arange(len(blocks) - 1)
+            links.append(sp.csc_array((np.r_[np.ones(len(link)), -np.ones(len(link))],
+                                       (np.r_[link, link], np.r_[link, link + 1])),
+                                      shape=(len(link), len(blocks))))
+            heads.append(start)
+            start += len(blocks)
+        return sp.hstack(columns, format="csc"), sp.block_diag(links, format="csc"), heads
+
+    def _highs(self, loads, cost, tie=None):
+        """A HiGHS model: columns ``g`` (>= 0), then the free load-factor chains of
+        :meth:`_load_columns`; equilibrium rows, link rows, and a row tying two loads to
+        one direction. Returns ``(highs, head columns, tie row)``."""
+        system, n = self.system, self.matrix.shape[1]
+        columns, links, heads = self._load_columns(loads)
+        heads = np.asarray(heads, dtype=np.int32) + n
+        A = sp.vstack([sp.hstack([self.matrix, columns]),
+                       sp.hstack([sp.csc_array((links.shape[0], n)), links])], format="csc")
+        lower = np.concatenate([-system.f_ext, np.zeros(links.shape[0])])
+        tie_row = A.shape[0]
         if tie is not None:
-            tie_row = sp.csc_array((np.asarray(tie), ([0, 0], [A.shape[1] - 2,
-                                                             A.shape[1] - 1])),
-                                   shape=(1, A.shape[1]))
-            A = sp.vstack([A, tie_row], format="csc")
-            lower, upper = np.append(lower, 0.0), np.append(upper, 0.0)
+            A = sp.vstack([A, sp.csc_array((np.asarray(tie), ([0, 0], heads)),
+                                           shape=(1, A.shape[1]))], format="csc")
+            lower = np.append(lower, 0.0)
         lp = highspy.HighsLp()
         lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
-        lp.col_cost_ = np.concatenate([np.zeros(self.matrix.shape[1]), cost])
-        lp.col_lower_ = np.concatenate([np.zeros(self.matrix.shape[1]),
-                                        np.full(m, -highspy.kHighsInf)])
+        col_cost, col_lower = np.zeros(A.shape[1]), np.full(A.shape[1], -highspy.kHighsInf)
+        col_cost[heads], col_lower[:n] = cost, 0.0
+        lp.col_cost_, lp.col_lower_ = col_cost, col_lower
         lp.col_upper_ = np.full(A.shape[1], highspy.kHighsInf)
-        lp.row_lower_, lp.row_upper_ = lower, upper
+        lp.row_lower_, lp.row_upper_ = lower, lower
         lp.sense_ = highspy.ObjSense.kMaximize
         lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
         lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
@@ -251,7 +279,7 @@ class CollapseLP:
             if highs.setOptionValue(name, value) != highspy.HighsStatus.kOk:
                 raise ValueError(f"HiGHS refused option {name}={value!r}")
         highs.passModel(lp)
-        return highs
+        return highs, heads, tie_row
 
     def _run(self, highs) -> highspy.HighsModelStatus:
         highs.run()
@@ -264,12 +292,9 @@ class CollapseLP:
             status = highs.getModelStatus()
         return status
 
-    def _stands_unloaded(self, highs) -> bool | None:
-        """Whether ``lambda = 0`` is feasible: the load columns fixed at 0, solved from
-        the current basis, then freed again."""
-        count = highs.getNumCol()
-        columns = np.arange(count - (2 if highs is self._lateral else 1), count,
-                            dtype=np.int32)
+    def _stands_unloaded(self, highs, columns) -> bool | None:
+        """Whether ``lambda = 0`` is feasible: the load factors (the chains' ``heads``)
+        fixed at 0, solved from the current basis, then freed again."""
         zeros = np.zeros(len(columns))
         highs.changeColsBounds(len(columns), columns, zeros, zeros)
         status = self._run(highs)
@@ -279,7 +304,7 @@ class CollapseLP:
             return True
         return False if status == highspy.HighsModelStatus.kInfeasible else None
 
-    def _result(self, highs, live, azimuth, start, dead_load_feasible) -> CollapseResult:
+    def _result(self, highs, heads, live, azimuth, start, dead_load_feasible) -> CollapseResult:
         status = self._run(highs)
         info = highs.getInfo()
         iterations = int(info.simplex_iteration_count + info.ipm_iteration_count)
@@ -291,7 +316,7 @@ class CollapseLP:
             elif status == Status.kUnbounded:
                 feasible, words = dead_load_feasible, "unbounded"
                 if feasible is None:
-                    feasible = self._stands_unloaded(highs)
+                    feasible = self._stands_unloaded(highs, heads)
             else:
                 feasible, words = dead_load_feasible, highs.modelStatusToString(status)
                 log.warning("collapse LP without a verdict: %s", words)
@@ -303,7 +328,6 @@ class CollapseLP:
         values = np.array(solution.col_value)
         dual = np.array(solution.row_dual)[: self.system.A_eq.shape[0]]
         factor = float(highs.getInfo().objective_function_value)
-        loads = values[n:]
         x_scaled = self.edges @ values[:n]
         load = self.scaled(live)
         total = self.system.f_ext + factor * load
@@ -313,11 +337,10 @@ class CollapseLP:
             # the largest factor is negative: lambda = 0 is past it
             dead_load_feasible = False
         elif dead_load_feasible is None:
-            dead_load_feasible = self._stands_unloaded(highs)
+            dead_load_feasible = self._stands_unloaded(highs, heads)
         motion = self._mechanism(dual, load, factor)
         x = self.system.to_newtons(x_scaled)
-        log.debug("collapse LP: lambda %.6g (load columns %s), %d iterations", factor,
-                  loads, iterations)
+        log.debug("collapse LP: lambda %.6g, %d iterations", factor, iterations)
         return CollapseResult(
             factor if dead_load_feasible else None, dead_load_feasible,
             "optimal" if dead_load_feasible else "dead load infeasible",
