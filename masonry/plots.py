@@ -198,3 +198,60 @@ def force_pngs(blocks, interfaces, forces: dict, fast=False) -> dict:
             out[f"{view}/{name}.png"] = _colour_plot(
                 blocks, interfaces, index, np.asarray(forces[key])[index], title, view, fast)
     return out
+
+
+MECHANISM_SCALE = 0.08
+"""Drawn exaggeration of a collapse mechanism: the largest displacement (1 after
+normalising) is drawn as this fraction of the model's bounding-box diagonal."""
+
+
+def mechanism_pngs(blocks, interfaces, mechanism, hinge, slides, title, fast=False) -> dict:
+    """The collapse mechanism (SPEC 6.9) drawn exaggerated over the undeformed structure:
+    displaced blocks coloured by their largest vertex displacement, the undeformed ones
+    as grey outlines, hinges (interfaces that open about a line) in red and sliding
+    interfaces in blue, at their undeformed places (``collapse/<view>_mechanism.png``).
+
+    Parameters
+    ----------
+    mechanism : (B, 6) float
+        Per block ``(u, theta)`` about its centroid, largest vertex displacement 1.
+    hinge, slides : (K,) bool
+    title : str
+    """
+    owner = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
+    arm = blocks.vertices - blocks.block_centroid[owner]
+    displacement = mechanism[owner, :3] + np.cross(mechanism[owner, 3:], arm)
+    size = float(np.linalg.norm(blocks.bounds[1] - blocks.bounds[0]))
+    moved = blocks.vertices + MECHANISM_SCALE * size * displacement
+    per_block = np.zeros(blocks.n_blocks)
+    np.maximum.at(per_block, owner, np.linalg.norm(displacement, axis=1))
+    free = ~np.asarray(blocks.block_is_support)
+    faces = np.flatnonzero(free[blocks.face_block])
+    starts, ends = blocks.face_offsets[faces], blocks.face_offsets[faces + 1]
+    undeformed = [blocks.vertices[blocks.face_vertices[a:b]] for a, b in zip(starts, ends)]
+    deformed = [moved[blocks.face_vertices[a:b]] for a, b in zip(starts, ends)]
+    norm = matplotlib.colors.Normalize(vmin=0.0, vmax=1.0)
+    cmap = matplotlib.colormaps["plasma"]
+    bounds = np.array([np.minimum(blocks.bounds[0], moved.min(axis=0)),
+                       np.maximum(blocks.bounds[1], moved.max(axis=0))])
+    out = {}
+    for view in ["01_angle"] if fast else ["01_angle", "02_front", "03_top"]:
+        fig, ax = _axes3d(bounds, view)
+        ax.add_collection3d(Poly3DCollection(undeformed, facecolors="none",
+                                             edgecolors="0.6", linewidths=0.1))
+        ax.add_collection3d(Poly3DCollection(
+            deformed, facecolors=cmap(norm(per_block[blocks.face_block[faces]])),
+            edgecolors="k", linewidths=0.05, alpha=0.9))
+        for mask, colour, label in ((hinge, "red", "hinge"), (slides, "blue", "sliding")):
+            index = np.flatnonzero(mask)
+            if len(index):
+                ax.add_collection3d(Poly3DCollection(_polygons(interfaces, index),
+                                                     facecolors=colour, edgecolors=colour,
+                                                     linewidths=2.0, label=label))
+        bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
+                           shrink=0.6, pad=0.1)
+        bar.set_label("virtual displacement (largest = 1)")
+        ax.set_title(f"{title}\n{int(hinge.sum())} hinges (red), {int(slides.sum())} "
+                     f"sliding (blue); displacement drawn at {MECHANISM_SCALE:g} x size")
+        out[f"collapse/{view}_mechanism.png"] = _png(fig, 60 if fast else 110)
+    return out

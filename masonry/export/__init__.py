@@ -136,6 +136,15 @@ def _plot_files(made: RunOutputs) -> Export:
     if made.forces is not None:
         pngs = plots.force_pngs(model.blocks, model.interfaces, made.forces, fast)
         files.update({f"RBE/{name}": png for name, png in pngs.items()})
+    collapse = made.collapse
+    if collapse is not None and collapse.mechanism is not None and collapse.load_factor:
+        title = (f"collapse mechanism: lambda = {collapse.load_factor:.4g}, "
+                 f"{collapse.live.description['kind']} load"
+                 + ("" if collapse.azimuth_deg is None
+                    else f" at {collapse.azimuth_deg:g} deg"))
+        files.update(plots.mechanism_pngs(model.blocks, model.interfaces,
+                                          collapse.mechanism, collapse.hinge,
+                                          collapse.slides, title, fast))
     return Export(files)
 
 
