@@ -270,3 +270,20 @@ def test_run_writes_the_collapse_record_and_files(tmp_path, capsys):
         assert (folder / "collapse" / name).stat().st_size > 0
     rows = (folder / "collapse" / "mechanism.csv").read_text().splitlines()
     assert rows[0] == "block,name,ux,uy,uz,rx,ry,rz" and len(rows) == 1 + 86
+
+
+def test_sweep_records_the_load_factor(tmp_path):
+    """An arch thickness study with a lateral load: lambda per variant, each equal to the
+    independent 2D LP's."""
+    study = tmp_path / "arch.toml"
+    study.write_text('[base]\nscene = "arch"\nblocks = 12\nlateral = 0\nmu = 0.9\n'
+                     '[grid]\nthickness = [0.8, 1.2]\n')
+    assert main(["sweep", str(study), "--workers", "1", "--out", str(tmp_path), "-q"]) == 0
+    rows = (tmp_path / "sweep_arch" / "summary.csv").read_text().splitlines()
+    header = rows[0].split(",")
+    for line in rows[1:]:
+        row = dict(zip(header, line.split(",")))
+        thickness = float(row["arch_thickness"])
+        expected = arch_lp(arch_profile("semicircular", 12, 10.0, thickness), 1.0, 0.9)
+        assert float(row["load_factor"]) == pytest.approx(expected, rel=1e-5)
+        assert float(row["load_azimuth_deg"]) == 0.0

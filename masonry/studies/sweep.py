@@ -27,8 +27,10 @@ log = logging.getLogger(__name__)
 SUMMARY_COLUMNS = ("variant", "status", "error", "feasible", "friction_used", "moi",
                    "moi_factor",
                    "objective", "weight_N", "bricks", "interfaces", "residual_eq",
-                   "time_s", "structure_id")
-"""Result columns of the summary; the swept inputs come first."""
+                   "load_factor", "load_azimuth_deg", "time_s", "structure_id")
+"""Result columns of the summary; the swept inputs come first. ``load_factor`` (and the
+lateral load's azimuth, the worst one for ``lateral = "all"``) when the study gives a live
+load (``lateral``, ``point-load`` or ``crown-load``, SPEC 6.8)."""
 
 
 @dataclass(frozen=True)
@@ -117,6 +119,9 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
             bricks=record["counts"]["bricks"],
             interfaces=sum(record["counts"].get("interfaces", {}).values()),
             residual_eq=rbe.get("residual_eq"), structure_id=record["structure_id"])
+        collapse = record.get("collapse", {})
+        row.update(load_factor=collapse.get("load_factor"),
+                   load_azimuth_deg=collapse.get("azimuth_deg"))
     row["time_s"] = round(time.perf_counter() - start, 3)
     return row
 
@@ -243,4 +248,15 @@ def summary_pngs(study: Study, rows) -> dict:
             bottom.set_xticks(range(len(labels)), labels)
         top.set_title(f"{len(done)} variants ({len(rows) - len(done)} failed)")
         out[f"moi_factor_{name}.png"] = _png(fig, 100)
+        factors = [(v, r["load_factor"]) for v, r in zip(xs, done)
+                   if r.get("load_factor") is not None]
+        if factors:
+            fig, ax = plt.subplots(figsize=(6, 3.5))
+            ax.scatter(*zip(*factors), c="C2", s=18)
+            ax.set_ylabel("collapse load factor lambda")
+            ax.set_xlabel(name)
+            if labels is not None:
+                ax.set_xticks(range(len(labels)), labels)
+            ax.set_ylim(bottom=0)
+            out[f"load_factor_{name}.png"] = _png(fig, 100)
     return out
