@@ -10,7 +10,7 @@ from scipy.optimize import linprog
 from masonry.blocks import Blocks
 from masonry.params import ParameterError, Params, from_preset, validate
 from masonry.rbe.boundary import Model, analysis_model
-from masonry.rbe.collapse import collapse_load, lateral_azimuths, worst_lateral
+from masonry.rbe.collapse import CollapseLP, collapse_load, lateral_azimuths, worst_lateral
 from masonry.rbe.loads import crown_load, lateral, point_loads
 from masonry.scenes import build
 from masonry.scenes.arch import arch_profile
@@ -74,8 +74,8 @@ def test_single_block_tips_at_b_over_h_or_slides_at_mu(azimuth, expected, mode):
     model = column(1, (0.2, 0.4, 0.5))
     live = lateral(model, azimuth, DENSITY)
     result = collapse_load(model, live, mu=0.7, density=DENSITY)
-    assert result.load_factor == pytest.approx(expected, rel=1e-9)
-    assert result.dead_load_feasible and result.residual < 1e-9
+    assert result.load_factor == pytest.approx(expected, rel=1e-6)
+    assert result.dead_load_feasible and result.residual < 1e-7
     assert result.hinge.all() == (mode == "tips")
     assert result.slides.all() == (mode == "slides")
     assert (result.note is not None) == (mode == "slides")
@@ -87,7 +87,7 @@ def test_column_tips_at_b_over_its_whole_height(count):
     model = column(count, (0.1, 0.3, 0.15))
     live = lateral(model, 0.0, DENSITY)
     result = collapse_load(model, live, mu=0.9, density=DENSITY)
-    assert result.load_factor == pytest.approx(0.1 / (0.15 * count), rel=1e-9)
+    assert result.load_factor == pytest.approx(0.1 / (0.15 * count), rel=1e-6)
     # the whole column rotates as one about its base: only the base joint opens
     assert result.opens.tolist() == [True] + [False] * (count - 1)
     check_mechanism(model, live, result)
@@ -100,7 +100,7 @@ def test_point_load_at_the_top_face_tips_a_block_at_the_lever_ratio():
     live = point_loads(model.blocks, ["b*:100,0,0"])
     weight = DENSITY * G * 0.2 * 0.4 * 0.5
     result = collapse_load(model, live, mu=0.9, density=DENSITY)
-    assert result.load_factor == pytest.approx(weight * 0.1 / (100 * 0.5), rel=1e-9)
+    assert result.load_factor == pytest.approx(weight * 0.1 / (100 * 0.5), rel=1e-6)
     check_mechanism(model, live, result)
     with pytest.raises(ParameterError, match="--point-load"):
         point_loads(model.blocks, ["nothing*:1,0,0"])
@@ -180,11 +180,13 @@ def arch_model(thickness, blocks=12):
     return params, analysis_model(build(params))
 
 
-@pytest.mark.parametrize("thickness, mu", [(1.0, 0.9), (1.6, 0.5)])
-def test_arch_under_horizontal_load_matches_an_independent_2d_lp(thickness, mu):
+@pytest.mark.parametrize("thickness, mu, method", [(1.0, 0.9, "clarabel"),
+                                                   (1.6, 0.5, "clarabel"),
+                                                   (1.0, 0.9, "ipm-crossover")])
+def test_arch_under_horizontal_load_matches_an_independent_2d_lp(thickness, mu, method):
     params, model = arch_model(thickness)
     live = lateral(model, 0.0, DENSITY)
-    result = collapse_load(model, live, mu=mu, density=DENSITY)
+    result = CollapseLP(model, mu=mu, density=DENSITY, method=method).solve(live)
     profile = arch_profile("semicircular", 12, params.arch_span, thickness)
     assert result.load_factor == pytest.approx(arch_lp(profile, params.arch_depth, mu),
                                                rel=1e-6)
@@ -222,11 +224,12 @@ def test_crown_load_on_the_cyclic_section_equals_the_full_dome():
     np.testing.assert_allclose(total, [0, 0, -newtons], atol=1e-9 * newtons)
 
 
-def test_worst_lateral_searches_the_symmetry_directions_with_one_model():
+@pytest.mark.parametrize("method", ["clarabel", "simplex"])
+def test_worst_lateral_searches_the_symmetry_directions_with_one_model(method):
     dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
     azimuths = lateral_azimuths(6)
     assert len(azimuths) >= 24 and {30.0, 90.0, 150.0} <= set(azimuths)
-    worst = worst_lateral(dome, azimuths, n_webs=6)
+    worst = worst_lateral(dome, azimuths, n_webs=6, method=method)
     factors = np.array([f for _, f in worst.azimuths])
     assert len(factors) == len(azimuths) and worst.load_factor == factors.min()
     # six-fold symmetry: the factor repeats every 60 degrees
@@ -265,7 +268,7 @@ def test_run_writes_the_collapse_record_and_files(tmp_path, capsys):
     record = json.loads((folder / "run.json").read_text())["collapse"]
     assert record["load_factor"] == pytest.approx(0.2, rel=1e-7)
     assert record["dead_load_feasible"] is True and record["azimuth_deg"] == 0.0
-    assert record["live_load"]["kind"] == "lateral" and record["residual"] < 1e-9
+    assert record["live_load"]["kind"] == "lateral" and record["residual"] < 1e-7
     for name in ("forces.csv", "interfaces.vtu", "mechanism.csv", "mechanism.vtu"):
         assert (folder / "collapse" / name).stat().st_size > 0
     rows = (folder / "collapse" / "mechanism.csv").read_text().splitlines()

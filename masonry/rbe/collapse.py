@@ -30,6 +30,7 @@ import logging
 import time
 from dataclasses import dataclass, field
 
+import clarabel
 import highspy
 import numpy as np
 import scipy.sparse as sp
@@ -47,6 +48,15 @@ above which an interface counts as opening or sliding in the mechanism."""
 FEASIBILITY_TOL = 1e-7
 """HiGHS's primal and dual feasibility tolerance (scaled rows: of order one)."""
 
+METHODS = ("clarabel", "ipm", "ipm-crossover", "simplex")
+"""Solvers of the collapse LP: Clarabel's interior point (direct LDL factorization), or
+HiGHS (``HIGHS_METHODS``). HiGHS decides the small scenes of the tests at once, and its
+dual simplex warm-starts across azimuths, but gave no verdict on preset 1's sections and
+dome within minutes (docs/collapse.md); Clarabel is the default."""
+
+CLARABEL_SETTINGS = {"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9, "tol_feas": 1e-9}
+"""Clarabel's tolerances for the collapse LP (scaled rows of order one)."""
+
 HIGHS_METHODS = {
     "ipm": {"solver": "ipm", "run_crossover": "off"},
     "ipm-crossover": {"solver": "ipm", "run_crossover": "on"},
@@ -54,8 +64,8 @@ HIGHS_METHODS = {
 }
 """HiGHS settings by name."""
 
-METHOD = "ipm-crossover"
-"""The default :data:`HIGHS_METHODS` entry."""
+METHOD = "clarabel"
+"""The default of :data:`METHODS`."""
 
 ASSOCIATED_NOTE = (
     "sliding interfaces take part in this mechanism: the load factor assumes associated "
@@ -64,7 +74,7 @@ ASSOCIATED_NOTE = (
 
 RESULT_KEYS = ("load_factor", "dead_load_feasible", "status", "solver", "iterations",
                "time_s", "residual", "work_balance", "mu", "azimuth_deg", "opening",
-               "sliding", "hinges", "note")
+               "sliding", "hinges", "friction_law", "associated_factor", "note")
 """Scalar fields of :class:`CollapseResult` in run.json, in order (plus ``live_load``)."""
 
 
@@ -106,6 +116,16 @@ class CollapseResult:
     opens, slides, hinge : (K,) bool or None
         Per interface: some vertex separates (relative normal motion > :data:`MOTION_TOL`);
         some vertex slips; opens with some vertex still closed (a hinge, not a separation).
+    vertex_slip : (IV, 2) float or None
+        Relative tangential motion (other block minus main block) along ``t1, t2`` at
+        every interface vertex, on the normalised mechanism.
+    azimuths : tuple of (float, float or None)
+        After :func:`worst_lateral`: every azimuth searched and its factor.
+    friction_law : str
+        ``associated`` (the LP of SPEC 6.8) or ``fixed directions`` (see
+        :func:`fixed_direction_factor`).
+    associated_factor : float or None
+        With ``fixed directions``: the associated factor it started from.
     """
 
     load_factor: float | None
@@ -125,7 +145,10 @@ class CollapseResult:
     opens: np.ndarray | None = None
     slides: np.ndarray | None = None
     hinge: np.ndarray | None = None
+    vertex_slip: np.ndarray | None = None
     azimuths: tuple = field(default=())
+    friction_law: str = "associated"
+    associated_factor: float | None = None
 
     @property
     def opening(self) -> int:
@@ -141,8 +164,9 @@ class CollapseResult:
 
     @property
     def note(self) -> str | None:
-        """:data:`ASSOCIATED_NOTE` when sliding takes part in the mechanism."""
-        return ASSOCIATED_NOTE if self.sliding > 0 else None
+        """:data:`ASSOCIATED_NOTE` when sliding takes part in an associated mechanism."""
+        return (ASSOCIATED_NOTE if self.sliding > 0 and self.friction_law == "associated"
+                else None)
 
     def to_dict(self) -> dict:
         """Plain values for run.json: :data:`RESULT_KEYS`, ``live_load`` and, after a
@@ -186,6 +210,33 @@ class CollapseLP:
         self._lateral = None
         self.method = METHOD if method is None else method
 
+    def with_friction_directions(self, fixed, direction) -> "CollapseLP":
+        """The same LP with the friction of the ``fixed`` vertices ((IV,) bool) along
+        ``direction`` ((IV, 2) unit vectors in ``(t1, t2)``): one ray ``(c, f1, f2) =
+        c (1, mu d1, mu d2)`` instead of the pyramid's four edges, so there the joint
+        slides without dilating (Coulomb's law with a known slip direction)."""
+        n_vertices = self.system.layout.n_vertices
+        fixed = np.asarray(fixed, dtype=bool)
+        rays = np.where(fixed, 1, 4)
+        start = np.concatenate([[0], np.cumsum(rays)])
+        pyramid = np.array([[1.0, 1.0, 1.0, 1.0], [0.0, 0.0, 0.0, 0.0],
+                            [self.mu, self.mu, -self.mu, -self.mu],
+                            [self.mu, -self.mu, self.mu, -self.mu]])
+        values = np.repeat(pyramid[None], n_vertices, axis=0)
+        values[fixed, :, 0] = np.column_stack([np.ones(fixed.sum()), np.zeros(fixed.sum()),
+                                               self.mu * direction[fixed]])
+        ray_vertex = np.repeat(np.arange(n_vertices), rays)
+        ray_index = np.arange(start[-1]) - start[ray_vertex]
+        rows = 4 * ray_vertex[:, None] + np.arange(4)
+        data = values[ray_vertex, :, ray_index]
+        edges = sp.csr_array((data.ravel(), (rows.ravel(), np.repeat(np.arange(start[-1]),
+                                                                      4))),
+                             shape=(4 * n_vertices, start[-1]))
+        out = CollapseLP.__new__(CollapseLP)
+        out.__dict__.update(self.__dict__, edges=edges, _lateral=None,
+                            matrix=sp.csc_array(self.system.A_eq @ edges))
+        return out
+
     def scaled(self, live: LiveLoad) -> np.ndarray:
         """(6 F,) float: a live load in the rows' scaling (free blocks only)."""
         wrench = live.wrench[self.system.free_block].ravel()
@@ -195,28 +246,31 @@ class CollapseLP:
         """The largest factor of ``live``; ``dead_load_feasible`` (e.g. the RBE's verdict)
         saves the check of ``lambda = 0`` when the optimum is positive."""
         start = time.perf_counter()
-        highs, heads, _ = self._highs(self.scaled(live)[:, None], np.ones(1))
-        return self._result(highs, heads, live, None, start, dead_load_feasible)
+        lp = self._backend(self.scaled(live)[:, None], np.ones(1))
+        return self._result(lp, live, None, start, dead_load_feasible)
 
     def solve_lateral(self, azimuth_deg: float, *, dead_load_feasible=None) -> CollapseResult:
-        """The factor of :func:`masonry.rbe.loads.lateral` at ``azimuth_deg``, warm-started
-        from the previous azimuth's basis."""
+        """The factor of :func:`masonry.rbe.loads.lateral` at ``azimuth_deg``, reusing the
+        previous azimuth's model (HiGHS: its basis; Clarabel: its symbolic
+        factorization)."""
         start = time.perf_counter()
         angle = np.radians(azimuth_deg)
         cos, sin = np.cos(angle), np.sin(angle)
         if self._lateral is None:
             loads = np.stack([self.scaled(lateral(self.model, 0.0, self.density)),
                               self.scaled(lateral(self.model, 90.0, self.density))], axis=1)
-            self._lateral = self._highs(loads, np.array([cos, sin]), tie=(-sin, cos))
+            self._lateral = self._backend(loads, np.array([cos, sin]), tie=(-sin, cos))
         else:
-            highs, heads, row = self._lateral
-            highs.changeCoeff(row, heads[0], -sin)
-            highs.changeCoeff(row, heads[1], cos)
-            highs.changeColsCost(2, heads, np.array([cos, sin]))
+            self._lateral.direct(cos, sin)
         live = lateral(self.model, azimuth_deg, self.density)
-        highs, heads, _ = self._lateral
-        return self._result(highs, heads, live, float(azimuth_deg) % 360.0, start,
+        return self._result(self._lateral, live, float(azimuth_deg) % 360.0, start,
                             dead_load_feasible)
+
+    def _backend(self, loads, cost, tie=None):
+        if self.method == "clarabel":
+            return _ClarabelLP(self.matrix, loads, -self.system.f_ext, cost, tie,
+                               self.time_limit)
+        return _HighsLP(*self._highs(loads, cost, tie), self)
 
     def _load_columns(self, loads):
         """Columns and link rows for ``loads`` ((6 F, m) float), one chain per load.
@@ -281,53 +335,19 @@ class CollapseLP:
         highs.passModel(lp)
         return highs, heads, tie_row
 
-    def _run(self, highs) -> highspy.HighsModelStatus:
-        highs.run()
-        status = highs.getModelStatus()
-        if status == highspy.HighsModelStatus.kUnboundedOrInfeasible:
-            # presolve's verdict does not say which; the simplex without it does
-            highs.setOptionValue("presolve", "off")
-            highs.run()
-            highs.setOptionValue("presolve", "choose")
-            status = highs.getModelStatus()
-        return status
-
-    def _stands_unloaded(self, highs, columns) -> bool | None:
-        """Whether ``lambda = 0`` is feasible: the load factors (the chains' ``heads``)
-        fixed at 0, solved from the current basis, then freed again."""
-        zeros = np.zeros(len(columns))
-        highs.changeColsBounds(len(columns), columns, zeros, zeros)
-        status = self._run(highs)
-        highs.changeColsBounds(len(columns), columns, zeros - highspy.kHighsInf,
-                               zeros + highspy.kHighsInf)
-        if status == highspy.HighsModelStatus.kOptimal:
-            return True
-        return False if status == highspy.HighsModelStatus.kInfeasible else None
-
-    def _result(self, highs, heads, live, azimuth, start, dead_load_feasible) -> CollapseResult:
-        status = self._run(highs)
-        info = highs.getInfo()
-        iterations = int(info.simplex_iteration_count + info.ipm_iteration_count)
-        common = dict(solver=f"highs-{self.method}", mu=self.mu, live=live, azimuth_deg=azimuth)
-        Status = highspy.HighsModelStatus
-        if status != Status.kOptimal:
-            if status == Status.kInfeasible:
-                feasible, words = False, "dead load infeasible"
-            elif status == Status.kUnbounded:
-                feasible, words = dead_load_feasible, "unbounded"
-                if feasible is None:
-                    feasible = self._stands_unloaded(highs, heads)
-            else:
-                feasible, words = dead_load_feasible, highs.modelStatusToString(status)
-                log.warning("collapse LP without a verdict: %s", words)
-            return CollapseResult(None, feasible, words, iterations=iterations,
-                                  time_s=time.perf_counter() - start, residual=np.nan,
-                                  work_balance=np.nan, **common)
-        solution = highs.getSolution()
+    def _result(self, lp, live, azimuth, start, dead_load_feasible) -> CollapseResult:
+        status, factor, values, dual, iterations = lp.run()
+        common = dict(solver=self.method, mu=self.mu, live=live, azimuth_deg=azimuth,
+                      iterations=iterations)
+        if status != "optimal":
+            feasible = False if status == "dead load infeasible" else dead_load_feasible
+            if status == "unbounded" and feasible is None:
+                feasible = lp.stands_unloaded()
+            if status not in ("dead load infeasible", "unbounded"):
+                log.warning("collapse LP without a verdict: %s", status)
+            return CollapseResult(None, feasible, status, time_s=time.perf_counter() - start,
+                                  residual=np.nan, work_balance=np.nan, **common)
         n = self.matrix.shape[1]
-        values = np.array(solution.col_value)
-        dual = np.array(solution.row_dual)[: self.system.A_eq.shape[0]]
-        factor = float(highs.getInfo().objective_function_value)
         x_scaled = self.edges @ values[:n]
         load = self.scaled(live)
         total = self.system.f_ext + factor * load
@@ -337,15 +357,15 @@ class CollapseLP:
             # the largest factor is negative: lambda = 0 is past it
             dead_load_feasible = False
         elif dead_load_feasible is None:
-            dead_load_feasible = self._stands_unloaded(highs, heads)
-        motion = self._mechanism(dual, load, factor)
+            dead_load_feasible = lp.stands_unloaded()
+        motion = self._mechanism(dual[: self.system.A_eq.shape[0]], load, factor)
         x = self.system.to_newtons(x_scaled)
         log.debug("collapse LP: lambda %.6g, %d iterations", factor, iterations)
         return CollapseResult(
             factor if dead_load_feasible else None, dead_load_feasible,
             "optimal" if dead_load_feasible else "dead load infeasible",
-            iterations=iterations, time_s=time.perf_counter() - start, residual=residual,
-            x=x, forces=interface_forces(self.system.layout, x), **motion, **common)
+            time_s=time.perf_counter() - start, residual=residual, x=x,
+            forces=interface_forces(self.system.layout, x), **motion, **common)
 
     def _mechanism(self, dual, load, factor) -> dict:
         """Mechanism, per-interface flags and the work balance from the equilibrium rows'
@@ -385,7 +405,123 @@ class CollapseLP:
         work_dead = float(np.sum(dead * mechanism[free]))
         balance = abs(factor * work_live + work_dead) / max(abs(work_dead), abs(work_live))
         return dict(mechanism=mechanism, opens=opens, slides=slides, hinge=opens & closed,
-                    work_balance=balance)
+                    work_balance=balance, vertex_slip=relative[:, 2:])
+
+
+class _HighsLP:
+    """A collapse LP held by HiGHS: ``run`` from the last basis, the load factors fixed at
+    0 for the dead load check, a new lateral direction."""
+
+    def __init__(self, highs, heads, tie_row, parent):
+        self.highs, self.heads, self.tie_row = highs, heads, tie_row
+        self.columns, self.time_limit = parent.matrix.shape[1], parent.time_limit
+
+    def _status(self) -> str:
+        # HiGHS's time limit counts from its creation: give every run its own
+        self.highs.setOptionValue("time_limit", self.highs.getRunTime() + self.time_limit)
+        self.highs.run()
+        Status = highspy.HighsModelStatus
+        status = self.highs.getModelStatus()
+        if status == Status.kUnboundedOrInfeasible:
+            # presolve's verdict does not say which; the solver without it does
+            self.highs.setOptionValue("presolve", "off")
+            self.highs.run()
+            self.highs.setOptionValue("presolve", "choose")
+            status = self.highs.getModelStatus()
+        return {Status.kOptimal: "optimal", Status.kInfeasible: "dead load infeasible",
+                Status.kUnbounded: "unbounded"}.get(
+                    status, self.highs.modelStatusToString(status))
+
+    def run(self):
+        """``(status, factor, column values, row duals, iterations)``."""
+        status = self._status()
+        info = self.highs.getInfo()
+        iterations = int(info.simplex_iteration_count + info.ipm_iteration_count)
+        if status != "optimal":
+            return status, None, None, None, iterations
+        solution = self.highs.getSolution()
+        return (status, float(info.objective_function_value), np.array(solution.col_value),
+                np.array(solution.row_dual), iterations)
+
+    def stands_unloaded(self) -> bool | None:
+        zeros = np.zeros(len(self.heads))
+        self.highs.changeColsBounds(len(self.heads), self.heads, zeros, zeros)
+        status = self._status()
+        self.highs.changeColsBounds(len(self.heads), self.heads, zeros - highspy.kHighsInf,
+                                    zeros + highspy.kHighsInf)
+        return {"optimal": True, "dead load infeasible": False}.get(status)
+
+    def direct(self, cos, sin):
+        self.highs.changeCoeff(self.tie_row, self.heads[0], -sin)
+        self.highs.changeCoeff(self.tie_row, self.heads[1], cos)
+        self.highs.changeColsCost(2, self.heads, np.array([cos, sin]))
+
+
+class _ClarabelLP:
+    """A collapse LP held by Clarabel (interior point, direct LDL): ``minimize -cost .
+    lambda`` over ``[g, lambda]`` with the equilibrium (and tie) rows in the zero cone and
+    ``g >= 0`` in the nonnegative cone. A new lateral direction updates two entries of
+    ``A`` and the costs in place, which keeps the symbolic factorization."""
+
+    def __init__(self, matrix, loads, rhs, cost, tie, time_limit):
+        n, m = matrix.shape[1], loads.shape[1]
+        top = sp.hstack([matrix, sp.csc_array(loads)])
+        rows = [top]
+        if tie is not None:
+            rows.append(sp.csc_array((np.asarray(tie, dtype=float), ([0, 0], [n, n + 1])),
+                                     shape=(1, n + m)))
+        self.n_eq = sum(r.shape[0] for r in rows)
+        rows.append(sp.hstack([-sp.identity(n), sp.csc_array((n, m))]))
+        self.A = sp.csc_matrix(sp.vstack(rows, format="csc"))
+        self.A.sort_indices()
+        self.b = np.concatenate([rhs, np.zeros(self.n_eq - len(rhs) + n)])
+        self.q = np.concatenate([np.zeros(n), -np.asarray(cost, dtype=float)])
+        self.n, self.m, self.time_limit = n, m, time_limit
+        if tie is not None:  # where the tie row's two entries sit in A.data
+            self.tie_at = [self.A.indptr[c] + np.flatnonzero(
+                self.A.indices[self.A.indptr[c]:self.A.indptr[c + 1]] == self.n_eq - 1)[0]
+                for c in (n, n + 1)]
+        self.solver = None
+
+    def _settings(self):
+        settings = clarabel.DefaultSettings()
+        settings.verbose = False
+        settings.presolve_enable = False  # keep the rows: data updates need them
+        settings.time_limit = float(self.time_limit)
+        for name, value in CLARABEL_SETTINGS.items():
+            setattr(settings, name, value)
+        return settings
+
+    def run(self):
+        """``(status, factor, variable values, equality-row duals, iterations)``."""
+        if self.solver is None:
+            cones = [clarabel.ZeroConeT(self.n_eq), clarabel.NonnegativeConeT(self.n)]
+            size = self.n + self.m
+            self.solver = clarabel.DefaultSolver(sp.csc_matrix((size, size)), self.q,
+                                                 self.A, self.b, cones, self._settings())
+        solution = self.solver.solve()
+        status = str(solution.status)
+        words = {"Solved": "optimal", "PrimalInfeasible": "dead load infeasible",
+                 "DualInfeasible": "unbounded"}.get(status, status)
+        if words != "optimal":
+            return words, None, None, None, int(solution.iterations)
+        x = np.array(solution.x)
+        return (words, float(-self.q[self.n:] @ x[self.n:]), x, np.array(solution.z),
+                int(solution.iterations))
+
+    def stands_unloaded(self) -> bool | None:
+        """The dead load alone: the load columns dropped, a zero objective."""
+        A = sp.csc_matrix(self.A[:, : self.n])
+        cones = [clarabel.ZeroConeT(self.n_eq), clarabel.NonnegativeConeT(self.n)]
+        solver = clarabel.DefaultSolver(sp.csc_matrix((self.n, self.n)), np.zeros(self.n),
+                                        A, self.b, cones, self._settings())
+        status = str(solver.solve().status)
+        return {"Solved": True, "PrimalInfeasible": False}.get(status)
+
+    def direct(self, cos, sin):
+        self.A.data[self.tie_at[0]], self.A.data[self.tie_at[1]] = -sin, cos
+        self.q[self.n:] = (-cos, -sin)
+        self.solver.update(q=self.q, A=self.A)
 
 
 def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=None,
@@ -419,7 +555,48 @@ def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=Non
     problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit)
     if friction is None:
         return problem.solve(live, dead_load_feasible=dead_load_feasible)
+    if friction == "fixed-directions":
+        return fixed_direction_factor(problem, live, dead_load_feasible=dead_load_feasible)
     raise ValueError(f"friction must be None or 'fixed-directions', not {friction!r}")
+
+
+FIXED_DIRECTION_ROUNDS = 20
+"""Most re-solves of :func:`fixed_direction_factor`."""
+
+
+def fixed_direction_factor(problem: CollapseLP, live: LiveLoad, *, dead_load_feasible=None,
+                           rounds=FIXED_DIRECTION_ROUNDS, rtol=1e-6) -> CollapseResult:
+    """A non-associative estimate of the load factor (SPEC 6.8's friction-law note).
+
+    Start from the associated LP; then, round after round, every vertex that slides in
+    the last mechanism gets a friction force of ``mu c`` against its slip direction (one
+    ray instead of the pyramid, :meth:`CollapseLP.with_friction_directions`: no
+    dilatancy), and the LP is solved again, until the factor changes by less than
+    ``rtol`` or after ``rounds`` re-solves. This is the fixed-point scheme of the
+    non-associative limit-analysis literature: an estimate, not a bound, but it removes
+    the dilatancy by which the associated factor overestimates sliding collapse.
+    """
+    start = time.perf_counter()
+    associated = problem.solve(live, dead_load_feasible=dead_load_feasible)
+    result, known = associated, associated.dead_load_feasible
+    for _ in range(rounds):
+        if result.load_factor is None or result.vertex_slip is None:
+            break
+        slip = result.vertex_slip
+        length = np.linalg.norm(slip, axis=1)
+        fixed = length > MOTION_TOL
+        if not fixed.any():
+            break
+        direction = -slip / np.where(fixed, length, 1.0)[:, None]
+        previous = result.load_factor
+        result = problem.with_friction_directions(fixed, direction).solve(
+            live, dead_load_feasible=known)
+        if (result.load_factor is None
+                or abs(result.load_factor - previous) <= rtol * abs(previous)):
+            break
+    return dataclasses.replace(result, friction_law="fixed directions",
+                               associated_factor=associated.load_factor,
+                               time_s=time.perf_counter() - start)
 
 
 def lateral_azimuths(n_webs=None, count=24) -> np.ndarray:
@@ -433,16 +610,18 @@ def lateral_azimuths(n_webs=None, count=24) -> np.ndarray:
 
 
 def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
-                  dead_load_feasible=None, time_limit=600.0) -> CollapseResult:
+                  dead_load_feasible=None, time_limit=600.0, method=None) -> CollapseResult:
     """The smallest lateral load factor over ``azimuths`` (``--lateral all``).
 
-    One HiGHS model serves every azimuth (:meth:`CollapseLP.solve_lateral`: two
-    coefficients and two costs change, the dual simplex restarts from the last basis),
+    One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: two coefficients and
+    two costs change; HiGHS's simplex restarts from the last basis, Clarabel keeps its
+    symbolic factorization), ``method`` one of :data:`METHODS`,
     and the dead load is checked once (unless ``dead_load_feasible`` is given). Returns the worst azimuth's result with every
     azimuth's factor in ``azimuths`` ((azimuth, factor or None) pairs).
     """
     azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
-    problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit)
+    problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit,
+                         method=method)
     start = time.perf_counter()
     results, known = [], dead_load_feasible
     for azimuth in azimuths:
