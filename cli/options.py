@@ -116,6 +116,8 @@ def collapse_summary(record, report):
     report(f"collapse: lambda = {c['load_factor']:.4g} for the {what}; mechanism: "
            f"{c['opening']} interfaces open ({c['hinges']} hinges), {c['sliding']} slide; "
            f"{c['solver']} {c['time_s']:.3g} s")
+    if c["note"]:
+        report(f"note: {c['note']}")
 
 
 def add_output_options(parser):

@@ -290,3 +290,23 @@ def test_sweep_records_the_load_factor(tmp_path):
         expected = arch_lp(arch_profile("semicircular", 12, 10.0, thickness), 1.0, 0.9)
         assert float(row["load_factor"]) == pytest.approx(expected, rel=1e-5)
         assert float(row["load_azimuth_deg"]) == 0.0
+
+
+def test_non_associative_friction_lowers_a_sliding_collapse_and_keeps_a_tipping_one():
+    """Fixed friction capacities (no dilatancy): a block that slides by translation or
+    tips needs no dilatancy and keeps its factor; the small dome's mixed mechanism loses
+    part of it."""
+    for azimuth, expected in ((0.0, 0.4), (90.0, 0.7)):
+        model = column(1, (0.2, 0.4, 0.5))
+        result = collapse_load(model, lateral(model, azimuth), friction="non-associative")
+        assert result.load_factor == pytest.approx(expected, rel=1e-6)
+        assert result.friction_law == "non-associative" and result.note is None
+    dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
+    live = lateral(dome, 0.0)
+    associated = collapse_load(dome, live)
+    estimate = collapse_load(dome, live, friction="non-associative")
+    assert associated.note is not None  # sliding takes part: the outputs say so
+    assert estimate.associated_factor == pytest.approx(associated.load_factor, rel=1e-6)
+    assert 0 < estimate.load_factor < 0.95 * associated.load_factor
+    assert estimate.x.reshape(-1, 4)[:, 1].max() == 0  # no tension
+    assert estimate.residual < 1e-7

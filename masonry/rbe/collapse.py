@@ -116,16 +116,13 @@ class CollapseResult:
     opens, slides, hinge : (K,) bool or None
         Per interface: some vertex separates (relative normal motion > :data:`MOTION_TOL`);
         some vertex slips; opens with some vertex still closed (a hinge, not a separation).
-    vertex_slip : (IV, 2) float or None
-        Relative tangential motion (other block minus main block) along ``t1, t2`` at
-        every interface vertex, on the normalised mechanism.
     azimuths : tuple of (float, float or None)
         After :func:`worst_lateral`: every azimuth searched and its factor.
     friction_law : str
-        ``associated`` (the LP of SPEC 6.8) or ``fixed directions`` (see
-        :func:`fixed_direction_factor`).
+        ``associated`` (the LP of SPEC 6.8) or ``non-associative`` (see
+        :func:`fixed_capacity_factor`).
     associated_factor : float or None
-        With ``fixed directions``: the associated factor it started from.
+        With ``non-associative``: the associated factor it started from.
     """
 
     load_factor: float | None
@@ -145,7 +142,6 @@ class CollapseResult:
     opens: np.ndarray | None = None
     slides: np.ndarray | None = None
     hinge: np.ndarray | None = None
-    vertex_slip: np.ndarray | None = None
     azimuths: tuple = field(default=())
     friction_law: str = "associated"
     associated_factor: float | None = None
@@ -209,32 +205,28 @@ class CollapseLP:
         self.mu, self.density, self.time_limit = float(mu), float(density), time_limit
         self._lateral = None
         self.method = METHOD if method is None else method
+        # bounds of the columns: edge rays are >= 0
+        self.lower = np.zeros(self.matrix.shape[1])
+        self.upper = np.full(self.matrix.shape[1], np.inf)
 
-    def with_friction_directions(self, fixed, direction) -> "CollapseLP":
-        """The same LP with the friction of the ``fixed`` vertices ((IV,) bool) along
-        ``direction`` ((IV, 2) unit vectors in ``(t1, t2)``): one ray ``(c, f1, f2) =
-        c (1, mu d1, mu d2)`` instead of the pyramid's four edges, so there the joint
-        slides without dilating (Coulomb's law with a known slip direction)."""
-        n_vertices = self.system.layout.n_vertices
-        fixed = np.asarray(fixed, dtype=bool)
-        rays = np.where(fixed, 1, 4)
-        start = np.concatenate([[0], np.cumsum(rays)])
-        pyramid = np.array([[1.0, 1.0, 1.0, 1.0], [0.0, 0.0, 0.0, 0.0],
-                            [self.mu, self.mu, -self.mu, -self.mu],
-                            [self.mu, -self.mu, self.mu, -self.mu]])
-        values = np.repeat(pyramid[None], n_vertices, axis=0)
-        values[fixed, :, 0] = np.column_stack([np.ones(fixed.sum()), np.zeros(fixed.sum()),
-                                               self.mu * direction[fixed]])
-        ray_vertex = np.repeat(np.arange(n_vertices), rays)
-        ray_index = np.arange(start[-1]) - start[ray_vertex]
-        rows = 4 * ray_vertex[:, None] + np.arange(4)
-        data = values[ray_vertex, :, ray_index]
-        edges = sp.csr_array((data.ravel(), (rows.ravel(), np.repeat(np.arange(start[-1]),
-                                                                      4))),
-                             shape=(4 * n_vertices, start[-1]))
+    def with_friction_capacity(self, capacity) -> "CollapseLP":
+        """The same LP with a fixed friction capacity: at every vertex ``c >= 0`` and
+        ``|f1|, |f2| <= capacity`` ((IV,) float, scaled units), the variables ``(c, f1,
+        f2)`` themselves instead of the pyramid's edge rays. A capacity that does not
+        grow with ``c`` has a purely tangential flow rule: joints slide without dilating
+        (non-associative friction, see :func:`fixed_capacity_factor`)."""
+        layout = self.system.layout
+        picked = np.stack([layout.columns(name) for name in ("c", "f1", "f2")], axis=1)
+        count = picked.size
+        edges = sp.csr_array((np.ones(count), (picked.ravel(), np.arange(count))),
+                             shape=(layout.n_columns, count))
+        capacity = np.asarray(capacity, dtype=float)
+        lower = np.column_stack([np.zeros_like(capacity), -capacity, -capacity])
+        upper = np.column_stack([np.full_like(capacity, np.inf), capacity, capacity])
         out = CollapseLP.__new__(CollapseLP)
         out.__dict__.update(self.__dict__, edges=edges, _lateral=None,
-                            matrix=sp.csc_array(self.system.A_eq @ edges))
+                            matrix=sp.csc_array(self.system.A_eq @ edges),
+                            lower=lower.ravel(), upper=upper.ravel())
         return out
 
     def scaled(self, live: LiveLoad) -> np.ndarray:
@@ -269,7 +261,7 @@ class CollapseLP:
     def _backend(self, loads, cost, tie=None):
         if self.method == "clarabel":
             return _ClarabelLP(self.matrix, loads, -self.system.f_ext, cost, tie,
-                               self.time_limit)
+                               self.time_limit, self.lower, self.upper)
         return _HighsLP(*self._highs(loads, cost, tie), self)
 
     def _load_columns(self, loads):
@@ -316,10 +308,12 @@ class CollapseLP:
             lower = np.append(lower, 0.0)
         lp = highspy.HighsLp()
         lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
-        col_cost, col_lower = np.zeros(A.shape[1]), np.full(A.shape[1], -highspy.kHighsInf)
-        col_cost[heads], col_lower[:n] = cost, 0.0
-        lp.col_cost_, lp.col_lower_ = col_cost, col_lower
-        lp.col_upper_ = np.full(A.shape[1], highspy.kHighsInf)
+        col_cost = np.zeros(A.shape[1])
+        col_cost[heads] = cost
+        free = np.full(A.shape[1] - n, highspy.kHighsInf)
+        lp.col_cost_ = col_cost
+        lp.col_lower_ = np.concatenate([self.lower, -free])
+        lp.col_upper_ = np.concatenate([np.minimum(self.upper, highspy.kHighsInf), free])
         lp.row_lower_, lp.row_upper_ = lower, lower
         lp.sense_ = highspy.ObjSense.kMaximize
         lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
@@ -405,7 +399,7 @@ class CollapseLP:
         work_dead = float(np.sum(dead * mechanism[free]))
         balance = abs(factor * work_live + work_dead) / max(abs(work_dead), abs(work_live))
         return dict(mechanism=mechanism, opens=opens, slides=slides, hinge=opens & closed,
-                    work_balance=balance, vertex_slip=relative[:, 2:])
+                    work_balance=balance)
 
 
 class _HighsLP:
@@ -463,7 +457,7 @@ class _ClarabelLP:
     ``g >= 0`` in the nonnegative cone. A new lateral direction updates two entries of
     ``A`` and the costs in place, which keeps the symbolic factorization."""
 
-    def __init__(self, matrix, loads, rhs, cost, tie, time_limit):
+    def __init__(self, matrix, loads, rhs, cost, tie, time_limit, lower, upper):
         n, m = matrix.shape[1], loads.shape[1]
         top = sp.hstack([matrix, sp.csc_array(loads)])
         rows = [top]
@@ -471,10 +465,15 @@ class _ClarabelLP:
             rows.append(sp.csc_array((np.asarray(tie, dtype=float), ([0, 0], [n, n + 1])),
                                      shape=(1, n + m)))
         self.n_eq = sum(r.shape[0] for r in rows)
-        rows.append(sp.hstack([-sp.identity(n), sp.csc_array((n, m))]))
+        # bounds as rows: -g <= -lower, g <= upper (finite ones)
+        low, high = np.flatnonzero(np.isfinite(lower)), np.flatnonzero(np.isfinite(upper))
+        for index, sign in ((low, -1.0), (high, 1.0)):
+            rows.append(sp.csc_array((np.full(len(index), sign),
+                                      (np.arange(len(index)), index)), shape=(len(index), n + m)))
+        self.n_bounds = len(low) + len(high)
         self.A = sp.csc_matrix(sp.vstack(rows, format="csc"))
         self.A.sort_indices()
-        self.b = np.concatenate([rhs, np.zeros(self.n_eq - len(rhs) + n)])
+        self.b = np.concatenate([rhs, np.zeros(self.n_eq - len(rhs)), -lower[low], upper[high]])
         self.q = np.concatenate([np.zeros(n), -np.asarray(cost, dtype=float)])
         self.n, self.m, self.time_limit = n, m, time_limit
         if tie is not None:  # where the tie row's two entries sit in A.data
@@ -495,7 +494,7 @@ class _ClarabelLP:
     def run(self):
         """``(status, factor, variable values, equality-row duals, iterations)``."""
         if self.solver is None:
-            cones = [clarabel.ZeroConeT(self.n_eq), clarabel.NonnegativeConeT(self.n)]
+            cones = [clarabel.ZeroConeT(self.n_eq), clarabel.NonnegativeConeT(self.n_bounds)]
             size = self.n + self.m
             self.solver = clarabel.DefaultSolver(sp.csc_matrix((size, size)), self.q,
                                                  self.A, self.b, cones, self._settings())
@@ -512,7 +511,7 @@ class _ClarabelLP:
     def stands_unloaded(self) -> bool | None:
         """The dead load alone: the load columns dropped, a zero objective."""
         A = sp.csc_matrix(self.A[:, : self.n])
-        cones = [clarabel.ZeroConeT(self.n_eq), clarabel.NonnegativeConeT(self.n)]
+        cones = [clarabel.ZeroConeT(self.n_eq), clarabel.NonnegativeConeT(self.n_bounds)]
         solver = clarabel.DefaultSolver(sp.csc_matrix((self.n, self.n)), np.zeros(self.n),
                                         A, self.b, cones, self._settings())
         status = str(solver.solve().status)
@@ -536,10 +535,10 @@ def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=Non
     mu : float
     density : float, kg/m^3
         Of the dead load (and of a lateral load built with the same density).
-    friction : None or 'fixed-directions'
-        None: associated friction, the LP above. ``'fixed-directions'``: the
-        non-associative estimate of :func:`fixed_direction_factor` (sliding interfaces
-        keep the slip direction of the associated mechanism and may not dilate).
+    friction : None or 'non-associative'
+        None: associated friction, the LP above. ``'non-associative'``: the estimate of
+        :func:`fixed_capacity_factor` (friction capacities fixed from the last collapse,
+        re-solved: joints slide without dilating).
     dead_load_feasible : bool, optional
         Known verdict on the dead load alone (e.g. the RBE's); otherwise the LP decides it
         with ``lambda`` fixed at 0.
@@ -555,46 +554,43 @@ def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=Non
     problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit)
     if friction is None:
         return problem.solve(live, dead_load_feasible=dead_load_feasible)
-    if friction == "fixed-directions":
-        return fixed_direction_factor(problem, live, dead_load_feasible=dead_load_feasible)
-    raise ValueError(f"friction must be None or 'fixed-directions', not {friction!r}")
+    if friction == "non-associative":
+        return fixed_capacity_factor(problem, live, dead_load_feasible=dead_load_feasible)
+    raise ValueError(f"friction must be None or 'non-associative', not {friction!r}")
 
 
-FIXED_DIRECTION_ROUNDS = 20
-"""Most re-solves of :func:`fixed_direction_factor`."""
+NON_ASSOCIATIVE_ROUNDS = 30
+"""Most re-solves of :func:`fixed_capacity_factor`."""
 
 
-def fixed_direction_factor(problem: CollapseLP, live: LiveLoad, *, dead_load_feasible=None,
-                           rounds=FIXED_DIRECTION_ROUNDS, rtol=1e-6) -> CollapseResult:
+def fixed_capacity_factor(problem: CollapseLP, live: LiveLoad, *, dead_load_feasible=None,
+                          rounds=NON_ASSOCIATIVE_ROUNDS, rtol=1e-4) -> CollapseResult:
     """A non-associative estimate of the load factor (SPEC 6.8's friction-law note).
 
-    Start from the associated LP; then, round after round, every vertex that slides in
-    the last mechanism gets a friction force of ``mu c`` against its slip direction (one
-    ray instead of the pyramid, :meth:`CollapseLP.with_friction_directions`: no
-    dilatancy), and the LP is solved again, until the factor changes by less than
-    ``rtol`` or after ``rounds`` re-solves. This is the fixed-point scheme of the
-    non-associative limit-analysis literature: an estimate, not a bound, but it removes
-    the dilatancy by which the associated factor overestimates sliding collapse.
+    Start from the associated LP; then fix every vertex's friction capacity at ``mu``
+    times its compression at the last collapse (:meth:`CollapseLP.with_friction_capacity`:
+    a capacity that does not grow with the compression lets joints slide without
+    dilating) and solve again, until the factor changes by less than ``rtol`` or after
+    ``rounds`` re-solves. This is the iterative scheme of Gilbert, Casapulla and Ahmed
+    (2006, Comput. Struct. 84) for non-associative frictional joints: an estimate, not a
+    bound, that removes the dilatancy by which the associated factor overestimates a
+    sliding collapse. ``friction_law`` of the result says ``non-associative``;
+    ``associated_factor`` keeps the starting factor.
     """
     start = time.perf_counter()
     associated = problem.solve(live, dead_load_feasible=dead_load_feasible)
     result, known = associated, associated.dead_load_feasible
     for _ in range(rounds):
-        if result.load_factor is None or result.vertex_slip is None:
+        if result.load_factor is None:
             break
-        slip = result.vertex_slip
-        length = np.linalg.norm(slip, axis=1)
-        fixed = length > MOTION_TOL
-        if not fixed.any():
-            break
-        direction = -slip / np.where(fixed, length, 1.0)[:, None]
+        compression = problem.system.to_scaled(result.x).reshape(-1, 4)[:, 0]
         previous = result.load_factor
-        result = problem.with_friction_directions(fixed, direction).solve(
+        result = problem.with_friction_capacity(problem.mu * compression).solve(
             live, dead_load_feasible=known)
         if (result.load_factor is None
                 or abs(result.load_factor - previous) <= rtol * abs(previous)):
             break
-    return dataclasses.replace(result, friction_law="fixed directions",
+    return dataclasses.replace(result, friction_law="non-associative",
                                associated_factor=associated.load_factor,
                                time_s=time.perf_counter() - start)
 
