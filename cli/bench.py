@@ -2,8 +2,9 @@
 
 import resource
 
-from masonry.studies.bench import SCENES, bench, frontier_png, table_csv, table_markdown
-from masonry.params import ACCURACIES, SOLVERS
+from masonry.studies.bench import (SCENES, bench, collapse_bench, collapse_markdown,
+                                   frontier_png, table_csv, table_markdown)
+from masonry.params import ACCURACIES, SOLVERS, Params, from_preset, validate
 from masonry.runfolder import RunFolder
 
 
@@ -24,16 +25,27 @@ def register(subparsers):
                              "(smaller: smaller domes, for a quick look)")
     parser.add_argument("--repeats", type=int, default=3,
                         help="runs per row; times are medians (default 3)")
+    parser.add_argument("--collapse", action="store_true",
+                        help="instead: the lateral collapse load factor at azimuth 0 of "
+                             "each preset's full dome against its balanced RBE solve, and "
+                             "the azimuth search (--lateral all) on a small dome against "
+                             "independent solves; writes DIR/bench_collapse/collapse.md")
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="writes DIR/bench/bench.csv, bench.md and frontier.png")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
     parser.set_defaults(handler=handle)
 
 
+SMALL_DOME = dict(scene="dome", stretch=1.0, n=6, r=0, p=3, cut=0.5)
+"""78 bricks: the azimuth search's row (a full search on a thesis dome takes hours)."""
+
+
 def handle(args, report):
     if args.repeats < 1:
         report("masonry: --repeats must be at least 1")
         return 2
+    if args.collapse:
+        return _collapse(args, report)
     rows = bench(presets=args.presets, scenes=args.scenes, accuracies=args.accuracy,
                  repeats=args.repeats, solvers=args.solvers,
                  overrides=None if args.p is None else {"p": args.p},
@@ -48,6 +60,22 @@ def handle(args, report):
         folder.write("frontier.png", frontier_png(rows))
     report(markdown)
     report(f"peak memory: {peak:.2f} GiB")
+    report(f"written: {folder.target}")
+    return 0
+
+
+def _collapse(args, report):
+    overrides = {} if args.p is None else {"p": args.p}
+    domes = {f"preset {k} full dome": from_preset(k, scene="dome", **overrides)
+             for k in args.presets}
+    small = {"small dome (n 6, p 3)": validate(Params(**SMALL_DOME))}
+    progress = None if args.quiet else _progress
+    rows = collapse_bench(domes, repeats=args.repeats, progress=progress)
+    rows += collapse_bench(small, repeats=args.repeats, search=True, progress=progress)
+    markdown = collapse_markdown(rows)
+    with RunFolder(args.out, "bench_collapse") as folder:
+        folder.write("collapse.md", markdown)
+    report(markdown)
     report(f"written: {folder.target}")
     return 0
 

@@ -15,12 +15,16 @@ def register(subparsers):
                         help="leave out the full domes (the slowest rows)")
     parser.add_argument("--lp-check", action="store_true",
                         help="also run the HiGHS feasibility LP on every row")
+    parser.add_argument("--lateral", action="store_true",
+                        help="also the worst lateral load factor of each full dome (the "
+                             "x.2 domes as a whole), over the azimuths its symmetry leaves")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
     parser.set_defaults(handler=handle)
 
 
 def handle(args, report):
-    rows = structures_table(full_dome=args.full_dome, lp_check=args.lp_check)
+    rows = structures_table(full_dome=args.full_dome, lp_check=args.lp_check,
+                            lateral=args.lateral)
     markdown = table_markdown(rows)
     with RunFolder(args.out, "structures") as folder:
         folder.write("table.csv", table_csv(rows))

@@ -14,6 +14,7 @@ from masonry.rbe.collapse import CollapseLP, collapse_load, lateral_azimuths, wo
 from masonry.rbe.loads import crown_load, lateral, point_loads
 from masonry.scenes import build
 from masonry.scenes.arch import arch_profile
+from masonry.studies.structures import lateral_record
 from masonry.studies.thrust_line import thrust_line_minimum_thickness
 from masonry.tolerances import G
 from masonry_cli.main import main
@@ -310,3 +311,15 @@ def test_non_associative_friction_lowers_a_sliding_collapse_and_keeps_a_tipping_
     assert 0 < estimate.load_factor < 0.95 * associated.load_factor
     assert estimate.x.reshape(-1, 4)[:, 1].max() == 0  # no tension
     assert estimate.residual < 1e-7
+
+
+def test_the_dome_symmetry_leaves_azimuths_from_a_web_to_its_corner():
+    """The worst lateral factor over 0..180/n (structures' search) is the worst over the
+    whole circle: rotation by 360/n and the mirror in a web's mid-plane map every
+    direction into that sector."""
+    params = validate(Params(scene="dome", **SMALL_DOME))
+    dome = analysis_model(build(params))
+    sector = lateral_record(dome, params, count=3)  # 0, 15, 30 degrees
+    circle = worst_lateral(dome, lateral_azimuths(6))  # every 15 degrees
+    assert sector["lateral_factor"] == pytest.approx(circle.load_factor, rel=1e-6)
+    assert sector["hinge_webs"] and sector["hinge_courses"]

@@ -611,9 +611,9 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
 
     One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: two coefficients and
     two costs change; HiGHS's simplex restarts from the last basis, Clarabel keeps its
-    symbolic factorization), ``method`` one of :data:`METHODS`,
-    and the dead load is checked once (unless ``dead_load_feasible`` is given). Returns the worst azimuth's result with every
-    azimuth's factor in ``azimuths`` ((azimuth, factor or None) pairs).
+    symbolic factorization), ``method`` one of :data:`METHODS`, and the dead load is
+    checked once (unless ``dead_load_feasible`` is given). Returns the worst azimuth's
+    result with every azimuth's factor in ``azimuths`` ((azimuth, factor or None) pairs).
     """
     azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
     problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit,

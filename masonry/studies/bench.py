@@ -28,6 +28,8 @@ from masonry.export.csv import forces_csv, interfaces_csv, locations_csv
 from masonry.export.obj import blocks_obj
 from masonry.params import from_preset
 from masonry.scenes import build
+from masonry.rbe.collapse import CollapseLP, lateral_azimuths, worst_lateral
+from masonry.rbe.loads import lateral
 from masonry.rbe.solve import ACCURACY, RBEProblem
 
 log = logging.getLogger(__name__)
@@ -250,3 +252,79 @@ def frontier_png(rows) -> bytes:
     fig.savefig(buffer, format="png")
     plt.close(fig)
     return buffer.getvalue()
+
+
+COLLAPSE_COLUMNS = ("structure", "bricks", "unknowns", "azimuths", "rbe_s", "collapse_s",
+                    "ratio", "load_factor", "azimuth_deg", "solver")
+"""Columns of a collapse bench row (medians over the repeats, seconds). One azimuth:
+``rbe_s`` is the balanced RBE solve with its assembly, ``collapse_s`` the collapse LP
+with its assembly, ``ratio`` their quotient (the target: at most 3). The azimuth search
+(``azimuths`` > 1): ``rbe_s`` holds the sum of independent one-azimuth LPs instead, and
+``ratio`` is ``collapse_s`` over that sum."""
+
+
+def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None,
+                   progress=None) -> list:
+    """Time the lateral collapse load factor (SPEC 6.8) against the balanced RBE solve.
+
+    Parameters
+    ----------
+    structures : dict str -> Params
+        Named structures (e.g. ``{"preset 1 full dome": from_preset("1", scene="dome")}``).
+    azimuth : float
+        Of the one-azimuth rows.
+    search : bool
+        Also a row for ``--lateral all`` (:func:`~masonry.rbe.collapse.worst_lateral`,
+        one LP reused) against independent one-azimuth LPs at the same azimuths.
+    """
+    rows = []
+    for name, params in structures.items():
+        model = analysis_model(build(params))
+        bricks = int((~model.blocks.block_is_support).sum())
+        rbe, one, factor = [], [], None
+        for _ in range(repeats):
+            start = time.perf_counter()
+            RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
+                       side_rotation=model.side_rotation).solve(
+                mu=params.mu, density=params.density, accuracy="balanced")
+            rbe.append(time.perf_counter() - start)
+            start = time.perf_counter()
+            problem = CollapseLP(model, mu=params.mu, density=params.density, method=method)
+            result = problem.solve(lateral(model, azimuth, params.density),
+                                   dead_load_feasible=True)
+            one.append(time.perf_counter() - start)
+            factor = result.load_factor
+            if progress:
+                progress(f"{name}: RBE {rbe[-1]:.3g} s, collapse LP {one[-1]:.3g} s")
+        unknowns = problem.matrix.shape[1]
+        rows.append(dict(structure=name, bricks=bricks, unknowns=unknowns, azimuths=1,
+                         rbe_s=statistics.median(rbe), collapse_s=statistics.median(one),
+                         ratio=statistics.median(one) / statistics.median(rbe),
+                         load_factor=factor, azimuth_deg=azimuth, solver=result.solver))
+        if not search:
+            continue
+        angles = lateral_azimuths(params.n if params.scene in ("section", "dome") else None)
+        start = time.perf_counter()
+        worst = worst_lateral(model, angles, mu=params.mu, density=params.density,
+                              dead_load_feasible=True, method=method)
+        together = time.perf_counter() - start
+        start = time.perf_counter()
+        for angle in angles:
+            CollapseLP(model, mu=params.mu, density=params.density, method=method).solve(
+                lateral(model, angle, params.density), dead_load_feasible=True)
+        apart = time.perf_counter() - start
+        rows.append(dict(structure=name, bricks=bricks, unknowns=unknowns,
+                         azimuths=len(angles), rbe_s=apart, collapse_s=together,
+                         ratio=together / apart, load_factor=worst.load_factor,
+                         azimuth_deg=worst.azimuth_deg, solver=worst.solver))
+    return rows
+
+
+def collapse_markdown(rows) -> str:
+    """A Markdown table of collapse bench rows."""
+    lines = ["| " + " | ".join(COLLAPSE_COLUMNS) + " |", "|" + "---|" * len(COLLAPSE_COLUMNS)]
+    for row in rows:
+        cells = [f"{row[c]:.4g}" if isinstance(row[c], float) else str(row[c])
+                 for c in COLLAPSE_COLUMNS]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"

@@ -11,7 +11,10 @@ the thesis could not compute (its future work, 5.6).
 import logging
 import time
 
+import numpy as np
+
 from masonry.rbe.boundary import analysis_model
+from masonry.rbe.collapse import worst_lateral
 from masonry.params import from_preset
 from masonry.scenes import build
 
@@ -48,12 +51,48 @@ COLUMNS = ("structure", "preset", "scene", "boundary", "friction", "mu", "feasib
            "unknowns", "residual_eq", "time_s", "thesis_feasible", "thesis_moi_factor")
 
 
-def structures_table(rows=ROWS, full_dome=True, lp_check=False):
+LATERAL_COLUMNS = ("lateral_factor", "lateral_azimuth", "hinge_webs", "hinge_courses",
+                   "sliding", "lateral_s")
+"""Columns added to the full-dome rows by ``lateral=True``: the worst lateral load factor
+(SPEC 6.8), its azimuth, the webs and courses of its hinges, the number of sliding
+interfaces, and the search's seconds."""
+
+
+def symmetric_azimuths(n_webs: int, count: int = 3):
+    """Azimuths that cover every lateral direction of a dome with ``n_webs`` webs:
+    ``count`` from the mid-plane of web 0 (0 degrees) to its corner (180/n). The dome is
+    symmetric under rotation by 360/n and under the mirror in a web's mid-plane (the
+    pattern is mirror-symmetric, SPEC 4.3), so every other direction repeats one of
+    these."""
+    return np.linspace(0.0, 180.0 / n_webs, count)
+
+
+def lateral_record(model, params, count=3) -> dict:
+    """The worst lateral load factor of a full dome and where its mechanism hinges."""
+    start = time.perf_counter()
+    worst = worst_lateral(model, symmetric_azimuths(params.n, count), mu=params.mu,
+                          density=params.density, n_webs=params.n, dead_load_feasible=True)
+    out = {"lateral_factor": worst.load_factor, "lateral_azimuth": worst.azimuth_deg,
+           "hinge_webs": "", "hinge_courses": "", "sliding": worst.sliding,
+           "lateral_s": round(time.perf_counter() - start, 1)}
+    if worst.hinge is not None and worst.hinge.any():
+        blocks = model.blocks
+        pair = model.interfaces.pair[worst.hinge]
+        webs = np.unique(blocks.block_web[pair])
+        courses = blocks.block_course[pair[:, 1]]
+        out["hinge_webs"] = " ".join(map(str, webs))
+        out["hinge_courses"] = f"{courses.min()}-{courses.max()}"
+    return out
+
+
+def structures_table(rows=ROWS, full_dome=True, lp_check=False, lateral=False):
     """Solve every row; return a list of dicts with :data:`COLUMNS`.
 
     ``full_dome=False`` leaves the full-dome rows out (they are the slowest: every web
     explicit). The LP check is off by default: the table reports the QP's verdict with its
-    recomputed residuals.
+    recomputed residuals. ``lateral=True`` adds :data:`LATERAL_COLUMNS` to the full-dome
+    rows (the x.2 domes as a whole: a lateral load breaks the symmetry a cyclic section
+    assumes), searched over :func:`symmetric_azimuths`.
     """
     from masonry.rbe.solve import solve_rbe
 
@@ -84,6 +123,9 @@ def structures_table(rows=ROWS, full_dome=True, lp_check=False):
             "residual_eq": d["residual_eq"], "time_s": round(time.perf_counter() - start, 2),
             "thesis_feasible": thesis[0], "thesis_moi_factor": thesis[1],
         })
+        if lateral and scene_name == "dome" and result.feasible:
+            log.info("structure %s: worst lateral load factor ...", structure)
+            out[-1].update(lateral_record(model, params))
     return out
 
 
@@ -94,8 +136,9 @@ def _cell(value):
 
 
 def table_csv(rows) -> bytes:
-    lines = [",".join(COLUMNS)]
-    lines += [",".join(_cell(row[c]) for c in COLUMNS) for row in rows]
+    columns = COLUMNS + (LATERAL_COLUMNS if any("lateral_factor" in r for r in rows) else ())
+    lines = [",".join(columns)]
+    lines += [",".join(_cell(row.get(c)) for c in columns) for row in rows]
     return ("\n".join(lines) + "\n").encode()
 
 
@@ -117,4 +160,11 @@ def table_markdown(rows) -> str:
                 f"{'feasible' if match[0]['feasible'] else 'infeasible'}, "
                 f"MoI factor {match[0]['moi_factor']:.3g}"))
         side.append(f"| {preset} | " + " | ".join(cells) + " |")
+    domes = [r for r in rows if "lateral_factor" in r]
+    if domes:
+        side += ["", "| full dome | worst lateral load factor | azimuth [deg] | hinges in "
+                 "webs | hinge courses | sliding interfaces |", "|---|---|---|---|---|---|"]
+        side += [f"| {r['preset']} | {_cell(r['lateral_factor'])} | "
+                 f"{_cell(r['lateral_azimuth'])} | {r['hinge_webs']} | {r['hinge_courses']} "
+                 f"| {r['sliding']} |" for r in domes]
     return "\n".join(lines + side) + "\n"
