@@ -208,8 +208,8 @@ normalising) is drawn as this fraction of the model's bounding-box diagonal."""
 def mechanism_pngs(blocks, interfaces, mechanism, hinge, slides, title, fast=False) -> dict:
     """The collapse mechanism (SPEC 6.9) drawn exaggerated over the undeformed structure:
     displaced blocks coloured by their largest vertex displacement, the undeformed ones
-    as grey outlines, hinges (interfaces that open about a line) in red and sliding
-    interfaces in blue, at their undeformed places (``collapse/<view>_mechanism.png``).
+    as grey outlines, hinges (interfaces that open about a line) filled red and sliding
+    interfaces outlined blue, at their undeformed places (``collapse/<view>_mechanism.png``).
 
     Parameters
     ----------
@@ -242,16 +242,19 @@ def mechanism_pngs(blocks, interfaces, mechanism, hinge, slides, title, fast=Fal
         ax.add_collection3d(Poly3DCollection(
             deformed, facecolors=cmap(norm(per_block[blocks.face_block[faces]])),
             edgecolors="k", linewidths=0.05, alpha=0.9))
-        for mask, colour, label in ((hinge, "red", "hinge"), (slides, "blue", "sliding")):
+        # sliding interfaces outlined, hinges filled, both where they are undeformed
+        for mask, face, edge, width in ((slides & ~hinge, "none", "blue", 0.6),
+                                        (hinge, "red", "red", 1.5)):
             index = np.flatnonzero(mask)
             if len(index):
                 ax.add_collection3d(Poly3DCollection(_polygons(interfaces, index),
-                                                     facecolors=colour, edgecolors=colour,
-                                                     linewidths=2.0, label=label))
+                                                     facecolors=face, edgecolors=edge,
+                                                     linewidths=width))
         bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
                            shrink=0.6, pad=0.1)
         bar.set_label("virtual displacement (largest = 1)")
         ax.set_title(f"{title}\n{int(hinge.sum())} hinges (red), {int(slides.sum())} "
-                     f"sliding (blue); displacement drawn at {MECHANISM_SCALE:g} x size")
+                     f"sliding (blue outline); displacement drawn at {MECHANISM_SCALE:g} x "
+                     "size")
         out[f"collapse/{view}_mechanism.png"] = _png(fig, 60 if fast else 110)
     return out
