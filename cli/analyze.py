@@ -41,5 +41,4 @@ def handle(args, report):
     report(f"read {scene.blocks.n_blocks} blocks ({source['supports']} supports) from "
            f"{len(source['files'])} file(s) in {source['read_s']:.3g} s")
     summary(record, report)
-    rbe_summary(record, report)
-    return 0
+    return rbe_summary(record, report)

@@ -5,7 +5,7 @@ from masonry.studies.thrust_line import thrust_line_minimum_thickness
 from masonry.params import SOLVERS, Params, validate
 from masonry.studies.thickness import minimum_thickness
 
-from .options import add_arch_options
+from .options import add_arch_options, add_material_options
 
 ANALYSIS = ("arch_blocks", "arch_span", "arch_shape", "arch_rise", "arch_depth", "mu",
             "density", "solver")
@@ -17,10 +17,10 @@ def register(subparsers):
                                "bisection on rigid block equilibrium")
     add_arch_options(parser, thickness=False)
     g = parser.add_argument_group("analysis")
-    g.add_argument("--mu", type=float, help="friction coefficient (default 0.7)")
-    g.add_argument("--density", type=float, help="kg/m^3 (default 2000)")
+    add_material_options(g)
     g.add_argument("--solver", choices=SOLVERS,
-                   help="QP solver: clarabel (interior point, default) or osqp")
+                   help="QP solver (default: the balanced preset's): newton, clarabel, osqp, "
+                        "clarabel-cvxpy or osqp-cvxpy")
     g.add_argument("--rtol", type=float, default=1e-4,
                    help="relative width of the final bisection bracket (default 1e-4)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")

@@ -19,5 +19,4 @@ def handle(args, report):
     record = run(params_from_args(args), args.out, analyse=True, plots_wanted=args.plots,
                  printable=args.printable, force=args.force)
     summary(record, report)
-    rbe_summary(record, report)
-    return 0
+    return rbe_summary(record, report)

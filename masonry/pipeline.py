@@ -24,7 +24,7 @@ from masonry.export import EXPORTERS, RunOutputs
 from masonry.params import Params, structure_id, validate
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.solve import RBEProblem, RBEResult
-from masonry.runfolder import RunFolder, write_file_atomically
+from masonry.runfolder import RunFolder, check_output_root, write_file_atomically
 from masonry.scenes import Scene, build
 from masonry.tolerances import G
 
@@ -123,39 +123,95 @@ def _geometry_key(params: Params) -> str:
 
 def _model(params: Params, out_root, timer: Timer):
     """Scene and analysis model (interfaces, boundary routing), from the geometry cache
-    when present: ``(scene, model, 'reused' | 'computed')``."""
-    cache = Path(out_root) / ".cache" / f"{_geometry_key(params)}.pickle"
-    if cache.is_file():
+    when it holds them: ``(scene, model, 'reused' | 'computed')``."""
+    cached = _read_cache(_cache_path(params, out_root))
+    if cached is not None:
         with timer.stage("model (cached)"):
-            with open(cache, "rb") as f:
-                scene, model = pickle.load(f)
             # the cached scene carries the geometry; the rest of the inputs are this run's
-            scene = dataclasses.replace(scene, params=params)
-        return scene, model, "reused"
+            scene = dataclasses.replace(cached[0], params=params)
+        return scene, cached[1], "reused"
     with timer.stage("model"):
         scene = build(params)
     with timer.stage("interfaces"):
         model = analysis_model(scene)
-    write_file_atomically(cache, pickle.dumps((scene, model),
-                                              protocol=pickle.HIGHEST_PROTOCOL))
     return scene, model, "computed"
 
 
-def _previous(target: Path, params: Params, outputs: dict):
-    """The record of a complete earlier run of the same input, else None."""
+def _cache_path(params: Params, out_root) -> Path:
+    return Path(out_root) / ".cache" / f"{_geometry_key(params)}.pickle"
+
+
+def _read_cache(path: Path):
+    """``(scene, model)`` from a cache file, or None when there is none or it is unusable
+    (truncated, corrupt, or not a cache of this code): then it is rebuilt, with a warning."""
+    try:
+        with open(path, "rb") as f:
+            content = pickle.load(f)
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    except Exception as error:  # unpickling garbage can raise anything
+        log.warning("the geometry cache %s is unreadable (%s: %s): rebuilding the model",
+                    path, type(error).__name__, error)
+        return None
+    if not (isinstance(content, tuple) and len(content) == 2
+            and isinstance(content[0], Scene) and isinstance(content[1], Model)):
+        log.warning("the geometry cache %s holds something else: rebuilding the model", path)
+        return None
+    return content
+
+
+def _write_cache(path: Path, scene: Scene, model: Model):
+    """Cache a computed model; a cache that cannot be written only costs the next run
+    the rebuild (warned), never this run's results."""
+    try:
+        write_file_atomically(path, pickle.dumps((scene, model),
+                                                 protocol=pickle.HIGHEST_PROTOCOL))
+    except OSError as error:
+        log.warning("the geometry cache %s was not written (%s): the next run rebuilds the "
+                    "model", path, error.strerror or error)
+
+
+def _previous(target: Path, params: Params):
+    """The record of a complete earlier run of the same input in ``target``, else None."""
     try:
         record = json.loads((target / "run.json").read_text())
     except (OSError, ValueError):
         return None
+    if not isinstance(record, dict):
+        return None
     same = (record.get("params") == json.loads(json.dumps(dataclasses.asdict(params)))
-            and record.get("outputs") == outputs and record.get("complete"))
+            and record.get("complete") is True)
     return record if same else None
+
+
+def _covers(record, outputs: dict) -> bool:
+    """Whether a run record wrote at least ``outputs`` (solve, plots, printable body)."""
+    had = record.get("outputs") or {}
+    return all(had.get(name) is True or not wanted for name, wanted in outputs.items())
+
+
+def _stamp(target: Path):
+    """Identity of the run.json in ``target`` (inode, mtime), or None: tells whether
+    another command published the folder while this run was computing."""
+    try:
+        stat = (target / "run.json").stat()
+    except OSError:
+        return None
+    return stat.st_ino, stat.st_mtime_ns
 
 
 # ---------------------------------------------------------------------------- the run
 def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
         printable=True, force=False, scene=None, source=None) -> dict:
     """Build, analyse and export ``params`` into ``out_root/<structure id>``.
+
+    A run folder only grows (no command degrades another's results): a folder that
+    already holds a complete run of the same input with at least the outputs asked for
+    is reused as it is (``masonry build`` after ``masonry run``, a sweep variant after a
+    full run); otherwise the run writes what is asked for *and* what the folder held
+    (``masonry run`` after a sweep writes the plots and the solve, ``--force`` after a
+    run with plots writes the plots again). When another command publishes the same
+    folder while this one computes, the richer of the two stays.
 
     Parameters
     ----------
@@ -168,7 +224,8 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
     plots_wanted, printable : bool
         Write the plots; unite and write the printable body.
     force : bool
-        Recompute even when the folder holds a complete run of the same input.
+        Recompute even when the folder holds a complete run of the same input (with at
+        least the outputs that run wrote).
     scene : Scene, optional
         An already built scene (``masonry analyze``: blocks read from files, see
         :func:`masonry.scenes.imported.load_assembly`), used as is instead of building
@@ -183,12 +240,18 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
         The run record (the content of ``run.json``) and its ``path``.
     """
     params = validate(params)
+    check_output_root(out_root)
     sid = structure_id(params)
+    target = Path(out_root) / sid
     outputs = {"analyse": analyse, "plots": plots_wanted, "printable": printable}
-    previous = None if force else _previous(Path(out_root) / sid, params, outputs)
+    previous, seen = _previous(target, params), _stamp(target)
     if previous is not None:
-        log.info("%s is up to date (use --force to recompute)", sid)
-        return {**previous, "path": str(Path(out_root) / sid), "reused": True}
+        if not force and _covers(previous, outputs):
+            log.info("%s is up to date (use --force to recompute)", sid)
+            return {**previous, "path": str(target), "reused": True}
+        # a run folder only grows: what the earlier run wrote is written again
+        outputs = {name: wanted or (previous.get("outputs") or {}).get(name) is True
+                   for name, wanted in outputs.items()}
 
     timer = Timer()
     if scene is None:
@@ -198,18 +261,26 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
         with timer.stage("interfaces"):
             model = analysis_model(scene)
     record = run_record(scene, model, outputs, cached, source)
-    result = _solve(model, params, timer) if analyse else None
+    result = _solve(model, params, timer) if outputs["analyse"] else None
     if result is not None:
         record["rbe"] = {**result.to_dict(), "attempts": list(result.attempts)}
     made = RunOutputs(scene, model, result,
                       result.per_interface() if result is not None and result.x is not None
-                      else None, plots=plots_wanted, printable=printable)
-    with RunFolder(out_root, sid) as folder:
+                      else None, plots=outputs["plots"], printable=outputs["printable"])
+
+    def keep(existing):
+        # another command published this input meanwhile, with at least these outputs
+        other = _previous(existing, params)
+        return _stamp(existing) != seen and other is not None and _covers(other, outputs)
+
+    with RunFolder(out_root, sid, keep=keep) as folder:
         write_exports(folder, made, record, timer)
         record["timings_s"] = timer.seconds
         record["versions"] = versions()
         record["complete"] = True
         folder.write_json("run.json", record)
+    if cached == "computed":  # only a model whose run completed is cached
+        _write_cache(_cache_path(params, out_root), scene, model)
     record["path"] = str(folder.target)
     return record
 

@@ -4,13 +4,122 @@ A run writes into a hidden temporary folder beside its target and swaps it into 
 only when everything is written. A failed or interrupted run removes its temporary folder
 and leaves the previous output exactly as it was. Single files outside a run folder (the
 geometry cache) are written the same way by :func:`write_file_atomically`.
+
+Temporary names carry the host and process id of their writer
+(``.<name>.tmp-<host>-<pid>-<tag>``), so the next run into the same root removes the
+leftovers of a killed run (its process is gone) and never those of a run still going.
+Publishing happens under an exclusive lock on the output root, so two commands writing
+into the same root at once never see a half-swapped folder; a caller may ask to keep the
+folder already there (see :meth:`RunFolder.publish`).
 """
 
+import fcntl
 import json
+import logging
 import os
+import re
 import shutil
+import socket
+import tempfile
 import uuid
+from contextlib import contextmanager
 from pathlib import Path
+
+from masonry.params import ParameterError
+
+log = logging.getLogger(__name__)
+
+_HOST = re.sub(r"[^A-Za-z0-9]", "_", socket.gethostname()) or "host"
+_LEFTOVER = re.compile(r"^\..+\.(tmp|old)-(?P<host>[A-Za-z0-9_]+)-(?P<pid>\d+)-[0-9a-f]{8}$")
+_LEGACY = re.compile(r"^\..+\.(tmp|old)-[0-9a-f]{8}$")  # masonry 0.1: no writer in the name
+
+
+def _tag() -> str:
+    """``<host>-<pid>-<random>``: who writes a temporary file, and a unique suffix."""
+    return f"{_HOST}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+
+
+def check_output_root(root, option="out") -> Path:
+    """Refuse an output root that cannot hold run folders, before anything is written.
+
+    The root may not exist yet; its nearest existing ancestor must be a folder this
+    process can create entries in (probed with a temporary folder, removed at once).
+
+    Raises
+    ------
+    ParameterError
+        Named ``option``: the root is empty, is (or lies under) a file, or is not writable.
+    """
+    if str(root).strip() == "":
+        raise ParameterError(option, str(root), "a folder path (an empty one names nothing)")
+    path = Path(root)
+    existing = path
+    while not os.path.lexists(existing) and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        what = "is a file" if existing == path else f"lies under the file {existing}"
+        raise ParameterError(option, str(root), f"a folder, but it {what}")
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".masonry-probe-", dir=existing))
+    except OSError as error:
+        raise ParameterError(option, str(root), f"a folder masonry can write in ({existing}: "
+                                                f"{error.strerror or error})") from None
+    return path
+
+
+def remove_leftovers(folder) -> list:
+    """Remove the temporary files and folders that killed runs left in ``folder``.
+
+    Only names of this host whose process no longer exists are removed.
+
+    Returns
+    -------
+    list of Path
+        What was removed.
+    """
+    removed = []
+    try:
+        entries = list(Path(folder).iterdir())
+    except OSError:
+        return removed
+    for entry in entries:
+        match = _LEFTOVER.match(entry.name)
+        if match is None:
+            if not _LEGACY.match(entry.name):
+                continue
+        elif match["host"] != _HOST or _alive(int(match["pid"])):
+            continue
+        if entry.is_dir() and not entry.is_symlink():
+            shutil.rmtree(entry, ignore_errors=True)
+        else:
+            entry.unlink(missing_ok=True)
+        removed.append(entry)
+    if removed:
+        log.info("removed %d leftover(s) of interrupted runs in %s", len(removed), folder)
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process
+        return True
+    return True
+
+
+@contextmanager
+def locked(folder):
+    """Hold an exclusive lock on ``folder`` (an existing directory) for the block."""
+    fd = os.open(folder, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
 
 
 def write_file_atomically(path, data: bytes):
@@ -18,7 +127,8 @@ def write_file_atomically(path, data: bytes):
     place when complete: a reader sees the old file or the whole new one, never a part."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp-{uuid.uuid4().hex[:8]}")
+    remove_leftovers(path.parent)
+    tmp = path.with_name(f".{path.name}.tmp-{_tag()}")
     try:
         with open(tmp, "wb") as f:
             f.write(data)
@@ -31,18 +141,31 @@ class RunFolder:
     """Collects a run's files and publishes them as ``root/name`` in one step.
 
     Use as a context manager: the folder is published when the block ends normally and
-    discarded when it raises (including ``KeyboardInterrupt``).
+    discarded when it raises (including ``KeyboardInterrupt``). Entering it removes the
+    leftovers of killed runs in ``root``.
+
+    Parameters
+    ----------
+    root : str or Path
+    name : str
+    keep : callable, optional
+        ``keep(target) -> bool``, asked under the root's lock just before publishing: True
+        keeps the folder already at ``target`` and discards this one (it holds at least
+        what this one would write; see :func:`masonry.pipeline.run`).
     """
 
-    def __init__(self, root, name):
+    def __init__(self, root, name, keep=None):
         self.root = Path(root)
         self.target = self.root / name
-        tag = uuid.uuid4().hex[:8]
+        tag = _tag()
         self.tmp = self.root / f".{name}.tmp-{tag}"
         self._old = self.root / f".{name}.old-{tag}"
+        self._keep = keep
+        self.kept = False
 
     def __enter__(self):
         self.root.mkdir(parents=True, exist_ok=True)
+        remove_leftovers(self.root)
         self.tmp.mkdir()
         return self
 
@@ -71,11 +194,19 @@ class RunFolder:
                    + "\n")
 
     def publish(self):
-        # two renames: the old folder moves aside, the new one takes its name, then the
-        # old one is removed; at no moment is a half-written folder under the target name
-        if self.target.exists():
-            os.rename(self.target, self._old)
-        os.rename(self.tmp, self.target)
+        """Swap the temporary folder into place, under the root's lock.
+
+        Two renames: the old folder moves aside, the new one takes its name, then the old
+        one is removed; at no moment is a half-written folder under the target name.
+        """
+        with locked(self.root):
+            if self._keep is not None and self.target.is_dir() and self._keep(self.target):
+                shutil.rmtree(self.tmp, ignore_errors=True)
+                self.kept = True
+                return
+            if os.path.lexists(self.target):
+                os.rename(self.target, self._old)
+            os.rename(self.tmp, self.target)
         shutil.rmtree(self._old, ignore_errors=True)
 
 
