@@ -3,8 +3,8 @@
 import resource
 
 from masonry.studies.bench import SCENES, bench, frontier_png, table_csv, table_markdown
-from masonry.params import ACCURACIES, SOLVERS
-from masonry.runfolder import RunFolder
+from masonry.params import ACCURACIES, SOLVERS, ParameterError
+from masonry.runfolder import RunFolder, check_output_root
 
 
 def register(subparsers):
@@ -25,15 +25,18 @@ def register(subparsers):
     parser.add_argument("--repeats", type=int, default=3,
                         help="runs per row; times are medians (default 3)")
     parser.add_argument("--out", default="exports", metavar="DIR",
-                        help="writes DIR/bench/bench.csv, bench.md and frontier.png")
+                        help="output root: writes DIR/bench/bench.csv, bench.md and "
+                             "frontier.png (default exports)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
     parser.set_defaults(handler=handle)
 
 
 def handle(args, report):
     if args.repeats < 1:
-        report("masonry: --repeats must be at least 1")
-        return 2
+        raise ParameterError("repeats", args.repeats, "an integer >= 1")
+    if args.p is not None and args.p < 1:
+        raise ParameterError("p", args.p, "an integer >= 1")
+    check_output_root(args.out)
     rows = bench(presets=args.presets, scenes=args.scenes, accuracies=args.accuracy,
                  repeats=args.repeats, solvers=args.solvers,
                  overrides=None if args.p is None else {"p": args.p},

@@ -40,6 +40,8 @@ def option_names(parser) -> dict:
         longs = [o for o in action.option_strings if o.startswith("--")]
         if longs:
             names.setdefault(action.dest, longs[0])
+        elif not action.option_strings:  # a positional argument: its metavar
+            names.setdefault(action.dest, action.metavar or action.dest.upper())
     return names
 
 
@@ -54,6 +56,8 @@ def describe_error(error, args) -> str:
     option = names.get(name, f"--{name.replace('_', '-')}")
     if error.where:
         return f"{error.where}: {name} = {value!r}: expected {expected}"
+    if not option.startswith("--"):  # a positional argument: its value says it
+        return f"{_typed(value)}: expected {expected}"
     if name not in Params.__dataclass_fields__ or _given(args, name):
         return f"{option} {_typed(value)}: expected {expected}"
     given = [r for r in error.related if _given(args, r)]
