@@ -4,6 +4,7 @@ import argparse
 import math
 import shlex
 
+from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS
 from masonry.params import (ACCURACIES, ARCH_SHAPES, BOUNDARIES, FRICTIONS, PRESETS,
                             RANGES, SCENE_FIELDS, SCENES, SOLVERS, ParameterError, Params,
                             from_preset, load, validate)
@@ -110,6 +111,10 @@ def add_model_options(parser):
                    help="wall scene: number of courses (default 10)")
     g.add_argument("--fast", action="store_true", default=None,
                    help="reduced output: one view, lower resolution")
+    g.add_argument("--max-bricks", dest="max_bricks", type=int, default=MAX_BRICKS,
+                   metavar="N", help=f"refuse a model estimated above N blocks before "
+                                     f"building it (default {MAX_BRICKS}, about "
+                                     f"{MAX_BRICKS * BYTES_PER_BRICK / 1e9:.0f} GB to solve)")
     add_arch_options(parser)
 
 

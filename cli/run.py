@@ -17,6 +17,6 @@ def register(subparsers):
 
 def handle(args, report):
     record = run(params_from_args(args), args.out, analyse=True, plots_wanted=args.plots,
-                 printable=args.printable, force=args.force)
+                 printable=args.printable, force=args.force, max_bricks=args.max_bricks)
     summary(record, report)
     return rbe_summary(record, report)

@@ -211,6 +211,10 @@ ARCH_RATIOS = {
 }
 
 
+MAX_INTEGER = 10**12
+"""No count of anything here comes near it; larger integers would overflow floats."""
+
+
 def _check(name, value, ok, expected):
     if not ok:
         raise ParameterError(name, value, expected)
@@ -222,6 +226,8 @@ def _number(name, value, integer=False):
         raise ParameterError(name, value, "an integer" if integer else "a number")
     if not math.isfinite(value):
         raise ParameterError(name, value, "a finite number")
+    if integer and abs(value) > MAX_INTEGER:
+        raise ParameterError(name, value, f"an integer of at most {MAX_INTEGER:.0e}")
     return value
 
 

@@ -25,8 +25,8 @@ from masonry.params import Params, structure_id, validate
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.solve import RBEProblem, RBEResult
 from masonry.runfolder import RunFolder, check_output_root, write_file_atomically
-from masonry.scenes import Scene, build
-from masonry.tolerances import G
+from masonry.scenes import Scene, build, check_size
+from masonry.tolerances import MAX_BRICKS, G
 
 log = logging.getLogger(__name__)
 
@@ -202,7 +202,8 @@ def _stamp(target: Path):
 
 # ---------------------------------------------------------------------------- the run
 def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
-        printable=True, force=False, scene=None, source=None) -> dict:
+        printable=True, force=False, scene=None, source=None,
+        max_bricks=MAX_BRICKS) -> dict:
     """Build, analyse and export ``params`` into ``out_root/<structure id>``.
 
     A run folder only grows (no command degrades another's results): a folder that
@@ -233,6 +234,9 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
         the run folder.
     source : dict, optional
         Where such a scene came from (files, supports), recorded in run.json.
+    max_bricks : int
+        A model estimated larger (:func:`masonry.scenes.check_size`) is refused before
+        anything is built.
 
     Returns
     -------
@@ -241,6 +245,8 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
     """
     params = validate(params)
     check_output_root(out_root)
+    if scene is None:
+        check_size(params, max_bricks)
     sid = structure_id(params)
     target = Path(out_root) / sid
     outputs = {"analyse": analyse, "plots": plots_wanted, "printable": printable}

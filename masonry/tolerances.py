@@ -12,6 +12,14 @@ import numpy as np
 G = 9.81
 """Gravitational acceleration, m/s^2 (SPEC 2)."""
 
+MAX_BRICKS = 50_000
+"""Largest model built without being asked (``--max-bricks``): solving takes about
+:data:`BYTES_PER_BRICK` each, so the default stays within 10 GB."""
+
+BYTES_PER_BRICK = 200e3
+"""Peak memory of a run per brick, accurate preset: 4.2 GiB for the 21,648 bricks of
+preset 1's full dome with ``--p 21`` (docs/bench.md; balanced takes half)."""
+
 
 @dataclass(frozen=True)
 class Tolerances:
