@@ -18,6 +18,7 @@ from pathlib import Path
 
 from masonry import __version__
 from masonry.params import ParameterError
+from masonry.rbe.boundary import UnsupportedError
 from masonry.rbe.solvers.newton import use_one_blas_thread
 from masonry.scenes.imported import AssemblyError
 
@@ -59,7 +60,7 @@ def main(argv=None) -> int:
     previous = _on_sigterm(_terminate)
     try:
         return args.handler(args, report)
-    except (ParameterError, AssemblyError) as error:
+    except (ParameterError, AssemblyError, UnsupportedError) as error:
         print(f"masonry: error: {describe_error(error, args)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as interrupt:

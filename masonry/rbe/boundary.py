@@ -23,6 +23,8 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse import coo_array
+from scipy.sparse.csgraph import connected_components
 
 from masonry.blocks import Blocks, concatenate, rotated_web, rotation_z
 from masonry.interfaces import INTERFACE_KINDS, Interfaces, detect
@@ -56,6 +58,41 @@ class Model:
         return int((self.interfaces.kind == BOUNDARY).sum())
 
 
+class UnsupportedError(ValueError):
+    """Some blocks have no path of contacts to a support: nothing can carry them, and no
+    equilibrium (not even friction+) exists. The message names them."""
+
+
+def unsupported_blocks(blocks: Blocks, interfaces: Interfaces) -> np.ndarray:
+    """Indices of the free blocks that no chain of interfaces joins to a support.
+
+    Returns
+    -------
+    (k,) int
+    """
+    n = blocks.n_blocks
+    pair = interfaces.pair
+    graph = coo_array((np.ones(len(pair)), (pair[:, 0], pair[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    carried = np.isin(label, label[blocks.block_is_support])
+    return np.flatnonzero(~carried)
+
+
+def check_supported(model: "Model") -> None:
+    """Raise :class:`UnsupportedError` naming the blocks of ``model`` that no chain of
+    interfaces joins to a support (before any solve)."""
+    lost = unsupported_blocks(model.blocks, model.interfaces)
+    if len(lost) == 0:
+        return
+    names = model.blocks.block_name
+    shown = ", ".join(repr(str(names[i])) if names is not None else str(i) for i in lost[:5])
+    more = f" and {len(lost) - 5} more" if len(lost) > 5 else ""
+    raise UnsupportedError(
+        f"{len(lost)} of {model.blocks.n_blocks} blocks have no path of contacts to a "
+        f"support: {shown}{more}. Nothing can carry them: a block floating, touching only "
+        f"along an edge or at a point, or with a gap wider than the contact tolerance")
+
+
 def _end_masks(scene):
     """Bricks mitered at the left (-pi/n) and right (+pi/n) corner planes."""
     layout = scene.layout
@@ -71,7 +108,19 @@ def _mark_web_boundaries(interfaces: Interfaces, blocks: Blocks) -> Interfaces:
 
 
 def analysis_model(scene) -> Model:
-    """Blocks, interfaces and routing for the scene and its boundary mode."""
+    """Blocks, interfaces and routing for the scene and its boundary mode.
+
+    Raises
+    ------
+    UnsupportedError
+        Some block has no path of contacts to a support (:func:`check_supported`).
+    """
+    model = _model(scene)
+    check_supported(model)
+    return model
+
+
+def _model(scene) -> Model:
     params = scene.params
     mode = params.boundary if params.scene == "section" else "free"
     if mode == "free":

@@ -60,6 +60,11 @@ COINCIDENT_ANGLE = 1e-6
 top of each other: the faces of two blocks in contact, never the two faces of one block's
 edge (no block has a dihedral angle that small)."""
 
+OVERLAP_REL = 1e-3
+"""Two blocks overlap when they interpenetrate by more than this fraction of the smaller
+one's size (its bounding box diagonal): overlapping solids are not a structure. Less is
+taken for the imprecision of a drawing (the interface detector closes such gaps)."""
+
 OUR_NAME = re.compile(r"^b\d+_(" + "|".join(BLOCK_CLASSES) + r")_c(\d+)$")
 """Block names written by :func:`masonry.export.obj.blocks_obj`: class and course."""
 
@@ -239,6 +244,13 @@ def load_assembly(paths, params, *, supports=(), support_below=None, ground=Fals
     if is_support.all():
         raise AssemblyError(f"every one of the {len(is_support)} blocks is a support: "
                             "nothing is left to analyse")
+    overlaps = overlapping_pairs(blocks)
+    if len(overlaps):
+        a, b = blocks.block_name[overlaps[0, 0]], blocks.block_name[overlaps[0, 1]]
+        more = f" ({len(overlaps) - 1} more pairs)" if len(overlaps) > 1 else ""
+        raise AssemblyError(f"blocks {a!r} and {b!r} overlap{more}: interpenetrating "
+                            "solids are not a structure (a block given twice, or the same "
+                            "file twice?)")
     blocks = dataclasses.replace(blocks, block_is_support=is_support)
     params = validate(params.replace(scene="assembly", assembly=assembly_name(paths, blocks)))
     source = {"files": [str(p) for p in paths], "support": list(supports),
@@ -369,12 +381,67 @@ def _pair_about_edge(vertices, lo, hi, third, forward, tri):
     return np.stack([tri[opening[ok]], tri[closing[partner[ok]]]], axis=1)
 
 
+def overlapping_pairs(blocks: Blocks) -> np.ndarray:
+    """Pairs of convex blocks that interpenetrate by more than :data:`OVERLAP_REL` of the
+    smaller one's size.
+
+    Candidates are blocks whose centroids are closer than the two largest blocks' reach;
+    each is decided exactly by the separating axis theorem (face normals of both blocks
+    and cross products of their edges).
+
+    Returns
+    -------
+    (P, 2) int
+        Block index pairs, lower index first, sorted.
+    """
+    n = blocks.n_blocks
+    points = [blocks.block_vertices(i) for i in range(n)]
+    centroid = np.array([p.mean(axis=0) for p in points])
+    reach = np.array([np.linalg.norm(p - c, axis=1).max() for p, c in zip(points, centroid)])
+    size = np.linalg.norm(np.diff(blocks.block_bounds, axis=1)[:, 0], axis=1)
+    if n < 2:
+        return np.zeros((0, 2), int)
+    candidates = cKDTree(centroid).query_pairs(2 * reach.max(), output_type="ndarray")
+    axes = [_block_axes(blocks, i) for i in range(n)]
+    found = []
+    for a, b in candidates:
+        if np.linalg.norm(centroid[a] - centroid[b]) >= reach[a] + reach[b]:
+            continue
+        depth = OVERLAP_REL * min(size[a], size[b])
+        normals, edges_a, edges_b = (np.vstack([axes[a][0], axes[b][0]]), axes[a][1],
+                                     axes[b][1])
+        cross = np.cross(edges_a[:, None, :], edges_b[None, :, :]).reshape(-1, 3)
+        length = np.linalg.norm(cross, axis=1)
+        cross = cross[length > 1e-9] / length[length > 1e-9, None]
+        every = np.vstack([normals, cross])
+        pa, pb = points[a] @ every.T, points[b] @ every.T
+        overlap = np.minimum(pa.max(axis=0) - pb.min(axis=0), pb.max(axis=0) - pa.min(axis=0))
+        if overlap.min() > depth:
+            found.append((min(a, b), max(a, b)))
+    return np.array(sorted(found), int).reshape(-1, 2)
+
+
+def _block_axes(blocks: Blocks, block: int):
+    """(unit face normals, unit edge directions) of one block."""
+    faces = blocks.block_faces(block)
+    edges = []
+    for face in faces:
+        polygon = blocks.face_polygon(face)
+        edges.append(np.roll(polygon, -1, axis=0) - polygon)
+    edges = np.vstack(edges)
+    length = np.linalg.norm(edges, axis=1)
+    edges = edges[length > 0] / length[length > 0, None]
+    return blocks.face_normal[faces], edges
+
+
 # ---------------------------------------------------------------------- readers
 def _read_file(path: Path) -> _Soup:
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise AssemblyError(f"{path}: unknown format {path.suffix!r}; masonry reads "
                             f"{', '.join(FORMATS)}")
+    if path.exists() and not path.is_file():  # a folder, FIFO or device never ends well
+        raise AssemblyError(f"{path}: not a regular file")
     try:
         data = path.read_bytes()
     except OSError as error:
@@ -391,6 +458,10 @@ def _read_file(path: Path) -> _Soup:
                             f"({type(error).__name__}: {error})") from None
     if len(soup.triangles) == 0:
         raise AssemblyError(f"{path}: no faces, so no block")
+    bad = ~np.isfinite(soup.vertices).all(axis=1)
+    if bad.any():
+        raise AssemblyError(f"{path}: {bad.sum()} vertices are not finite numbers (nan or "
+                            f"inf), the first at {soup.vertices[bad][0].tolist()}")
     return soup
 
 
@@ -471,7 +542,8 @@ def _read_stl(data: bytes) -> _Soup:
         count = int.from_bytes(data[80:84], "little")
         if len(data) == 84 + 50 * count:
             points = np.frombuffer(data, _STL_RECORD, count=count, offset=84)["points"]
-            return _soup_of_triangles(points.astype(float))
+            with np.errstate(invalid="ignore"):  # NaNs are refused after reading
+                return _soup_of_triangles(points.astype(float))
     text = data.decode("ascii", errors="replace")
     if not text.lstrip().startswith("solid"):
         raise AssemblyError(f"not an STL file: {len(data)} bytes is not 84 + 50 n (binary "
