@@ -321,24 +321,29 @@ def check_arch(params: Params) -> None:
                                               "size", related=("arch_span",))
     if p.arch_shape == "semicircular" and rise is not None and rise != span / 2:
         raise ParameterError("arch_rise", rise, f"none for a semicircular arch (its rise is "
-                                                f"span / 2 = {span / 2:g} m)")
+                                                f"span / 2 = {span / 2:g} m)",
+                             related=("arch_shape",))
     if p.arch_shape == "segmental" and rise is not None and not 0 < rise < span / 2:
         raise ParameterError("arch_rise", rise, f"0 < rise < span / 2 = {span / 2:g} m for "
-                                                "a segmental arch")
+                                                "a segmental arch",
+                             related=("arch_span", "arch_shape"))
     if p.arch_shape == "pointed":
         if rise is not None and not rise > span / 2:
             raise ParameterError("arch_rise", rise, f"> span / 2 = {span / 2:g} m for a "
-                                                    "pointed arch")
+                                                    "pointed arch",
+                                 related=("arch_span", "arch_shape"))
         if p.arch_blocks % 2:
             raise ParameterError("arch_blocks", p.arch_blocks, "an even number for a "
-                                                               "pointed arch")
+                                                               "pointed arch",
+                                 related=("arch_shape",))
     radius, _ = arch_radius(p.arch_shape, span, rise)
     # the intrados must exist: radius R - t/2 > 0, and for a pointed arch it must still
     # reach the crown, R - t/2 > R - span/2
     limit = span if p.arch_shape == "pointed" else 2 * radius
     if not t < limit:
         raise ParameterError("arch_thickness", t, f"< {limit:g} m (the intrados of this "
-                                                  f"arch vanishes at t = {limit:g} m)")
+                                                  f"arch vanishes at t = {limit:g} m)",
+                             related=("arch_span", "arch_shape", "arch_rise"))
 
 
 def structure_id(params: Params) -> str:

@@ -248,7 +248,8 @@ def load_assembly(paths, params, *, supports=(), support_below=None, ground=Fals
     if len(overlaps):
         a, b = blocks.block_name[overlaps[0, 0]], blocks.block_name[overlaps[0, 1]]
         more = f" ({len(overlaps) - 1} more pairs)" if len(overlaps) > 1 else ""
-        raise AssemblyError(f"blocks {a!r} and {b!r} overlap{more}: interpenetrating "
+        files = ", ".join(str(p) for p in paths)
+        raise AssemblyError(f"{files}: blocks {a!r} and {b!r} overlap{more}: interpenetrating "
                             "solids are not a structure (a block given twice, or the same "
                             "file twice?)")
     blocks = dataclasses.replace(blocks, block_is_support=is_support)
