@@ -156,13 +156,21 @@ def handle(args, report):
     logging.getLogger("distributed").setLevel(logging.ERROR)  # cluster start and stop
     show = sys.stderr.isatty() and not args.quiet
     results, failed = [], 0
-    for i, inputs, row in execute(study, args.out, workers, scheduler):
-        results.append((i, inputs, row))
-        failed += row["status"] == "failed"
-        if show:
-            _progress(len(results), total, failed)
+    # one display: the bar replaces the variants' stage lines (warnings still show)
+    library = logging.getLogger("masonry")
+    level = library.level
     if show:
-        sys.stderr.write("\n")
+        library.setLevel(logging.WARNING)
+    try:
+        for i, inputs, row in execute(study, args.out, workers, scheduler):
+            results.append((i, inputs, row))
+            failed += row["status"] == "failed"
+            if show:
+                _progress(len(results), total, failed)
+    finally:
+        library.setLevel(level)
+        if show:
+            sys.stderr.write("\n")
     rows = summary_rows(study, results)
     name = f"sweep_{Path(args.study).stem}"
     with RunFolder(args.out, name) as folder:
