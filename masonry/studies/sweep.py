@@ -14,8 +14,10 @@ import dataclasses
 import itertools
 import json
 import logging
+import signal
 import time
 import traceback
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
@@ -152,8 +154,10 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
 
     cluster = None
     if scheduler is None:
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               host="127.0.0.1", dashboard_address=None)
+        with _children_ignore_ctrl_c():
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   host="127.0.0.1", dashboard_address=None,
+                                   silence_logs=logging.ERROR)
     client = Client(cluster if cluster is not None else scheduler)
     try:
         # the first variant of each geometry builds it; the others of its group wait for
@@ -180,6 +184,23 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+@contextmanager
+def _children_ignore_ctrl_c():
+    """Processes started inside the block ignore SIGINT (an ignored signal stays ignored
+    in a child): Ctrl-C in a terminal reaches every process of its group, and the worker
+    processes would each print a traceback. This process alone gets it, and stops them
+    as it unwinds."""
+    try:
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:  # not the main thread: nothing to change
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def summary_rows(study: Study, results) -> list:
