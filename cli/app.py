@@ -48,8 +48,9 @@ def make_parser():
 
 def main(argv=None) -> int:
     args = make_parser().parse_args(argv)
-    # progress on a terminal only; --quiet silences it there too
-    verbose = sys.stderr.isatty() and not getattr(args, "quiet", False)
+    # progress on a terminal (or with --verbose); --quiet silences it there too
+    verbose = getattr(args, "verbose", False) or (sys.stderr.isatty()
+                                                   and not getattr(args, "quiet", False))
     logging.basicConfig(level=logging.INFO if verbose else logging.WARNING,
                         format="masonry: %(message)s", stream=sys.stderr, force=True)
     logging.getLogger("matplotlib").setLevel(logging.WARNING)

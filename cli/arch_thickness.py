@@ -8,7 +8,7 @@ from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.thickness import folder_name, minimum_thickness, steps_csv
 from masonry.studies.thrust_line import thrust_line_minimum_thickness
 
-from .options import add_arch_options, add_material_options
+from .options import add_arch_options, add_material_options, add_verbosity
 
 ANALYSIS = ("arch_blocks", "arch_span", "arch_shape", "arch_rise", "arch_depth", "mu",
             "density", "solver")
@@ -29,7 +29,7 @@ def register(subparsers):
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root: writes DIR/arch-thickness_<inputs>/ with "
                              "result.json and steps.csv (default exports)")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    add_verbosity(parser)
     parser.set_defaults(handler=handle)
 
 

@@ -6,6 +6,8 @@ from masonry.studies.bench import SCENES, bench, frontier_png, table_csv, table_
 from masonry.params import ACCURACIES, SOLVERS, ParameterError
 from masonry.runfolder import RunFolder, check_output_root
 
+from .options import add_verbosity
+
 
 def register(subparsers):
     parser = subparsers.add_parser(
@@ -27,7 +29,7 @@ def register(subparsers):
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root: writes DIR/bench/bench.csv, bench.md and "
                              "frontier.png (default exports)")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    add_verbosity(parser)
     parser.set_defaults(handler=handle)
 
 

@@ -176,7 +176,18 @@ def add_output_options(parser):
                    help="skip the printable body (dome.stl, dome.obj)")
     g.add_argument("--force", action="store_true",
                    help="recompute even if the run folder holds this input's results")
-    g.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    add_verbosity(g)
+
+
+def add_verbosity(parser):
+    """``-q`` (only warnings and errors) and ``-v`` (progress and solver choices even
+    when the output is redirected); by default progress shows on a terminal only."""
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("-q", "--quiet", action="store_true",
+                       help="no progress messages, only warnings and errors")
+    group.add_argument("-v", "--verbose", action="store_true",
+                       help="progress and the solvers' choices (fallbacks), also when "
+                            "the output is redirected")
 
 
 def params_from_args(args) -> Params:

@@ -4,6 +4,8 @@ side by side."""
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.structures import structures_table, table_csv, table_markdown
 
+from .options import add_verbosity
+
 
 def register(subparsers):
     parser = subparsers.add_parser(
@@ -16,7 +18,7 @@ def register(subparsers):
                         help="leave out the full domes (the slowest rows)")
     parser.add_argument("--lp-check", action="store_true",
                         help="also run the HiGHS feasibility LP on every row")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    add_verbosity(parser)
     parser.set_defaults(handler=handle)
 
 

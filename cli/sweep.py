@@ -12,7 +12,7 @@ from masonry.studies.sweep import (Study, execute, summary_csv, summary_parquet,
                            summary_rows)
 
 from . import run as run_command
-from .options import Parser
+from .options import Parser, add_verbosity
 
 log = logging.getLogger("masonry")
 
@@ -31,7 +31,7 @@ def register(subparsers):
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root of the variants' run folders and of "
                              "sweep_<study>/ with the summary (default exports)")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    add_verbosity(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -154,9 +154,10 @@ def handle(args, report):
                         "cluster: pip install 'masonry[dask]'")
             workers, scheduler = 1, None
     logging.getLogger("distributed").setLevel(logging.ERROR)  # cluster start and stop
-    show = sys.stderr.isatty() and not args.quiet
+    # one display: on a terminal the bar replaces the variants' stage lines (warnings
+    # still show); --verbose shows the lines instead
+    show = sys.stderr.isatty() and not args.quiet and not args.verbose
     results, failed = [], 0
-    # one display: the bar replaces the variants' stage lines (warnings still show)
     library = logging.getLogger("masonry")
     level = library.level
     if show:

@@ -7,6 +7,7 @@ checks). A new format is a module and one :class:`Exporter` row in :data:`EXPORT
 """
 
 import logging
+from functools import cache
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -82,9 +83,15 @@ def _model_files(made: RunOutputs) -> Export:
     })
 
 
+@cache
+def _say_rhino_missing():
+    """Once per process (a sweep runs many variants in one)."""
+    log.info("bricks.3dm skipped: pip install 'masonry[rhino]' to write it")
+
+
 def _rhino_files(made: RunOutputs) -> Export:
     if not rhino.available():
-        log.info("bricks.3dm skipped: pip install 'masonry[rhino]' to write it")
+        _say_rhino_missing()
         return Export({})
     return Export({"bricks.3dm": rhino.blocks_3dm(made.scene.blocks)})
 
