@@ -229,11 +229,19 @@ def summary(record, report):
     report(f"{state}: {record['path']}")
 
 
+def _verdict(rbe) -> str:
+    """The verdict of a record written without one: a friction+ result always has a
+    finite MoI, so one without is a solve that stopped short."""
+    if rbe.get("friction") == "plus" and not math.isfinite(rbe.get("moi", math.nan)):
+        return "not solved"
+    return "feasible" if rbe["feasible"] else "infeasible"
+
+
 def rbe_summary(record, report) -> int:
     """The lines about the rigid block equilibrium of a run record; returns the exit code:
     3 when the equilibrium was not solved (no verdict), else 0."""
     rbe = record["rbe"]
-    verdict = rbe.get("verdict") or ("feasible" if rbe["feasible"] else "infeasible")
+    verdict = rbe.get("verdict") or _verdict(rbe)
     if verdict == "not solved":
         report(f"RBE: not solved (friction-{rbe['friction']}, mu {rbe['mu']:g}): "
                f"{rbe['solver']} stopped with status {rbe.get('status')!r}, residual "

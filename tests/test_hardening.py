@@ -173,6 +173,12 @@ def test_not_solved_has_its_own_exit_code(tmp_path, monkeypatch, capsys):
     assert main(["run", *WALL, "--out", str(tmp_path)]) == 3
     out = capsys.readouterr().out
     assert "RBE: not solved" in out and "user_limit" in out and "MoI" not in out
+    # a record without a verdict: friction+ without a finite MoI was not solved either
+    del record["rbe"]["verdict"]
+    assert main(["run", *WALL, "--out", str(tmp_path)]) == 3
+    record["rbe"].update(moi=12.0, moi_factor=0.1, residual_eq=1e-9)
+    assert main(["run", *WALL, "--out", str(tmp_path)]) == 0
+    assert "RBE: infeasible (friction-plus" in capsys.readouterr().out
 
 
 def test_friction_net_on_an_infeasible_structure_suggests_auto(tmp_path, capsys):
