@@ -103,12 +103,14 @@ def add_model_options(parser):
                         f"({_preset_values('cut')})")
     g.add_argument("--unit", type=float,
                    help=f"brick unit in metres ({_range('unit')}; default {DEFAULTS.unit:g})")
-    g.add_argument("--min-fill", dest="min_fill", type=float,
-                   help="shortest fill-in brick in units (default 1)")
-    g.add_argument("--wall-length", dest="wall_length", type=float,
-                   help="wall scene: length in units (default 32)")
-    g.add_argument("--wall-courses", dest="wall_courses", type=int,
-                   help="wall scene: number of courses (default 10)")
+    g.add_argument("--min-fill", dest="min_fill", type=float, metavar="F",
+                   help=f"shortest fill-in brick in units (0 < F <= 4; default "
+                        f"{DEFAULTS.min_fill:g})")
+    g.add_argument("--wall-length", dest="wall_length", type=float, metavar="L",
+                   help=f"wall scene: length in units (>= 4; default {DEFAULTS.wall_length:g})")
+    g.add_argument("--wall-courses", dest="wall_courses", type=int, metavar="K",
+                   help=f"wall scene: number of courses (>= 1; default "
+                        f"{DEFAULTS.wall_courses})")
     g.add_argument("--fast", action="store_true", default=None,
                    help="reduced output: one view, lower resolution")
     g.add_argument("--max-bricks", dest="max_bricks", type=int, default=MAX_BRICKS,
@@ -120,19 +122,23 @@ def add_model_options(parser):
 
 def add_arch_options(parser, thickness=True):
     g = parser.add_argument_group("arch scene (metres; the span and rise of the centre line)")
-    g.add_argument("--blocks", dest="arch_blocks", type=int,
-                   help="number of voussoirs (>= 2; default 16; even for a pointed arch)")
+    g.add_argument("--blocks", dest="arch_blocks", type=int, metavar="N",
+                   help=f"number of voussoirs (>= 2; default {DEFAULTS.arch_blocks}; even "
+                        "for a pointed arch)")
     if thickness:
-        g.add_argument("--thickness", dest="arch_thickness", type=float,
-                       help="thickness t along the joints (default 0.6)")
-    g.add_argument("--span", dest="arch_span", type=float, help="span (default 10)")
+        g.add_argument("--thickness", dest="arch_thickness", type=float, metavar="T",
+                       help=f"thickness t along the joints (at least 0.001 span; default "
+                            f"{DEFAULTS.arch_thickness:g})")
+    g.add_argument("--span", dest="arch_span", type=float, metavar="S",
+                   help=f"span ({_range('arch_span')}; default {DEFAULTS.arch_span:g})")
     g.add_argument("--shape", dest="arch_shape", choices=ARCH_SHAPES,
                    help="semicircular (default), pointed or segmental")
-    g.add_argument("--rise", dest="arch_rise", type=float,
+    g.add_argument("--rise", dest="arch_rise", type=float, metavar="H",
                    help="rise of a pointed (> span/2, default equilateral) or segmental "
-                        "(< span/2, default span/4) arch")
-    g.add_argument("--depth", dest="arch_depth", type=float,
-                   help="depth along y (default 1)")
+                        "(< span/2 and at least 0.01 span, default span/4) arch")
+    g.add_argument("--depth", dest="arch_depth", type=float, metavar="D",
+                   help=f"depth along y (0.001 to 1000 spans; default "
+                        f"{DEFAULTS.arch_depth:g})")
 
 
 def add_analysis_options(parser, boundary=True):

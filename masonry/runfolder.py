@@ -13,7 +13,6 @@ into the same root at once never see a half-swapped folder; a caller may ask to 
 folder already there (see :meth:`RunFolder.publish`).
 """
 
-import fcntl
 import json
 import logging
 import os
@@ -26,6 +25,11 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from masonry.params import ParameterError
+
+try:
+    import fcntl
+except ImportError:  # Windows: no advisory locks; publishing stays two renames
+    fcntl = None
 
 log = logging.getLogger(__name__)
 
@@ -113,7 +117,11 @@ def _alive(pid: int) -> bool:
 
 @contextmanager
 def locked(folder):
-    """Hold an exclusive lock on ``folder`` (an existing directory) for the block."""
+    """Hold an exclusive lock on ``folder`` (an existing directory) for the block (POSIX
+    advisory lock; nothing on systems without one)."""
+    if fcntl is None:
+        yield
+        return
     fd = os.open(folder, os.O_RDONLY)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX)
