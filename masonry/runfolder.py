@@ -104,7 +104,7 @@ def remove_leftovers(folder) -> list:
 
 
 def _alive(pid: int) -> bool:
-    if pid == os.getpid():
+    if pid == os.getpid() or os.name == "nt":  # Windows' os.kill(pid, 0) would kill it
         return True
     try:
         os.kill(pid, 0)
