@@ -11,6 +11,7 @@ import hashlib
 import json
 import logging
 import pickle
+import threading
 import time
 from functools import cache
 from contextlib import contextmanager
@@ -44,8 +45,13 @@ def versions() -> dict:
     return out
 
 
+HEARTBEAT_S = 15.0
+"""A stage running longer logs how long it has run, every this many seconds."""
+
+
 class Timer:
-    """Wall-clock seconds per stage, logged as each stage starts."""
+    """Wall-clock seconds per stage, logged as each stage starts (and, while progress is
+    logged, every :data:`HEARTBEAT_S` seconds of a long stage)."""
 
     def __init__(self):
         self.seconds = {}
@@ -55,9 +61,18 @@ class Timer:
         """Time a stage; a stage entered again (several exporters) adds up."""
         log.info("%s ...", name)
         start = time.perf_counter()
+        done = threading.Event()
+
+        def heartbeat():
+            while not done.wait(HEARTBEAT_S):
+                log.info("%s ... %.0f s", name, time.perf_counter() - start)
+
+        if log.isEnabledFor(logging.INFO):
+            threading.Thread(target=heartbeat, daemon=True).start()
         try:
             yield
         finally:
+            done.set()
             total = self.seconds.get(name, 0.0) + time.perf_counter() - start
             self.seconds[name] = round(total, 4)
 

@@ -3,6 +3,7 @@ runs leave nothing behind, a corrupt cache is rebuilt, internal failures are one
 
 import json
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -194,3 +195,19 @@ def test_version(capsys):
         main(["--version"])
     assert exit_info.value.code == 0
     assert capsys.readouterr().out.strip().startswith("masonry 0.")
+
+
+def test_a_long_stage_says_it_is_still_running(monkeypatch, caplog):
+    from masonry import pipeline
+
+    monkeypatch.setattr(pipeline, "HEARTBEAT_S", 0.02)
+    timer = pipeline.Timer()
+    with caplog.at_level("INFO", logger="masonry.pipeline"):
+        with timer.stage("solve"):
+            time.sleep(0.3)
+    beats = [r.getMessage() for r in caplog.records if re.fullmatch(r"solve \.\.\. \d+ s",
+                                                                      r.getMessage())]
+    assert beats and timer.seconds["solve"] >= 0.3
+    caplog.clear()
+    time.sleep(0.1)  # the heartbeat stopped with the stage
+    assert not caplog.records
