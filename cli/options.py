@@ -94,12 +94,17 @@ def add_model_options(parser):
     g.add_argument("--scene", choices=[s for s in SCENES if s != "assembly"],
                    help="section (one web, default), dome (all n webs), wall (validation), "
                         "arch (voussoirs, see the arch options)")
-    g.add_argument("--stretch", type=float, help=f"dome height / circumradius ({_range('stretch')}; "
+    g.add_argument("--stretch", type=float,
+                   help=f"dome height / circumradius ({_range('stretch')}; "
                         f"{_preset_values('stretch')})")
-    g.add_argument("--n", type=int, help=f"walls of the polygonal dome (>= 3; {_preset_values('n')})")
-    g.add_argument("--r", type=int, help=f"full rhombi across the section (>= 0; {_preset_values('r')})")
-    g.add_argument("--p", type=int, help=f"pattern bricks per rhombus side (>= 1; {_preset_values('p')})")
-    g.add_argument("--cut", type=float, help=f"fraction of the height cut off, 0 <= cut < 1 "
+    g.add_argument("--n", type=int,
+                   help=f"walls of the polygonal dome (>= 3; {_preset_values('n')})")
+    g.add_argument("--r", type=int,
+                   help=f"full rhombi across the section (>= 0; {_preset_values('r')})")
+    g.add_argument("--p", type=int,
+                   help=f"pattern bricks per rhombus side (>= 1; {_preset_values('p')})")
+    g.add_argument("--cut", type=float,
+                   help=f"fraction of the height cut off, 0 <= cut < 1 "
                         f"({_preset_values('cut')})")
     g.add_argument("--unit", type=float,
                    help=f"brick unit in metres ({_range('unit')}; default {DEFAULTS.unit:g})")
