@@ -24,7 +24,7 @@ from masonry.rbe.solvers.newton import use_one_blas_thread
 from masonry.scenes.imported import AssemblyError
 
 from . import analyze, arch_thickness, bench, build, run, structures, sweep
-from .options import Parser, describe_error, option_names
+from .options import Parser, describe_error, option_names, typed_values
 
 SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, bench)
 
@@ -47,7 +47,9 @@ def make_parser():
 
 
 def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = make_parser().parse_args(argv)
+    args.typed = typed_values(argv)
     # progress on a terminal (or with --verbose); --quiet silences it there too
     verbose = getattr(args, "verbose", False) or (sys.stderr.isatty()
                                                    and not getattr(args, "quiet", False))
@@ -69,7 +71,7 @@ def main(argv=None) -> int:
         print("masonry: interrupted; the previous output is untouched", file=sys.stderr)
         return 143 if isinstance(interrupt, Terminated) else 130
     except Exception as error:  # anything unexpected: one line, the traceback in a log
-        log_file = write_failure_log(argv if argv is not None else sys.argv[1:])
+        log_file = write_failure_log(argv)
         print(f"masonry: internal error: {type(error).__name__}: {_first_line(error)}; the "
               f"previous output is untouched; details in {log_file}", file=sys.stderr)
         return 1

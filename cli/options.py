@@ -59,17 +59,37 @@ def describe_error(error, args) -> str:
         return f"{error.where}: {name} = {value!r}: expected {expected}"
     if not option.startswith("--"):  # a positional argument: its value says it
         return f"{_typed(value)}: expected {expected}"
+    typed = getattr(args, "typed", {})
     if name not in Params.__dataclass_fields__ or _given(args, name):
-        return f"{option} {_typed(value)}: expected {expected}"
+        return f"{option} {typed.get(option, _typed(value))}: expected {expected}"
     given = [r for r in error.related if _given(args, r)]
     origin = (f"from --params {args.params}" if getattr(args, "params", None) else
               f"from --preset {args.preset}" if getattr(args, "preset", None) else
               "the default")
     subject = f"{option} {_typed(value)} ({origin})"
     if given:
-        typed = ", ".join(f"{names.get(r, r)} {_typed(getattr(args, r))}" for r in given)
-        subject = f"{typed} with {subject}"
+        options = [names.get(r, r) for r in given]
+        these = ", ".join(f"{o} {typed.get(o, _typed(getattr(args, r)))}"
+                          for o, r in zip(options, given))
+        subject = f"{these} with {subject}"
     return f"{subject}: expected {expected}"
+
+
+def typed_values(argv) -> dict:
+    """``--option`` -> the value as typed on the command line (the last one given), so an
+    error line repeats ``1e-9`` rather than Python's ``1e-09``."""
+    typed = {}
+    for i, token in enumerate(argv):
+        if not token.startswith("--"):
+            continue
+        if "=" in token:
+            option, value = token.split("=", 1)
+        elif i + 1 < len(argv):
+            option, value = token, argv[i + 1]
+        else:
+            continue
+        typed[option] = shlex.quote(value)
+    return typed
 
 
 def _given(args, name) -> bool:
