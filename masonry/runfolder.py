@@ -38,6 +38,11 @@ _LEFTOVER = re.compile(r"^\..+\.(tmp|old)-(?P<host>[A-Za-z0-9_]+)-(?P<pid>\d+)-[
 _LEGACY = re.compile(r"^\..+\.(tmp|old)-[0-9a-f]{8}$")  # masonry 0.1: no writer in the name
 
 
+NAME_MAX = 200
+"""Longest folder name accepted in an output root (bytes): file systems allow 255, and
+the run folders' temporary names add up to about 50 to a structure id."""
+
+
 def _tag() -> str:
     """``<host>-<pid>-<random>``: who writes a temporary file, and a unique suffix."""
     return f"{_HOST}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
@@ -57,6 +62,10 @@ def check_output_root(root, option="out") -> Path:
     if str(root).strip() == "":
         raise ParameterError(option, str(root), "a folder path (an empty one names nothing)")
     path = Path(root)
+    longest = max((len(os.fsencode(part)) for part in path.parts), default=0)
+    if longest > NAME_MAX:
+        raise ParameterError(option, str(root), f"a folder path whose names are at most "
+                                                f"{NAME_MAX} bytes long (one has {longest})")
     existing = path
     while not os.path.lexists(existing) and existing != existing.parent:
         existing = existing.parent

@@ -108,16 +108,45 @@ def test_listed_command_line_mistakes(tmp_path, args):
     assert_clean(argv, out, code, err)
 
 
+OTHER_COMMANDS = [
+    ["bench", "--repeats", "0"], ["bench", "--p", "0"], ["arch-thickness", "--rtol", "0"],
+    ["arch-thickness", "--rtol", "nan"], ["arch-thickness", "--blocks", "1"],
+    ["arch-thickness", "--mu", "0.01", "--blocks", "8"],  # slides at every thickness
+    ["analyze", "missing.obj", "--ground"], ["--bogus"], [],
+]
+
+
+@pytest.mark.parametrize("args", OTHER_COMMANDS)
+def test_other_commands_mistakes(tmp_path, args):
+    out = tmp_path / "out"
+    argv = [*args, "--out", str(out)] if args and not args[0].startswith("--") else args
+    code, _, err = call(argv)
+    assert code == 2
+    assert_clean(argv, out, code, err, files=["missing.obj"])
+
+
+@pytest.mark.parametrize("address", ["foo://bar", "nonsense"])
+def test_a_bad_scheduler_address(tmp_path, address):
+    pytest.importorskip("dask.distributed")
+    study = tmp_path / "study.toml"
+    study.write_text("[grid]\nmu = [0.7]\n")
+    out = tmp_path / "out"
+    argv = ["sweep", str(study), "--scheduler", address, "--out", str(out)]
+    code, _, err = call(argv)
+    assert code == 2 and "running Dask scheduler" in err
+    assert_clean(argv, out, code, err)
+
+
 @pytest.mark.parametrize("command", ["run", "build", "structures", "sweep", "bench",
                                      "arch-thickness"])
-@pytest.mark.parametrize("where", ["file", "under_file", "proc", "empty"])
+@pytest.mark.parametrize("where", ["file", "under_file", "proc", "empty", "long_name"])
 def test_output_locations(tmp_path, command, where):
     a_file = tmp_path / "a_file"
     a_file.write_text("x")
     study = tmp_path / "study.toml"
     study.write_text("[grid]\nmu = [0.7]\n")
     out = {"file": a_file, "under_file": a_file / "sub", "proc": "/proc/masonry",
-           "empty": ""}[where]
+           "empty": "", "long_name": tmp_path / ("a" * 300)}[where]
     head = {"sweep": ["sweep", str(study)], "bench": ["bench", "--repeats", "1"]}
     argv = [*head.get(command, [command]), "--out", str(out), "-q"]
     code, _, err = call(argv)
@@ -374,5 +403,32 @@ def test_fuzz_parameter_files(content):
         path, out = Path(tmp) / "params.toml", Path(tmp) / "out"
         path.write_bytes(content)
         argv = ["build", "--params", str(path), "--max-bricks", "1500", "--out", str(out)]
+        code, _, err = call(argv)
+        assert_clean(argv, out, code, err, files=[path])
+
+
+STUDY_KEYS = ["mu", "density", "friction", "stretch", "dome", "preset", "count", "seed",
+              "plots", "colour", "wall-length"]
+
+
+@settings(max_examples=150, deadline=None, derandomize=True, database=None,
+          suppress_health_check=list(HealthCheck))
+@given(st.one_of(
+    st.dictionaries(st.sampled_from(["base", "grid", "sample", "outputs", "grids"]),
+                    st.dictionaries(st.sampled_from(STUDY_KEYS), TOML_VALUES, max_size=3),
+                    max_size=3).map(
+        lambda tables: "".join(f"[{name}]\n" + "".join(f"{k} = {toml_value(v)}\n"
+                                                       for k, v in table.items())
+                               for name, table in tables.items()).encode()),
+    st.binary(max_size=40)))
+def test_fuzz_study_files(content):
+    rows = {"status": "computed", "error": ""}
+    with tempfile.TemporaryDirectory() as tmp, pytest.MonkeyPatch.context() as patch:
+        # the study is read and checked for real; its variants are not run here
+        patch.setattr("masonry_cli.sweep.execute", lambda study, *args: (
+            (i, inputs, rows) for i, inputs in enumerate(study.variants()[:3])))
+        path, out = Path(tmp) / "study.toml", Path(tmp) / "out"
+        path.write_bytes(content)
+        argv = ["sweep", str(path), "--workers", "1", "--out", str(out)]
         code, _, err = call(argv)
         assert_clean(argv, out, code, err, files=[path])

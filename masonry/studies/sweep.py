@@ -143,6 +143,11 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
     ``workers=1`` and no ``scheduler``: serially, in this process. Otherwise on Dask: a
     ``LocalCluster`` of ``workers`` single-threaded processes, or the scheduler at
     ``scheduler`` (``tcp://host:port``). A variant whose worker dies is recorded as failed.
+
+    Raises
+    ------
+    ParameterError
+        Named ``scheduler``: no Dask scheduler answers at that address.
     """
     variants = study.variants()
     options = dict(analyse=study.analyse, plots=study.plots, printable=study.printable)
@@ -158,7 +163,14 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
                                    host="127.0.0.1", dashboard_address=None,
                                    silence_logs=logging.ERROR)
-    client = Client(cluster if cluster is not None else scheduler)
+    try:
+        client = Client(cluster if cluster is not None else scheduler)
+    except (OSError, ValueError, TypeError) as error:  # no scheduler there
+        if cluster is not None:
+            cluster.close()
+            raise
+        raise ParameterError("scheduler", scheduler, f"the address of a running Dask "
+                                                     f"scheduler ({error})") from None
     try:
         # the first variant of each geometry builds it; the others of its group wait for
         # it and reuse the cached geometry instead of building it again in parallel
