@@ -7,6 +7,7 @@ parameter, the value and the valid range.
 
 import dataclasses
 import math
+import os
 import tomllib
 from dataclasses import dataclass
 
@@ -165,6 +166,10 @@ def load(path, **overrides) -> Params:
                              related=error.related, where=str(path)) from None
 
 
+MAX_TOML_BYTES = 2**20
+"""Parameter and study files are a few hundred bytes; a larger one is not one of them."""
+
+
 def read_toml(path, name) -> dict:
     """The table of a TOML file (UTF-8, a byte order mark allowed).
 
@@ -177,6 +182,11 @@ def read_toml(path, name) -> dict:
     if str(path).strip() == "":
         raise ParameterError(name, str(path), "a TOML file (an empty path names nothing)")
     try:
+        if os.path.exists(path) and not os.path.isfile(path):
+            raise ParameterError(name, str(path), "a TOML file, not a folder or a device")
+        if os.path.getsize(path) > MAX_TOML_BYTES:
+            raise ParameterError(name, str(path), f"a TOML file of at most "
+                                                  f"{MAX_TOML_BYTES // 2**20} MiB")
         with open(path, "rb") as f:
             text = f.read().decode("utf-8-sig")
         return tomllib.loads(text)

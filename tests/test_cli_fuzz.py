@@ -175,11 +175,17 @@ def test_broken_parameter_files(tmp_path, name):
     assert_clean(argv, out, code, err, files=[path])
 
 
-def test_a_folder_or_a_bom_as_parameter_file(tmp_path):
+def test_a_folder_a_device_a_huge_file_or_a_bom_as_parameter_file(tmp_path):
     out = tmp_path / "out"
-    argv = ["build", "--params", str(tmp_path), "--out", str(out)]
+    for path in (tmp_path, "/dev/zero"):  # a device would be read forever
+        argv = ["build", "--params", str(path), "--out", str(out)]
+        code, _, err = call(argv)
+        assert code == 2 and "not a folder or a device" in err
+    big = tmp_path / "big.toml"
+    big.write_bytes(b"#" * 2**21)
+    argv = ["build", "--params", str(big), "--out", str(out)]
     code, _, err = call(argv)
-    assert code == 2 and "Is a directory" in err
+    assert code == 2 and "at most 1 MiB" in err
     bom = tmp_path / "bom.toml"
     bom.write_bytes(b"\xef\xbb\xbfn = 2\n")  # read (BOM allowed), then refused for n
     argv = ["build", "--params", str(bom), "--out", str(out)]
