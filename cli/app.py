@@ -53,8 +53,7 @@ def main(argv=None) -> int:
     # progress on a terminal (or with --verbose); --quiet silences it there too
     verbose = getattr(args, "verbose", False) or (sys.stderr.isatty()
                                                    and not getattr(args, "quiet", False))
-    logging.basicConfig(level=logging.INFO if verbose else logging.WARNING,
-                        format="masonry: %(message)s", stream=sys.stderr, force=True)
+    _log_to_stderr(logging.INFO if verbose else logging.WARNING)
     logging.getLogger("matplotlib").setLevel(logging.WARNING)
     use_one_blas_thread()
 
@@ -77,6 +76,22 @@ def main(argv=None) -> int:
         return 1
     finally:
         _on_sigterm(previous)
+
+
+class _StderrHandler(logging.StreamHandler):
+    """This command's one log handler: ``masonry: <message>`` on the current stderr."""
+
+
+def _log_to_stderr(level):
+    """Log at ``level`` to the current stderr, replacing the handler an earlier ``main``
+    call in this process installed (and no other: a host's handlers stay)."""
+    root = logging.getLogger()
+    for handler in [h for h in root.handlers if isinstance(h, _StderrHandler)]:
+        root.removeHandler(handler)
+    handler = _StderrHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("masonry: %(message)s"))
+    root.addHandler(handler)
+    root.setLevel(level)
 
 
 def _terminate(signum, frame):
