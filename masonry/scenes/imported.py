@@ -384,55 +384,89 @@ def _pair_about_edge(vertices, lo, hi, third, forward, tri):
 
 def overlapping_pairs(blocks: Blocks) -> np.ndarray:
     """Pairs of convex blocks that interpenetrate by more than :data:`OVERLAP_REL` of the
-    smaller one's size.
+    smaller one's size (its bounding box diagonal).
 
-    Candidates are blocks whose centroids are closer than the two largest blocks' reach;
-    each is decided exactly by the separating axis theorem (face normals of both blocks
-    and cross products of their edges).
+    Decided by the separating axis theorem: pairs whose bounding boxes overlap are
+    projected on the face normals of both blocks, all at once (blocks in contact are
+    separated by their common face's normal); the few left are projected on the cross
+    products of their edges too, which makes the test exact.
 
     Returns
     -------
     (P, 2) int
         Block index pairs, lower index first, sorted.
     """
-    n = blocks.n_blocks
-    points = [blocks.block_vertices(i) for i in range(n)]
-    centroid = np.array([p.mean(axis=0) for p in points])
-    reach = np.array([np.linalg.norm(p - c, axis=1).max() for p, c in zip(points, centroid)])
-    size = np.linalg.norm(np.diff(blocks.block_bounds, axis=1)[:, 0], axis=1)
-    if n < 2:
-        return np.zeros((0, 2), int)
-    candidates = cKDTree(centroid).query_pairs(2 * reach.max(), output_type="ndarray")
-    axes = [_block_axes(blocks, i) for i in range(n)]
-    found = []
-    for a, b in candidates:
-        if np.linalg.norm(centroid[a] - centroid[b]) >= reach[a] + reach[b]:
-            continue
-        depth = OVERLAP_REL * min(size[a], size[b])
-        normals, edges_a, edges_b = (np.vstack([axes[a][0], axes[b][0]]), axes[a][1],
-                                     axes[b][1])
-        cross = np.cross(edges_a[:, None, :], edges_b[None, :, :]).reshape(-1, 3)
-        length = np.linalg.norm(cross, axis=1)
-        cross = cross[length > 1e-9] / length[length > 1e-9, None]
-        every = np.vstack([normals, cross])
-        pa, pb = points[a] @ every.T, points[b] @ every.T
-        overlap = np.minimum(pa.max(axis=0) - pb.min(axis=0), pb.max(axis=0) - pa.min(axis=0))
-        if overlap.min() > depth:
-            found.append((min(a, b), max(a, b)))
+    lo, hi = blocks.block_bounds[:, 0], blocks.block_bounds[:, 1]
+    size = np.linalg.norm(hi - lo, axis=1)
+    a, b = _box_pairs(lo, hi)
+    depth = OVERLAP_REL * np.minimum(size[a], size[b])
+    boxes = (np.minimum(hi[a], hi[b]) - np.maximum(lo[a], lo[b])).min(axis=1) > depth
+    a, b, depth = a[boxes], b[boxes], depth[boxes]
+    points, normals = _padded(blocks)
+    deep = np.zeros(len(a), bool)
+    for start in range(0, len(a), 4096):  # bounded memory
+        i, j = a[start:start + 4096], b[start:start + 4096]
+        axes = np.concatenate([normals[i], normals[j]], axis=1)
+        pa = np.einsum("pvk,pfk->pvf", points[i], axes)
+        pb = np.einsum("pvk,pfk->pvf", points[j], axes)
+        overlap = np.minimum(pa.max(axis=1) - pb.min(axis=1), pb.max(axis=1) - pa.min(axis=1))
+        deep[start:start + 4096] = overlap.min(axis=1) > depth[start:start + 4096]
+    found = [(min(i, j), max(i, j)) for i, j, d in zip(a[deep], b[deep], depth[deep])
+             if _overlap_on_edge_axes(blocks, i, j) > d]
     return np.array(sorted(found), int).reshape(-1, 2)
 
 
-def _block_axes(blocks: Blocks, block: int):
-    """(unit face normals, unit edge directions) of one block."""
-    faces = blocks.block_faces(block)
+def _box_pairs(lo, hi):
+    """Index pairs ``(a, b)`` of boxes whose x ranges overlap (a sweep along x)."""
+    n = len(lo)
+    order = np.argsort(lo[:, 0], kind="stable")
+    start = lo[order, 0]
+    end = np.searchsorted(start, hi[order, 0], side="left")
+    counts = np.maximum(end - np.arange(n) - 1, 0)
+    first = np.repeat(np.arange(n), counts)
+    offset = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    return order[first], order[first + 1 + offset]
+
+
+def _padded(blocks: Blocks):
+    """``(B, V, 3)`` vertices and ``(B, F, 3)`` face normals per block, each padded with
+    its block's first one (which changes no projection's range)."""
+    vertex_counts = np.diff(blocks.vertex_offsets)
+    rank = np.arange(len(blocks.vertices)) - np.repeat(blocks.vertex_offsets[:-1],
+                                                       vertex_counts)
+    points = np.repeat(blocks.vertices[blocks.vertex_offsets[:-1], None, :],
+                       vertex_counts.max(), axis=1)
+    points[np.repeat(np.arange(blocks.n_blocks), vertex_counts), rank] = blocks.vertices
+    face_counts = np.bincount(blocks.face_block, minlength=blocks.n_blocks)
+    first_face = np.concatenate([[0], np.cumsum(face_counts)[:-1]])
+    rank = np.arange(blocks.n_faces) - first_face[blocks.face_block]
+    normals = np.repeat(blocks.face_normal[first_face, None, :], face_counts.max(), axis=1)
+    normals[blocks.face_block, rank] = blocks.face_normal
+    return points, normals
+
+
+def _overlap_on_edge_axes(blocks: Blocks, a: int, b: int) -> float:
+    """Smallest overlap of two blocks along the cross products of their edges."""
+    edges_a, edges_b = _block_edges(blocks, a), _block_edges(blocks, b)
+    cross = np.cross(edges_a[:, None, :], edges_b[None, :, :]).reshape(-1, 3)
+    length = np.linalg.norm(cross, axis=1)
+    axes = cross[length > 1e-9] / length[length > 1e-9, None]
+    if len(axes) == 0:
+        return np.inf
+    pa, pb = blocks.block_vertices(a) @ axes.T, blocks.block_vertices(b) @ axes.T
+    return float(np.minimum(pa.max(axis=0) - pb.min(axis=0),
+                            pb.max(axis=0) - pa.min(axis=0)).min())
+
+
+def _block_edges(blocks: Blocks, block: int) -> np.ndarray:
+    """(E, 3) unit edge directions of one block (each edge once per face using it)."""
     edges = []
-    for face in faces:
+    for face in blocks.block_faces(block):
         polygon = blocks.face_polygon(face)
         edges.append(np.roll(polygon, -1, axis=0) - polygon)
     edges = np.vstack(edges)
     length = np.linalg.norm(edges, axis=1)
-    edges = edges[length > 0] / length[length > 0, None]
-    return blocks.face_normal[faces], edges
+    return edges[length > 0] / length[length > 0, None]
 
 
 # ---------------------------------------------------------------------- readers
