@@ -270,7 +270,7 @@ def test_overlapping_pairs_agree_with_the_intersection_volume():
     for trial in range(150):
         sizes = rng.uniform(0.5, 2.0, (2, 3))
         turns = Rotation.random(2, random_state=rng.integers(1 << 30)).as_matrix()
-        moves = np.array([[0, 0, 0], rng.uniform(-2.0, 2.0, 3)])
+        moves = np.array([[0, 0, 0], rng.uniform(-1.5, 2.0, 3)])
         corners = np.stack([(unit * sizes[k]) @ turns[k].T + moves[k] for k in range(2)])
         blocks = Blocks.from_hexahedra(corners, block_class=[0, 0])
         solids = [manifold3d.Manifold.hull_points(c) for c in corners]
