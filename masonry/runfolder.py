@@ -83,7 +83,8 @@ def check_output_root(root, option="out") -> Path:
 def remove_leftovers(folder) -> list:
     """Remove the temporary files and folders that killed runs left in ``folder``.
 
-    Only names of this host whose process no longer exists are removed.
+    Only names of this host whose process no longer exists are removed. A previous folder
+    set aside by a publish that was killed before the new one took its name is put back.
 
     Returns
     -------
@@ -101,6 +102,12 @@ def remove_leftovers(folder) -> list:
             if not _LEGACY.match(entry.name):
                 continue
         elif match["host"] != _HOST or _alive(int(match["pid"])):
+            continue
+        original = entry.with_name(entry.name[1:].rsplit(".old-", 1)[0])
+        if ".old-" in entry.name and not os.path.lexists(original):
+            # killed between the two renames of a publish: the previous folder goes back
+            os.rename(entry, original)
+            log.warning("restored %s, set aside by a run that was killed", original)
             continue
         if entry.is_dir() and not entry.is_symlink():
             shutil.rmtree(entry, ignore_errors=True)

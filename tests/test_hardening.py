@@ -91,8 +91,13 @@ def test_leftovers_of_dead_runs_are_removed_and_live_ones_kept(tmp_path):
     for folder in (stale, legacy, live):
         folder.mkdir()
         (folder / "bricks.obj").write_text("partial")
+    # a publish killed between its two renames: the previous folder was set aside
+    aside = tmp_path / f".{WALL_ID}.old-{host}-{dead}-0123abcd"
+    aside.mkdir()
+    (aside / "run.json").write_text("{}")
     assert sorted(remove_leftovers(tmp_path)) == sorted([stale, legacy])
     assert live.is_dir()
+    assert (tmp_path / WALL_ID / "run.json").read_text() == "{}" and not aside.exists()
 
 
 def test_sigterm_during_the_exports_leaves_the_previous_run(tmp_path):
