@@ -67,12 +67,15 @@ class Timer:
             while not done.wait(HEARTBEAT_S):
                 log.info("%s ... %.0f s", name, time.perf_counter() - start)
 
+        beating = threading.Thread(target=heartbeat, daemon=True)
         if log.isEnabledFor(logging.INFO):
-            threading.Thread(target=heartbeat, daemon=True).start()
+            beating.start()
         try:
             yield
         finally:
             done.set()
+            if beating.is_alive():
+                beating.join()  # no beat after the stage
             total = self.seconds.get(name, 0.0) + time.perf_counter() - start
             self.seconds[name] = round(total, 4)
 
