@@ -17,6 +17,8 @@ from functools import cached_property
 
 import numpy as np
 
+from masonry.tolerances import HORIZONTAL_SIN, TIE_REL
+
 BLOCK_CLASSES = ("ground", "regular", "pattern", "fill_in", "block")
 """Names of the ``block_class`` codes. ``block`` is an imported or scene block (arch)."""
 
@@ -63,7 +65,7 @@ def tangent_basis(normal, reference=None):
     """
     normal = np.asarray(normal, dtype=float).reshape(-1, 3)
     t1 = np.cross(np.array([0.0, 0.0, 1.0]), normal)
-    flat = np.linalg.norm(t1, axis=1) < 1e-6
+    flat = np.linalg.norm(t1, axis=1) < HORIZONTAL_SIN
     ref = (np.broadcast_to([1.0, 0.0, 0.0], normal.shape) if reference is None
            else np.asarray(reference, dtype=float).reshape(-1, 3))[flat]
     t1[flat] = ref - normal[flat] * np.einsum("ij,ij->i", normal[flat], ref)[:, None]
@@ -252,7 +254,7 @@ class Blocks:
         owner = np.repeat(np.arange(self.n_faces), self.face_polygon_count)
         # the first edge of maximal length (up to rounding) in each face
         longest = np.maximum.reduceat(length, self.face_offsets[:-1])
-        is_longest = length >= longest[owner] * (1 - 1e-9)
+        is_longest = length >= longest[owner] * (1 - TIE_REL)
         first = np.full(self.n_faces, len(fv))
         np.minimum.at(first, owner[is_longest], np.flatnonzero(is_longest))
         return edge[first]

@@ -26,7 +26,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from masonry.blocks import Blocks
-from masonry.tolerances import Tolerances
+from masonry.tolerances import BED_JOINT_ANGLE, Tolerances
 
 INTERFACE_KINDS = ("horizontal", "vertical", "support", "boundary")
 """Names of the ``kind`` codes. ``support``: one block is a fixed support (the ground);
@@ -330,7 +330,7 @@ def _order_main(blocks, face_a, face_b, up):
     support_a = blocks.block_is_support[block_a]
     support_b = blocks.block_is_support[block_b]
     rise = np.einsum("ij,ij->i", blocks.face_normal[face_a], up[block_a])
-    is_bed = np.abs(rise) > np.cos(np.pi / 4)
+    is_bed = np.abs(rise) > np.cos(BED_JOINT_ANGLE)
     a_lower = np.where(is_bed, rise > 0, block_a < block_b)
     a_main = support_a | (~support_b & a_lower)
     return np.where(a_main, face_a, face_b), np.where(a_main, face_b, face_a)
@@ -384,7 +384,7 @@ def _intersect(blocks, main, comp, faces, tol, up):
     normal_k, t1_k, t2_k = normal[main], t1[main], t2[main]
 
     is_support = blocks.block_is_support[block_m] | blocks.block_is_support[block_c]
-    is_horizontal = np.abs(np.einsum("ij,ij->i", normal_k, up[block_m])) > np.cos(np.pi / 4)
+    is_horizontal = np.abs(np.einsum("ij,ij->i", normal_k, up[block_m])) > np.cos(BED_JOINT_ANGLE)
     kind = np.select([is_support, is_horizontal],
                      [INTERFACE_KINDS.index("support"), INTERFACE_KINDS.index("horizontal")],
                      INTERFACE_KINDS.index("vertical")).astype(np.int8)

@@ -36,23 +36,13 @@ import numpy as np
 
 from masonry.blocks import Blocks, concatenate, rotated_web, rotation_z
 from masonry.meshing import merge_vertices
-from masonry.tolerances import Tolerances
+from masonry.tolerances import MIN_CORNER_DET, OVERLAP_REL, Tolerances
 
 log = logging.getLogger(__name__)
 
-OVERLAP_REL = 1e-5
-"""Default growth of every brick, relative to the scene size ``tol.scale`` (the bounding
-box diagonal): 80 micrometres for the CAD-offset section of preset 1 (8 m), 34 for the
-wall. Ten times the cleaning distance ``tol.contact`` (1e-6 of the size), so cleaning
-never undoes an overlap, and small against a brick (unit 0.1 m). The union grows by its
-exposed surface times the overlap: +0.15 to +0.16 % of the volume for the sections of
-presets 1 to 3, +0.04 % for the wall."""
-
 _CLEAN_ROUNDS = 4
-# A vertex lies on exactly three faces of a simple convex block (every box and mitered
-# box). Its three face normals are independent when |det| exceeds this; a corner of
-# nearly parallel faces goes to the halfspace path, which has no conditioning issue.
-_MIN_CORNER_DET = 1e-6
+"""Rounds of merging near vertices and dropping degenerate faces before the body must be
+clean."""
 
 
 class PrintableError(ValueError):
@@ -119,7 +109,7 @@ def grown_blocks(blocks: Blocks, overlap: float, tol: Tolerances | None = None):
     corner = np.flatnonzero(degree == 3)
     corner_faces = entry_face[order[first[corner][:, None] + np.arange(3)]]
     matrix = normal[corner_faces]  # (C, 3, 3): one face normal per row
-    solvable = np.abs(np.linalg.det(matrix)) > _MIN_CORNER_DET
+    solvable = np.abs(np.linalg.det(matrix)) > MIN_CORNER_DET
     corner = corner[solvable]
     points = np.full((n_vertices, 3), np.nan)
     rhs = np.full((len(corner), 3, 1), float(overlap))

@@ -11,8 +11,8 @@ from conftest import scene_of
 
 from masonry.blocks import Blocks
 from masonry.export.stl import obj_body_bytes, readback_check, stl_bytes
-from masonry.printable import OVERLAP_REL, PrintableError, grown_blocks, printable_body
-from masonry.tolerances import Tolerances
+from masonry.printable import PrintableError, grown_blocks, printable_body
+from masonry.tolerances import OVERLAP_REL, Tolerances
 
 SCENES = ("1", "2", "3", "wall")
 # float32 STL: 24-bit mantissa at coordinates up to 7 m is 5e-7 m, so volumes read back

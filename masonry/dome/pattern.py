@@ -19,8 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# slack for comparing positions in units against the section's half widths
-_EPS = 1e-9
+from masonry.tolerances import UNIT_SLACK
 
 
 @dataclass(frozen=True)
@@ -72,7 +71,7 @@ class Pattern:
 
 
 def _fits(s, half_width):
-    return (s >= -half_width - _EPS) & (s + 1 <= half_width + _EPS)
+    return (s >= -half_width - UNIT_SLACK) & (s + 1 <= half_width + UNIT_SLACK)
 
 
 def _conflicts(old, new):
@@ -122,7 +121,7 @@ def build_pattern(half_width, p: int, r: int) -> Pattern:
     pos, step = np.array(pos), np.array(step)
     # clamp the corner lines inside the first two courses (the brick spans both)
     w = half_width[1]
-    pos = np.clip(pos, np.ceil(-w - _EPS), np.floor(w + _EPS) - 1).astype(int)
+    pos = np.clip(pos, np.ceil(-w - UNIT_SLACK), np.floor(w + UNIT_SLACK) - 1).astype(int)
     alive = np.ones(len(pos), bool)
 
     course, s, line = [], [], []

@@ -46,17 +46,13 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
-from masonry.tolerances import G
+from masonry.tolerances import COEFFICIENT_NOISE, G
 
 TENSION_WEIGHT = 1.0
 """Diagonal of ``H`` for tension (thesis eq. 3.27)."""
 
 OTHER_WEIGHT = 1e-3
 """Diagonal of ``H`` for compression and friction (thesis eq. 3.27)."""
-
-COEFFICIENT_NOISE = 1e-12
-"""Scaled ``A_eq`` coefficients (unit directions, arms per ``L_ref``: of order one) at or
-below this are floating-point noise of exact zeros and are not stored."""
 
 FRICTION_METHODS = ("net", "plus")
 """``net``: friction-net, ``|f1|, |f2| <= mu (c - t)`` (thesis eq. 3.26);
