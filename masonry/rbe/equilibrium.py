@@ -282,9 +282,31 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
 
     block_row = np.full(blocks.n_blocks, -1)
     block_row[free_block] = np.arange(len(free_block))
-
     side_block = (np.asarray(interfaces.pair, dtype=np.int64) if side_block is None
                   else np.asarray(side_block, dtype=np.int64))
+    coefficients = _vertex_coefficients(blocks, interfaces, layout, side_block[
+        layout.vertex_interface], side_rotation, block_row, length_ref)
+    side_rows = np.maximum(block_row[side_block[layout.vertex_interface]], 0)
+    A_eq = _equilibrium_matrix(coefficients, side_rows, 6 * len(free_block), layout)
+
+    f_ext = np.zeros((len(free_block), 6))
+    f_ext[:, 2] = -block_weight[free_block] / weight_ref
+    lower = np.tile([0.0, 0.0, -np.inf, -np.inf], n_vertices)
+    h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], n_vertices)
+    return EquilibriumSystem(layout=layout, free_block=free_block, A_eq=A_eq,
+                             f_ext=f_ext.ravel(),
+                             lower=lower, h=h, mu=float(mu), block_weight=block_weight,
+                             weight_ref=weight_ref, length_ref=length_ref,
+                             side_row=block_row[side_block],
+                             vertex_coefficients=coefficients, density=float(density))
+
+
+def _vertex_coefficients(blocks, interfaces, layout: VariableLayout, vertex_side_block,
+                         side_rotation, block_row, length_ref: float) -> np.ndarray:
+    """(IV, 2, 6, 4) float: the scaled ``A_eq`` rows (force, moment per ``length_ref``)
+    that every vertex's ``(c, t, f1, f2)`` give the block of each side,
+    ``vertex_side_block`` ((IV, 2) int); zero for a support side (``block_row`` -1) and
+    for coefficients at or below :data:`~masonry.tolerances.COEFFICIENT_NOISE`."""
     vertex_interface = layout.vertex_interface
     point = np.asarray(interfaces.vertices, dtype=float)
     # direction of each variable's unit force on the other block: c -> n, t -> -n,
@@ -292,12 +314,9 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     normal = interfaces.normal[vertex_interface]
     direction = np.stack([normal, -normal, interfaces.t1[vertex_interface],
                           interfaces.t2[vertex_interface]], axis=1)
-
-    # every column (a vertex's c, t, f1 or f2) has six rows on each side's block: build
-    # A_eq column by column in CSC form, no triplet sort (0.1 s on preset 1's full dome)
-    side_rows, side_coefficients = [], []
+    out = []
     for side, sign in ((0, -1.0), (1, 1.0)):
-        block = side_block[vertex_interface, side]
+        block = vertex_side_block[:, side]
         side_direction, side_point = sign * direction, point
         if side_rotation is not None:
             rotation = np.asarray(side_rotation, dtype=float)[vertex_interface, side]
@@ -310,39 +329,36 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
         # (about 40% of the triplets of a wall; HiGHS warns about them and every solver
         # would carry them)
         keep = (block_row[block] >= 0)[:, None, None] & (np.abs(coeff) > COEFFICIENT_NOISE)
-        side_coefficients.append(np.where(keep, coeff, 0.0).transpose(0, 2, 1))
-        side_rows.append(np.maximum(block_row[block], 0))
+        out.append(np.where(keep, coeff, 0.0).transpose(0, 2, 1))
+    return np.stack(out, axis=1)
+
+
+def _equilibrium_matrix(coefficients, side_rows, n_rows: int,
+                        layout: VariableLayout) -> sp.csr_array:
+    """``A_eq`` ((n_rows, n) csr) from the per-vertex ``coefficients`` ((IV, 2, 6, 4))
+    and the free-block row of each side ``side_rows`` ((IV, 2) int).
+
+    Every column (a vertex's c, t, f1 or f2) has six rows on each side's block, so the
+    matrix is built column by column in CSC form, with no triplet sort.
+    """
     # rows of a column in increasing order: the side on the lower block first
-    swap = side_rows[0] > side_rows[1]
-    first = np.where(swap, side_rows[1], side_rows[0])
-    second = np.where(swap, side_rows[0], side_rows[1])
+    swap = side_rows[:, 0] > side_rows[:, 1]
+    first = np.where(swap, side_rows[:, 1], side_rows[:, 0])
+    second = np.where(swap, side_rows[:, 0], side_rows[:, 1])
     offsets = np.arange(6)
     indices = np.concatenate([6 * first[:, None] + offsets, 6 * second[:, None] + offsets],
                              axis=1)                                     # (IV, 12)
-    low = np.where(swap[:, None, None], side_coefficients[1], side_coefficients[0])
-    high = np.where(swap[:, None, None], side_coefficients[0], side_coefficients[1])
+    low = np.where(swap[:, None, None], coefficients[:, 1], coefficients[:, 0])
+    high = np.where(swap[:, None, None], coefficients[:, 0], coefficients[:, 1])
     data = np.concatenate([low, high], axis=1).transpose(0, 2, 1)       # (IV, 4, 12)
-    shape = (6 * len(free_block), layout.n_columns)
     # both sides on one block (cyclic symmetry routes an image onto the brick it copies)
     # add up; then the dropped coefficients go
     A_eq = sp.csc_array((data.ravel(), np.repeat(indices[:, None, :], layout.WIDTH, axis=1)
-                         .ravel(), np.arange(0, 12 * layout.n_columns + 1, 12)), shape=shape)
+                         .ravel(), np.arange(0, 12 * layout.n_columns + 1, 12)),
+                        shape=(n_rows, layout.n_columns))
     A_eq.sum_duplicates()
     A_eq.eliminate_zeros()
-    A_eq = A_eq.tocsr()
-
-    f_ext = np.zeros((len(free_block), 6))
-    f_ext[:, 2] = -block_weight[free_block] / weight_ref
-
-    lower = np.tile([0.0, 0.0, -np.inf, -np.inf], n_vertices)
-    h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], n_vertices)
-    return EquilibriumSystem(layout=layout, free_block=free_block, A_eq=A_eq,
-                             f_ext=f_ext.ravel(),
-                             lower=lower, h=h, mu=float(mu), block_weight=block_weight,
-                             weight_ref=weight_ref, length_ref=length_ref,
-                             side_row=block_row[side_block],
-                             vertex_coefficients=np.stack(side_coefficients, axis=1),
-                             density=float(density))
+    return A_eq.tocsr()
 
 
 def friction_pyramids(n_vertices: int, mu: float) -> dict:
