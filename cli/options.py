@@ -5,9 +5,6 @@ import argparse
 from masonry.params import (ACCURACIES, ARCH_SHAPES, BOUNDARIES, FRICTIONS, PRESETS,
                             SCENES, SOLVERS, Params, from_preset, load, validate)
 
-GEOMETRY = ("stretch", "n", "r", "p", "cut", "unit", "min_fill", "wall_length",
-            "wall_courses")
-
 
 class Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit code 2."""

@@ -421,5 +421,5 @@ def _newell(polygons):
 
 def _sum_by(index, values, n) -> np.ndarray:
     """(n, C) float: ``out[i]`` is the sum of the rows of ``values`` (N, C) whose ``index``
-    is ``i``; ``np.add.at`` in the same order, one bincount per column (5x faster)."""
+    is ``i``; ``np.add.at`` in the same order, one bincount per column (faster: docs/bench.md)."""
     return np.stack([np.bincount(index, column, minlength=n) for column in values.T], axis=1)

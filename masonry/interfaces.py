@@ -11,12 +11,10 @@ Why the polygons are clipped here and not by shapely (GEOS), unlike SPEC 5 step 
 every pair is a pair of convex polygons, and in masonry they share edges and corners as
 a rule. GEOS's overlay has no tolerance: it returned two points for two coincident
 quadrilaterals 3e-17 m apart, and a polygon plus a 1e-12 m line elsewhere, so it needed
-a snap-rounding retry wherever the result was not one polygon. On the 28,600 face pairs
-of preset 1's full dome that took 0.6 s (overlay 0.37 s, retries 0.1 s, building the
-shapely polygons 0.07 s), where issue 8 gives this whole stage 0.3 s. Convex clipping
-of all pairs at once (:func:`_clip_convex`, Sutherland-Hodgman with a point-on-line
-tolerance) takes 0.11 s there and has no degenerate cases. Shapely stays its reference
-in the tests (``test_convex_clipping_matches_shapely``).
+a snap-rounding retry wherever the result was not one polygon, and was several times
+slower (docs/bench.md). Convex clipping of all pairs at once (:func:`_clip_convex`,
+Sutherland-Hodgman with a point-on-line tolerance) has no degenerate cases. Shapely
+stays its reference in the tests (``test_convex_clipping_matches_shapely``).
 """
 
 from dataclasses import dataclass

@@ -18,8 +18,8 @@ method (SPEC 7):
    union is cleaned here: edges shorter than ``tol.contact`` are collapsed, then
    ``simplify(tol.contact)`` swaps away degenerate triangles and drops redundant
    coplanar vertices (a quarter of the triangles), repeated until no short edge is left.
-3. ``Manifold.decompose()`` is far too slow for a body count (110 s and 15.6 GB on
-   10,000 shells); bodies are counted on the mesh's connectivity (trimesh's
+3. ``Manifold.decompose()`` is far too slow and memory-hungry for a body count
+   (docs/bench.md); bodies are counted on the mesh's connectivity (trimesh's
    ``body_count``) instead.
 
 The result is verified, not assumed: watertight, consistently wound, one body, no

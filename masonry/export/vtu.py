@@ -77,8 +77,7 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
 
     # meshio writes to paths only (and drops field data in VTU), so the file is
     # written to a temporary folder and the kind legend goes into a comment. Not
-    # compressed: zlib took 0.2 s of a dome's 0.25 s (17,728 interfaces), for a file
-    # 4 times smaller (1.8 MB against 6.8 MB)
+    # compressed: zlib would take most of the export's time (docs/bench.md)
     with tempfile.TemporaryDirectory() as folder:
         path = os.path.join(folder, "interfaces.vtu")
         meshio.write(path, mesh, file_format="vtu", binary=True, compression=None)

@@ -245,7 +245,8 @@ class EquilibriumSystem:
 
 def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
              side_rotation=None) -> EquilibriumSystem:
-    """Assemble the scaled RBE matrices (vectorized: ``A_eq`` built column by column in CSC form).
+    """Assemble the scaled RBE matrices (vectorized: ``A_eq`` built column by column in
+    CSC form).
 
     Parameters
     ----------
