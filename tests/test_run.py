@@ -8,7 +8,11 @@ import numpy as np
 import pytest
 import trimesh
 
-from masonry.params import from_preset
+from masonry.export import EXPORTERS, RunOutputs
+from masonry.params import from_preset, validate
+from masonry.pipeline import Timer, write_exports
+from masonry.rbe.boundary import analysis_model
+from masonry.rbe.solve import RBEProblem
 from masonry.scenes import build
 from masonry_cli.main import main
 
@@ -40,6 +44,50 @@ def test_run_writes_every_output(wall_run):
     assert record["printable"]["readback"]["bodies"] == 1
     text = (folder / "RBE/00_objective.txt").read_text()
     assert "feasible" in text and "MoI factor" in text and "friction-net" in text
+
+
+def wall_outputs(plots, printable):
+    """What ``masonry run --preset wall --fast`` makes, built here step by step."""
+    params = validate(from_preset("wall", fast=True))
+    scene = build(params)
+    model = analysis_model(scene)
+    result = RBEProblem(model.blocks, model.interfaces).solve(
+        mu=params.mu, density=params.density, friction=params.friction,
+        solver=params.solver, accuracy=params.solver_accuracy)
+    return RunOutputs(scene, model, result, result.per_interface(), plots=plots,
+                      printable=printable)
+
+
+class RecordingFolder:
+    """Stands in for a RunFolder: keeps what is written."""
+
+    def __init__(self):
+        self.files = {}
+
+    def write(self, relative, data):
+        assert relative not in self.files, f"{relative} written twice"
+        self.files[relative] = data
+
+
+def test_the_run_writes_what_the_registry_makes(wall_run):
+    """The expected files come from the registry's exporters themselves: each one the
+    run wants writes exactly its files, the others none, and the CLI's run folder holds
+    the same files (byte for byte where no time is recorded in them)."""
+    _, folder = wall_run
+    made = wall_outputs(plots=False, printable=False)
+    wanted = [e for e in EXPORTERS if e.wanted(made)]
+    assert {e.stage for e in wanted} == {"exports"}  # plots and the printable body are off
+    expected = {}
+    for exporter in wanted:
+        expected.update(exporter.make(made).files)
+    recorder, record = RecordingFolder(), {}
+    write_exports(recorder, made, record, Timer())
+    assert recorder.files.keys() == expected.keys()
+    for name, data in expected.items():
+        assert (folder / name).is_file(), name
+        if name.endswith((".csv", ".obj", ".vtu")):
+            data = data.encode() if isinstance(data, str) else data
+            assert (folder / name).read_bytes() == data, name
 
 
 def _forces_table(folder):
