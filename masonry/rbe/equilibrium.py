@@ -81,18 +81,22 @@ class VariableLayout:
 
     @classmethod
     def from_interfaces(cls, interfaces) -> "VariableLayout":
+        """The layout of ``interfaces`` (:class:`masonry.interfaces.Interfaces`)."""
         return cls(np.asarray(interfaces.offsets, dtype=np.int64))
 
     @property
     def n_interfaces(self) -> int:
+        """``K``, the number of interfaces."""
         return len(self.offsets) - 1
 
     @property
     def n_vertices(self) -> int:
+        """``IV``, the number of interface vertices (all interfaces)."""
         return int(self.offsets[-1])
 
     @property
     def n_columns(self) -> int:
+        """``n = 4 IV``, the length of ``x``."""
         return self.WIDTH * self.n_vertices
 
     @cached_property
@@ -105,7 +109,7 @@ class VariableLayout:
         return self.WIDTH * np.arange(self.n_vertices) + self.COMPONENTS.index(component)
 
     def vertex_columns(self, vertex: int) -> slice:
-        """Columns ``(c, t, f1, f2)`` of one vertex."""
+        """Columns ``(c, t, f1, f2)`` of vertex ``vertex`` (int), as a slice of ``x``."""
         return slice(self.WIDTH * vertex, self.WIDTH * (vertex + 1))
 
     def component(self, x, component: str) -> np.ndarray:
@@ -188,7 +192,20 @@ class EquilibriumSystem:
         """The same scene with another friction coefficient or density, without
         assembling again: ``mu`` changes only the pyramids, and ``density`` only the
         newtons per solver unit (the scaled ``A_eq`` and ``f_ext`` depend on neither,
-        since the reference weight grows with the density)."""
+        since the reference weight grows with the density).
+
+        Parameters
+        ----------
+        mu : float, optional
+            Friction coefficient; default unchanged.
+        density : float, kg/m^3, optional
+            Default unchanged.
+
+        Returns
+        -------
+        EquilibriumSystem
+            ``self`` when nothing changes.
+        """
         out = self
         if mu is not None and float(mu) != self.mu:
             out = dataclasses.replace(out, mu=float(mu))
@@ -226,11 +243,11 @@ class EquilibriumSystem:
         return self.h / OTHER_WEIGHT
 
     def to_scaled(self, x) -> np.ndarray:
-        """Variables in newtons -> solver units."""
+        """(n,) float: variables ``x`` in newtons ((n,) float) -> solver units."""
         return np.asarray(x, dtype=float) / self.weight_ref
 
     def to_newtons(self, x_scaled) -> np.ndarray:
-        """Solver units -> newtons."""
+        """(n,) float: variables in solver units ((n,) float) -> newtons."""
         return np.asarray(x_scaled, dtype=float) * self.weight_ref
 
     def contact_wrench(self, x) -> np.ndarray:
@@ -251,7 +268,9 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     Parameters
     ----------
     blocks : masonry.blocks.Blocks
+        ``B`` blocks, metres; supports (``block_is_support``) get no equilibrium rows.
     interfaces : masonry.interfaces.Interfaces
+        ``K`` interfaces with ``IV`` vertices in all, metres.
     mu : float
         Friction coefficient (thesis ``alpha``).
     density : float, kg/m^3
@@ -268,6 +287,12 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     Returns
     -------
     EquilibriumSystem
+        ``A_eq`` (6 F, 4 IV) and ``f_ext`` (6 F,) scaled, for the ``F`` free blocks.
+
+    Raises
+    ------
+    ValueError
+        When every block is a support.
     """
     layout = VariableLayout.from_interfaces(interfaces)
     n_vertices = layout.n_vertices
@@ -364,7 +389,21 @@ def _equilibrium_matrix(coefficients, side_rows, n_rows: int,
 
 def friction_pyramids(n_vertices: int, mu: float) -> dict:
     """``A_fr['net']`` and ``A_fr['plus']`` (thesis eq. 3.26, 3.25): 4 rows per vertex,
-    ``A_fr x <= 0``, rows ``+f1, -f1, +f2, -f2`` over columns ``(c, t, f1, f2)``."""
+    ``A_fr x <= 0``, rows ``+f1, -f1, +f2, -f2`` over columns ``(c, t, f1, f2)``.
+
+    Parameters
+    ----------
+    n_vertices : int
+        ``IV``, interface vertices.
+    mu : float
+        Friction coefficient (thesis ``alpha``), dimensionless.
+
+    Returns
+    -------
+    dict str -> (4 IV, 4 IV) scipy.sparse.csr_array
+        ``'net'``: ``|f1|, |f2| <= mu (c - t)``; ``'plus'``: ``|f1|, |f2| <= mu c``.
+        Dimensionless, so valid for ``x`` in newtons or in solver units.
+    """
     pyramid_net = np.array([[-mu, mu, 1.0, 0.0],
                             [-mu, mu, -1.0, 0.0],
                             [-mu, mu, 0.0, 1.0],
