@@ -152,7 +152,19 @@ box). Its three unit face normals are independent when the absolute determinant 
 their matrix exceeds this; a corner of nearly parallel faces goes to the halfspace path,
 which has no conditioning issue (:func:`masonry.printable.grown_blocks`)."""
 
+# ---------------------------------------------------------------------- exports
+READBACK_VOLUME_RTOL = 1e-5
+"""The printable body read back from its STL as a slicer would (float32 vertices, merged)
+must keep the union's volume within this fraction
+(:func:`masonry.export.stl.readback_check`). Float32 rounding moves a vertex of an 8 m
+dome by about 5e-7 m; the measured changes are -8.3e-8 (section of preset 1), -3.5e-8
+(preset 3) and -7.8e-8 (the wall)."""
+
 # ---------------------------------------------------------------------- studies
+THICKNESS_BRACKET = (0.01, 0.8)
+"""Default starting ``(infeasible, feasible)`` thickness ratios ``t/R`` of the arch's
+minimum-thickness bisection (:func:`masonry.studies.thickness.minimum_thickness`)."""
+
 THICKNESS_RTOL = 1e-4
 """Default relative width of the final bracket of the arch's minimum-thickness
 bisection (:func:`masonry.studies.thickness.minimum_thickness`, ``masonry
@@ -162,3 +174,22 @@ THICKNESS_LIMIT_FRACTION = 0.99
 """The thickest arch the bisection starts from is at most this fraction of the
 thickness at which the shape's intrados vanishes
 (:func:`masonry.studies.thickness.minimum_thickness`)."""
+
+THRUST_SCAN = (1e-3, 0.999, 60)
+"""The thrust-line minimum thickness scans ``t/R`` on a geometric grid of 60 points
+from 1e-3 up to 0.999 of the ratio at which the intrados vanishes, for the first
+thickness a thrust line fits, before refining it by root finding
+(:func:`masonry.studies.thrust_line.thrust_line_minimum_thickness`)."""
+
+THRUST_XTOL = 1e-12
+"""Default absolute tolerance on ``t/R`` of that refinement (Brent's ``xtol``)."""
+
+THRUST_MARGIN_XATOL_REL = 1e-13
+"""Absolute tolerance of the bounded search for the thrust ``H`` that maximises the
+thrust line's margin, relative to the half arch's total weight
+(:func:`masonry.studies.thrust_line.thrust_line_margin`)."""
+
+THRUST_ACTIVE_REL = 1e-7
+"""A joint's intrados or extrados bound is active at the best thrust line when the line
+passes within this fraction of (total weight x R) of it
+(:func:`masonry.studies.thrust_line.thrust_line_margin`)."""

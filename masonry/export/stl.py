@@ -12,6 +12,7 @@ import io
 import numpy as np
 
 from masonry.printable import PrintableError
+from masonry.tolerances import READBACK_VOLUME_RTOL
 
 
 def stl_bytes(mesh) -> bytes:
@@ -32,7 +33,7 @@ def obj_body_bytes(mesh, name="dome") -> bytes:
     return (f"# masonry printable body, metres, z up\no {name}\n" + text).encode()
 
 
-def readback_check(stl: bytes, volume_m3=None, rtol=0.01) -> dict:
+def readback_check(stl: bytes, volume_m3=None, rtol=READBACK_VOLUME_RTOL) -> dict:
     """Load STL bytes as a slicer would (trimesh, vertices merged) and check the body.
 
     Parameters
