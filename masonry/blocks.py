@@ -25,6 +25,12 @@ BLOCK_CLASSES = ("ground", "regular", "pattern", "fill_in", "block")
 GROUND = BLOCK_CLASSES.index("ground")
 """``block_class`` code of a ground slab or support block."""
 
+PATTERN = BLOCK_CLASSES.index("pattern")
+"""``block_class`` code of a pattern (herringbone) brick, two courses high."""
+
+BLOCK = BLOCK_CLASSES.index("block")
+"""``block_class`` code of an imported or scene block (an arch's voussoir)."""
+
 # Corner order of a hexahedral brick: index = ix + 2 * iy + 4 * iz, with local axes
 # x = through the wall (0 inner, 1 outer), y = along the wall, z = up the course.
 HEX_FACES = np.array(
@@ -161,7 +167,7 @@ class Blocks:
         block_class = block_class.astype(np.int8)
         block_course = (np.zeros(count, int) if block_course is None
                         else np.asarray(block_course, dtype=int))
-        block_is_support = (block_class == BLOCK_CLASSES.index("ground")
+        block_is_support = (block_class == GROUND
                             if block_is_support is None
                             else np.asarray(block_is_support, dtype=bool))
         block_web = np.zeros(count, int) if block_web is None else np.asarray(block_web, int)

@@ -14,7 +14,7 @@ import numpy as np  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
-from masonry.blocks import BLOCK_CLASSES  # noqa: E402
+from masonry.blocks import BLOCK_CLASSES, PATTERN  # noqa: E402
 
 CLASS_COLOURS = {
     "ground": "#9e9e9e",
@@ -45,7 +45,7 @@ def pattern_png(scene, fast=False) -> bytes:
     against course, pattern, regular and fill-in bricks in distinct colours, the web's
     half width at every course in blue."""
     layout, levels, unit = scene.layout, scene.levels, scene.params.unit
-    height = np.where(layout.klass == BLOCK_CLASSES.index("pattern"), 2, 1)
+    height = np.where(layout.klass == PATTERN, 2, 1)
     # mitered ends reach the web's boundary (at the course's lower, wider edge)
     w_low = levels.y[layout.course - 1] / unit
     s0 = np.where(layout.miter_left, -w_low, layout.s0)
@@ -66,7 +66,7 @@ def pattern_png(scene, fast=False) -> bytes:
     ax.set_xlim(-w.max() - 1, w.max() + 1)
     ax.set_ylim(-0.5, len(w) + 0.5)
     ax.set_title(f"{scene.params.scene}: {len(layout)} bricks, "
-                 f"{int((layout.klass == BLOCK_CLASSES.index('pattern')).sum())} pattern")
+                 f"{int((layout.klass == PATTERN).sum())} pattern")
     return _png(fig, 80 if fast else 130)
 
 
@@ -109,7 +109,7 @@ def structure_pngs(scene, fast=False) -> dict:
     view at lower resolution when ``fast``."""
     blocks = scene.blocks
     bounds = blocks.bounds
-    pattern = blocks.block_class == BLOCK_CLASSES.index("pattern")
+    pattern = blocks.block_class == PATTERN
     stages = {"3_structure": np.ones(blocks.n_blocks, bool)}
     if pattern.any():
         stages = {"1_boundaries": np.zeros(blocks.n_blocks, bool),

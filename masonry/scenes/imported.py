@@ -39,7 +39,7 @@ from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
-from masonry.blocks import BLOCK_CLASSES, Blocks, concatenate, tangent_basis
+from masonry.blocks import BLOCK, BLOCK_CLASSES, Blocks, concatenate, tangent_basis
 from masonry.meshing import merge_vertices
 from masonry.params import validate
 from masonry.scenes.base import Scene
@@ -708,7 +708,7 @@ def _unique_names(names):
 def _classes_from_names(names):
     """(B,) class and course from our own names (``b0042_regular_c12``), else ``block``
     and 0."""
-    block_class = np.full(len(names), BLOCK_CLASSES.index("block"), dtype=np.int8)
+    block_class = np.full(len(names), BLOCK, dtype=np.int8)
     block_course = np.zeros(len(names), int)
     for i, name in enumerate(names):
         match = OUR_NAME.match(name)
