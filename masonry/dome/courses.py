@@ -196,6 +196,15 @@ def _sequences(course, w, cells, pattern_ends) -> list:
     return out
 
 
+def _pieces(candidates, start, length, below, min_fill):
+    """The pieces of a sequence of ``length`` units from ``start``: the best of
+    ``candidates(length, min_fill)`` against the joints ``below``, or one piece shorter
+    than ``min_fill`` (then True) when the sequence is that short."""
+    if length < min_fill - UNIT_SLACK:
+        return [length], True
+    return _choose(candidates(length, min_fill), start, below), False
+
+
 def _fill_course(rows, course, sequences, below, min_fill, miter):
     """Append the regular and fill-in bricks of one course's ``sequences`` to ``rows``,
     mirror-symmetric about ``s = 0``; return its sorted joints and the number of fill-ins
@@ -203,21 +212,15 @@ def _fill_course(rows, course, sequences, below, min_fill, miter):
     joints, short = [], 0
     for u, v, u_bound, v_bound in sequences:
         if v <= UNIT_SLACK:  # left half: fill, then mirror
-            if v - u < min_fill - UNIT_SLACK:
-                pieces = [v - u]
-                short += 2
-            else:
-                pieces = _choose(_side_candidates(v - u, min_fill), u, below)
+            pieces, too_short = _pieces(_side_candidates, u, v - u, below, min_fill)
+            short += 2 * too_short
             joints += _lay(rows, course, u, pieces, miter and u_bound, miter and v_bound)
             if u < -UNIT_SLACK or v < -UNIT_SLACK:  # its mirror image on the right
                 joints += _lay(rows, course, -v, pieces[::-1], miter and v_bound,
                                miter and u_bound)
         elif u < -UNIT_SLACK:  # the centre sequence
-            if v - u < min_fill - UNIT_SLACK:
-                pieces = [v - u]
-                short += 1
-            else:
-                pieces = _choose(_centre_candidates(v - u, min_fill), u, below)
+            pieces, too_short = _pieces(_centre_candidates, u, v - u, below, min_fill)
+            short += too_short
             joints += _lay(rows, course, u, pieces, miter and u_bound, miter and v_bound)
     return np.sort(np.array(joints)), short
 
