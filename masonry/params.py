@@ -11,6 +11,8 @@ import math
 import tomllib
 from dataclasses import dataclass
 
+from masonry.tolerances import STRETCH_USUAL_RANGE
+
 log = logging.getLogger(__name__)
 
 SCENES = ("section", "wall", "dome", "assembly", "arch")
@@ -184,9 +186,10 @@ def validate(params: Params) -> Params:
     if p.scene == "assembly":
         _check("assembly", p.assembly, bool(p.assembly),
                "the name of an imported model (masonry analyze sets it)")
-    if p.scene in ("section", "dome") and not 0.2 <= p.stretch <= 5:
-        log.warning("stretch=%g is outside 0.2..5: the dome is unusually flat or tall",
-                    p.stretch)
+    low, high = STRETCH_USUAL_RANGE
+    if p.scene in ("section", "dome") and not low <= p.stretch <= high:
+        log.warning("stretch=%g is outside %g..%g: the dome is unusually flat or tall",
+                    p.stretch, low, high)
     return p
 
 

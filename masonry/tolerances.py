@@ -69,6 +69,12 @@ class Tolerances:
         return cls(scale=scale if scale > 0 else 1.0, **kwargs)
 
 
+# ---------------------------------------------------------------------- inputs
+STRETCH_USUAL_RANGE = (0.2, 5.0)
+"""Dome height over circumradius outside this range is accepted with a warning
+(:func:`masonry.params.validate`): the thesis's structures have 0.8 to 2.0, and beyond
+the range the dome is unusually flat or tall."""
+
 # ---------------------------------------------------------------------- model (dome/)
 UNIT_SLACK = 1e-9
 """Brick units. Positions along the flattened section (pattern cells, joints, the
