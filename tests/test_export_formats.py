@@ -60,7 +60,8 @@ def check_vtu_round_trip(interfaces, forces, tmp_path):
     assert sum(len(block.data) for block in mesh.cells) == len(interfaces)
     data = {name: np.concatenate(arrays) for name, arrays in mesh.cell_data.items()}
     row = data["interface"]
-    np.testing.assert_array_equal(np.sort(row), np.arange(len(interfaces)))
+    # cells in interface order: the rows of interfaces.csv and forces.csv
+    np.testing.assert_array_equal(row, np.arange(len(interfaces)))
     expected = dict(forces, kind=interfaces.kind, area=interfaces.area,
                     frame_normal=interfaces.normal, frame_t1=interfaces.t1,
                     frame_t2=interfaces.t2)
@@ -91,12 +92,20 @@ def test_vtu_round_trips_the_interfaces_of_preset_1(tmp_path):
     check_vtu_round_trip(interfaces, random_forces(len(interfaces), seed=1), tmp_path)
 
 
-def test_vtu_names_the_kinds_and_is_binary():
+def test_vtu_names_the_kinds_in_field_data_and_is_binary(tmp_path):
     data = interfaces_vtu(polygon_interfaces(), {})
-    legend = ", ".join(f"{code} {name}" for code, name in enumerate(INTERFACE_KINDS))
-    assert f"<!--masonry interfaces, kind: {legend}-->".encode() in data
+    mesh = read_vtu(data, tmp_path)
+    assert {name: int(value[0]) for name, value in mesh.field_data.items()} == {
+        f"kind_{name}": code for code, name in enumerate(INTERFACE_KINDS)}
     # binary, not compressed (zlib was most of a run's export time)
     assert b'format="binary"' in data and b"compressor" not in data
+
+
+def test_vtu_takes_vector_cell_data(tmp_path):
+    interfaces = polygon_interfaces()
+    shear = np.random.default_rng(2).normal(size=(len(interfaces), 3))
+    mesh = read_vtu(interfaces_vtu(interfaces, {"shear": shear}), tmp_path)
+    np.testing.assert_array_equal(np.concatenate(mesh.cell_data["shear"]), shear)
 
 
 def test_vtu_rejects_bad_forces():

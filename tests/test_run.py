@@ -60,6 +60,45 @@ def test_interfaces_vtu_round_trips_with_the_forces(wall_run):
         np.testing.assert_allclose(values, table[f"{name}_N"][order], rtol=1e-9, atol=1e-9)
 
 
+# every column of interfaces.csv and forces.csv and its pandas type: the same in every run
+INTEGER_COLUMNS = ("id", "block_a", "block_b", "course_a", "course_b", "vertices")
+TEXT_COLUMNS = ("name_a", "name_b", "kind")
+
+
+def test_tables_keep_their_column_types_and_vtu_order(wall_run):
+    """A wall carries no tension: its tension column is all zeros and must still read as
+    floats; forces.csv, interfaces.csv and the VTU cells are in the same order."""
+    pandas = pytest.importorskip("pandas")
+    _, folder = wall_run
+    forces = pandas.read_csv(folder / "RBE/forces.csv")
+    interfaces = pandas.read_csv(folder / "interfaces.csv")
+    assert (forces["tension_N"].abs() < 1e-6 * forces["compression_N"].max()).all()
+    for table in (forces, interfaces):
+        for column, dtype in table.dtypes.items():
+            expected = ("i" if column in INTEGER_COLUMNS else
+                        "O" if column in TEXT_COLUMNS else "f")
+            assert (dtype.kind if expected != "O" else dtype.kind in "OT"
+                    and "O") == expected, (column, dtype)
+    shared = [c for c in interfaces.columns if c != "vertices"]
+    pandas.testing.assert_frame_equal(forces[shared], interfaces[shared])
+    np.testing.assert_array_equal(forces["id"], np.arange(len(forces)))
+    mesh = meshio.read(folder / "RBE/interfaces.vtu")
+    np.testing.assert_array_equal(np.concatenate(mesh.cell_data["interface"]), forces["id"])
+    for name in ("compression", "tension", "normal", "friction"):
+        np.testing.assert_allclose(np.concatenate(mesh.cell_data[name]),
+                                   forces[f"{name}_N"], rtol=1e-11, atol=1e-9)
+    # every force column says its unit; the resultant carries the normal force
+    assert all(c.endswith(("_N", "_Nm")) for c in forces.columns if c.startswith(
+        ("compression", "tension", "t1_N", "t2_N", "friction", "shear", "torsion")))
+    shear = forces[["shear_x_N", "shear_y_N", "shear_z_N"]].to_numpy()
+    np.testing.assert_allclose(np.linalg.norm(shear, axis=1), forces["friction_N"],
+                               rtol=1e-9, atol=1e-9)
+    # no tension: every resultant within its joint; none where no force passes
+    e = forces["eccentricity"]
+    assert ((e.dropna() >= 0) & (e.dropna() <= 1 + 1e-9)).all()
+    assert (forces["compression_N"][e.isna()] <= 1e-9 * forces["compression_N"].max()).all()
+
+
 def test_bricks_obj_round_trips(wall_run):
     _, folder = wall_run
     blocks = build(from_preset("wall")).blocks

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from masonry import plots
 from masonry.export import csv, obj, rhino, stl, summaries, vtu
 from masonry.printable import printable_blocks, printable_body
+from masonry.rbe.resultants import interface_resultants
 
 log = logging.getLogger(__name__)
 
@@ -93,9 +94,14 @@ def _rbe_files(made: RunOutputs) -> Export:
     files = {"RBE/00_objective.txt": summaries.objective_text(made.result)}
     if made.forces is not None:
         blocks, interfaces = made.model.blocks, made.model.interfaces
-        files["RBE/forces.csv"] = csv.forces_csv(blocks, interfaces, made.forces)
+        resultants = interface_resultants(interfaces, made.result.layout, made.result.x)
+        files["RBE/forces.csv"] = csv.forces_csv(blocks, interfaces, made.forces, resultants)
         if len(interfaces):
-            files["RBE/interfaces.vtu"] = vtu.interfaces_vtu(interfaces, made.forces)
+            cell_data = {**made.forces, "shear": resultants["shear"],
+                         "point": resultants["point"],
+                         "eccentricity": resultants["eccentricity"],
+                         "torsion": resultants["torsion"]}
+            files["RBE/interfaces.vtu"] = vtu.interfaces_vtu(interfaces, cell_data)
     return Export(files)
 
 
