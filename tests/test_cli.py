@@ -106,3 +106,10 @@ def test_cad_offset_moves_bricks_inward(tmp_path):
     moved = scene.cad_vertices() - scene.blocks.vertices
     np.testing.assert_allclose(np.linalg.norm(moved, axis=1), 0.1, rtol=1e-12)
     assert np.all(moved[:, 0] < 0)  # the section faces +x: inward is -x
+    # run.json says which files are moved and by how much
+    from masonry.pipeline import coordinates_record
+
+    record = coordinates_record(scene)
+    assert record["cad_offset_m"] == pytest.approx(0.1, rel=1e-12)
+    assert {"locations.csv", "dome.stl"} <= set(record["moved_inward"])
+    assert {"bricks.obj", "bricks.3dm", "RBE/forces.csv"} <= set(record["model"])

@@ -37,6 +37,11 @@ def test_run_writes_every_output(wall_run):
     assert record["counts"]["interfaces"] == {"horizontal": 144, "vertical": 75,
                                               "support": 8, "boundary": 0}
     assert record["printable"]["readback"]["watertight"]
+    # the record says by how much locations.csv is moved from the model's bricks
+    scene = build(from_preset("wall"))
+    shift = np.linalg.norm(scene.cad_vertices() - scene.blocks.vertices, axis=1)
+    assert record["coordinates"]["cad_offset_m"] == pytest.approx(shift.max(), rel=1e-12)
+    assert "locations.csv" in record["coordinates"]["moved_inward"]
     assert record["printable"]["readback"]["bodies"] == 1
     text = (folder / "RBE/00_objective.txt").read_text()
     assert "feasible" in text and "MoI factor" in text and "friction-net" in text

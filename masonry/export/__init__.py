@@ -87,7 +87,9 @@ def _rhino_files(made: RunOutputs) -> Export:
     if not rhino.available():
         log.info("bricks.3dm skipped: pip install 'masonry[rhino]' to write it")
         return Export({})
-    return Export({"bricks.3dm": rhino.blocks_3dm(made.scene.blocks)})
+    blocks = made.scene.blocks
+    text = rhino.block_user_text(blocks, made.model, made.forces)
+    return Export({"bricks.3dm": rhino.blocks_3dm(blocks, user_text=text)})
 
 
 def _rbe_files(made: RunOutputs) -> Export:
