@@ -223,3 +223,18 @@ def test_obj_body_round_trips():
     assert back.is_watertight and back.body_count == 1
     # 8 decimals in metres
     assert back.volume == pytest.approx(report["volume_m3"], rel=1e-7)
+
+
+# ---------------------------------------------------------------------- 3MF
+@pytest.mark.parametrize("name, size_mm", [("wall", 150.0), ("1", 180.0)])
+def test_3mf_reads_back_in_millimetres_at_the_print_size(name, size_mm):
+    from masonry.export.threemf import readback_3mf, threemf_bytes
+
+    mesh, report, _, _ = body_of(name)
+    back = readback_3mf(threemf_bytes(mesh, size_mm))
+    assert back["unit"] == "millimeter" and back["objects"] == 1 and back["watertight"]
+    assert max(back["extents_mm"]) == pytest.approx(size_mm, rel=1e-6)
+    scale = size_mm / np.ptp(mesh.vertices, axis=0).max()  # mm per metre
+    np.testing.assert_allclose(back["extents_mm"], np.ptp(mesh.vertices, axis=0) * scale,
+                               rtol=1e-6)
+    assert back["volume_mm3"] == pytest.approx(report["volume_m3"] * scale ** 3, rel=1e-5)

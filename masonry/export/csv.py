@@ -4,6 +4,10 @@ import numpy as np
 
 from masonry.blocks import BLOCK_CLASSES, Blocks
 from masonry.export._text import format_floats
+from masonry.tolerances import TENSION_REPORTED_REL
+
+TENSION_TOP_COUNT = 20
+"""Rows of ``RBE/tension_top.csv``: the interfaces with the largest tension."""
 
 
 def _table(columns) -> bytes:
@@ -104,3 +108,37 @@ def forces_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict) -> by
                   + _xyz("point", resultants["point"], "m")
                   + [("eccentricity", resultants["eccentricity"]),
                      ("torsion_Nm", resultants["torsion"])])
+
+
+def tension_top(forces: dict, weight_N: float, count=TENSION_TOP_COUNT) -> np.ndarray:
+    """Interfaces with the largest tension, largest first: at most ``count``, each above
+    :data:`~masonry.tolerances.TENSION_REPORTED_REL` of ``weight_N``.
+
+    Returns
+    -------
+    (m,) int
+        Interface ids, ``m <= count`` (none for a feasible structure).
+    """
+    tension = np.asarray(forces["tension"], dtype=float)
+    order = np.argsort(-tension, kind="stable")[:count]
+    return order[tension[order] > TENSION_REPORTED_REL * weight_N]
+
+
+def tension_top_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict,
+                    top) -> bytes:
+    """``RBE/tension_top.csv``: where the structure fails, one row per interface of
+    ``top`` (:func:`tension_top`): rank, the interface's columns of ``forces.csv``
+    (blocks, their names and courses, kind, centre), its tension, compression, normal
+    force and eccentricity. Only the header when nothing is in tension."""
+    from masonry.interfaces import INTERFACE_KINDS
+
+    top = np.asarray(top, dtype=np.int64)
+    a, b = interfaces.pair[top, 0], interfaces.pair[top, 1]
+    return _table([("rank", np.arange(1, len(top) + 1)), ("id", top),
+                   ("name_a", blocks.block_name[a]), ("name_b", blocks.block_name[b]),
+                   ("course_a", blocks.block_course[a]), ("course_b", blocks.block_course[b]),
+                   ("kind", np.array(INTERFACE_KINDS, dtype=object)[interfaces.kind[top]]),
+                   *((f"{n}_N", np.asarray(forces[n], dtype=float)[top])
+                     for n in ("tension", "compression", "normal")),
+                   ("eccentricity", resultants["eccentricity"][top]),
+                   *_xyz("centre", interfaces.centre[top], "m")])
