@@ -18,6 +18,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.collections import PolyCollection  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
@@ -33,15 +34,13 @@ CLASS_COLOURS = {
     "block": "#c9b79c",
 }
 
-# folder: (elevation, azimuth, the axis pointing at the viewer): the thesis's four views
-# (section 3.4); the three elevations are orthographic and hide the axis seen end on (its
-# tick labels would pile up in one spot)
-VIEWS = {
-    "01_angle": (25, -50, None),
-    "02_front": (0, 0, "x"),
-    "03_top": (90, -90, "z"),
-    "04_side": (0, -90, "y"),
-}
+# the thesis's four views (section 3.4): a 3D view from an angle (elevation, azimuth in
+# degrees) and three elevations, drawn as 2D projections at equal scale (3D axes seen
+# end on pile their tick labels up): (horizontal axis, vertical axis, depth axis, +1 when
+# a larger depth coordinate is nearer the viewer)
+VIEWS = ("01_angle", "02_front", "03_top", "04_side")
+ANGLE = (25, -50)
+ELEVATIONS = {"02_front": (1, 2, 0, 1), "03_top": (0, 1, 2, 1), "04_side": (0, 2, 1, -1)}
 
 COLOUR_PERCENTILE = 99.0
 """Colour scales end at this percentile of the plotted magnitudes: a few support values
@@ -117,8 +116,23 @@ def _faces_3d(blocks, mask):
     return polys, colours
 
 
-def _axes3d(bounds, view):
-    """3D axes on ``bounds`` ((2, 3) float, metres) at equal scale in x, y and z."""
+def _axes(bounds, view):
+    """Axes for ``view`` on ``bounds`` ((2, 3) float, metres), equal scale."""
+    if view not in ELEVATIONS:
+        return _axes3d(bounds)
+    h, v, _, _ = ELEVATIONS[view]
+    fig, ax = plt.subplots(figsize=(7, 6))
+    margin = 0.03 * float(np.ptp(bounds, axis=0).max())
+    ax.set_xlim(bounds[0, h] - margin, bounds[1, h] + margin)
+    ax.set_ylim(bounds[0, v] - margin, bounds[1, v] + margin)
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"{'xyz'[h]} [m]")
+    ax.set_ylabel(f"{'xyz'[v]} [m]")
+    return fig, ax
+
+
+def _axes3d(bounds):
+    """3D axes from :data:`ANGLE` on ``bounds`` at equal scale in x, y and z."""
     fig = plt.figure(figsize=(7, 7))
     ax = fig.add_subplot(projection="3d")
     # the box follows the extents (a cube around a flat dome leaves half the figure
@@ -130,15 +144,48 @@ def _axes3d(bounds, view):
     ax.set_ylim(low[1], high[1])
     ax.set_zlim(low[2], high[2])
     ax.set_box_aspect(tuple(extent))
-    elevation, azimuth, hidden = VIEWS[view]
-    ax.view_init(elevation, azimuth)
+    ax.view_init(*ANGLE)
     for axis in "xyz":
         getattr(ax, f"set_{axis}label")(f"{axis} [m]")
-    if hidden is not None:
-        ax.set_proj_type("ortho")
-        getattr(ax, f"set_{hidden}ticks")([])
-        getattr(ax, f"set_{hidden}label")("")
+        getattr(ax, f"{axis}axis").set_major_locator(matplotlib.ticker.MaxNLocator(5))
     return fig, ax
+
+
+def _add_polygons(ax, view, polygons, facecolors, edgecolors="face", linewidths=0.3):
+    """Draw ``polygons`` (list of (m, 3) float, metres) in ``view``: 3D, or projected
+    onto an elevation's plane, farthest first."""
+    polygons = list(polygons)
+    faces = np.broadcast_to(matplotlib.colors.to_rgba_array(facecolors),
+                            (len(polygons), 4))
+    edges = faces if isinstance(edgecolors, str) and edgecolors == "face" else edgecolors
+    if view not in ELEVATIONS:
+        ax.add_collection3d(Poly3DCollection(polygons, facecolors=faces, edgecolors=edges,
+                                             linewidths=linewidths))
+        return
+    h, v, depth, sign = ELEVATIONS[view]
+    order = np.argsort([sign * p[:, depth].mean() for p in polygons], kind="stable")
+    if not isinstance(edges, str):
+        edges = np.broadcast_to(matplotlib.colors.to_rgba_array(edges),
+                                (len(polygons), 4))[order]
+    ax.add_collection(PolyCollection([polygons[i][:, [h, v]] for i in order],
+                                     facecolors=faces[order], edgecolors=edges,
+                                     linewidths=linewidths))
+
+
+def _line(ax, view, points, **style):
+    """A polyline ((m, 3) float, metres) in ``view``."""
+    points = np.asarray(points, dtype=float)
+    if view not in ELEVATIONS:
+        ax.plot(points[:, 0], points[:, 1], points[:, 2], **style)
+    else:
+        h, v, _, _ = ELEVATIONS[view]
+        ax.plot(points[:, h], points[:, v], **style)
+
+
+def _interface_linewidth(count: int) -> float:
+    """Edge width of interface polygons: wide for a few (seen edge on they are lines),
+    thin for thousands (wide edges would cover their faces)."""
+    return float(np.clip(12.0 / np.sqrt(max(count, 1)), 0.3, 3.0))
 
 
 def _class_legend(ax, codes):
@@ -147,20 +194,21 @@ def _class_legend(ax, codes):
     ax.legend(handles=handles, loc="upper left", fontsize=8, frameon=False)
 
 
-def _outline(ax, scene):
+def _outline(ax, view, scene):
     levels = scene.levels
     if levels is None or scene.dims is None:
         return
     for sign in (-1, 1):
-        ax.plot(levels.x, sign * levels.y, levels.z, color="b", linewidth=1)
-    ax.plot(levels.x[[0, 0]], levels.y[[0, 0]] * [-1, 1], [0, 0], color="b", linewidth=1)
+        _line(ax, view, np.column_stack([levels.x, sign * levels.y, levels.z]), color="b",
+              linewidth=1)
+    _line(ax, view, [[levels.x[0], -levels.y[0], 0.0], [levels.x[0], levels.y[0], 0.0]],
+          color="b", linewidth=1)
 
 
-def _draw_blocks(ax, blocks, mask, linewidth=0.1):
+def _draw_blocks(ax, view, blocks, mask, linewidth=0.1):
     if mask.any():
         polys, colours = _faces_3d(blocks, mask)
-        ax.add_collection3d(Poly3DCollection(polys, facecolors=colours, edgecolors="k",
-                                             linewidths=linewidth))
+        _add_polygons(ax, view, polys, colours, edgecolors="k", linewidths=linewidth)
         _class_legend(ax, blocks.block_class[mask])
 
 
@@ -176,22 +224,23 @@ def structure_pngs(scene, fast=False) -> dict:
     if pattern.any():
         stages = {"1_boundaries": np.zeros(blocks.n_blocks, bool),
                   "2_pattern": pattern, **stages}
-    views = ["01_angle"] if fast else list(VIEWS)
+    views = ["01_angle"] if fast else VIEWS
     out = {}
     for view in views:
         for stage, mask in stages.items():
-            fig, ax = _axes3d(bounds, view)
-            _outline(ax, scene)
-            _draw_blocks(ax, blocks, mask)
+            fig, ax = _axes(bounds, view)
+            _outline(ax, view, scene)
+            _draw_blocks(ax, view, blocks, mask)
             count = int((mask & ~blocks.block_is_support).sum())
-            ax.set_title(f"{stage[2:]}: {count} bricks\n{scene_title(scene)}", fontsize=9)
+            what = "blocks" if scene.params.scene in ("arch", "assembly") else "bricks"
+            ax.set_title(f"{stage[2:]}: {count} {what}\n{scene_title(scene)}", fontsize=9)
             out[f"{view}/{stage}.png"] = _png(fig, 60 if fast else 110)
     if is_cyclic(scene):
         n = scene.params.n
         whole = concatenate([rotated_web(blocks, k, n, ~blocks.block_is_support)
                              for k in range(n)])
-        fig, ax = _axes3d(whole.bounds, "01_angle")
-        _draw_blocks(ax, whole, np.ones(whole.n_blocks, bool), linewidth=0.05)
+        fig, ax = _axes3d(whole.bounds)
+        _draw_blocks(ax, "01_angle", whole, np.ones(whole.n_blocks, bool), linewidth=0.05)
         ax.set_title(f"the whole dome: the section rotated {n} times, {whole.n_blocks} "
                      f"bricks\n{scene_title(scene)}", fontsize=9)
         out["05_dome/3_structure.png"] = _png(fig, 70 if fast else 130)
@@ -261,13 +310,13 @@ def _colour_bar(fig, ax, scale, quantity):
 def _colour_plot(blocks, interfaces, index, values, title, view, fast, quantity,
                  signed=False, is_force=True, subtitle=""):
     """One view of the interfaces ``index`` coloured by ``values`` (SI units)."""
-    fig, ax = _axes3d(blocks.bounds, view)
+    fig, ax = _axes(blocks.bounds, view)
     scale = colour_scale(values, signed, is_force)
     shown = np.asarray(values, dtype=float) * scale["factor"]
     colours = scale["cmap"](scale["norm"](shown))
     # edges in the face colour: interfaces seen edge on stay visible as coloured lines
-    ax.add_collection3d(Poly3DCollection(_polygons(interfaces, index), facecolors=colours,
-                                         edgecolors=colours, linewidths=0.4))
+    _add_polygons(ax, view, _polygons(interfaces, index), colours,
+                  linewidths=_interface_linewidth(len(index)))
     _colour_bar(fig, ax, scale, quantity)
     ax.set_title(f"{title} ({len(index)} interfaces)\n{subtitle}", fontsize=9)
     return _png(fig, 60 if fast else 110)
@@ -277,7 +326,7 @@ def interface_pngs(scene, blocks, interfaces, fast=False) -> dict:
     """Horizontal and vertical interfaces drawn as polygons (thesis figures 3.12-3.13),
     coloured by area; a group without interfaces has no plot."""
     out = {}
-    views = ["01_angle"] if fast else list(VIEWS)
+    views = ["01_angle"] if fast else VIEWS
     horizontal = np.isin(interfaces.kind, HORIZONTAL_KINDS)
     groups = {"interfaces_horizontal": np.flatnonzero(horizontal),
               "interfaces_vertical": np.flatnonzero(~horizontal)}
@@ -317,7 +366,7 @@ def force_pngs(scene, blocks, interfaces, forces: dict, fast=False) -> dict:
               "vertical": np.flatnonzero(~horizontal),
               "all": np.arange(len(interfaces))}
     out = {}
-    views = ["01_angle"] if fast else list(VIEWS)
+    views = ["01_angle"] if fast else VIEWS
     for view in views:
         for name, key, group, title, signed in FORCE_PLOTS:
             index = select[group]
@@ -342,11 +391,10 @@ def _whole_dome_pngs(scene, interfaces, forces, fast) -> dict:
     for name, title, signed in (("normal", "normal force (tension +)", True),
                                 ("tension", "tension", False)):
         values = np.tile(np.asarray(forces[name], dtype=float), n)
-        fig, ax = _axes3d(whole.bounds, "01_angle")
+        fig, ax = _axes3d(whole.bounds)
         scale = colour_scale(values, signed)
         colours = scale["cmap"](scale["norm"](values * scale["factor"]))
-        ax.add_collection3d(Poly3DCollection(polygons, facecolors=colours,
-                                             edgecolors=colours, linewidths=0.2))
+        _add_polygons(ax, "01_angle", polygons, colours, linewidths=0.2)
         _colour_bar(fig, ax, scale, FORCE_LABELS[name])
         ax.set_title(f"the whole dome ({n} webs by rotation): {title}\n"
                      f"{scene_title(scene)}", fontsize=9)
@@ -439,17 +487,15 @@ def failure_png(scene, blocks, interfaces, top, forces, fast=False) -> bytes:
     """Where it fails: every interface in light grey and the interfaces ``top`` (the
     rows of ``RBE/tension_top.csv``, largest tension first) coloured by tension, the
     first ten numbered by their rank."""
-    fig, ax = _axes3d(blocks.bounds, "01_angle")
-    ax.add_collection3d(Poly3DCollection(_polygons(interfaces, range(len(interfaces))),
-                                         facecolors=(0.6, 0.6, 0.6, 0.2),
-                                         edgecolors="none"))
+    fig, ax = _axes3d(blocks.bounds)
+    _add_polygons(ax, "01_angle", _polygons(interfaces, range(len(interfaces))),
+                  (0.6, 0.6, 0.6, 0.2), edgecolors="none")
     tension = np.asarray(forces["tension"], dtype=float)[top]
     factor, unit = force_unit(tension.max())
     norm = matplotlib.colors.Normalize(0, tension.max() * factor)
     cmap = matplotlib.colormaps["inferno_r"]
     colours = cmap(norm(tension * factor))
-    ax.add_collection3d(Poly3DCollection(_polygons(interfaces, top), facecolors=colours,
-                                         edgecolors=colours, linewidths=1.0))
+    _add_polygons(ax, "01_angle", _polygons(interfaces, top), colours, linewidths=1.0)
     for rank, k in enumerate(top[:10], start=1):
         ax.text(*interfaces.centre[k], str(rank), fontsize=7, color="k")
     bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,

@@ -232,19 +232,24 @@ def frontier_png(rows) -> bytes:
         x = [r["solve_s"] for r in own]
         y = [max(r["force_deviation"] if r["force_deviation"] > 0 else r["residual_eq"],
                  floor) if np.isfinite(r["force_deviation"]) else np.nan for r in own]
-        ax.plot(x, y, "-", color=colour, alpha=0.5)
+        ax.plot(x, y, "-", color=colour, alpha=0.5, label=f"preset {preset}, {scene}")
         for r, xi, yi in zip(own, x, y):
-            ax.plot(xi, yi, markers.get(r["accuracy"], "x"), color=colour,
-                    label=f"{preset} {scene}" if r is own[0] else None)
-    for name, marker in markers.items():
-        ax.plot([], [], marker, color="black", label=name)
+            ax.plot(xi, yi, markers.get(r["accuracy"], "x"), color=colour)
+    # two legends: colour = structure, marker = accuracy preset (only those run)
+    structures_legend = ax.legend(fontsize=7, loc="upper right", title="structure",
+                                  title_fontsize=7)
+    ax.add_artist(structures_legend)
+    ran = dict.fromkeys(r["accuracy"] for r in rows)
+    handles = [ax.plot([], [], markers.get(name, "x"), color="black", label=name)[0]
+               for name in ran]
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("solve time, s (median)")
     ax.set_ylabel("force deviation from the accurate solution")
     ax.set_title("speed / accuracy frontier (lower left is better)")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
+    ax.legend(handles=handles, fontsize=7, loc="lower left", title="accuracy",
+              title_fontsize=7)
     buffer = io.BytesIO()
     fig.tight_layout()
     fig.savefig(buffer, format="png")
