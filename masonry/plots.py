@@ -95,7 +95,8 @@ def pattern_png(scene, fast=False) -> bytes:
     z = np.arange(len(w))
     ax.plot(w, z, "b-", -w, z, "b-", linewidth=1.2)
     for name in ("pattern", "regular", "fill_in"):
-        ax.add_patch(Rectangle((0, 0), 0, 0, facecolor=CLASS_COLOURS[name], label=name))
+        ax.add_patch(Rectangle((0, 0), 0, 0, facecolor=CLASS_COLOURS[name],
+                               label=name.replace("_", "-")))
     ax.legend(loc="upper right", fontsize=7)
     ax.set_xlabel("position along the wall s [units]")
     ax.set_ylabel("course")
@@ -301,6 +302,8 @@ def _colour_bar(fig, ax, scale, quantity):
     bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=scale["norm"], cmap=scale["cmap"]),
                        ax=ax, shrink=0.6, pad=0.1, extend=scale["extend"])
     label = f"{quantity} [{scale['unit']}]" if scale["unit"] else quantity
+    if scale["largest"] == 0:
+        label += "\nall zero"
     if scale["clipped"]:
         label += (f"\nscale ends at the {COLOUR_PERCENTILE:g}th percentile; "
                   f"{scale['clipped']} beyond, up to {scale['largest']:.3g} {scale['unit']}")

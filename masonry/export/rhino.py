@@ -106,8 +106,12 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None) -> bytes:
         support_layer = model.Layers.AddLayer(SUPPORT_LAYER, _SUPPORT_COLOUR)
 
     face_start = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks + 1))
+    corner_start = blocks.face_offsets[face_start].tolist()
+    corners = vertices[blocks.face_vertices].tolist()  # every face's corners, in order
+    sizes = np.diff(blocks.face_offsets).tolist()
     for i in range(blocks.n_blocks):
-        mesh = _unwelded_mesh(rhino3dm, blocks, vertices, face_start[i], face_start[i + 1])
+        mesh = _unwelded_mesh(rhino3dm, corners[corner_start[i]:corner_start[i + 1]],
+                              sizes[face_start[i]:face_start[i + 1]])
         attributes = rhino3dm.ObjectAttributes()
         attributes.Name = str(blocks.block_name[i])
         attributes.LayerIndex = (layer[blocks.block_class[i]] if free[i] else support_layer)
@@ -124,22 +128,24 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None) -> bytes:
             return f.read()
 
 
-def _unwelded_mesh(rhino3dm, blocks, vertices, first_face, end_face):
-    """A rhino3dm Mesh of faces ``first_face:end_face``, each with its own vertices."""
+def _unwelded_mesh(rhino3dm, corners, sizes):
+    """A rhino3dm Mesh whose faces have their own vertices: ``corners`` (list of (x, y, z),
+    metres) holds the faces' corners face after face, ``sizes`` their counts."""
     mesh = rhino3dm.Mesh()
-    for f in range(first_face, end_face):
-        ids = blocks.face_vertices[blocks.face_offsets[f]:blocks.face_offsets[f + 1]]
-        start = len(mesh.Vertices)
-        # rhino3dm 8: Vertices.Add stores float32; AddPoint3d stores doubles, which the
-        # file keeps when the flag is set after the vertices exist (set on an empty
-        # list, it stays False)
-        for x, y, z in vertices[ids].tolist():
-            mesh.Vertices.AddPoint3d(x, y, z)
-        if len(ids) == 4:
-            mesh.Faces.AddFace(start, start + 1, start + 2, start + 3)
+    add_point, add_face = mesh.Vertices.AddPoint3d, mesh.Faces.AddFace
+    # rhino3dm 8: Vertices.Add stores float32; AddPoint3d stores doubles, which the file
+    # keeps when the flag is set after the vertices exist (set on an empty list, it
+    # stays False)
+    for x, y, z in corners:
+        add_point(x, y, z)
+    start = 0
+    for size in sizes:
+        if size == 4:
+            add_face(start, start + 1, start + 2, start + 3)
         else:
-            for k in range(1, len(ids) - 1):
-                mesh.Faces.AddFace(start, start + k, start + k + 1)
+            for k in range(1, size - 1):
+                add_face(start, start + k, start + k + 1)
+        start += size
     mesh.Vertices.UseDoublePrecisionVertices = True
     mesh.Normals.ComputeNormals()
     return mesh
