@@ -99,21 +99,38 @@ def _resultants(made: RunOutputs) -> dict:
     return interface_resultants(made.model.interfaces, made.result.layout, made.result.x)
 
 
+def force_tables(blocks, interfaces, result, forces: dict, resultants=None) -> dict:
+    """The per-interface files of a solve: ``RBE/forces.csv``, ``RBE/tension_top.csv``
+    and ``RBE/interfaces.vtu`` (path -> bytes), as a run writes them.
+
+    Parameters
+    ----------
+    blocks, interfaces : the analysed model's
+    result : masonry.rbe.solve.RBEResult
+        With a solution (``x``).
+    forces : dict str -> (K,) float, N
+        ``result.per_interface()``.
+    resultants : dict, optional
+        :func:`~masonry.rbe.resultants.interface_resultants`, computed when None.
+    """
+    if resultants is None:
+        resultants = interface_resultants(interfaces, result.layout, result.x)
+    top = csv.tension_top(forces, result.weight_N)
+    files = {"RBE/forces.csv": csv.forces_csv(blocks, interfaces, forces, resultants),
+             "RBE/tension_top.csv": csv.tension_top_csv(blocks, interfaces, forces,
+                                                        resultants, top)}
+    if len(interfaces):
+        cell_data = {**forces, **{name: resultants[name] for name in
+                                  ("shear", "point", "eccentricity", "torsion")}}
+        files["RBE/interfaces.vtu"] = vtu.interfaces_vtu(interfaces, cell_data)
+    return files
+
+
 def _rbe_files(made: RunOutputs) -> Export:
     files = {"RBE/00_objective.txt": summaries.objective_text(made.result)}
     if made.forces is not None:
-        blocks, interfaces = made.model.blocks, made.model.interfaces
-        resultants = _resultants(made)
-        files["RBE/forces.csv"] = csv.forces_csv(blocks, interfaces, made.forces, resultants)
-        top = csv.tension_top(made.forces, made.result.weight_N)
-        files["RBE/tension_top.csv"] = csv.tension_top_csv(blocks, interfaces, made.forces,
-                                                           resultants, top)
-        if len(interfaces):
-            cell_data = {**made.forces, "shear": resultants["shear"],
-                         "point": resultants["point"],
-                         "eccentricity": resultants["eccentricity"],
-                         "torsion": resultants["torsion"]}
-            files["RBE/interfaces.vtu"] = vtu.interfaces_vtu(interfaces, cell_data)
+        files.update(force_tables(made.model.blocks, made.model.interfaces, made.result,
+                                  made.forces, _resultants(made)))
     return Export(files)
 
 

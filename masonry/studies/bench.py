@@ -24,7 +24,8 @@ import time
 import numpy as np
 
 from masonry.rbe.boundary import analysis_model
-from masonry.export.csv import forces_csv, interfaces_csv, locations_csv
+from masonry.export import force_tables
+from masonry.export.csv import interfaces_csv, locations_csv
 from masonry.export.obj import blocks_obj
 from masonry.params import from_preset
 from masonry.scenes import build
@@ -140,11 +141,7 @@ def _run(params, accuracy, solver, exports=True):
         blocks_obj(scene.blocks)
         interfaces_csv(model.blocks, model.interfaces)
         if result.x is not None:
-            from masonry.export.vtu import interfaces_vtu
-
-            forces = result.per_interface()
-            forces_csv(model.blocks, model.interfaces, forces)
-            interfaces_vtu(model.interfaces, forces)
+            force_tables(model.blocks, model.interfaces, result, result.per_interface())
     seconds["exports"] = time.perf_counter() - start
     counts = {"bricks": int((~scene.blocks.block_is_support).sum()),
               "unknowns": problem.system.layout.n_columns}
