@@ -63,7 +63,7 @@ def check_vtu_round_trip(interfaces, forces, tmp_path):
     row = data["interface"]
     # cells in interface order: the rows of interfaces.csv and forces.csv
     np.testing.assert_array_equal(row, np.arange(len(interfaces)))
-    expected = dict(forces, kind=interfaces.kind, area=interfaces.area,
+    expected = dict(forces, kind=interfaces.kind, area_m2=interfaces.area,
                     frame_normal=interfaces.normal, frame_t1=interfaces.t1,
                     frame_t2=interfaces.t2)
     assert set(data) == set(expected) | {"interface"}

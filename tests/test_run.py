@@ -61,7 +61,7 @@ def test_interfaces_vtu_round_trips_with_the_forces(wall_run):
     order = np.concatenate(mesh.cell_data["interface"]).astype(int)
     assert sorted(order) == list(range(len(table["compression_N"])))
     for name in ("compression", "tension", "normal", "t1", "t2", "friction"):
-        values = np.concatenate(mesh.cell_data[name])
+        values = np.concatenate(mesh.cell_data[f"{name}_N"])
         np.testing.assert_allclose(values, table[f"{name}_N"][order], rtol=1e-9, atol=1e-9)
 
 
@@ -89,9 +89,13 @@ def test_tables_keep_their_column_types_and_vtu_order(wall_run):
     np.testing.assert_array_equal(forces["id"], np.arange(len(forces)))
     mesh = meshio.read(folder / "RBE/interfaces.vtu")
     np.testing.assert_array_equal(np.concatenate(mesh.cell_data["interface"]), forces["id"])
-    for name in ("compression", "tension", "normal", "friction"):
-        np.testing.assert_allclose(np.concatenate(mesh.cell_data[name]),
-                                   forces[f"{name}_N"], rtol=1e-11, atol=1e-9)
+    for name in ("compression_N", "tension_N", "normal_N", "friction_N", "eccentricity",
+                 "torsion_Nm"):
+        np.testing.assert_allclose(np.concatenate(mesh.cell_data[name]), forces[name],
+                                   rtol=1e-11, atol=1e-9)
+    np.testing.assert_allclose(np.concatenate(mesh.cell_data["shear_N"]),
+                               forces[["shear_x_N", "shear_y_N", "shear_z_N"]], rtol=1e-11,
+                               atol=1e-9)
     # every force column says its unit; the resultant carries the normal force
     assert all(c.endswith(("_N", "_Nm")) for c in forces.columns if c.startswith(
         ("compression", "tension", "t1_N", "t2_N", "friction", "shear", "torsion")))

@@ -120,8 +120,11 @@ def force_tables(blocks, interfaces, result, forces: dict, resultants=None) -> d
              "RBE/tension_top.csv": csv.tension_top_csv(blocks, interfaces, forces,
                                                         resultants, top)}
     if len(interfaces):
-        cell_data = {**forces, **{name: resultants[name] for name in
-                                  ("shear", "point", "eccentricity", "torsion")}}
+        # named as the columns of forces.csv, units included
+        cell_data = {**{f"{name}_N": value for name, value in forces.items()},
+                     "shear_N": resultants["shear"], "point_m": resultants["point"],
+                     "eccentricity": resultants["eccentricity"],
+                     "torsion_Nm": resultants["torsion"]}
         files["RBE/interfaces.vtu"] = vtu.interfaces_vtu(interfaces, cell_data)
     return files
 

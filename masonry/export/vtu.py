@@ -5,8 +5,10 @@ Interface polygons have 3 to 8 vertices. meshio stores a cell block as one
 (cells, vertices per cell) array, so every run of consecutive interfaces with the same
 vertex count becomes one block (``triangle``, ``quad`` or ``polygon``): the file's cells
 are the interfaces in id order, the rows of ``interfaces.csv`` and ``RBE/forces.csv``
-(the cell data ``interface`` repeats the id). The ``kind`` codes are named in the file's
-field data (``kind_horizontal = 0``, ...), which ParaView lists in its Information panel.
+(the cell data ``interface`` repeats the id). Array names carry their unit as the CSV
+columns do (``compression_N``), since ParaView titles a colour bar with the array's name.
+The ``kind`` codes are named in the file's field data (``kind_horizontal = 0``, ...),
+which ParaView lists in its Information panel.
 """
 
 import os
@@ -17,7 +19,7 @@ import numpy as np
 from masonry.interfaces import INTERFACE_KINDS
 
 _CELL_TYPES = {3: "triangle", 4: "quad"}
-_RESERVED = ("interface", "kind", "area", "frame_normal", "frame_t1", "frame_t2")
+_RESERVED = ("interface", "kind", "area_m2", "frame_normal", "frame_t1", "frame_t2")
 
 
 def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> bytes:
@@ -39,8 +41,8 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
     -------
     bytes
         Binary VTU (base64, not compressed), cells in interface order. Cell data: every
-        entry of ``forces`` (float64), ``interface`` (int64, row in ``forces.csv``), ``kind`` (int8 code),
-        ``area`` (m^2), ``frame_normal``, ``frame_t1``, ``frame_t2`` ((K, 3) unit
+        entry of ``forces`` (float64), ``interface`` (int64, row in ``forces.csv``),
+        ``kind`` (int8 code), ``area_m2``, ``frame_normal``, ``frame_t1``, ``frame_t2`` ((K, 3) unit
         vectors: the directions of the normal, t1 and t2 forces). Field data:
         ``kind_<name>`` (the code of every kind name).
 
@@ -65,7 +67,7 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
                              f"({count},) or ({count}, 3)")
         values[name] = value
     values.update(interface=np.arange(count, dtype=np.int64),
-                  kind=np.asarray(interfaces.kind, dtype=np.int8), area=interfaces.area,
+                  kind=np.asarray(interfaces.kind, dtype=np.int8), area_m2=interfaces.area,
                   frame_normal=interfaces.normal, frame_t1=interfaces.t1,
                   frame_t2=interfaces.t2)
 
