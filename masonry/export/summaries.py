@@ -1,6 +1,6 @@
 """The text summaries of a run: ``00_parameters.txt`` and ``RBE/00_objective.txt``."""
 
-from masonry.params import structure_id
+from masonry.params import arch_radius, structure_id
 from masonry.rbe.solve import ACCURACY
 
 # the inputs of each scene, with their units, in the order they are printed
@@ -15,7 +15,7 @@ _GEOMETRY = {
              ("unit", "m, the brick unit")),
     "arch": (("arch_shape", ""), ("arch_blocks", "voussoirs"),
              ("arch_span", "m, of the centre line"),
-             ("arch_rise", "m, of the centre line (None: the shape's)"),
+             ("arch_rise", "m, of the centre line"),
              ("arch_thickness", "m"), ("arch_depth", "m, along y")),
     "assembly": (("assembly", "the imported model"),),
 }
@@ -28,6 +28,7 @@ _OUTPUT = (("fast", "one view, lower resolution"),
 
 
 def _line(name, value, note) -> str:
+    value = f"{value:.6g}" if isinstance(value, float) else value
     return (f"{name:>14} = {value!s:<12} # {note}" if note else f"{name:>14} = {value}")
 
 
@@ -38,7 +39,7 @@ def parameters_text(params) -> str:
     solvers = (params.solver if params.solver is not None
                else f"{preset.net_solver} (friction-net), {preset.plus_solver} (friction+)")
     lines = [f"structure id: {structure_id(params)}", "", _line("scene", params.scene, "")]
-    lines += [_line(name, getattr(params, name), note)
+    lines += [_line(name, _value(params, name), note)
               for name, note in _GEOMETRY.get(params.scene, ())]
     lines += ["", *(_line(name, getattr(params, name), note) for name, note in _ANALYSIS),
               _line("accuracy", preset.name, f"solver preset; residual <= {preset.residual:g}"),
@@ -46,6 +47,13 @@ def parameters_text(params) -> str:
               ""]
     lines += [_line(name, getattr(params, name), note) for name, note in _OUTPUT]
     return "\n".join(lines) + "\n"
+
+
+def _value(params, name):
+    """A parameter's value as the run used it (an arch's default rise resolved)."""
+    if name == "arch_rise" and params.arch_rise is None:
+        return arch_radius(params.arch_shape, params.arch_span)[1]
+    return getattr(params, name)
 
 
 def lp_check_text(result) -> str:
