@@ -20,6 +20,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
+from mpl_toolkits.axes_grid1 import make_axes_locatable  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from masonry.blocks import BLOCK_CLASSES, concatenate, rotated_web, rotation_z  # noqa: E402
@@ -299,8 +300,12 @@ def colour_scale(values, signed: bool, is_force: bool = True) -> dict:
 
 def _colour_bar(fig, ax, scale, quantity):
     """A colour bar labelled ``quantity [unit]``, saying where the scale is clipped."""
-    bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=scale["norm"], cmap=scale["cmap"]),
-                       ax=ax, shrink=0.6, pad=0.1, extend=scale["extend"])
+    mappable = matplotlib.cm.ScalarMappable(norm=scale["norm"], cmap=scale["cmap"])
+    if hasattr(ax, "get_zlim"):  # a 3D box sits inside its axes: a shorter bar
+        bar = fig.colorbar(mappable, ax=ax, shrink=0.6, pad=0.1, extend=scale["extend"])
+    else:  # as tall as the equal-scale plot
+        cax = make_axes_locatable(ax).append_axes("right", size="4%", pad=0.12)
+        bar = fig.colorbar(mappable, cax=cax, extend=scale["extend"])
     label = f"{quantity} [{scale['unit']}]" if scale["unit"] else quantity
     if scale["largest"] == 0:
         label += "\nall zero"
