@@ -104,8 +104,10 @@ def pattern_png(scene, fast=False) -> bytes:
     ax.set_xlim(-w.max() - 1, w.max() + 1)
     ax.set_ylim(-0.5, len(w) + 0.5)
     pattern = int((layout.klass == BLOCK_CLASSES.index("pattern")).sum())
-    one_web = "one web" if scene.params.scene == "section" else "web 0"
-    ax.set_title(f"{one_web} of {scene.params.n}, flattened: {len(layout)} bricks "
+    what = {"section": f"one web of {scene.params.n}, flattened",
+            "dome": f"web 0 of {scene.params.n}, flattened"}.get(scene.params.scene,
+                                                               scene.params.scene)
+    ax.set_title(f"{what}: {len(layout)} bricks "
                  f"({pattern} pattern)\n{scene_title(scene)}", fontsize=9)
     return _png(fig, 80 if fast else 130)
 
