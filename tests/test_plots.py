@@ -49,3 +49,34 @@ def test_tension_top_orders_by_tension_and_drops_solver_noise():
     top = tension_top({"tension": tension}, weight, count=4)
     assert top.tolist() == [3, 1, 4, 5]
     assert tension_top({"tension": np.full(3, 1e-3)}, weight).tolist() == []
+
+
+def test_mid_plane_cuts_a_joint_where_its_edges_cross_it():
+    from test_rbe import make_interfaces
+
+    from masonry.plots import _cut_at_y
+
+    # a joint tilted about y: (0, -1, 0) .. (1, 1, 0.5), cut at y = 0.25
+    square = np.array([[0, -1, 0], [1, -1, 0.5], [1, 1, 0.5], [0, 1, 0]], float)
+    normal = np.cross(square[1] - square[0], square[2] - square[1])
+    joint = make_interfaces([(0, 1)], [square], [normal / np.linalg.norm(normal)], 0)
+    segment = _cut_at_y(joint, [0], 0.25)[0]
+    np.testing.assert_allclose(sorted(segment.tolist()), [[0, 0.25, 0], [1, 0.25, 0.5]],
+                               atol=1e-15)
+
+
+def test_cyclic_runs_get_whole_dome_views():
+    from conftest import scene_of
+
+    from masonry.interfaces import detect
+    from masonry.plots import force_pngs, structure_pngs
+
+    scene = scene_of("3", boundary="cyclic", p=4)
+    interfaces = detect(scene.blocks, up=scene.block_up)
+    forces = {key: np.ones(len(interfaces)) for key in
+              ("compression", "tension", "normal", "t1", "t2", "friction")}
+    assert {"05_dome/normal.png", "05_dome/tension.png"} <= set(
+        force_pngs(scene, scene.blocks, interfaces, forces, fast=True))
+    assert "05_dome/3_structure.png" in structure_pngs(scene, fast=True)
+    free = scene_of("3", p=4)
+    assert not any(k.startswith("05_dome") for k in structure_pngs(free, fast=True))
