@@ -282,9 +282,10 @@ def colour_scale(values, signed: bool, is_force: bool = True) -> dict:
     values = np.asarray(values, dtype=float)
     magnitude = np.abs(values)
     largest = float(magnitude.max()) if len(values) else 0.0
-    factor, unit = force_unit(largest) if is_force else (1.0, "")
     top = float(np.percentile(magnitude, COLOUR_PERCENTILE)) if len(values) else 0.0
     top = top if top > 0 else (largest if largest > 0 else 1.0)
+    # the unit of the bar's range, not of a few clipped supports
+    factor, unit = force_unit(top) if is_force else (1.0, "")
     if signed:
         norm = matplotlib.colors.Normalize(-top * factor, top * factor)
         clipped = magnitude > top

@@ -42,8 +42,8 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
     bytes
         Binary VTU (base64, not compressed), cells in interface order. Cell data: every
         entry of ``forces`` (float64), ``interface`` (int64, row in ``forces.csv``),
-        ``kind`` (int8 code), ``area_m2``, ``frame_normal``, ``frame_t1``, ``frame_t2`` ((K, 3) unit
-        vectors: the directions of the normal, t1 and t2 forces). Field data:
+        ``kind`` (int8 code), ``area_m2``, ``frame_normal``, ``frame_t1``, ``frame_t2``
+        ((K, 3) unit vectors: the directions of the normal, t1 and t2 forces). Field data:
         ``kind_<name>`` (the code of every kind name).
 
     Raises
