@@ -276,12 +276,31 @@ def run_record(scene: Scene, model: Model, outputs: dict, cached: str, source=No
         "params": dataclasses.asdict(params),
         "outputs": outputs,
         **model_record(scene),
+        "coordinates": coordinates_record(scene),
         "cache": {"geometry": cached},
     }
     if source is not None:
         record["source"] = source
     record["counts"]["interfaces"] = model.interfaces.counts()
     return record
+
+
+MOVED_FILES = ("locations.csv", "dome.stl", "dome.obj", "dome.3mf")
+"""The files whose bricks are moved inward by the CAD offset (SPEC 7, thesis 3.4.1)."""
+
+
+def coordinates_record(scene: Scene) -> dict:
+    """run.json's ``coordinates``: which files hold model coordinates and which are moved
+    inward by ``cad_offset`` (metres, along each brick's inward normal), so that files
+    imported together line up once the user knows it."""
+    params = scene.params
+    moved = scene.block_inward is not None and params.cad_offset != 0
+    return {
+        "cad_offset_m": params.cad_offset * params.unit if moved else 0.0,
+        "moved_inward": list(MOVED_FILES) if moved else [],
+        "model": ["bricks.obj", "bricks.3dm", "interfaces.csv", "RBE/forces.csv",
+                  "RBE/interfaces.vtu"] + ([] if moved else list(MOVED_FILES)),
+    }
 
 
 def _solve(model: Model, params: Params, timer: Timer) -> RBEResult:

@@ -17,6 +17,12 @@ import numpy as np
 G = 9.81
 """Gravitational acceleration, m/s^2 (SPEC 2)."""
 
+TENSION_REPORTED_REL = 1e-6
+"""An interface's tension counts as tension in ``RBE/tension_top.csv`` above this fraction
+of the structure's weight; below, it is the solver's tolerance (a feasible structure's
+tensions are of the order of its residual, 1e-5 relative in the balanced preset, spread
+over thousands of interfaces)."""
+
 
 @dataclass(frozen=True)
 class Tolerances:

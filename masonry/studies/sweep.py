@@ -307,7 +307,8 @@ def summary_parquet(study: Study, rows):
 
 
 def summary_pngs(study: Study, rows) -> dict:
-    """MoI factor and feasibility against each swept input (one figure per input).
+    """MoI factor and feasibility against each swept input (one figure per input); with
+    a second swept input, one colour per value of it (the first other swept input).
 
     Returns
     -------
@@ -318,14 +319,30 @@ def summary_pngs(study: Study, rows) -> dict:
     out = {}
     done = [r for r in rows if r["status"] != "failed"]
     for name in study.swept:
+        others = [other for other in study.swept if other != name]
+        group = others[0] if others else None
         fig, (top, bottom) = plt.subplots(2, 1, figsize=(6, 6), sharex=True)
         x = [r[name] for r in done]
         numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in x)
         labels = sorted({str(v) for v in x}) if not numeric else None
-        xs = x if numeric else [labels.index(str(v)) for v in x]
-        top.scatter(xs, [r["moi_factor"] for r in done], c="C3", s=18)
+        xs = np.array(x if numeric else [labels.index(str(v)) for v in x], dtype=float)
+        keys = [None] if group is None else sorted({r[group] for r in done}, key=str)
+        if len(keys) > 8:  # e.g. a sampled input: too many values to tell apart
+            group, keys = None, [None]
+        # feasibility points of the groups side by side, not on top of each other
+        offsets = 0.06 * (np.arange(len(keys)) - (len(keys) - 1) / 2)
+        for colour, key, offset in zip(plt.cm.viridis(np.linspace(0, 0.9, len(keys))), keys,
+                                       offsets):
+            mine = [i for i, r in enumerate(done) if group is None or r[group] == key]
+            mine.sort(key=lambda i: xs[i])
+            label = None if group is None else f"{group} = {key}"
+            top.plot(xs[mine], [done[i]["moi_factor"] for i in mine], "-o", color=colour,
+                     markersize=4, linewidth=1, label=label)
+            bottom.plot(xs[mine], [(1 if done[i]["feasible"] else 0) + offset for i in mine],
+                        "o", color=colour, markersize=4)
+        if group is not None:
+            top.legend(fontsize=7, frameon=False)
         top.set_ylabel("MoI factor")
-        bottom.scatter(xs, [1 if r["feasible"] else 0 for r in done], c="C0", s=18)
         bottom.set_yticks([0, 1], ["infeasible", "feasible"])
         bottom.set_xlabel(name)
         if labels is not None:
