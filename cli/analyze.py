@@ -4,9 +4,10 @@ from masonry.scenes.imported import load_assembly
 from masonry.params import Params, validate
 from masonry.pipeline import run
 
-from .options import add_analysis_options, add_output_options, rbe_summary, summary
+from .options import (add_analysis_options, add_output_options, check_print_size,
+                      rbe_summary, summary)
 
-ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast")
+ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast", "print_size")
 
 
 def register(subparsers):
@@ -34,6 +35,7 @@ def register(subparsers):
 def handle(args, report):
     given = {k: getattr(args, k) for k in ANALYSIS if getattr(args, k) is not None}
     params = validate(Params(**given))
+    check_print_size(args, params)
     scene, source = load_assembly(args.files, params, supports=args.support,
                                   support_below=args.support_below, ground=args.ground)
     record = run(scene.params, args.out, analyse=True, plots_wanted=args.plots,

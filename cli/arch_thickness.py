@@ -7,6 +7,7 @@ from masonry.params import SOLVERS, Params, validate
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.thickness import folder_name, minimum_thickness, steps_csv
 from masonry.studies.thrust_line import thrust_line_minimum_thickness
+from masonry.tolerances import THICKNESS_RTOL
 
 from .options import add_arch_options, add_material_options, add_verbosity
 
@@ -24,8 +25,8 @@ def register(subparsers):
     g.add_argument("--solver", choices=SOLVERS,
                    help="QP solver (default: the balanced preset's): newton, clarabel, osqp, "
                         "clarabel-cvxpy or osqp-cvxpy")
-    g.add_argument("--rtol", type=float, default=1e-4,
-                   help="relative width of the final bisection bracket (default 1e-4)")
+    g.add_argument("--rtol", type=float, default=THICKNESS_RTOL,
+                   help="relative width of the final bisection bracket (default %(default)g)")
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root: writes DIR/arch-thickness_<inputs>/ with "
                              "result.json and steps.csv (default exports)")

@@ -11,9 +11,6 @@ from masonry.params import (ACCURACIES, ARCH_SHAPES, BOUNDARIES, FRICTIONS, PRES
 
 DEFAULTS = Params()
 
-GEOMETRY = ("stretch", "n", "r", "p", "cut", "unit", "min_fill", "wall_length",
-            "wall_courses")
-
 
 class Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit code 2."""
@@ -205,6 +202,9 @@ def add_output_options(parser):
     g.add_argument("--no-plots", dest="plots", action="store_false", help="skip all plots")
     g.add_argument("--no-printable", dest="printable", action="store_false",
                    help="skip the printable body (dome.stl, dome.obj)")
+    g.add_argument("--print-size", dest="print_size", type=float, metavar="MM",
+                   help=f"also write dome.3mf for a slicer, in millimetres, its largest "
+                        f"dimension MM ({_range('print_size')}; default: no 3MF)")
     g.add_argument("--force", action="store_true",
                    help="recompute even if the run folder holds this input's results")
     add_verbosity(g)
@@ -244,7 +244,16 @@ def params_from_args(args) -> Params:
     if getattr(args, "dome", False) and params.scene != "section":
         raise ParameterError("dome", True, f"an option of a section, not of this "
                                            f"{params.scene} scene")
+    check_print_size(args, params)
     return params
+
+
+def check_print_size(args, params: Params):
+    """Refuse ``--print-size`` beside ``--no-printable``: the 3MF is the printable body."""
+    if params.print_size is not None and not args.printable:
+        raise ParameterError("print_size", params.print_size,
+                             "no --no-printable beside it (dome.3mf is the printable body "
+                             "at that size)")
 
 
 def summary(record, report):

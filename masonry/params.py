@@ -77,7 +77,8 @@ class Params:
     Analysis: ``mu`` friction coefficient, ``density`` kg/m^3, ``friction`` net | plus |
     auto, ``accuracy`` solver preset (fast | balanced | accurate; None: fast in fast
     mode, else balanced, SPEC 3), ``solver`` (None: the preset's; a name overrides it).
-    Output: ``fast`` (one view, low resolution), ``cad_offset`` (units).
+    Output: ``fast`` (one view, low resolution), ``cad_offset`` (units), ``print_size``
+    (mm: the largest dimension of ``dome.3mf``; None writes no 3MF).
     """
 
     stretch: float = 1.0
@@ -98,6 +99,7 @@ class Params:
     solver: str | None = None
     fast: bool = False
     cad_offset: float = 1.0
+    print_size: float | None = None
     arch_blocks: int = 16
     arch_span: float = 10.0
     arch_thickness: float = 0.6
@@ -209,6 +211,8 @@ RANGES = {
                        "the friction cones are flat or closed to the solvers' precision"),
     "stretch": (0.05, 20.0, "dome height / circumradius"),
     "arch_span": (0.01, 1e4, "metres"),
+    "print_size": (1.0, 1e4, "millimetres, the largest dimension of dome.3mf: printers' "
+                             "beds are 100 to 1000 mm"),
 }
 """Physically meaningful and numerically safe ranges, checked by :func:`validate`."""
 
@@ -275,6 +279,8 @@ def validate(params: Params) -> Params:
            "0 < min_fill <= 4 (units)")
     _check("cad_offset", p.cad_offset, 0 <= _number("cad_offset", p.cad_offset) <= 4,
            "0 to 4 (units)")
+    if p.print_size is not None:
+        _in_range(p, "print_size")
     _check("wall_length", p.wall_length, _number("wall_length", p.wall_length) >= 4,
            ">= 4 (units, one regular brick)")
     _check("wall_courses", p.wall_courses,

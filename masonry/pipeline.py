@@ -36,6 +36,13 @@ PACKAGES = ("numpy", "scipy", "trimesh", "manifold3d", "cvxpy", "osqp", "highspy
 
 
 def versions() -> dict:
+    """The versions of masonry and of the :data:`PACKAGES` it runs on, for run.json.
+
+    Returns
+    -------
+    dict str -> str or None
+        ``{"masonry": version, package: version or None when not installed}``.
+    """
     out = {"masonry": __version__}
     for name in PACKAGES:
         try:
@@ -51,14 +58,21 @@ HEARTBEAT_S = 15.0
 
 class Timer:
     """Wall-clock seconds per stage, logged as each stage starts (and, while progress is
-    logged, every :data:`HEARTBEAT_S` seconds of a long stage)."""
+    logged, every :data:`HEARTBEAT_S` seconds of a long stage).
+
+    Attributes
+    ----------
+    seconds : dict str -> float
+        Seconds per stage name, rounded to 0.1 ms; run.json's ``timings_s``.
+    """
 
     def __init__(self):
         self.seconds = {}
 
     @contextmanager
     def stage(self, name):
-        """Time a stage; a stage entered again (several exporters) adds up."""
+        """Context manager timing the block under stage ``name`` (str); a stage entered
+        again (several exporters) adds up."""
         log.info("%s ...", name)
         start = time.perf_counter()
         done = threading.Event()
@@ -81,7 +95,20 @@ class Timer:
 
 
 def model_record(scene) -> dict:
-    """Counts, volume and weight of a built scene, and its pattern report."""
+    """Counts, volume and weight of a built scene, and its pattern report.
+
+    Parameters
+    ----------
+    scene : masonry.scenes.base.Scene
+
+    Returns
+    -------
+    dict
+        ``counts`` (free bricks, by class, courses; ints), ``volume_m3`` (m^3) and
+        ``weight_N`` (N) of the free blocks (supports left out), and where the scene has
+        them ``layout`` (repeated joints, short fill-ins) and ``pattern`` (nodes, near
+        nodes, boundary bounces, ended lines).
+    """
     blocks, params = scene.blocks, scene.params
     free = ~blocks.block_is_support
     classes = {name: int(((blocks.block_class == i) & free).sum())
@@ -122,7 +149,14 @@ GEOMETRY_SOURCES = ("params.py", "tolerances.py", "blocks.py", "meshing.py", "in
 @cache
 def geometry_code_digest() -> str:
     """SHA-1 of the source of :data:`GEOMETRY_SOURCES`: part of the cache key, so an edited
-    geometry stage never reuses a stale cache at the same version number."""
+    geometry stage never reuses a stale cache at the same version number.
+
+    Returns
+    -------
+    str
+        40 hex digits over every file's path and bytes, in sorted order; computed once
+        per process.
+    """
     root = Path(masonry.__file__).parent
     digest = hashlib.sha1()
     for name in GEOMETRY_SOURCES:
@@ -189,23 +223,44 @@ def _write_cache(path: Path, scene: Scene, model: Model):
                     "model", path, error.strerror or error)
 
 
+OUTPUT_FIELDS = ("print_size",)
+"""``Params`` fields that only choose a file's form (the 3MF's size), not the results:
+they are not in the structure id, and a folder whose run differs only in them holds the
+same input."""
+
+
+def _input(fields) -> dict:
+    """A run's parameters without :data:`OUTPUT_FIELDS`."""
+    return {k: v for k, v in fields.items() if k not in OUTPUT_FIELDS}
+
+
 def _previous(target: Path, params: Params):
     """The record of a complete earlier run of the same input in ``target``, else None."""
     try:
         record = json.loads((target / "run.json").read_text())
     except (OSError, ValueError):
         return None
-    if not isinstance(record, dict):
+    if not isinstance(record, dict) or not isinstance(record.get("params"), dict):
         return None
-    same = (record.get("params") == json.loads(json.dumps(dataclasses.asdict(params)))
-            and record.get("complete") is True)
+    same = (_input(record["params"]) == _input(json.loads(json.dumps(
+        dataclasses.asdict(params)))) and record.get("complete") is True)
     return record if same else None
 
 
-def _covers(record, outputs: dict) -> bool:
-    """Whether a run record wrote at least ``outputs`` (solve, plots, printable body)."""
+def _print_size(record):
+    """The size (mm) of the ``dome.3mf`` a run record wrote, or None."""
+    printable = record.get("printable")
+    written = printable.get("print") if isinstance(printable, dict) else None
+    return written.get("size_mm") if isinstance(written, dict) else None
+
+
+def _covers(record, outputs: dict, print_size=None) -> bool:
+    """Whether a run record wrote at least ``outputs`` (solve, plots, printable body) and,
+    when ``print_size`` (mm) asks for a 3MF beside the printable body, one of that size."""
     had = record.get("outputs") or {}
-    return all(had.get(name) is True or not wanted for name, wanted in outputs.items())
+    wrote = all(had.get(name) is True or not wanted for name, wanted in outputs.items())
+    return wrote and (print_size is None or not outputs.get("printable")
+                      or _print_size(record) == print_size)
 
 
 def _stamp(target: Path):
@@ -229,7 +284,9 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
     is reused as it is (``masonry build`` after ``masonry run``, a sweep variant after a
     full run); otherwise the run writes what is asked for *and* what the folder held
     (``masonry run`` after a sweep writes the plots and the solve, ``--force`` after a
-    run with plots writes the plots again). When another command publishes the same
+    run with plots writes the plots again). ``print_size`` is an output choice here
+    (:data:`OUTPUT_FIELDS`): a run without it keeps the folder's ``dome.3mf``, a run with
+    another size writes the 3MF at that size. When another command publishes the same
     folder while this one computes, the richer of the two stays.
 
     Parameters
@@ -270,12 +327,15 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
     outputs = {"analyse": analyse, "plots": plots_wanted, "printable": printable}
     previous, seen = _previous(target, params), _stamp(target)
     if previous is not None:
-        if not force and _covers(previous, outputs):
+        if not force and _covers(previous, outputs, params.print_size):
             log.info("%s is up to date (use --force to recompute)", sid)
             return {**previous, "path": str(target), "reused": True}
-        # a run folder only grows: what the earlier run wrote is written again
+        # a run folder only grows: what the earlier run wrote is written again (its 3MF
+        # too, at its size, unless this run asks for another)
         outputs = {name: wanted or (previous.get("outputs") or {}).get(name) is True
                    for name, wanted in outputs.items()}
+        if params.print_size is None and _print_size(previous) is not None:
+            params = params.replace(print_size=_print_size(previous))
 
     timer = Timer()
     if scene is None:
@@ -295,7 +355,8 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
     def keep(existing):
         # another command published this input meanwhile, with at least these outputs
         other = _previous(existing, params)
-        return _stamp(existing) != seen and other is not None and _covers(other, outputs)
+        return (_stamp(existing) != seen and other is not None
+                and _covers(other, outputs, params.print_size))
 
     with RunFolder(out_root, sid, keep=keep) as folder:
         write_exports(folder, made, record, timer)
@@ -310,7 +371,26 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
 
 
 def run_record(scene: Scene, model: Model, outputs: dict, cached: str, source=None) -> dict:
-    """The run.json record of a built model, before any solve."""
+    """The run.json record of a built model, before any solve.
+
+    Parameters
+    ----------
+    scene : masonry.scenes.base.Scene
+    model : masonry.rbe.boundary.Model
+        Its analysis model; its interface counts by kind go into ``counts``.
+    outputs : dict str -> bool
+        What the run writes (``analyse``, ``plots``, ``printable``).
+    cached : str
+        ``'reused'``, ``'computed'`` or ``'given'``: where the geometry came from.
+    source : dict, optional
+        Where an imported scene came from.
+
+    Returns
+    -------
+    dict
+        Structure id, scene name, parameters, outputs, :func:`model_record`, cache
+        state and source.
+    """
     params = scene.params
     record = {
         "structure_id": structure_id(params),
@@ -318,12 +398,31 @@ def run_record(scene: Scene, model: Model, outputs: dict, cached: str, source=No
         "params": dataclasses.asdict(params),
         "outputs": outputs,
         **model_record(scene),
+        "coordinates": coordinates_record(scene),
         "cache": {"geometry": cached},
     }
     if source is not None:
         record["source"] = source
     record["counts"]["interfaces"] = model.interfaces.counts()
     return record
+
+
+MOVED_FILES = ("locations.csv", "dome.stl", "dome.obj", "dome.3mf")
+"""The files whose bricks are moved inward by the CAD offset (SPEC 7, thesis 3.4.1)."""
+
+
+def coordinates_record(scene: Scene) -> dict:
+    """run.json's ``coordinates``: which files hold model coordinates and which are moved
+    inward by ``cad_offset`` (metres, along each brick's inward normal), so that files
+    imported together line up once the user knows it."""
+    params = scene.params
+    moved = scene.block_inward is not None and params.cad_offset != 0
+    return {
+        "cad_offset_m": params.cad_offset * params.unit if moved else 0.0,
+        "moved_inward": list(MOVED_FILES) if moved else [],
+        "model": ["bricks.obj", "bricks.3dm", "interfaces.csv", "RBE/forces.csv",
+                  "RBE/interfaces.vtu"] + ([] if moved else list(MOVED_FILES)),
+    }
 
 
 def _solve(model: Model, params: Params, timer: Timer) -> RBEResult:
@@ -337,7 +436,19 @@ def _solve(model: Model, params: Params, timer: Timer) -> RBEResult:
 
 def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer):
     """Every wanted exporter of :data:`masonry.export.EXPORTERS` into ``folder``; their
-    records go into ``record`` under their names."""
+    records go into ``record`` under their names.
+
+    Parameters
+    ----------
+    folder : RunFolder
+        Anything with ``write(relative, data)``.
+    made : masonry.export.RunOutputs
+        What the run made; each exporter's ``wanted(made)`` decides whether it writes.
+    record : dict
+        The run record, updated in place.
+    timer : Timer
+        Each exporter's time counts towards its stage.
+    """
     for exporter in EXPORTERS:
         if not exporter.wanted(made):
             continue

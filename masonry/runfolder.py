@@ -54,6 +54,18 @@ def check_output_root(root, option="out") -> Path:
     The root may not exist yet; its nearest existing ancestor must be a folder this
     process can create entries in (probed with a temporary folder, removed at once).
 
+    Parameters
+    ----------
+    root : str or Path
+        The output root as the user gave it.
+    option : str
+        The parameter named in the error (the front end shows it as typed, ``--out``).
+
+    Returns
+    -------
+    Path
+        ``root``.
+
     Raises
     ------
     ParameterError
@@ -85,6 +97,12 @@ def remove_leftovers(folder) -> list:
 
     Only names of this host whose process no longer exists are removed. A previous folder
     set aside by a publish that was killed before the new one took its name is put back.
+
+    Parameters
+    ----------
+    folder : str or Path
+        An output root (or the folder of a single file written atomically); a missing
+        or unreadable one holds no leftovers.
 
     Returns
     -------
@@ -148,7 +166,21 @@ def locked(folder):
 
 def write_file_atomically(path, data: bytes):
     """Write ``data`` to ``path`` through a hidden temporary file beside it, renamed into
-    place when complete: a reader sees the old file or the whole new one, never a part."""
+    place when complete: a reader sees the old file or the whole new one, never a part.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write; missing parent folders are created.
+    data : bytes
+        The whole content.
+
+    Raises
+    ------
+    OSError
+        When the file cannot be written; the temporary file is removed and ``path`` is
+        left as it was.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     remove_leftovers(path.parent)
@@ -171,11 +203,28 @@ class RunFolder:
     Parameters
     ----------
     root : str or Path
+        The output root (created on entry when missing).
     name : str
+        The run folder's name inside ``root`` (the structure id).
     keep : callable, optional
         ``keep(target) -> bool``, asked under the root's lock just before publishing: True
         keeps the folder already at ``target`` and discards this one (it holds at least
         what this one would write; see :func:`masonry.pipeline.run`).
+
+    Attributes
+    ----------
+    target : Path
+        ``root/name``, where the folder is published.
+    tmp : Path
+        The hidden temporary folder the files are written into until then.
+    kept : bool
+        True when ``keep`` kept the folder already at ``target`` (this one was discarded).
+
+    Examples
+    --------
+    >>> with RunFolder("exports", "wall_L32") as folder:  # doctest: +SKIP
+    ...     folder.write("notes.txt", "text")
+    ...     folder.write_json("run.json", {"complete": True})
     """
 
     def __init__(self, root, name, keep=None):
@@ -201,24 +250,35 @@ class RunFolder:
         return False
 
     def path(self, relative) -> Path:
-        """Where ``relative`` lives in the temporary folder (for writers that need a path)."""
+        """Where ``relative`` (a path inside the run folder, ``/``-separated) lives in the
+        temporary folder, its parent folders created: for writers that need a path."""
         path = self.tmp / relative
         path.parent.mkdir(parents=True, exist_ok=True)
         return path
 
     def write(self, relative, data):
-        """Write bytes or text to ``relative`` inside the run folder."""
-        mode = "wb" if isinstance(data, bytes) else "w"
-        with open(self.path(relative), mode) as f:
-            f.write(data)
+        """Write ``data`` (bytes, or text, written as UTF-8) to ``relative``, a path
+        inside the run folder."""
+        self.path(relative).write_bytes(data if isinstance(data, bytes)
+                                        else data.encode("utf-8"))
 
     def write_json(self, relative, record):
-        """Write ``record`` as indented JSON (numpy scalars and arrays as plain values)."""
+        """Write ``record`` (a dict of JSON values, numpy scalars and arrays) to
+        ``relative`` as indented JSON; numpy values become plain numbers and lists.
+
+        Raises
+        ------
+        TypeError
+            For a value JSON cannot hold (not a number, string, list, dict or numpy
+            value).
+        """
         self.write(relative, json.dumps(record, indent=2, sort_keys=False, default=_jsonable)
                    + "\n")
 
     def publish(self):
-        """Swap the temporary folder into place, under the root's lock.
+        """Swap the temporary folder into place as :attr:`target` (called on a normal
+        exit of the ``with`` block), under the root's lock; a previous folder of that name
+        is removed, unless ``keep`` keeps it (then this one is discarded).
 
         Two renames: the old folder moves aside, the new one takes its name, then the old
         one is removed; at no moment is a half-written folder under the target name.

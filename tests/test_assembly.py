@@ -52,7 +52,7 @@ def test_dome_section_round_trips_through_bricks_obj(tmp_path, capsys):
     assert a.keys() == b.keys() and len(a) == 273
     for key, row in a.items():
         assert b[key]["kind"] == row["kind"], key
-        for column in ("area_m2", "centre_x", "centre_y", "centre_z", "normal_x",
+        for column in ("area_m2", "centre_x_m", "centre_y_m", "centre_z_m", "normal_x",
                        "normal_y", "normal_z"):
             assert float(b[key][column]) == pytest.approx(float(row[column]), abs=1e-9)
 
@@ -261,7 +261,8 @@ def test_overlapping_pairs_agree_with_the_intersection_volume():
     import manifold3d
 
     from masonry.blocks import Blocks
-    from masonry.scenes.imported import OVERLAP_REL, overlapping_pairs
+    from masonry.scenes.imported import overlapping_pairs
+    from masonry.tolerances import INTERPENETRATION_REL
     from scipy.spatial.transform import Rotation
 
     rng = np.random.default_rng(7)
@@ -279,8 +280,9 @@ def test_overlapping_pairs_agree_with_the_intersection_volume():
         smaller = min(np.linalg.norm(s) for s in sizes)
         # the intersection lies in a slab as wide as the overlap along any axis, and its
         # sections are no larger than smaller^2 (smaller: the smaller box's diagonal), so
-        # volume > OVERLAP_REL * smaller^3 means a penetration deeper than the threshold
-        if volume > OVERLAP_REL * smaller**3:
+        # volume > INTERPENETRATION_REL * smaller^3 means a penetration deeper than the
+        # threshold
+        if volume > INTERPENETRATION_REL * smaller**3:
             assert found, (trial, volume)
             judged[True] += 1
         elif volume == 0.0:

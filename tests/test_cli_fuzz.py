@@ -27,6 +27,7 @@ from masonry.params import Params, validate
 from masonry.pipeline import model_record
 from masonry.runfolder import check_output_root
 from masonry.scenes import build, check_size
+from masonry_cli.app import make_parser
 from masonry_cli.main import main
 
 OPTION = re.compile(r"--[a-z][a-z-]*")
@@ -94,6 +95,8 @@ LISTED = [
     ["--min-fill", "0"], ["--wall-courses", "0", "--scene", "wall"],
     ["--n", "eight"], ["--scene", "moon"], ["--params", ""], ["--params", "missing.toml"],
     ["--max-bricks", "x"], ["--max-bricks", "10"],
+    ["--print-size", "-5"], ["--print-size", "0"], ["--print-size", "nan"],
+    ["--print-size", "1e308"], ["--print-size", "150", "--no-printable"],
 ]
 RUN_ONLY = [["--scene", "arch", "--boundary", "cyclic"], ["--scene", "wall", "--dome"],
             ["--friction", "none"], ["--solver", "gurobi"]]
@@ -332,6 +335,7 @@ PLAUSIBLE = {
     "--boundary": ["free", "rigid", "cyclic", "open"],
     "--friction": ["net", "plus", "auto", "none"],
     "--accuracy": ["fast", "balanced", "accurate", "best"],
+    "--print-size": ["100", "150", "200"],
 }
 INTEGER_OPTIONS = {"--n", "--r", "--p", "--wall-courses", "--blocks"}
 SCENE_OPTIONS = {
@@ -340,7 +344,16 @@ SCENE_OPTIONS = {
     "wall": ["--wall-length", "--wall-courses", "--unit"],
     "arch": ["--span", "--thickness", "--rise", "--depth", "--blocks", "--shape"],
 }
-ANALYSIS = ["--mu", "--density", "--friction", "--accuracy"]
+EVERY_SCENE = ["--mu", "--density", "--friction", "--accuracy", "--print-size"]
+
+
+def test_the_tables_cover_every_option_of_run():
+    # a new option of `masonry run` that sets a parameter is fuzzed, or at least listed
+    parser = make_parser()._subparsers._group_actions[0].choices["run"]
+    options = {action.option_strings[-1] for action in parser._actions
+               if action.dest in Params.__dataclass_fields__ and action.nargs != 0}
+    covered = set(PLAUSIBLE) | {a for args in LISTED + RUN_ONLY for a in args}
+    assert "--print-size" in options and options <= covered, options - covered
 
 
 def value_of(option):
@@ -357,7 +370,7 @@ def command_lines(draw):
     sometimes another scene's option or a wild value."""
     scene = draw(st.sampled_from([None, "dome", "wall", "arch"]))
     every = sorted(PLAUSIBLE)
-    mostly = SCENE_OPTIONS[scene] + ANALYSIS
+    mostly = SCENE_OPTIONS[scene] + EVERY_SCENE
     names = draw(st.lists(st.one_of(*[st.sampled_from(mostly)] * 6, st.sampled_from(every)),
                           max_size=4, unique=True))
     argv = [] if scene is None else ["--scene", scene]

@@ -33,6 +33,23 @@ def test_build_after_run_keeps_the_forces(tmp_path, capsys):
     assert snapshot(tmp_path / WALL_ID) == before
 
 
+def test_the_print_size_is_an_output_choice_not_another_input(tmp_path, capsys):
+    # the 3MF's size is not in the structure id: a build after a run with a 3MF keeps
+    # the forces and the 3MF; another size rewrites the 3MF at that size, nothing else
+    folder = tmp_path / WALL_ID
+    assert main(["run", *WALL, "--print-size", "120", "--out", str(tmp_path), "-q"]) == 0
+    before = snapshot(folder)
+    assert main(["build", *WALL, "--out", str(tmp_path), "-q"]) == 0
+    assert "up to date, reused" in capsys.readouterr().out
+    assert snapshot(folder) == before
+    assert main(["run", *WALL, "--no-plots", "--print-size", "90", "--out", str(tmp_path),
+                 "-q"]) == 0
+    record = json.loads((folder / "run.json").read_text())
+    assert record["printable"]["print"]["size_mm"] == 90
+    assert max(record["printable"]["print"]["readback"]["extents_mm"]) == pytest.approx(90)
+    assert set(snapshot(folder)) == set(before)  # the plots kept, nothing lost
+
+
 def test_run_after_build_adds_the_forces_and_keeps_the_plots(tmp_path):
     assert main(["build", *WALL, "--out", str(tmp_path), "--no-printable", "-q"]) == 0
     assert main(["run", *WALL, "--out", str(tmp_path), "--no-plots", "--no-printable",

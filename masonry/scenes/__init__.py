@@ -20,7 +20,7 @@ from masonry.scenes.arch import build_arch
 from masonry.scenes.base import Scene
 from masonry.scenes.section import build_dome, build_section
 from masonry.scenes.wall import build_wall
-from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS
+from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS, UNITS_PER_BRICK
 
 BUILDERS = {"section": build_section, "wall": build_wall, "dome": build_dome,
             "arch": build_arch}
@@ -37,17 +37,13 @@ def build(params: Params) -> Scene:
     return builder(params)
 
 
-UNITS_PER_BRICK = 2.7
-"""Intrados area of a section per brick, in square units: 2.0 to 3.3 on the presets and
-their extremes (pattern and fill-in bricks are smaller than regular ones)."""
-
-
 def estimate_bricks(params: Params) -> float:
     """The number of blocks ``params`` would build, from its dimensions alone (without
     building anything): exact for the arch, within a factor 1.4 for a dome section.
 
     The section's count is its intrados area (the web's width integrated along the
-    quarter ellipse) over :data:`UNITS_PER_BRICK`; the dome has ``n`` sections.
+    quarter ellipse) over :data:`~masonry.tolerances.UNITS_PER_BRICK`; the dome has ``n``
+    sections.
     """
     p = params
     if p.scene == "arch":

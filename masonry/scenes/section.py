@@ -18,13 +18,9 @@ from masonry.dome.pattern import build_pattern
 from masonry.params import ParameterError, Params
 from masonry.scenes.base import Scene, hexahedra_frames
 from masonry.scenes.bricks import blocks_from_layout, posed_corners
-from masonry.tolerances import Tolerances
+from masonry.tolerances import STRETCH_USUAL_RANGE, Tolerances
 
 log = logging.getLogger(__name__)
-
-USUAL_STRETCH = (0.2, 5.0)
-"""Stretches outside this range build unusually flat or tall domes (a warning)."""
-
 
 def build_section(params: Params) -> Scene:
     """One web of the dome (SPEC 4.2 to 4.5) on its ground slab (block 0).
@@ -48,7 +44,7 @@ def build_section(params: Params) -> Scene:
             f"{np.degrees(widest):.1f} degrees, more than the {np.degrees(limit):g} "
             f"degrees whose gaps can be closed; raise p or r, or the stretch",
             related=("stretch", "r", "n", "unit"))
-    low, high = USUAL_STRETCH
+    low, high = STRETCH_USUAL_RANGE
     if not low <= params.stretch <= high:
         log.warning("stretch=%g is outside %g..%g: the dome is unusually flat or tall",
                     params.stretch, low, high)

@@ -24,7 +24,8 @@ import time
 import numpy as np
 
 from masonry.rbe.boundary import analysis_model
-from masonry.export.csv import forces_csv, interfaces_csv, locations_csv
+from masonry.export import force_tables
+from masonry.export.csv import interfaces_csv, locations_csv
 from masonry.export.obj import blocks_obj
 from masonry.params import from_preset
 from masonry.scenes import build
@@ -140,11 +141,7 @@ def _run(params, accuracy, solver, exports=True):
         blocks_obj(scene.blocks)
         interfaces_csv(model.blocks, model.interfaces)
         if result.x is not None:
-            from masonry.export.vtu import interfaces_vtu
-
-            forces = result.per_interface()
-            forces_csv(model.blocks, model.interfaces, forces)
-            interfaces_vtu(model.interfaces, forces)
+            force_tables(model.blocks, model.interfaces, result, result.per_interface())
     seconds["exports"] = time.perf_counter() - start
     counts = {"bricks": int((~scene.blocks.block_is_support).sum()),
               "unknowns": problem.system.layout.n_columns}
@@ -232,19 +229,24 @@ def frontier_png(rows) -> bytes:
         x = [r["solve_s"] for r in own]
         y = [max(r["force_deviation"] if r["force_deviation"] > 0 else r["residual_eq"],
                  floor) if np.isfinite(r["force_deviation"]) else np.nan for r in own]
-        ax.plot(x, y, "-", color=colour, alpha=0.5)
+        ax.plot(x, y, "-", color=colour, alpha=0.5, label=f"preset {preset}, {scene}")
         for r, xi, yi in zip(own, x, y):
-            ax.plot(xi, yi, markers.get(r["accuracy"], "x"), color=colour,
-                    label=f"{preset} {scene}" if r is own[0] else None)
-    for name, marker in markers.items():
-        ax.plot([], [], marker, color="black", label=name)
+            ax.plot(xi, yi, markers.get(r["accuracy"], "x"), color=colour)
+    # two legends: colour = structure, marker = accuracy preset (only those run)
+    structures_legend = ax.legend(fontsize=7, loc="upper right", title="structure",
+                                  title_fontsize=7)
+    ax.add_artist(structures_legend)
+    ran = dict.fromkeys(r["accuracy"] for r in rows)
+    handles = [ax.plot([], [], markers.get(name, "x"), color="black", label=name)[0]
+               for name in ran]
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("solve time, s (median)")
     ax.set_ylabel("force deviation from the accurate solution")
     ax.set_title("speed / accuracy frontier (lower left is better)")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
+    ax.legend(handles=handles, fontsize=7, loc="lower left", title="accuracy",
+              title_fontsize=7)
     buffer = io.BytesIO()
     fig.tight_layout()
     fig.savefig(buffer, format="png")
