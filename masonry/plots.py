@@ -11,7 +11,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.patches import Rectangle  # noqa: E402
+from matplotlib.patches import Patch, Rectangle  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from masonry.blocks import BLOCK_CLASSES  # noqa: E402
@@ -127,6 +127,71 @@ def structure_pngs(scene, fast=False) -> dict:
             ax.set_title(f"{stage[2:]}: {int(mask.sum())} bricks")
             out[f"{view}/{stage}.png"] = _png(fig, 60 if fast else 110)
     return out
+
+
+MARK_COLOUR = "#1f3bb3"
+"""Colour of marked blocks (e.g. the bricks that carry tension at a construction stage)."""
+
+
+def marked_structure_pngs(scene, blocks, is_marked, title, mark_label="marked",
+                          fast=False) -> dict:
+    """The structure views of ``blocks`` (a part of ``scene``'s, e.g. a construction
+    stage) in their class colours, the blocks of ``is_marked`` ((B,) bool) in
+    :data:`MARK_COLOUR` (legend ``mark_label``), the scene's web outline for reference.
+    ``{view}.png`` per view, one view at lower resolution when ``fast``."""
+    colours = np.array([CLASS_COLOURS[name] for name in BLOCK_CLASSES], dtype=object)
+    out = {}
+    for view in ["01_angle"] if fast else list(VIEWS):
+        fig, ax = _axes3d(scene.blocks.bounds, view)
+        _outline(ax, scene)
+        owner = blocks.face_block
+        face_colours = np.where(is_marked[owner], MARK_COLOUR,
+                                colours[blocks.block_class[owner]])
+        polys = [blocks.face_polygon(f) for f in range(blocks.n_faces)]
+        ax.add_collection3d(Poly3DCollection(polys,
+                                             facecolors=list(face_colours),
+                                             edgecolors="k", linewidths=0.1))
+        ax.legend(handles=[Patch(facecolor=MARK_COLOUR, label=mark_label)],
+                  loc="upper left", fontsize=8)
+        ax.set_title(title)
+        out[f"{view}.png"] = _png(fig, 60 if fast else 110)
+    return out
+
+
+def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="") -> bytes:
+    """MoI factor (and the collapse load factor, where given) against the construction
+    stage: stages that stand in green, those that need support in red.
+
+    Parameters
+    ----------
+    stage : (N,) int
+    moi_factor : (N,) float (NaN: not solved)
+    feasible : (N,) bool
+    load_factor : (N,) float or None (NaN: not computed)
+    """
+    stage = np.asarray(stage)
+    moi = np.asarray(moi_factor, dtype=float)
+    feasible = np.asarray(feasible, dtype=bool)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(stage, moi, color="0.6", linewidth=0.8, zorder=1)
+    ax.scatter(stage[feasible], moi[feasible], s=14, color="#2ca02c", label="stands",
+               zorder=2)
+    ax.scatter(stage[~feasible], moi[~feasible], s=14, color="#d62728",
+               label="needs support", zorder=2)
+    ax.set_xlabel("stage")
+    ax.set_ylabel("MoI factor (tension / weight)")
+    handles, labels = ax.get_legend_handles_labels()
+    if load_factor is not None and np.isfinite(np.asarray(load_factor, float)).any():
+        right = ax.twinx()
+        right.plot(stage, np.asarray(load_factor, float), color="#1f77b4", marker=".",
+                   label="load factor")
+        right.set_ylabel("collapse load factor")
+        extra = right.get_legend_handles_labels()
+        handles, labels = handles + extra[0], labels + extra[1]
+    ax.legend(handles, labels, loc="upper left", fontsize=8)
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    return _png(fig, 110)
 
 
 def _polygons(interfaces, index):
