@@ -7,10 +7,10 @@ from masonry.scenes.imported import AssemblyError
 from masonry.params import ParameterError
 from masonry.rbe.solvers.newton import use_one_blas_thread
 
-from . import analyze, arch_thickness, bench, build, run, structures, sweep
+from . import analyze, arch_thickness, bench, build, run, stages, structures, sweep
 from .options import Parser
 
-SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, bench)
+SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, bench, stages)
 
 
 def make_parser():

@@ -121,7 +121,7 @@ def _geometry_key(params: Params) -> str:
     return hashlib.sha1(key.encode()).hexdigest()[:16]
 
 
-def _model(params: Params, out_root, timer: Timer):
+def cached_model(params: Params, out_root, timer: Timer):
     """Scene and analysis model (interfaces, boundary routing), from the geometry cache
     when present: ``(scene, model, 'reused' | 'computed')``."""
     cache = Path(out_root) / ".cache" / f"{_geometry_key(params)}.pickle"
@@ -192,7 +192,7 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
 
     timer = Timer()
     if scene is None:
-        scene, model, cached = _model(params, out_root, timer)
+        scene, model, cached = cached_model(params, out_root, timer)
     else:
         scene, cached = dataclasses.replace(scene, params=params), "given"
         with timer.stage("interfaces"):

@@ -42,9 +42,9 @@ import numpy as np
 from masonry import plots
 from masonry.blocks import BLOCK_CLASSES
 from masonry.export.summaries import parameters_text
-from masonry.params import ParameterError, structure_id
-from masonry.pipeline import versions
-from masonry.rbe.boundary import Model, restrict
+from masonry.params import ParameterError, structure_id, validate
+from masonry.pipeline import Timer, cached_model, model_record, versions
+from masonry.rbe.boundary import Model, analysis_model, restrict
 from masonry.rbe.solve import ACCURACY, RBEProblem
 from masonry.runfolder import RunFolder
 from masonry.tolerances import Tolerances
@@ -133,7 +133,7 @@ def course_plan(blocks) -> StagePlan:
     course = np.asarray(blocks.block_course)
     free = ~blocks.block_is_support
     if (course[free] < 1).any():
-        raise ParameterError("by", "course", "a model built in courses (a dome or a wall); "
+        raise ParameterError("--by", "course", "a model built in courses (a dome or a wall); "
                                              "lay other blocks by --order names or z")
     stage = np.where(free, course, 0)
     return StagePlan(stage, np.arange(1, stage.max() + 1), by="course")
@@ -151,12 +151,12 @@ def brick_plan(scene, course: int, order: str = "pattern-first") -> StagePlan:
     """
     layout = scene.layout
     if layout is None:
-        raise ParameterError("by", "brick", "a dome model (scene section or dome)")
+        raise ParameterError("--by", "brick", "a dome model (scene section or dome)")
     if order not in BRICK_ORDERS:
-        raise ParameterError("order", order, f"one of {', '.join(BRICK_ORDERS)}")
+        raise ParameterError("--order", order, f"one of {', '.join(BRICK_ORDERS)}")
     courses = int(layout.course.max())
     if not isinstance(course, (int, np.integer)) or not 1 <= course <= courses:
-        raise ParameterError("course", course, f"a course of this model, 1..{courses}")
+        raise ParameterError("--course", course, f"a course of this model, 1..{courses}")
     rank = _laying_rank(layout, course, order)
     per_web = np.concatenate([[0], rank])  # the web's ground slab first (SPEC 4.4)
     webs, rest = divmod(scene.blocks.n_blocks, len(per_web))
@@ -204,7 +204,7 @@ def block_plan(blocks, order: str = "z", tol: Tolerances | None = None) -> Stage
         ``Tolerances.for_points(blocks.vertices)``.
     """
     if order not in BLOCK_ORDERS:
-        raise ParameterError("order", order, f"one of {', '.join(BLOCK_ORDERS)}")
+        raise ParameterError("--order", order, f"one of {', '.join(BLOCK_ORDERS)}")
     if tol is None:
         tol = Tolerances.for_points(blocks.vertices)
     free = np.flatnonzero(~blocks.block_is_support)
@@ -306,3 +306,226 @@ def tension_by_block(part: Model, result, plan: StagePlan, floor: float) -> dict
 
 def _number(value):
     return None if value is None or not np.isfinite(value) else float(value)
+
+
+# ---------------------------------------------------------------------- every stage
+def make_plan(scene, by: str = "course", order: str | None = None,
+              course: int | None = None) -> StagePlan:
+    """The stage plan of ``scene``: ``by`` course, brick (of ``course``, in ``order``,
+    default ``pattern-first``) or block (in ``order``, default ``z``).
+
+    Raises
+    ------
+    ParameterError
+        An option that does not fit ``by`` or the scene (named as the user types it).
+    """
+    if by == "course":
+        if order is not None or course is not None:
+            raise ParameterError("--order/--course", order or course,
+                                 "no laying order or course with --by course")
+        return course_plan(scene.blocks)
+    if by == "brick":
+        if course is None:
+            raise ParameterError("--course", None, "the course laid brick by brick "
+                                                   "(--by brick --course K)")
+        return brick_plan(scene, course, order or "pattern-first")
+    if by == "block":
+        if course is not None:
+            raise ParameterError("--course", course, "no course with --by block")
+        return block_plan(scene.blocks, order or "z")
+    raise ParameterError("--by", by, "course, brick or block")
+
+
+def analyse_stages(model: Model, params, plan: StagePlan) -> list:
+    """:func:`analyse_stage` of stages ``1..N`` in order, logging ``stage k of N``."""
+    rows = []
+    for stage in range(1, plan.n_stages + 1):
+        row = analyse_stage(model, params, plan, stage)
+        log.info("stage %d of %d: %d bricks, %s, MoI factor %s, %.2f s", stage,
+                 plan.n_stages, row["bricks"], "stands" if row["feasible"] else "needs support",
+                 "-" if row["moi_factor"] is None else f"{row['moi_factor']:.3g}",
+                 row["solve_s"])
+        rows.append(row)
+    return rows
+
+
+def first_unsupported(rows) -> dict | None:
+    """The row of the first stage that does not stand, None when every stage stands."""
+    return next((row for row in rows if not row["feasible"]), None)
+
+
+def stages_csv(rows) -> bytes:
+    """``stages.csv``: :data:`STAGE_COLUMNS`, one row per stage; empty cells for None."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(STAGE_COLUMNS)
+    for row in rows:
+        writer.writerow(["" if row[c] is None else
+                         f"{row[c]:.6g}" if isinstance(row[c], float) else row[c]
+                         for c in STAGE_COLUMNS])
+    return buf.getvalue().encode()
+
+
+def held_csv(scene, row) -> bytes:
+    """``first_unsupported/held.csv``: the bricks that carry tension at the first stage
+    that needs support (block, name, class, course, tension in newtons), largest first."""
+    blocks = scene.blocks
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(("block", "name", "class", "course", "tension_N"))
+    for block, newtons in row["tension"].items():
+        writer.writerow((block, blocks.block_name[block],
+                         BLOCK_CLASSES[blocks.block_class[block]],
+                         int(blocks.block_course[block]), f"{newtons:.6g}"))
+    return buf.getvalue().encode()
+
+
+# ---------------------------------------------------------------------- the run
+def stages_folder_name(params, plan: StagePlan) -> str:
+    """The run folder of a stage study: the structure id and the plan, so it never
+    replaces the folder of ``masonry run`` or of another plan."""
+    return f"{structure_id(params)}_stages_{plan.tag}"
+
+
+def run_stages(params, out_root="exports", *, by="course", order=None, course=None,
+               plots_wanted=True, force=False, scene=None, source=None) -> dict:
+    """Every construction stage of ``params`` (or of ``scene``) into its own run folder.
+
+    Parameters
+    ----------
+    params : masonry.params.Params
+        The structure and the analysis inputs, as for :func:`masonry.pipeline.run`.
+    out_root : str or Path
+        The run folder is ``out_root/<structure id>_stages_<plan>``.
+    by, order, course
+        The stage plan, see :func:`make_plan`.
+    plots_wanted, force : bool
+        Write the plots; recompute when the folder holds this input's complete study.
+    scene : Scene, optional
+        An already built scene (imported blocks, :func:`masonry.scenes.imported.load_assembly`).
+    source : dict, optional
+        Where such a scene came from, recorded in run.json.
+
+    Returns
+    -------
+    dict
+        The record written as ``run.json``, its ``path``, and ``rows`` (one dict per
+        stage, :data:`STAGE_COLUMNS` and ``tension``).
+    """
+    params = validate(params)
+    timer = Timer()
+    if scene is None:
+        scene, model, cached = cached_model(params, out_root, timer)
+    else:
+        scene, cached = dataclasses.replace(scene, params=params), "given"
+        with timer.stage("interfaces"):
+            model = analysis_model(scene)
+    plan = make_plan(scene, by, order, course)
+    target = Path(out_root) / stages_folder_name(params, plan)
+    outputs = {"plots": plots_wanted}
+    previous = None if force else _previous(target, params, plan, outputs)
+    if previous is not None:
+        log.info("%s is up to date (use --force to recompute)", target.name)
+        return {**previous, "path": str(target), "reused": True}
+
+    with timer.stage("stages"):
+        rows = analyse_stages(model, params, plan)
+    record = _record(scene, model, plan, rows, outputs, cached, source)
+    with RunFolder(out_root, target.name) as folder:
+        folder.write("00_parameters.txt", parameters_text(params))
+        folder.write("stages.csv", stages_csv(rows))
+        first = first_unsupported(rows)
+        if first is not None:
+            folder.write("first_unsupported/held.csv", held_csv(scene, first))
+        if plots_wanted:
+            with timer.stage("plots"):
+                for name, png in stage_pngs(scene, plan, rows).items():
+                    folder.write(name, png)
+        record["timings_s"] = timer.seconds
+        record["versions"] = versions()
+        record["complete"] = True
+        folder.write_json("run.json", record)
+    return {**record, "path": str(folder.target), "rows": rows}
+
+
+def _record(scene, model, plan, rows, outputs, cached, source) -> dict:
+    """run.json of a stage study, before timings."""
+    params = scene.params
+    first = first_unsupported(rows)
+    held = [] if first is None else [
+        {"block": block, "name": str(scene.blocks.block_name[block]), "tension_N": newtons}
+        for block, newtons in first["tension"].items()]
+    record = {
+        "structure_id": structure_id(params),
+        "scene": params.scene,
+        "params": dataclasses.asdict(params),
+        "outputs": outputs,
+        "plan": {**plan.record(), "described": _described(plan)},
+        **model_record(scene),
+        "cache": {"geometry": cached},
+        "stages": {
+            "count": plan.n_stages,
+            "standing": int(sum(bool(row["feasible"]) for row in rows)),
+            "first_unsupported": None if first is None else {
+                "stage": first["stage"], "course": first["course"],
+                "bricks": first["bricks"], "moi_factor": first["moi_factor"],
+                "held": held},
+            "solve_s": round(sum(row["solve_s"] for row in rows), 4),
+        },
+    }
+    record["counts"]["interfaces"] = model.interfaces.counts()
+    if source is not None:
+        record["source"] = source
+    return record
+
+
+def _described(plan: StagePlan) -> str:
+    if plan.by == "course":
+        return "stage k: every brick starting on courses 1..k, in every web"
+    if plan.by == "brick":
+        return f"courses 1..{plan.course - 1}, then course {plan.course}: " + \
+            BRICK_ORDERS[plan.order]
+    return BLOCK_ORDERS[plan.order]
+
+
+def _previous(target: Path, params, plan, outputs):
+    """The record of a complete earlier study of the same input and plan, else None."""
+    try:
+        record = json.loads((target / "run.json").read_text())
+    except (OSError, ValueError):
+        return None
+    same = (record.get("params") == json.loads(json.dumps(dataclasses.asdict(params)))
+            and record.get("plan", {}).get("stages") == plan.n_stages
+            and {k: record.get("plan", {}).get(k) for k in ("by", "order", "course")}
+            == {k: plan.record()[k] for k in ("by", "order", "course")}
+            and record.get("outputs") == outputs and record.get("complete"))
+    return record if same else None
+
+
+def stage_pngs(scene, plan: StagePlan, rows) -> dict:
+    """``stages.png`` (MoI factor of every stage, which stand) and, when a stage needs
+    support, ``first_unsupported/<view>.png``: that stage with its held bricks marked."""
+    params = scene.params
+    what = {"course": "course stages", "brick": f"course {plan.course} brick by brick "
+            f"({plan.order})", "block": f"block by block ({plan.order})"}[plan.by]
+    title = f"{structure_id(params)}: {what}, {sum(bool(r['feasible']) for r in rows)} of " \
+            f"{len(rows)} stages stand (mu {params.mu:g})"
+    out = {"stages.png": plots.stage_chart_png(
+        [r["stage"] for r in rows],
+        [np.nan if r["moi_factor"] is None else r["moi_factor"] for r in rows],
+        [bool(r["feasible"]) for r in rows],
+        [np.nan if r["load_factor"] is None else r["load_factor"] for r in rows],
+        title=title)}
+    first = first_unsupported(rows)
+    if first is None:
+        return out
+    present = plan.is_present(first["stage"])
+    held = np.zeros(scene.blocks.n_blocks, bool)
+    held[list(first["tension"])] = True
+    views = plots.marked_structure_pngs(
+        scene, scene.blocks.subset(present), held[present],
+        f"stage {first['stage']} of {plan.n_stages}: {first['bricks']} bricks, "
+        f"{int(held.sum())} carry tension", mark_label="carry tension (hold them)",
+        fast=params.fast)
+    out.update({f"first_unsupported/{name}": png for name, png in views.items()})
+    return out
