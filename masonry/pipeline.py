@@ -121,9 +121,10 @@ def _geometry_key(params: Params) -> str:
     return hashlib.sha1(key.encode()).hexdigest()[:16]
 
 
-def cached_model(params: Params, out_root, timer: Timer):
+def cached_model(params: Params, out_root, timer: Timer, check=None):
     """Scene and analysis model (interfaces, boundary routing), from the geometry cache
-    when present: ``(scene, model, 'reused' | 'computed')``."""
+    when present: ``(scene, model, 'reused' | 'computed')``. ``check(scene)``, when
+    given, runs on the scene before anything is written (it raises on bad input)."""
     cache = Path(out_root) / ".cache" / f"{_geometry_key(params)}.pickle"
     if cache.is_file():
         with timer.stage("model (cached)"):
@@ -131,9 +132,13 @@ def cached_model(params: Params, out_root, timer: Timer):
                 scene, model = pickle.load(f)
             # the cached scene carries the geometry; the rest of the inputs are this run's
             scene = dataclasses.replace(scene, params=params)
+        if check is not None:
+            check(scene)
         return scene, model, "reused"
     with timer.stage("model"):
         scene = build(params)
+    if check is not None:
+        check(scene)
     with timer.stage("interfaces"):
         model = analysis_model(scene)
     write_file_atomically(cache, pickle.dumps((scene, model),

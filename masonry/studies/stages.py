@@ -320,9 +320,12 @@ def make_plan(scene, by: str = "course", order: str | None = None,
         An option that does not fit ``by`` or the scene (named as the user types it).
     """
     if by == "course":
-        if order is not None or course is not None:
-            raise ParameterError("--order/--course", order or course,
-                                 "no laying order or course with --by course")
+        if order is not None:
+            raise ParameterError("--order", order, "no laying order with --by course "
+                                                   "(one for --by brick or --by block)")
+        if course is not None:
+            raise ParameterError("--course", course, "no course with --by course "
+                                                     "(--by brick --course K)")
         return course_plan(scene.blocks)
     if by == "brick":
         if course is None:
@@ -414,13 +417,19 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
     """
     params = validate(params)
     timer = Timer()
+    plan = None
+
+    def check(built):  # bad plan options are refused before anything is written
+        nonlocal plan
+        plan = make_plan(built, by, order, course)
+
     if scene is None:
-        scene, model, cached = cached_model(params, out_root, timer)
+        scene, model, cached = cached_model(params, out_root, timer, check=check)
     else:
         scene, cached = dataclasses.replace(scene, params=params), "given"
+        check(scene)
         with timer.stage("interfaces"):
             model = analysis_model(scene)
-    plan = make_plan(scene, by, order, course)
     target = Path(out_root) / stages_folder_name(params, plan)
     outputs = {"plots": plots_wanted}
     previous = None if force else _previous(target, params, plan, outputs)
