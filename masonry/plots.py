@@ -133,34 +133,44 @@ MARK_COLOUR = "#1f3bb3"
 """Colour of marked blocks (e.g. the bricks that carry tension at a construction stage)."""
 
 
-def marked_structure_pngs(scene, blocks, is_marked, title, mark_label="marked",
+def marked_structure_pngs(scene, is_present, is_marked, title, mark_label="marked",
                           fast=False) -> dict:
-    """The structure views of ``blocks`` (a part of ``scene``'s, e.g. a construction
-    stage) in their class colours, the blocks of ``is_marked`` ((B,) bool) in
-    :data:`MARK_COLOUR` (legend ``mark_label``), the scene's web outline for reference.
-    ``{view}.png`` per view, one view at lower resolution when ``fast``."""
+    """The structure views of a part of ``scene`` (e.g. a construction stage): the blocks
+    of ``is_present`` ((B,) bool) in their class colours, those of ``is_marked`` ((B,)
+    bool) in :data:`MARK_COLOUR` (legend ``mark_label``), the rest of the scene's blocks
+    as faint outlines. ``{view}.png`` per view, one view at lower resolution when
+    ``fast``."""
+    blocks = scene.blocks
     colours = np.array([CLASS_COLOURS[name] for name in BLOCK_CLASSES], dtype=object)
+    owner = blocks.face_block
+    shown = np.flatnonzero(is_present[owner])
+    ghost = np.flatnonzero(~is_present[owner] & ~blocks.block_is_support[owner])
+    face_colours = np.where(is_marked[owner[shown]], MARK_COLOUR,
+                            colours[blocks.block_class[owner[shown]]])
     out = {}
     for view in ["01_angle"] if fast else list(VIEWS):
-        fig, ax = _axes3d(scene.blocks.bounds, view)
+        fig, ax = _axes3d(blocks.bounds, view)
         _outline(ax, scene)
-        owner = blocks.face_block
-        face_colours = np.where(is_marked[owner], MARK_COLOUR,
-                                colours[blocks.block_class[owner]])
-        polys = [blocks.face_polygon(f) for f in range(blocks.n_faces)]
-        ax.add_collection3d(Poly3DCollection(polys,
+        if len(ghost):
+            ax.add_collection3d(Poly3DCollection(
+                [blocks.face_polygon(f) for f in ghost], facecolors="none",
+                edgecolors="0.8", linewidths=0.15))
+        ax.add_collection3d(Poly3DCollection([blocks.face_polygon(f) for f in shown],
                                              facecolors=list(face_colours),
                                              edgecolors="k", linewidths=0.1))
-        ax.legend(handles=[Patch(facecolor=MARK_COLOUR, label=mark_label)],
+        ax.legend(handles=[Patch(facecolor=MARK_COLOUR, label=mark_label),
+                           Patch(facecolor="none", edgecolor="0.7", label="not yet laid")],
                   loc="upper left", fontsize=8)
         ax.set_title(title)
         out[f"{view}.png"] = _png(fig, 60 if fast else 110)
     return out
 
 
-def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="") -> bytes:
+def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="",
+                    xlabel="stage") -> bytes:
     """MoI factor (and the collapse load factor, where given) against the construction
-    stage: stages that stand in green, those that need support in red.
+    stage: stages that stand in green, those that need support in red, the first of
+    them marked by a dashed line.
 
     Parameters
     ----------
@@ -174,12 +184,17 @@ def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="") -> 
     feasible = np.asarray(feasible, dtype=bool)
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(stage, moi, color="0.6", linewidth=0.8, zorder=1)
-    ax.scatter(stage[feasible], moi[feasible], s=14, color="#2ca02c", label="stands",
-               zorder=2)
+    ax.scatter(stage[feasible], moi[feasible], s=14, color="#2ca02c",
+               label=f"stands ({int(feasible.sum())})", zorder=2)
     ax.scatter(stage[~feasible], moi[~feasible], s=14, color="#d62728",
-               label="needs support", zorder=2)
-    ax.set_xlabel("stage")
+               label=f"needs support ({int((~feasible).sum())})", zorder=2)
+    if not feasible.all():
+        first = stage[np.argmin(feasible)]
+        ax.axvline(first, color="#d62728", linestyle="--", linewidth=0.8,
+                   label=f"first needs support: {first}")
+    ax.set_xlabel(xlabel)
     ax.set_ylabel("MoI factor (tension / weight)")
+    ax.set_ylim(bottom=min(-0.02 * max(np.nanmax(moi, initial=0), 0.05), 0))
     handles, labels = ax.get_legend_handles_labels()
     if load_factor is not None and np.isfinite(np.asarray(load_factor, float)).any():
         right = ax.twinx()

@@ -524,7 +524,8 @@ def stage_pngs(scene, plan: StagePlan, rows) -> dict:
         [np.nan if r["moi_factor"] is None else r["moi_factor"] for r in rows],
         [bool(r["feasible"]) for r in rows],
         [np.nan if r["load_factor"] is None else r["load_factor"] for r in rows],
-        title=title)}
+        title=title, xlabel={"course": "stage (courses laid)", "brick": f"stage (bricks "
+                             f"of course {plan.course} laid, per web)"}.get(plan.by, "stage"))}
     first = first_unsupported(rows)
     if first is None:
         return out
@@ -532,7 +533,7 @@ def stage_pngs(scene, plan: StagePlan, rows) -> dict:
     held = np.zeros(scene.blocks.n_blocks, bool)
     held[list(first["tension"])] = True
     views = plots.marked_structure_pngs(
-        scene, scene.blocks.subset(present), held[present],
+        scene, present, held,
         f"stage {first['stage']} of {plan.n_stages}: {first['bricks']} bricks, "
         f"{int(held.sum())} carry tension", mark_label="carry tension (hold them)",
         fast=params.fast)
