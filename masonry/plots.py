@@ -129,24 +129,33 @@ def structure_pngs(scene, fast=False) -> dict:
     return out
 
 
-MARK_COLOUR = "#1f3bb3"
-"""Colour of marked blocks (e.g. the bricks that carry tension at a construction stage)."""
+MARK_DECADES = 3
+"""Decades of the colour scale of :func:`marked_structure_pngs`: blocks whose value is
+below ``10**-MARK_DECADES`` of the largest keep their class colour."""
 
 
-def marked_structure_pngs(scene, is_present, is_marked, title, mark_label="marked",
+def marked_structure_pngs(scene, is_present, value, title, value_label="value",
                           fast=False) -> dict:
     """The structure views of a part of ``scene`` (e.g. a construction stage): the blocks
-    of ``is_present`` ((B,) bool) in their class colours, those of ``is_marked`` ((B,)
-    bool) in :data:`MARK_COLOUR` (legend ``mark_label``), the rest of the scene's blocks
-    as faint outlines. ``{view}.png`` per view, one view at lower resolution when
-    ``fast``."""
+    of ``is_present`` ((B,) bool), coloured by ``value`` ((B,) float >= 0, e.g. the
+    tension a brick carries, newtons) on a logarithmic scale over
+    :data:`MARK_DECADES` decades, in their class colours below it; the rest of the
+    scene's blocks as faint outlines. ``{view}.png`` per view, one view at lower
+    resolution when ``fast``."""
+    from matplotlib.colors import LogNorm, to_rgba
+
     blocks = scene.blocks
-    colours = np.array([CLASS_COLOURS[name] for name in BLOCK_CLASSES], dtype=object)
     owner = blocks.face_block
     shown = np.flatnonzero(is_present[owner])
     ghost = np.flatnonzero(~is_present[owner] & ~blocks.block_is_support[owner])
-    face_colours = np.where(is_marked[owner[shown]], MARK_COLOUR,
-                            colours[blocks.block_class[owner[shown]]])
+    top = max(float(np.max(value[is_present], initial=0.0)), 1e-300)
+    norm = LogNorm(top * 10.0**-MARK_DECADES, top)
+    cmap = plt.get_cmap("viridis_r")
+    face_value = value[owner[shown]]
+    is_marked = face_value >= norm.vmin
+    face_colours = np.array([to_rgba(CLASS_COLOURS[BLOCK_CLASSES[k]])
+                             for k in blocks.block_class[owner[shown]]])
+    face_colours[is_marked] = cmap(norm(face_value[is_marked]))
     out = {}
     for view in ["01_angle"] if fast else list(VIEWS):
         fig, ax = _axes3d(blocks.bounds, view)
@@ -156,10 +165,13 @@ def marked_structure_pngs(scene, is_present, is_marked, title, mark_label="marke
                 [blocks.face_polygon(f) for f in ghost], facecolors="none",
                 edgecolors="0.8", linewidths=0.15))
         ax.add_collection3d(Poly3DCollection([blocks.face_polygon(f) for f in shown],
-                                             facecolors=list(face_colours),
+                                             facecolors=face_colours,
                                              edgecolors="k", linewidths=0.1))
-        ax.legend(handles=[Patch(facecolor=MARK_COLOUR, label=mark_label),
-                           Patch(facecolor="none", edgecolor="0.7", label="not yet laid")],
+        if is_marked.any():
+            bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
+                               shrink=0.6, pad=0.04)
+            bar.set_label(value_label)
+        ax.legend(handles=[Patch(facecolor="none", edgecolor="0.7", label="not yet laid")],
                   loc="upper left", fontsize=8)
         ax.set_title(title)
         out[f"{view}.png"] = _png(fig, 60 if fast else 110)
@@ -224,7 +236,7 @@ def _colour_plot(blocks, interfaces, index, values, title, view, fast, label="N"
                                              facecolors=cmap(norm(values)),
                                              edgecolors="k", linewidths=0.05))
         bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
-                           shrink=0.6, pad=0.1)
+                           shrink=0.6, pad=0.04)
         bar.set_label(label)
     ax.set_title(f"{title} ({len(index)} interfaces)")
     return _png(fig, 60 if fast else 110)

@@ -9,6 +9,7 @@ import pytest
 from test_interfaces import box_corners
 
 from masonry.blocks import BLOCK_CLASSES, Blocks
+from masonry.export.obj import blocks_obj
 from masonry.interfaces import detect
 from masonry.params import ParameterError, Params, from_preset, validate
 from masonry.rbe.boundary import Model, analysis_model, restrict
@@ -273,3 +274,21 @@ def test_bad_stage_options_get_one_line_and_write_nothing(tmp_path, capsys, args
     error = capsys.readouterr().err.strip()
     assert len(error.splitlines()) == 1 and option in error
     assert not out.exists()
+
+
+@pytest.mark.parametrize("order", ["names", "z"])
+def test_imported_stack_laid_by_names_or_height(tmp_path, capsys, order):
+    # the stack of 0.3 b overhangs, as an OBJ file: block names b0001 ... b0006 bottom
+    # up, so both orders lay it bottom up and stage 4 is the first to need support
+    blocks, centre = stack(np.full(5, 0.3))
+    path = tmp_path / "stack.obj"
+    path.write_bytes(blocks_obj(blocks))
+    assert main(["stages", str(path), "--support", "*ground*", "--order", order,
+                 "--no-plots", "--out", str(tmp_path / "out"), "-q"]) == 0
+    (folder,) = (tmp_path / "out").glob(f"*_stages_{order}")
+    with open(folder / "stages.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["feasible"] == "True" for r in rows] == stands_by_statics(centre)
+    record = json.loads((folder / "run.json").read_text())
+    assert record["stages"]["first_unsupported"]["stage"] == 4
+    assert "first stage that needs support: 4" in capsys.readouterr().out

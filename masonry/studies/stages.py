@@ -68,7 +68,9 @@ BLOCK_ORDERS = {
 
 STAGE_COLUMNS = ("stage", "course", "bricks", "feasible", "moi", "moi_factor",
                  "load_factor", "solve_s")
-"""Columns of ``stages.csv``, one row per stage."""
+"""Columns of ``stages.csv``, one row per stage. ``load_factor`` (the collapse load
+factor of the stage under a lateral load) is empty: the collapse analysis is not part of
+this package yet, and :func:`analyse_stage` is the one place that will fill it."""
 
 NOT_LAID = -1
 """``StagePlan.block_stage`` of a block the plan never lays."""
@@ -252,6 +254,8 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
     """
     start = time.perf_counter()
     part = restrict(model, plan.is_present(stage))
+    # load_factor: the collapse load factor of ``part`` under a lateral load goes here
+    # once the collapse analysis exists; until then it is not computed (empty)
     row = {"stage": stage, "course": int(plan.stage_course[stage - 1]) or None,
            "bricks": int((~part.blocks.block_is_support).sum()), "load_factor": None}
     if len(part.interfaces) == 0:
@@ -529,13 +533,12 @@ def stage_pngs(scene, plan: StagePlan, rows) -> dict:
     first = first_unsupported(rows)
     if first is None:
         return out
-    present = plan.is_present(first["stage"])
-    held = np.zeros(scene.blocks.n_blocks, bool)
-    held[list(first["tension"])] = True
+    tension = np.zeros(scene.blocks.n_blocks)
+    tension[list(first["tension"])] = list(first["tension"].values())
     views = plots.marked_structure_pngs(
-        scene, present, held,
+        scene, plan.is_present(first["stage"]), tension,
         f"stage {first['stage']} of {plan.n_stages}: {first['bricks']} bricks, "
-        f"{int(held.sum())} carry tension", mark_label="carry tension (hold them)",
-        fast=params.fast)
+        f"{len(first['tension'])} carry tension", value_label="tension the brick carries "
+        "[N] (hold it)", fast=params.fast)
     out.update({f"first_unsupported/{name}": png for name, png in views.items()})
     return out
