@@ -129,7 +129,7 @@ def structure_pngs(scene, fast=False) -> dict:
     return out
 
 
-MARK_DECADES = 3
+MARK_DECADES = 2
 """Decades of the colour scale of :func:`marked_structure_pngs`: blocks whose value is
 below ``10**-MARK_DECADES`` of the largest keep their class colour."""
 
@@ -163,13 +163,13 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
         if len(ghost):
             ax.add_collection3d(Poly3DCollection(
                 [blocks.face_polygon(f) for f in ghost], facecolors="none",
-                edgecolors="0.8", linewidths=0.15))
+                edgecolors="0.87", linewidths=0.1))
         ax.add_collection3d(Poly3DCollection([blocks.face_polygon(f) for f in shown],
                                              facecolors=face_colours,
                                              edgecolors="k", linewidths=0.1))
         if is_marked.any():
             bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
-                               shrink=0.6, pad=0.04)
+                               shrink=0.6, pad=0.1)
             bar.set_label(value_label)
         ax.legend(handles=[Patch(facecolor="none", edgecolor="0.7", label="not yet laid")],
                   loc="upper left", fontsize=8)
@@ -236,7 +236,7 @@ def _colour_plot(blocks, interfaces, index, values, title, view, fast, label="N"
                                              facecolors=cmap(norm(values)),
                                              edgecolors="k", linewidths=0.05))
         bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
-                           shrink=0.6, pad=0.04)
+                           shrink=0.6, pad=0.1)
         bar.set_label(label)
     ax.set_title(f"{title} ({len(index)} interfaces)")
     return _png(fig, 60 if fast else 110)
