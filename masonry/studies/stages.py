@@ -494,7 +494,7 @@ def _record(scene, model, plan, rows, outputs, cached, source) -> dict:
 
 def _described(plan: StagePlan) -> str:
     if plan.by == "course":
-        return "stage k: every brick starting on courses 1..k, in every web"
+        return "stage k: every brick starting on courses 1..k"
     if plan.by == "brick":
         return f"courses 1..{plan.course - 1}, then course {plan.course}: " + \
             BRICK_ORDERS[plan.order]
