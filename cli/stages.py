@@ -73,10 +73,9 @@ def handle(args, report):
            f"{stages['solve_s']:.3g} s")
     first = stages["first_unsupported"]
     if first is not None:
-        names = ", ".join(h["name"] for h in first["held"][:5])
-        more = len(first["held"]) - 5
+        largest = ", ".join(f"{h['name']} ({h['tension_N']:.3g} N)" for h in first["held"][:3])
         report(f"first stage that needs support: {first['stage']} ({first['bricks']} "
-               f"bricks); {len(first['held'])} carry tension: {names}"
-               f"{f' and {more} more' if more > 0 else ''}")
+               f"bricks, MoI factor {first['moi_factor']:.3g}); most tension in {largest}; "
+               f"{len(first['held'])} bricks carry some (first_unsupported/held.csv)")
     report(f"{state}: {record['path']}")
     return 0
