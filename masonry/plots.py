@@ -129,19 +129,23 @@ def structure_pngs(scene, fast=False) -> dict:
     return out
 
 
+OUTLINE_COLOUR = "#ff00ff"
+"""Edge colour of the outlined blocks of :func:`marked_structure_pngs`."""
+
 MARK_DECADES = 2
 """Decades of the colour scale of :func:`marked_structure_pngs`: blocks whose value is
 below ``10**-MARK_DECADES`` of the largest keep their class colour."""
 
 
 def marked_structure_pngs(scene, is_present, value, title, value_label="value",
-                          fast=False) -> dict:
+                          is_outlined=None, outline_label="outlined", fast=False) -> dict:
     """The structure views of a part of ``scene`` (e.g. a construction stage): the blocks
     of ``is_present`` ((B,) bool), coloured by ``value`` ((B,) float >= 0, e.g. the
     tension a brick carries, newtons) on a logarithmic scale over
-    :data:`MARK_DECADES` decades, in their class colours below it; the rest of the
-    scene's blocks as faint outlines. ``{view}.png`` per view, one view at lower
-    resolution when ``fast``."""
+    :data:`MARK_DECADES` decades, in their class colours below it; the blocks of
+    ``is_outlined`` ((B,) bool, e.g. the ones just laid) with thick red edges (legend
+    ``outline_label``); the rest of the scene's blocks as faint outlines. ``{view}.png``
+    per view, one view at lower resolution when ``fast``."""
     from matplotlib.colors import LogNorm, to_rgba
 
     blocks = scene.blocks
@@ -159,6 +163,7 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
     out = {}
     for view in ["01_angle"] if fast else list(VIEWS):
         fig, ax = _axes3d(blocks.bounds, view)
+        ax.computed_zorder = False  # draw in the order below: the rings on top
         _outline(ax, scene)
         if len(ghost):
             ax.add_collection3d(Poly3DCollection(
@@ -166,13 +171,24 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
                 edgecolors="0.87", linewidths=0.1))
         ax.add_collection3d(Poly3DCollection([blocks.face_polygon(f) for f in shown],
                                              facecolors=face_colours,
-                                             edgecolors="k", linewidths=0.1))
+                                             edgecolors="k", linewidths=0.1, zorder=3))
+        handles = [Patch(facecolor="none", edgecolor="0.7", label="not yet laid")]
+        if is_outlined is not None and is_outlined.any():
+            edged = np.flatnonzero(is_outlined[owner] & is_present[owner])
+            ax.add_collection3d(Poly3DCollection(
+                [blocks.face_polygon(f) for f in edged], facecolors="none",
+                edgecolors=OUTLINE_COLOUR, linewidths=2.0, zorder=4))
+            # a ring around each, so that a single brick shows at any scale
+            centre = blocks.block_centroid[is_outlined & is_present]
+            ax.scatter(*centre.T, s=160, facecolors="none", edgecolors=OUTLINE_COLOUR,
+                       linewidths=1.5, depthshade=False, zorder=10)
+            handles.append(Patch(facecolor="none", edgecolor=OUTLINE_COLOUR,
+                                 label=outline_label))
         if is_marked.any():
             bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
                                shrink=0.6, pad=0.1)
             bar.set_label(value_label)
-        ax.legend(handles=[Patch(facecolor="none", edgecolor="0.7", label="not yet laid")],
-                  loc="upper left", fontsize=8)
+        ax.legend(handles=handles, loc="upper left", fontsize=8)
         ax.set_title(title)
         out[f"{view}.png"] = _png(fig, 60 if fast else 110)
     return out

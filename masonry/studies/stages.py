@@ -482,6 +482,8 @@ def _record(scene, model, plan, rows, outputs, cached, source) -> dict:
             "first_unsupported": None if first is None else {
                 "stage": first["stage"], "course": first["course"],
                 "bricks": first["bricks"], "moi_factor": first["moi_factor"],
+                "laid": [str(name) for name in scene.blocks.block_name[
+                    plan.block_stage == first["stage"]]],
                 "held": held},
             "solve_s": round(sum(row["solve_s"] for row in rows), 4),
         },
@@ -539,6 +541,7 @@ def stage_pngs(scene, plan: StagePlan, rows) -> dict:
         scene, plan.is_present(first["stage"]), tension,
         f"stage {first['stage']} of {plan.n_stages}: {first['bricks']} bricks, "
         f"{len(first['tension'])} carry tension", value_label="tension the brick carries "
-        "[N] (hold it)", fast=params.fast)
+        "[N] (hold it)", is_outlined=plan.block_stage == first["stage"],
+        outline_label=f"laid at stage {first['stage']}", fast=params.fast)
     out.update({f"first_unsupported/{name}": png for name, png in views.items()})
     return out
