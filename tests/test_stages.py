@@ -290,5 +290,7 @@ def test_imported_stack_laid_by_names_or_height(tmp_path, capsys, order):
         rows = list(csv.DictReader(f))
     assert [r["feasible"] == "True" for r in rows] == stands_by_statics(centre)
     record = json.loads((folder / "run.json").read_text())
-    assert record["stages"]["first_unsupported"]["stage"] == 4
+    first = record["stages"]["first_unsupported"]
+    assert first["stage"] == 4 and len(first["laid"]) == 1
+    assert first["laid"][0] == str(blocks.block_name[4])  # the fourth above the slab
     assert "first stage that needs support: 4" in capsys.readouterr().out
