@@ -12,6 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
 from masonry.blocks import BLOCK_CLASSES  # noqa: E402
@@ -231,7 +232,8 @@ def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="",
         right.set_ylabel("collapse load factor")
         extra = right.get_legend_handles_labels()
         handles, labels = handles + extra[0], labels + extra[1]
-    ax.legend(handles, labels, loc="upper left", fontsize=8)
+    ax.legend(handles, labels, loc="best", fontsize=8)
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
     return _png(fig, 110)
