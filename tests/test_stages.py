@@ -70,13 +70,14 @@ def test_harmonic_stack_stands_at_every_stage():
     assert all(r["moi_factor"] == pytest.approx(0, abs=1e-6) for r in rows)
 
 
-@pytest.mark.parametrize("offset, first_failing", [
-    (0.3, 4),   # blocks 2-4 together tip over block 1: (0.3 + 0.6 + 0.9) / 3 > 0.5
-    (0.55, 2),  # the second block alone tips
+@pytest.mark.parametrize("offsets, first_failing", [
+    (np.full(5, 0.3), 4),   # blocks 2-4 together tip over block 1: (0.3+0.6+0.9)/3 > 0.5
+    (np.full(5, 0.55), 2),  # the second block alone tips
+    (1.05 / (2 * np.arange(5, 0, -1)), 6),  # 5 % beyond harmonic: the top block tips
 ])
-def test_overhanging_stack_fails_at_the_stage_statics_says(offset, first_failing):
-    n = 6
-    blocks, centre = stack(np.full(n - 1, offset))
+def test_overhanging_stack_fails_at_the_stage_statics_says(offsets, first_failing):
+    n = len(offsets) + 1
+    blocks, centre = stack(offsets)
     expected = stands_by_statics(centre)
     assert expected.index(False) + 1 == first_failing
     plan, rows = stage_verdicts(blocks, order="names")
