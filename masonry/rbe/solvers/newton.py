@@ -240,14 +240,15 @@ class NewtonSystem:
     def dual_value(self, y, x):
         return float(self.b @ y - 0.5 * np.sum(self.h * x * x))
 
-    def newton_blocks(self, jacobian, shift):
+    def newton_blocks(self, jacobian, shift, incremental=True):
         """Stored blocks of ``A J A^T + shift I``.
 
         The Jacobian is piecewise constant: from one Newton step to the next only the
         vertices that moved to another face of their cone change it (preset 1's full
         dome: 18,000 of 75,000 vertices at the second step, 500 at the ninth), so the
-        per-interface sums of the last call are updated with those vertices alone."""
-        if self._last is None:
+        per-interface sums of the last call are updated with those vertices alone, unless
+        ``incremental`` is False (the interior point method changes every vertex)."""
+        if self._last is None or not incremental:
             vertices, delta = np.arange(len(jacobian)), jacobian
             sums = np.zeros((self._vertex_sum.shape[0], 144))
         else:
@@ -267,6 +268,23 @@ class NewtonSystem:
         blocks = (self._scatter @ quarters).reshape(-1, 6, 6)
         blocks[self._diagonal] += shift * np.eye(6)
         return blocks
+
+    def diagonal_scale(self) -> float:
+        """Mean diagonal entry of ``A H^-1 A^T``: the scale of the Newton matrix, which
+        the regularization and the damping are relative to."""
+        base = np.zeros((len(self.h), self.width, self.width))
+        base[:, np.arange(self.width), np.arange(self.width)] = 1.0 / self.h
+        blocks = self.newton_blocks(base, 0.0, incremental=False)
+        return float(np.mean(np.trace(blocks[self._diagonal], axis1=1, axis2=2)) / 6.0)
+
+    def full_vector(self, x, layout):
+        """(IV, width) forces in this system's columns -> the (4 IV,) vector of
+        ``layout`` (zero in the columns not solved for); None stays None."""
+        if x is None:
+            return None
+        full = np.zeros(layout.n_columns)
+        full.reshape(-1, layout.WIDTH)[:, list(self.components)] = x
+        return full
 
     def polar_excess(self, w):
         """Per vertex, the norm of the part of ``w`` that is not in the polar cone of K
@@ -297,7 +315,7 @@ def use_one_blas_thread():
     _blas_controller().limit(limits=1, user_api="blas")
 
 
-def _one_blas_thread(function):
+def one_blas_thread(function):
     """Run ``function`` with BLAS on one thread (see :func:`use_one_blas_thread`): the
     Newton method's factorizations, when the library is used without the command line."""
     @functools.wraps(function)
@@ -307,7 +325,7 @@ def _one_blas_thread(function):
     return limited
 
 
-@_one_blas_thread
+@one_blas_thread
 def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOutcome:
     """Solve the scaled RBE QP of ``system`` for ``method`` (``'net'`` or ``'plus'``).
 
@@ -435,19 +453,26 @@ def _certifies_infeasibility(ns, step, w_step, b_one, tol) -> bool:
     return float(ns.polar_excess(w_step).max()) <= tol * gain / b_one
 
 
+def prepared_system(system, method, workspace) -> NewtonSystem:
+    """The :class:`NewtonSystem` of ``method`` kept in ``workspace`` (made on first use;
+    the friction models share one symbolic factorization), set to ``system.mu``."""
+    prepared = workspace.setdefault("systems", {})
+    if method not in prepared:
+        symbolic = next((s.symbolic for s in prepared.values()), None)
+        prepared[method] = NewtonSystem(system, method, symbolic=symbolic)
+    ns = prepared[method]
+    ns.mu = system.mu
+    return ns
+
+
 def backend(system, method, options, workspace, y0=None) -> QPOutcome:
     """The :mod:`masonry.rbe.solvers` interface: ``options`` are :class:`NewtonOptions`
     fields. The workspace keeps the prepared systems (their symbolic factorization is
     shared by both friction models) and the last dual point per model, which starts the
     next solve of that model (another ``mu``) unless ``y0`` is given (a polish)."""
     start = time.perf_counter()
-    prepared = workspace.setdefault("systems", {})
-    if method not in prepared:
-        symbolic = next((s.symbolic for s in prepared.values()), None)
-        prepared[method] = NewtonSystem(system, method, symbolic=symbolic)
-    ns = prepared[method]
+    ns = prepared_system(system, method, workspace)
     preparation = time.perf_counter() - start
-    ns.mu = system.mu
     warm = workspace.setdefault("warm", {}).get(method)
     warm = warm if y0 is None else y0
     outcome = solve(system, method, NewtonOptions(**options), y0=warm, newton_system=ns)
