@@ -45,16 +45,21 @@ import numpy as np
 import scipy.sparse as sp
 from threadpoolctl import ThreadpoolController
 
-from masonry.rbe.solvers.base import QPOutcome
+from masonry.rbe.equilibrium import VariableLayout
+from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
 from masonry.rbe.solvers.cholesky import BlockCholesky
 
 log = logging.getLogger(__name__)
 
-# columns of a vertex, (c, t, f1, f2), used by each friction model
-COMPONENTS = {"net": (0, 2, 3), "plus": (0, 1, 2, 3)}
+MODEL_COMPONENTS = {"net": ("c", "f1", "f2"), "plus": ("c", "t", "f1", "f2")}
+"""The vertex unknowns each friction model solves for (friction-net has ``t = 0`` at
+its optimum, see above)."""
 
-DAMPING_CEILING = 1e-2
-"""Largest shift of the Newton matrix, relative to its mean diagonal."""
+COMPONENTS = {method: tuple(VariableLayout.COMPONENTS.index(name) for name in names)
+              for method, names in MODEL_COMPONENTS.items()}
+"""Their columns in a vertex's :class:`~masonry.rbe.equilibrium.VariableLayout` block."""
+
+TENSION = VariableLayout.COMPONENTS.index("t")
 
 VERTEX_CHUNK = 32768
 """Vertices per stacked product when forming Newton matrices (bounds the buffers)."""
@@ -83,10 +88,20 @@ class NewtonOptions:
         ``eps`` of the Newton matrix, relative to the mean of its first diagonal: keeps
         it positive definite when a block has no active contact.
     infeasibility_tol : float
-        A step ``d`` certifies friction-net infeasibility when ``b^T d > 0`` and the
-        largest per-vertex part of ``A^T d`` outside the polar cone is below
+        A direction ``d`` certifies friction-net infeasibility when ``b^T d > 0`` and
+        the largest per-vertex part of ``A^T d`` outside the polar cone is below
         ``infeasibility_tol * b^T d / ||b||_1``: then no forces with ``||x||_1`` up to
         ``||b||_1 / infeasibility_tol`` (in reference weights) can balance the loads.
+    sufficient_increase : float
+        Armijo constant of the backtracking line search on the dual.
+    backtracks : int
+        Step halvings before the line search counts as stalled.
+    short_step : float
+        Damping (Levenberg-Marquardt): a step shorter than this raises the shift of the
+        Newton matrix by ``damping_raise``; a full step lowers it by ``damping_lower``.
+    damping_raise, damping_lower : float
+    damping_ceiling : float
+        Largest shift, relative to the mean diagonal.
     """
 
     tol: float = 1e-9
@@ -95,6 +110,12 @@ class NewtonOptions:
     divergence: float = 1e6
     regularization: float = 1e-10
     infeasibility_tol: float = 1e-4
+    sufficient_increase: float = 1e-4
+    backtracks: int = 50
+    short_step: float = 0.25
+    damping_raise: float = 100.0
+    damping_lower: float = 10.0
+    damping_ceiling: float = 1e-2
 
 
 def project_pyramid(p, mu):
@@ -165,9 +186,9 @@ class NewtonSystem:
         width = len(columns)
         self.width = width
         self.h = system.h_solver.reshape(-1, layout.WIDTH)[:, columns]
-        pyramid = [i for i, c in enumerate(columns) if c != 1]
+        pyramid = [i for i, c in enumerate(columns) if c != TENSION]
         self.pyramid = np.asarray(pyramid)
-        self.tension = [i for i, c in enumerate(columns) if c == 1]
+        self.tension = [i for i, c in enumerate(columns) if c == TENSION]
         if np.ptp(self.h[:, self.pyramid]) != 0:
             raise ValueError("the pyramid projection needs equal weights on c, f1, f2")
         keep = (layout.WIDTH * np.arange(layout.n_vertices)[:, None] + columns).ravel()
@@ -352,105 +373,133 @@ def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOut
     start = time.perf_counter()
     ns = NewtonSystem(system, method) if newton_system is None else newton_system
     setup = time.perf_counter() - start
-    A, AT, b = ns.A, ns.AT, ns.b
-    b_inf, b_one = np.abs(b).max(), np.abs(b).sum()
-    n_vertices = len(ns.coefficients)
-
-    # first point: the dual of the QP without cones (J = H^-1), or the given one
-    base = np.zeros((n_vertices, ns.width, ns.width))
-    base[:, np.arange(ns.width), np.arange(ns.width)] = 1.0 / ns.h
-    first = ns.newton_blocks(base, 0.0)
-    diagonal_scale = float(np.mean(np.trace(first[ns._diagonal], axis1=1, axis2=2)) / 6.0)
-    floor = options.regularization * diagonal_scale
-    shift = floor
-    factorizations = 0
+    scale = ns.diagonal_scale()
     if y0 is None:
-        first[ns._diagonal] += shift * np.eye(6)
-        y = ns.symbolic.factor(first).solve(b)
-        factorizations += 1
+        y = _unconstrained_dual(ns, options.regularization * scale)
     else:
         y = np.asarray(y0, dtype=float).copy()
+    run = _Run(ns, y, options, scale)
+    status = run.iterate(certify=method == "net")
+    return QPOutcome(status=status,
+                     x=None if status == INFEASIBLE else ns.full_vector(run.x, system.layout),
+                     iterations=run.steps, y=run.y, setup_time=setup,
+                     solve_time=time.perf_counter() - start - setup,
+                     info={"factorizations": run.factorizations + (y0 is None)})
 
-    y_scale = max(float(np.abs(y).max()), np.finfo(float).tiny)
-    w = (AT @ y).reshape(n_vertices, ns.width)
-    x, jacobian = ns.project(w)
-    value = ns.dual_value(y, x)
-    status, iterations = "user_limit", 0
-    best, best_at, previous = np.inf, 0, np.inf
-    for iterations in range(1, options.max_iter + 1):
-        residual = b - A @ x.ravel()
-        size = np.abs(residual).max()
-        if size <= options.tol * b_inf:
-            status = "optimal"
-            iterations -= 1
-            break
-        if size < 0.5 * best:
-            best, best_at = size, iterations
-        elif iterations - best_at >= options.stall:
-            log.info("Newton stalled: residual %.2e, no halving in %d steps",
-                     size / b_inf, options.stall)
-            iterations -= 1
-            break
-        if np.abs(y).max() > options.divergence * y_scale:
-            log.info("Newton diverging (the dual point grew %.0e times): likely infeasible",
-                     options.divergence)
-            iterations -= 1
-            break
-        try:
-            factor = ns.symbolic.factor(ns.newton_blocks(jacobian, shift))
-        except np.linalg.LinAlgError as error:
-            log.warning("Newton matrix not positive definite: %s", error)
-            status = "solver_error"
-            break
-        factorizations += 1
-        step = factor.solve(residual)
-        w_step = (AT @ step).reshape(n_vertices, ns.width)
-        # a Farkas direction shows up as a step that does not shrink: test only those
-        growing = iterations == 1 or size >= previous
-        previous = size
-        if method == "net" and growing and _certifies_infeasibility(
-                ns, step, w_step, b_one, options.infeasibility_tol):
-            status = "infeasible"
-            break
-        slope = float(residual @ step)
+
+def _unconstrained_dual(ns, shift):
+    """The dual point of the QP without cones: ``A H^-1 A^T y = b``."""
+    base = np.zeros((len(ns.h), ns.width, ns.width))
+    base[:, np.arange(ns.width), np.arange(ns.width)] = 1.0 / ns.h
+    return ns.symbolic.factor(ns.newton_blocks(base, shift)).solve(ns.b)
+
+
+class _Run:
+    """The state of Newton's iterations on the dual ``g(y)``: the point, its forces and
+    Jacobian, the damping shift, and the counts."""
+
+    def __init__(self, ns, y, options, scale):
+        self.ns, self.options, self.scale = ns, options, scale
+        self.b_inf, self.b_one = np.abs(ns.b).max(), np.abs(ns.b).sum()
+        self.floor = options.regularization * scale
+        self.shift = self.floor
+        self.steps = self.factorizations = 0
+        self.y_scale = max(float(np.abs(y).max()), np.finfo(float).tiny)
+        self._move_to(y, (ns.AT @ y).reshape(len(ns.h), ns.width))
+
+    def _move_to(self, y, w, projected=None):
+        self.y, self.w = y, w
+        self.x, self.jacobian = self.ns.project(w) if projected is None else projected
+        self.value = self._value(y, self.x)
+
+    def _value(self, y, x):
+        return self.ns.dual_value(y, x)
+
+    def gradient(self):
+        """``b - A x(y)``, the equilibrium residual."""
+        return self.ns.b - self.ns.A @ self.x.ravel()
+
+    def iterate(self, certify) -> str:
+        """Newton steps until converged (``optimal``), certified infeasible (``certify``
+        and a step is a Farkas certificate: ``infeasible``), stalled, diverging or out
+        of steps (``user_limit``), or a matrix that is not positive definite."""
+        options = self.options
+        best, best_at, previous = np.inf, 0, np.inf
+        for step in range(1, options.max_iter + 1):
+            residual = self.gradient()
+            size = np.abs(residual).max()
+            if size <= options.tol * self.b_inf:
+                return OPTIMAL
+            if size < 0.5 * best:
+                best, best_at = size, step
+            elif step - best_at >= options.stall:
+                log.info("Newton stalled: residual %.2e, no halving in %d steps",
+                         size / self.b_inf, options.stall)
+                return USER_LIMIT
+            if np.abs(self.y).max() > options.divergence * self.y_scale:
+                log.info("Newton diverging (the dual point grew %.0e times): likely "
+                         "infeasible", options.divergence)
+                return USER_LIMIT
+            try:
+                direction = self._direction(residual)
+            except np.linalg.LinAlgError as error:
+                log.warning("Newton matrix not positive definite: %s", error)
+                return SOLVER_ERROR
+            self.steps += 1
+            w_step = (self.ns.AT @ direction).reshape(self.w.shape)
+            # a Farkas direction shows up as a step that does not shrink: test only those
+            if certify and (step == 1 or size >= previous) and certifies_infeasibility(
+                    self.ns, direction, w_step, self.b_one, options.infeasibility_tol):
+                return INFEASIBLE
+            previous = size
+            if not self._line_search(residual, direction, w_step):
+                log.info("Newton line search stalled at step %d", step)
+                return USER_LIMIT
+        return USER_LIMIT
+
+    def _direction(self, residual):
+        """Solve the generalized Newton system ``(A J A^T + shift I) d = r``."""
+        blocks = self.ns.newton_blocks(self.jacobian, self.shift)
+        self.factorizations += 1
+        return self.ns.symbolic.factor(blocks).solve(residual)
+
+    def _line_search(self, residual, direction, w_step) -> bool:
+        """Backtracking (Armijo) along ``direction``, then the damping update; False
+        when no step length gives a sufficient increase."""
+        options = self.options
+        slope = float(residual @ direction)
         length = 1.0
-        for _ in range(50):
-            x_new, jacobian_new = ns.project(w + length * w_step)
-            value_new = ns.dual_value(y + length * step, x_new)
-            if value_new >= value + 1e-4 * length * slope:
+        for _ in range(options.backtracks):
+            projected = self.ns.project(self.w + length * w_step)
+            y_new = self.y + length * direction
+            if (self._value(y_new, projected[0])
+                    >= self.value + options.sufficient_increase * length * slope):
                 break
             length *= 0.5
         else:
-            log.info("Newton line search stalled at step %d", iterations)
-            break
-        log.debug("Newton step %d: residual %.3e, step length %.3g, shift %.1e",
-                  iterations, np.abs(residual).max() / b_inf, length, shift / diagonal_scale)
+            return False
+        log.debug("Newton step %d: residual %.3e, step length %.3g, shift %.1e", self.steps,
+                  np.abs(residual).max() / self.b_inf, length, self.shift / self.scale)
         # damping (Levenberg-Marquardt): a block whose contacts all opened has no
         # curvature but the shift, its step is huge and the line search cuts every
         # other block's step with it; short steps raise the shift, full steps lower it
-        if length < 0.25:
-            shift = min(shift * 100.0, DAMPING_CEILING * diagonal_scale)
+        if length < options.short_step:
+            self.shift = min(self.shift * options.damping_raise,
+                             options.damping_ceiling * self.scale)
         elif length == 1.0:
-            shift = max(shift / 10.0, floor)
-        y = y + length * step
-        w = w + length * w_step
-        x, jacobian, value = x_new, jacobian_new, value_new
-
-    x_full = np.zeros(system.layout.n_columns)
-    x_full.reshape(-1, system.layout.WIDTH)[:, list(ns.components)] = x
-    return QPOutcome(status=status, x=None if status == "infeasible" else x_full,
-                     iterations=iterations, y=y, setup_time=setup,
-                     solve_time=time.perf_counter() - start - setup,
-                     info={"factorizations": factorizations})
+            self.shift = max(self.shift / options.damping_lower, self.floor)
+        self._move_to(y_new, self.w + length * w_step, projected)
+        return True
 
 
-def _certifies_infeasibility(ns, step, w_step, b_one, tol) -> bool:
-    """Whether the direction ``step`` is a Farkas certificate within ``tol``: ``b^T d > 0``
-    and ``A^T d`` nearly in the polar cone of K (see :class:`NewtonOptions`)."""
-    gain = float(ns.b @ step)
+def certifies_infeasibility(ns, d, w_d, b_one, tol) -> bool:
+    """Whether the direction ``d`` ((6 F,) float, ``w_d = A^T d`` per vertex) is a
+    Farkas certificate within ``tol``: ``b^T d > 0`` and ``A^T d`` nearly in the polar
+    cone of K (see :class:`NewtonOptions`)."""
+    gain = float(ns.b @ d)
     if gain <= 0:
         return False
-    return float(ns.polar_excess(w_step).max()) <= tol * gain / b_one
+    return float(ns.polar_excess(w_d).max()) <= tol * gain / b_one
 
 
 def prepared_system(system, method, workspace) -> NewtonSystem:
