@@ -126,13 +126,15 @@ def _dense_factor(factor, n_scalar):
     return low
 
 
-@pytest.mark.parametrize("small_update", [0, 10**9])
-def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_update):
+@pytest.mark.parametrize("small_update, parallel", [(0, False), (10**9, False), (0, True)])
+def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_update, parallel):
     # the Cholesky factor of an SPD matrix is unique: every entry of the multifrontal
     # factor (assembly, extend-add of the children's updates, relaxed supernodes) must
     # equal LAPACK's dense factor of the same permuted matrix; small_update forces every
-    # extend-add through the run-by-run path (0) or the flat-position path (huge)
+    # extend-add through the run-by-run path (0) or the flat-position path (huge);
+    # parallel: subtrees on two threads whatever the size
     monkeypatch.setattr(cholesky, "SMALL_UPDATE", small_update)
+    monkeypatch.setattr(cholesky, "PARALLEL_FLOPS", 0.0 if parallel else np.inf)
     rng = np.random.default_rng(7)
     n, bs = 40, 3
     # a 2D grid graph with a few long-range edges: fronts with several children
@@ -140,6 +142,9 @@ def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_upda
     edges = np.array(grid + [(0, 37), (5, 30), (12, 39)])
     sym = BlockCholesky(n, edges, block_size=bs)
     assert any(len(children) > 1 for children in sym._children)
+    if parallel:
+        threads, top = sym._parallel_schedule()
+        assert len(threads) == 2 and all(threads) and top
     values = rng.normal(size=(len(sym.lower_rows), bs, bs))
     dense = np.zeros((bs * n, bs * n))
     for k, (i, j) in enumerate(zip(sym.lower_rows, sym.lower_cols)):
