@@ -7,10 +7,14 @@ positive definite matrix of dense 6 x 6 blocks whose block pattern is the contac
 for a scene while the values change at every Newton step, so the ordering and the
 symbolic analysis are done once and reused.
 
-Why not a library: scipy has no sparse Cholesky; ``qdldl`` (simplicial LDL^T, through
-cvxpy) took 1.1 s for the 38,000-row matrix of preset 1's full dome, SuperLU 23 s.
-Dense 6 x 6 blocks and supernodes let LAPACK and BLAS do the arithmetic
-(``dpotrf``, ``dtrsm``, ``dsyrk``): 0.3 s for the same matrix on one core.
+Why our own: scipy has no sparse Cholesky. Its SuperLU (``splu``, an LU that ignores
+the symmetry) and ``qdldl`` (a simplicial LDL^T, already a dependency for its AMD
+ordering) are several times slower on the Newton matrix of a full dome; CHOLMOD
+(scikit-sparse, cvxopt) and MKL PARDISO (pypardiso) are faster but bring a GPL/LGPL
+library or a 200 MB binary that would become the default install of every user. Dense
+6 x 6 blocks and supernodes let LAPACK and BLAS do the arithmetic (``dpotrf``,
+``dtrsm``, ``dsyrk``) from scipy alone. The measurements are in ``docs/bench.md``
+("The sparse Cholesky against libraries").
 
 Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1992):
 
@@ -43,16 +47,14 @@ RELAX_ZEROS = 0.2
 the merged supernode's stored entries are explicit zeros ..."""
 
 RELAX_COLUMNS = 8
-"""... or if the merged supernode has at most this many block columns. Measured on
-preset 1's full dome: 0.38 s per factorization against 0.50 s for fundamental
-supernodes only (1,888 against 4,438 supernodes; 2.9 against 2.1 GFlop)."""
+"""... or if the merged supernode has at most this many block columns (fewer, larger
+fronts: more flops, far fewer Python-level steps; measured in ``docs/bench.md``)."""
 
 
 SMALL_UPDATE = 120
 """Update matrices up to this size are added to their parent's front by one add at
-precomputed flat positions, larger ones run by run (run-by-run adds took 0.077 s of
-0.28 s per factorization of preset 1's full dome with all updates run by run; 60, 120,
-240 and 480 measured 0.25, 0.235, 0.24 and 0.265 s)."""
+precomputed flat positions, larger ones run by run (the fastest of 60, 120, 240 and
+480 on preset 1's full dome; ``docs/bench.md``)."""
 
 
 FACTOR_THREADS = 2

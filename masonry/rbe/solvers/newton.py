@@ -24,10 +24,11 @@ generalized Hessian ``-(A J A^T + eps I)``, ``J`` the Jacobian of the projection
 (Armijo) line search on ``g`` globalizes them. Once the set of active pyramid faces is
 found the step is exact, so the method ends with residuals near rounding.
 
-Why (measured on preset 1's full dome, 6,328 blocks, 299,000 unknowns, one core):
-Clarabel took 37 s (16 interior-point iterations, each factoring a 790,000-row KKT
-system), OSQP 30 s for eps 1e-3 (575 iterations, friction violation 9e-3); this method
-took 9 Newton steps on a 38,000-row system of 6 x 6 blocks.
+Why: an interior point solver (Clarabel) factors the whole KKT system, one row per
+unknown and constraint (790,000 rows on preset 1's full dome), at every iteration, and
+ADMM (OSQP) needs hundreds of iterations for a loose friction tolerance; this method
+factors a system of six rows per block (38,000 rows), about ten times on a feasible
+full dome (``docs/bench.md``).
 
 When friction-net is infeasible the dual is unbounded: the iterates run off along a
 Farkas direction ``d`` with ``b^T d > 0`` and ``A^T d`` in the polar cone of ``K``. The
@@ -79,7 +80,7 @@ class NewtonOptions:
         Give up when the residual has not halved in this many steps; an interior-point
         method takes over. The residual wanders before the active set settles: preset
         1's full dome went 4 steps without halving it, with p = 19 (18,000 blocks) 19
-        steps (then converged at step 25, 55 s, where Clarabel took 455 s).
+        steps (then converged at step 25).
     divergence : float
         Give up when the dual point has grown this many times larger than the first one:
         the iterates run off along a direction of infeasibility without certifying it
@@ -325,13 +326,11 @@ def use_one_blas_thread():
     workers call this first).
 
     A factorization makes thousands of small BLAS calls; with a BLAS thread per core
-    every call waits for its threads, and while another process kept one of this
-    machine's two cores busy, one factorization of preset 1's full dome took 5 to 10 s
-    instead of 0.35 s (21,648 blocks: 15 to 38 s instead of 1.8 s). On an idle machine
-    the full dome from parameters to forces took 5.7 s with a BLAS thread per core and
-    4.4 s with one (``masonry bench --presets 1 --scenes dome``, median of 5): idle
-    BLAS threads spin on the other core. Nothing here does dense algebra large enough
-    to gain from more (Clarabel, OSQP and HiGHS have their own threads).
+    every call waits for its threads (15 to 30 times slower while another process
+    keeps a core busy), and idle BLAS threads spin on the other cores (measured in
+    ``docs/bench.md``). The cores are used by factoring independent subtrees on
+    threads instead (:meth:`masonry.rbe.solvers.cholesky.BlockCholesky.factor`).
+    Clarabel, OSQP and HiGHS have their own threads.
     """
     _blas_controller().limit(limits=1, user_api="blas")
 
