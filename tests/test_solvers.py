@@ -23,7 +23,8 @@ from masonry.rbe.solve import ACCURACY, RBEProblem, solve_rbe
 from masonry.rbe.solvers import BACKENDS
 from masonry.rbe.solvers import cholesky
 from masonry.rbe.solvers.cholesky import BlockCholesky
-from masonry.rbe.solvers.newton import NewtonSystem, project_pyramid
+from masonry.rbe.solvers.interior import vertex_constraints, vertex_inverse
+from masonry.rbe.solvers.newton import COMPONENTS, NewtonSystem, project_pyramid
 from masonry.rbe.solvers.standard_form import standard_form
 from masonry.tolerances import Tolerances
 from masonry_cli.main import main
@@ -161,6 +162,18 @@ def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_upda
     factor = sym.factor(values)
     np.testing.assert_allclose(_dense_factor(factor, bs * n), expected, rtol=0,
                                atol=1e-12 * np.abs(expected).max())
+
+
+@pytest.mark.parametrize("method", ["net", "plus"])
+def test_interior_point_vertex_blocks_are_the_inverse(method):
+    components = COMPONENTS[method]
+    rng = np.random.default_rng(5)
+    G = vertex_constraints(components, 0.6)
+    h = rng.uniform(0.5, 2.0, size=(200, len(components)))
+    w = np.exp(rng.uniform(-6.0, 6.0, size=(200, len(G))))
+    stiffness = h[:, :, None] * np.eye(len(components)) + np.einsum("ki,vk,kj->vij", G, w, G)
+    np.testing.assert_allclose(vertex_inverse(h, w, 0.6, components),
+                               np.linalg.inv(stiffness), rtol=0, atol=1e-12)
 
 
 def test_newton_matrices_equal_the_sparse_products():
