@@ -227,9 +227,10 @@ def solve(ns: NewtonSystem, options: InteriorOptions) -> QPOutcome:
         r_cone = x @ G.T + s
         gap = float(s.ravel() @ z.ravel()) / m
         objective = 0.5 * float(np.sum(h * x * x))
-        # the dual residual is left out: it stalls near 1e-7 of the largest multiplier
-        # (the vertex blocks D lose digits as z / s spreads), and the points are
-        # judged on their recomputed equilibrium and friction residuals, then polished
+        # the dual residual is left out: it grows to 1e-7..1e-5 of the largest
+        # multiplier in the last iterations (z / s spreads over 20 decades, and
+        # dz = W (G dx + r) loses digits); the points are judged on their recomputed
+        # equilibrium and friction residuals, then polished by Newton from y
         if (np.abs(r_primal).max() <= options.tol * b_inf
                 and gap * m <= options.tol * (1.0 + abs(objective))):
             status = OPTIMAL
