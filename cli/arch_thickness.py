@@ -4,6 +4,7 @@ feasibility, beside the thrust line's value."""
 from masonry.studies.thrust_line import thrust_line_minimum_thickness
 from masonry.params import SOLVERS, Params, validate
 from masonry.studies.thickness import minimum_thickness
+from masonry.tolerances import THICKNESS_RTOL
 
 from .options import add_arch_options
 
@@ -21,8 +22,8 @@ def register(subparsers):
     g.add_argument("--density", type=float, help="kg/m^3 (default 2000)")
     g.add_argument("--solver", choices=SOLVERS,
                    help="QP solver: clarabel (interior point, default) or osqp")
-    g.add_argument("--rtol", type=float, default=1e-4,
-                   help="relative width of the final bisection bracket (default 1e-4)")
+    g.add_argument("--rtol", type=float, default=THICKNESS_RTOL,
+                   help="relative width of the final bisection bracket (default %(default)g)")
     parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
     parser.set_defaults(handler=handle)
 

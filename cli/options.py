@@ -5,9 +5,6 @@ import argparse
 from masonry.params import (ACCURACIES, ARCH_SHAPES, BOUNDARIES, FRICTIONS, PRESETS,
                             SCENES, SOLVERS, Params, from_preset, load, validate)
 
-GEOMETRY = ("stretch", "n", "r", "p", "cut", "unit", "min_fill", "wall_length",
-            "wall_courses")
-
 
 class Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit code 2."""
@@ -91,6 +88,9 @@ def add_output_options(parser):
     g.add_argument("--no-plots", dest="plots", action="store_false", help="skip all plots")
     g.add_argument("--no-printable", dest="printable", action="store_false",
                    help="skip the printable body (dome.stl, dome.obj)")
+    g.add_argument("--print-size", dest="print_size", type=float, metavar="MM",
+                   help="also write dome.3mf for a slicer, in millimetres, its largest "
+                        "dimension MM")
     g.add_argument("--force", action="store_true",
                    help="recompute even if the run folder holds this input's results")
     g.add_argument("-q", "--quiet", action="store_true", help="no progress messages")

@@ -11,13 +11,15 @@ import math
 import tomllib
 from dataclasses import dataclass
 
+from masonry.tolerances import STRETCH_USUAL_RANGE
+
 log = logging.getLogger(__name__)
 
 SCENES = ("section", "wall", "dome", "assembly", "arch")
 FRICTIONS = ("net", "plus", "auto")
 BOUNDARIES = ("free", "rigid", "cyclic")
 # QP solvers (masonry.rbe.solvers.BACKENDS) and accuracy presets (masonry.rbe.solve.ACCURACY)
-SOLVERS = ("newton", "clarabel", "osqp", "clarabel-cvxpy", "osqp-cvxpy")
+SOLVERS = ("newton", "interior", "clarabel", "osqp", "clarabel-cvxpy", "osqp-cvxpy")
 ACCURACIES = ("fast", "balanced", "accurate")
 ARCH_SHAPES = ("semicircular", "pointed", "segmental")
 
@@ -58,7 +60,8 @@ class Params:
     Analysis: ``mu`` friction coefficient, ``density`` kg/m^3, ``friction`` net | plus |
     auto, ``accuracy`` solver preset (fast | balanced | accurate; None: fast in fast
     mode, else balanced, SPEC 3), ``solver`` (None: the preset's; a name overrides it).
-    Output: ``fast`` (one view, low resolution), ``cad_offset`` (units).
+    Output: ``fast`` (one view, low resolution), ``cad_offset`` (units), ``print_size``
+    (mm: the largest dimension of ``dome.3mf``; None writes no 3MF).
     """
 
     stretch: float = 1.0
@@ -79,6 +82,7 @@ class Params:
     solver: str | None = None
     fast: bool = False
     cad_offset: float = 1.0
+    print_size: float | None = None
     arch_blocks: int = 16
     arch_span: float = 10.0
     arch_thickness: float = 0.6
@@ -166,6 +170,9 @@ def validate(params: Params) -> Params:
     _check("density", p.density, _number("density", p.density) > 0, "> 0 (kg/m^3)")
     _check("cad_offset", p.cad_offset, _number("cad_offset", p.cad_offset) >= 0,
            ">= 0 (units)")
+    if p.print_size is not None:
+        _check("print_size", p.print_size, _number("print_size", p.print_size) > 0,
+               "> 0 (mm, the largest dimension of the print)")
     _check("wall_length", p.wall_length, _number("wall_length", p.wall_length) >= 4,
            ">= 4 (units, one regular brick)")
     _check("wall_courses", p.wall_courses,
@@ -184,9 +191,10 @@ def validate(params: Params) -> Params:
     if p.scene == "assembly":
         _check("assembly", p.assembly, bool(p.assembly),
                "the name of an imported model (masonry analyze sets it)")
-    if p.scene in ("section", "dome") and not 0.2 <= p.stretch <= 5:
-        log.warning("stretch=%g is outside 0.2..5: the dome is unusually flat or tall",
-                    p.stretch)
+    low, high = STRETCH_USUAL_RANGE
+    if p.scene in ("section", "dome") and not low <= p.stretch <= high:
+        log.warning("stretch=%g is outside %g..%g: the dome is unusually flat or tall",
+                    p.stretch, low, high)
     return p
 
 

@@ -35,6 +35,13 @@ PACKAGES = ("numpy", "scipy", "trimesh", "manifold3d", "cvxpy", "osqp", "highspy
 
 
 def versions() -> dict:
+    """The versions of masonry and of the :data:`PACKAGES` it runs on, for run.json.
+
+    Returns
+    -------
+    dict str -> str or None
+        ``{"masonry": version, package: version or None when not installed}``.
+    """
     out = {"masonry": __version__}
     for name in PACKAGES:
         try:
@@ -45,14 +52,21 @@ def versions() -> dict:
 
 
 class Timer:
-    """Wall-clock seconds per stage, logged as each stage starts."""
+    """Wall-clock seconds per stage, logged as each stage starts.
+
+    Attributes
+    ----------
+    seconds : dict str -> float
+        Seconds per stage name, rounded to 0.1 ms; run.json's ``timings_s``.
+    """
 
     def __init__(self):
         self.seconds = {}
 
     @contextmanager
     def stage(self, name):
-        """Time a stage; a stage entered again (several exporters) adds up."""
+        """Context manager timing the block under stage ``name`` (str); a stage entered
+        again (several exporters) adds up."""
         log.info("%s ...", name)
         start = time.perf_counter()
         try:
@@ -63,7 +77,20 @@ class Timer:
 
 
 def model_record(scene) -> dict:
-    """Counts, volume and weight of a built scene, and its pattern report."""
+    """Counts, volume and weight of a built scene, and its pattern report.
+
+    Parameters
+    ----------
+    scene : masonry.scenes.base.Scene
+
+    Returns
+    -------
+    dict
+        ``counts`` (free bricks, by class, courses; ints), ``volume_m3`` (m^3) and
+        ``weight_N`` (N) of the free blocks (supports left out), and where the scene has
+        them ``layout`` (repeated joints, short fill-ins) and ``pattern`` (nodes, near
+        nodes, boundary bounces, ended lines).
+    """
     blocks, params = scene.blocks, scene.params
     free = ~blocks.block_is_support
     classes = {name: int(((blocks.block_class == i) & free).sum())
@@ -104,7 +131,14 @@ GEOMETRY_SOURCES = ("params.py", "tolerances.py", "blocks.py", "meshing.py", "in
 @cache
 def geometry_code_digest() -> str:
     """SHA-1 of the source of :data:`GEOMETRY_SOURCES`: part of the cache key, so an edited
-    geometry stage never reuses a stale cache at the same version number."""
+    geometry stage never reuses a stale cache at the same version number.
+
+    Returns
+    -------
+    str
+        40 hex digits over every file's path and bytes, in sorted order; computed once
+        per process.
+    """
     root = Path(masonry.__file__).parent
     digest = hashlib.sha1()
     for name in GEOMETRY_SOURCES:
@@ -220,7 +254,26 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
 
 
 def run_record(scene: Scene, model: Model, outputs: dict, cached: str, source=None) -> dict:
-    """The run.json record of a built model, before any solve."""
+    """The run.json record of a built model, before any solve.
+
+    Parameters
+    ----------
+    scene : masonry.scenes.base.Scene
+    model : masonry.rbe.boundary.Model
+        Its analysis model; its interface counts by kind go into ``counts``.
+    outputs : dict str -> bool
+        What the run writes (``analyse``, ``plots``, ``printable``).
+    cached : str
+        ``'reused'``, ``'computed'`` or ``'given'``: where the geometry came from.
+    source : dict, optional
+        Where an imported scene came from.
+
+    Returns
+    -------
+    dict
+        Structure id, scene name, parameters, outputs, :func:`model_record`, cache
+        state and source.
+    """
     params = scene.params
     record = {
         "structure_id": structure_id(params),
@@ -228,12 +281,31 @@ def run_record(scene: Scene, model: Model, outputs: dict, cached: str, source=No
         "params": dataclasses.asdict(params),
         "outputs": outputs,
         **model_record(scene),
+        "coordinates": coordinates_record(scene),
         "cache": {"geometry": cached},
     }
     if source is not None:
         record["source"] = source
     record["counts"]["interfaces"] = model.interfaces.counts()
     return record
+
+
+MOVED_FILES = ("locations.csv", "dome.stl", "dome.obj", "dome.3mf")
+"""The files whose bricks are moved inward by the CAD offset (SPEC 7, thesis 3.4.1)."""
+
+
+def coordinates_record(scene: Scene) -> dict:
+    """run.json's ``coordinates``: which files hold model coordinates and which are moved
+    inward by ``cad_offset`` (metres, along each brick's inward normal), so that files
+    imported together line up once the user knows it."""
+    params = scene.params
+    moved = scene.block_inward is not None and params.cad_offset != 0
+    return {
+        "cad_offset_m": params.cad_offset * params.unit if moved else 0.0,
+        "moved_inward": list(MOVED_FILES) if moved else [],
+        "model": ["bricks.obj", "bricks.3dm", "interfaces.csv", "RBE/forces.csv",
+                  "RBE/interfaces.vtu"] + ([] if moved else list(MOVED_FILES)),
+    }
 
 
 def _solve(model: Model, params: Params, timer: Timer) -> RBEResult:
@@ -247,7 +319,19 @@ def _solve(model: Model, params: Params, timer: Timer) -> RBEResult:
 
 def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer):
     """Every wanted exporter of :data:`masonry.export.EXPORTERS` into ``folder``; their
-    records go into ``record`` under their names."""
+    records go into ``record`` under their names.
+
+    Parameters
+    ----------
+    folder : RunFolder
+        Anything with ``write(relative, data)``.
+    made : masonry.export.RunOutputs
+        What the run made; each exporter's ``wanted(made)`` decides whether it writes.
+    record : dict
+        The run record, updated in place.
+    timer : Timer
+        Each exporter's time counts towards its stage.
+    """
     for exporter in EXPORTERS:
         if not exporter.wanted(made):
             continue

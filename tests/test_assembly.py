@@ -52,7 +52,7 @@ def test_dome_section_round_trips_through_bricks_obj(tmp_path, capsys):
     assert a.keys() == b.keys() and len(a) == 273
     for key, row in a.items():
         assert b[key]["kind"] == row["kind"], key
-        for column in ("area_m2", "centre_x", "centre_y", "centre_z", "normal_x",
+        for column in ("area_m2", "centre_x_m", "centre_y_m", "centre_z_m", "normal_x",
                        "normal_y", "normal_z"):
             assert float(b[key][column]) == pytest.approx(float(row[column]), abs=1e-9)
 

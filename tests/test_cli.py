@@ -106,3 +106,24 @@ def test_cad_offset_moves_bricks_inward(tmp_path):
     moved = scene.cad_vertices() - scene.blocks.vertices
     np.testing.assert_allclose(np.linalg.norm(moved, axis=1), 0.1, rtol=1e-12)
     assert np.all(moved[:, 0] < 0)  # the section faces +x: inward is -x
+    # run.json says which files are moved and by how much
+    from masonry.pipeline import coordinates_record
+
+    record = coordinates_record(scene)
+    assert record["cad_offset_m"] == pytest.approx(0.1, rel=1e-12)
+    assert {"locations.csv", "dome.stl"} <= set(record["moved_inward"])
+    assert {"bricks.obj", "bricks.3dm", "RBE/forces.csv"} <= set(record["model"])
+
+
+def test_print_size_writes_a_3mf_and_rejects_bad_sizes(tmp_path, capsys):
+    assert main(["run", "--preset", "wall", "--fast", "--no-plots", "--print-size", "120",
+                 "--out", str(tmp_path), "-q"]) == 0
+    folder = next(tmp_path.glob("wall_*"))
+    record = json.loads((folder / "run.json").read_text())
+    assert (folder / "dome.3mf").is_file()
+    assert record["printable"]["print"]["readback"]["unit"] == "millimeter"
+    assert max(record["printable"]["print"]["readback"]["extents_mm"]) == pytest.approx(120)
+    assert main(["run", "--preset", "wall", "--print-size", "-5", "--out",
+                 str(tmp_path / "bad"), "-q"]) == 2
+    assert "print_size" in capsys.readouterr().err
+    assert not (tmp_path / "bad").exists()

@@ -131,14 +131,18 @@ def test_the_command_line_reports_a_refused_input_in_one_line(capsys, tmp_path):
 @pytest.mark.parametrize("boundary", ["free", "cyclic"])
 def test_friction_coefficient_extremes(mu, boundary):
     _, _, result = analyse(mu=mu, boundary=boundary)
-    if mu == 0.05:
-        # almost no friction: the inclined courses slide
+    if mu == 0.05 or boundary == "free":
+        # almost no friction: the inclined courses slide; a free web overhangs its base
+        # whatever the friction
         assert not result.feasible and result.moi > 0
+    else:
+        # between its neighbours the web stands, with no tension at all
+        assert result.feasible and result.moi_factor <= 1e-9
 
 
-def test_friction_raises_the_measure_of_infeasibility_monotonically():
+def test_friction_lowers_the_measure_of_infeasibility_strictly():
     moi = [analyse(mu=mu, boundary="free")[2].moi_factor for mu in (0.05, 0.3, 1.0, 5.0)]
-    assert all(a >= b for a, b in zip(moi, moi[1:]))
+    assert all(a > b for a, b in zip(moi, moi[1:])), moi
 
 
 def test_density_over_six_decades_only_scales_the_forces():

@@ -6,13 +6,15 @@ writes them. An exporter may also return a record for ``run.json`` (the printabl
 checks). A new format is a module and one :class:`Exporter` row in :data:`EXPORTERS`.
 """
 
+import functools
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from masonry import plots
-from masonry.export import csv, obj, rhino, stl, summaries, vtu
+from masonry.export import csv, obj, rhino, stl, summaries, threemf, vtu
 from masonry.printable import printable_blocks, printable_body
+from masonry.rbe.resultants import interface_resultants
 
 log = logging.getLogger(__name__)
 
@@ -86,24 +88,66 @@ def _rhino_files(made: RunOutputs) -> Export:
     if not rhino.available():
         log.info("bricks.3dm skipped: pip install 'masonry[rhino]' to write it")
         return Export({})
-    return Export({"bricks.3dm": rhino.blocks_3dm(made.scene.blocks)})
+    blocks = made.scene.blocks
+    text = rhino.block_user_text(blocks, made.model, made.forces)
+    return Export({"bricks.3dm": rhino.blocks_3dm(blocks, user_text=text)})
+
+
+@functools.lru_cache(maxsize=1)
+def _resultants(made: RunOutputs) -> dict:
+    """The interface resultants of a run with forces, computed once for all exporters."""
+    return interface_resultants(made.model.interfaces, made.result.layout, made.result.x)
+
+
+def force_tables(blocks, interfaces, result, forces: dict, resultants=None) -> dict:
+    """The per-interface files of a solve: ``RBE/forces.csv``, ``RBE/tension_top.csv``
+    and ``RBE/interfaces.vtu`` (path -> bytes), as a run writes them.
+
+    Parameters
+    ----------
+    blocks, interfaces : the analysed model's
+    result : masonry.rbe.solve.RBEResult
+        With a solution (``x``).
+    forces : dict str -> (K,) float, N
+        ``result.per_interface()``.
+    resultants : dict, optional
+        :func:`~masonry.rbe.resultants.interface_resultants`, computed when None.
+    """
+    if resultants is None:
+        resultants = interface_resultants(interfaces, result.layout, result.x)
+    top = csv.tension_top(forces, result.weight_N)
+    files = {"RBE/forces.csv": csv.forces_csv(blocks, interfaces, forces, resultants),
+             "RBE/tension_top.csv": csv.tension_top_csv(blocks, interfaces, forces,
+                                                        resultants, top)}
+    if len(interfaces):
+        # named as the columns of forces.csv, units included
+        cell_data = {**{f"{name}_N": value for name, value in forces.items()},
+                     "shear_N": resultants["shear"], "point_m": resultants["point"],
+                     "eccentricity": resultants["eccentricity"],
+                     "torsion_Nm": resultants["torsion"]}
+        files["RBE/interfaces.vtu"] = vtu.interfaces_vtu(interfaces, cell_data)
+    return files
 
 
 def _rbe_files(made: RunOutputs) -> Export:
     files = {"RBE/00_objective.txt": summaries.objective_text(made.result)}
     if made.forces is not None:
-        blocks, interfaces = made.model.blocks, made.model.interfaces
-        files["RBE/forces.csv"] = csv.forces_csv(blocks, interfaces, made.forces)
-        if len(interfaces):
-            files["RBE/interfaces.vtu"] = vtu.interfaces_vtu(interfaces, made.forces)
+        files.update(force_tables(made.model.blocks, made.model.interfaces, made.result,
+                                  made.forces, _resultants(made)))
     return Export(files)
 
 
 def _printable_files(made: RunOutputs) -> Export:
     body, report = printable_body(*printable_blocks(made.scene))
     data = stl.stl_bytes(body)
-    report["readback"] = stl.readback_check(data, report["volume_m3"], rtol=1e-5)
-    return Export({"dome.stl": data, "dome.obj": stl.obj_body_bytes(body)}, report)
+    report["readback"] = stl.readback_check(data, report["volume_m3"])
+    files = {"dome.stl": data, "dome.obj": stl.obj_body_bytes(body)}
+    size = made.scene.params.print_size
+    if size is not None:
+        files["dome.3mf"] = threemf.threemf_bytes(body, size)
+        report["print"] = {"size_mm": size, "mm_per_m": threemf.print_scale(body, size),
+                           "readback": threemf.readback_3mf(files["dome.3mf"])}
+    return Export(files, report)
 
 
 def _plot_files(made: RunOutputs) -> Export:
@@ -112,10 +156,19 @@ def _plot_files(made: RunOutputs) -> Export:
     if scene.layout is not None:
         files["00_pattern.png"] = plots.pattern_png(scene, fast)
     files.update(plots.structure_pngs(scene, fast))
-    files.update(plots.interface_pngs(model.blocks, model.interfaces, fast))
-    if made.forces is not None:
-        pngs = plots.force_pngs(model.blocks, model.interfaces, made.forces, fast)
-        files.update({f"RBE/{name}": png for name, png in pngs.items()})
+    files.update(plots.interface_pngs(scene, model.blocks, model.interfaces, fast))
+    if made.forces is None:
+        return Export(files)
+    pngs = plots.force_pngs(scene, model.blocks, model.interfaces, made.forces, fast)
+    files.update({f"RBE/{name}": png for name, png in pngs.items()})
+    if scene.params.scene in ("arch", "section", "dome"):
+        png = plots.thrust_line_png(scene, model.interfaces, _resultants(made), fast)
+        if png is not None:
+            files["RBE/thrust_line.png"] = png
+    top = csv.tension_top(made.forces, made.result.weight_N)
+    if len(top):
+        files["RBE/where_it_fails.png"] = plots.failure_png(
+            scene, model.blocks, model.interfaces, top, made.forces, fast)
     return Export(files)
 
 

@@ -17,6 +17,7 @@ from masonry.interfaces import detect
 from masonry.params import Params, arch_radius, validate
 from masonry.rbe.solve import solve_rbe
 from masonry.scenes.arch import build_arch
+from masonry.tolerances import THICKNESS_BRACKET, THICKNESS_LIMIT_FRACTION, THICKNESS_RTOL
 
 log = logging.getLogger(__name__)
 
@@ -56,7 +57,8 @@ def is_feasible(params: Params) -> bool:
     return bool(result.feasible)
 
 
-def minimum_thickness(params: Params, rtol=1e-4, bracket=(0.01, 0.8)) -> ThicknessResult:
+def minimum_thickness(params: Params, rtol=THICKNESS_RTOL,
+                      bracket=THICKNESS_BRACKET) -> ThicknessResult:
     """The minimum thickness of the arch of ``params`` (its ``arch_thickness`` is
     ignored), by bisection on :func:`is_feasible`.
 
@@ -72,7 +74,8 @@ def minimum_thickness(params: Params, rtol=1e-4, bracket=(0.01, 0.8)) -> Thickne
     rtol : float
         Relative width of the final bracket.
     bracket : (float, float)
-        Starting ``(infeasible, feasible)`` t/R; the upper end is cut to 0.99 of the
+        Starting ``(infeasible, feasible)`` t/R; the upper end is cut to
+        :data:`~masonry.tolerances.THICKNESS_LIMIT_FRACTION` (0.99) of the
         largest thickness the shape allows (the intrados vanishes there).
 
     Raises
@@ -85,7 +88,7 @@ def minimum_thickness(params: Params, rtol=1e-4, bracket=(0.01, 0.8)) -> Thickne
     params = params.replace(scene="arch")
     radius, _ = arch_radius(params.arch_shape, params.arch_span, params.arch_rise)
     most = (params.arch_span if params.arch_shape == "pointed" else 2 * radius) / radius
-    lo, hi = bracket[0], min(bracket[1], 0.99 * most)
+    lo, hi = bracket[0], min(bracket[1], THICKNESS_LIMIT_FRACTION * most)
     steps = []
 
     def feasible(ratio):
