@@ -262,6 +262,9 @@ def _points(ax, view, points, **style):
         ax.scatter(points[:, h], points[:, v], zorder=10, **style)
 
 
+NO_FILL = (0.0, 0.0, 0.0, 0.0)
+"""Face colour of polygons drawn as outlines only."""
+
 OUTLINE_COLOUR = "#ff00ff"
 """Edge colour of the outlined blocks of :func:`marked_structure_pngs`."""
 
@@ -300,14 +303,14 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
             ax.computed_zorder = False  # draw in the order below: the rings on top
         _outline(ax, view, scene)
         if len(ghost):
-            _add_polygons(ax, view, [blocks.face_polygon(f) for f in ghost], "none",
+            _add_polygons(ax, view, [blocks.face_polygon(f) for f in ghost], NO_FILL,
                           edgecolors="0.87", linewidths=0.1)
         _add_polygons(ax, view, [blocks.face_polygon(f) for f in shown], face_colours,
                       edgecolors="k", linewidths=0.1)
         handles = [Patch(facecolor="none", edgecolor="0.7", label="not yet laid")]
         if is_outlined is not None and is_outlined.any():
             edged = np.flatnonzero(is_outlined[owner] & is_present[owner])
-            _add_polygons(ax, view, [blocks.face_polygon(f) for f in edged], "none",
+            _add_polygons(ax, view, [blocks.face_polygon(f) for f in edged], NO_FILL,
                           edgecolors=OUTLINE_COLOUR, linewidths=2.0)
             # a ring around each, so that a single brick shows at any scale
             centre = blocks.block_centroid[is_outlined & is_present]
