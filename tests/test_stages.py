@@ -295,3 +295,26 @@ def test_imported_stack_laid_by_names_or_height(tmp_path, capsys, order):
     assert first["stage"] == 4 and len(first["laid"]) == 1
     assert first["laid"][0] == str(blocks.block_name[4])  # the fourth above the slab
     assert "first stage that needs support: 4" in capsys.readouterr().out
+
+
+def test_first_unsupported_stage_is_drawn_with_its_new_block_outlined(tmp_path):
+    # the 0.3 b stack again, with plots: stage 4's views must show the magenta outline
+    # of the block laid at that stage in every view (2D elevations and the 3D angle)
+    import matplotlib.image
+
+    from masonry.plots import OUTLINE_COLOUR
+
+    blocks, _ = stack(np.full(5, 0.3))
+    path = tmp_path / "stack.obj"
+    path.write_bytes(blocks_obj(blocks))
+    assert main(["stages", str(path), "--support", "*ground*", "--out",
+                 str(tmp_path / "out"), "-q"]) == 0
+    (folder,) = (tmp_path / "out").glob("*_stages_z")
+    magenta = np.array(matplotlib.colors.to_rgb(OUTLINE_COLOUR))
+    views = sorted((folder / "first_unsupported").glob("*.png"))
+    assert [v.name for v in views] == ["01_angle.png", "02_front.png", "03_top.png",
+                                       "04_side.png"]
+    for view in views:
+        pixels = matplotlib.image.imread(view)[..., :3]
+        assert (np.abs(pixels - magenta).max(axis=-1) < 0.05).sum() > 50, view.name
+    assert (folder / "stages.png").stat().st_size > 10_000
