@@ -23,10 +23,10 @@ from masonry.rbe.boundary import UnsupportedError
 from masonry.rbe.solvers.newton import use_one_blas_thread
 from masonry.scenes.imported import AssemblyError
 
-from . import analyze, arch_thickness, bench, build, run, structures, sweep
+from . import analyze, arch_thickness, bench, build, run, stages, structures, sweep
 from .options import Parser, describe_error, option_names, typed_values
 
-SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, bench)
+SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, bench, stages)
 
 
 class Terminated(KeyboardInterrupt):

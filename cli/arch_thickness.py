@@ -23,8 +23,7 @@ def register(subparsers):
     g = parser.add_argument_group("analysis")
     add_material_options(g)
     g.add_argument("--solver", choices=SOLVERS,
-                   help="QP solver (default: the balanced preset's): newton, clarabel, osqp, "
-                        "clarabel-cvxpy or osqp-cvxpy")
+                   help=f"QP solver (default: the balanced preset's): {', '.join(SOLVERS)}")
     g.add_argument("--rtol", type=float, default=THICKNESS_RTOL,
                    help="relative width of the final bisection bracket (default %(default)g)")
     parser.add_argument("--out", default="exports", metavar="DIR",

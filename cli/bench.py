@@ -2,7 +2,8 @@
 
 import resource
 
-from masonry.studies.bench import SCENES, bench, frontier_png, table_csv, table_markdown
+from masonry.studies.bench import (SCENES, bench, frontier_png, ratios_markdown, table_csv,
+                                   table_markdown)
 from masonry.params import ACCURACIES, SOLVERS, ParameterError
 from masonry.runfolder import RunFolder, check_output_root
 
@@ -16,7 +17,8 @@ def register(subparsers):
     parser.add_argument("--presets", nargs="+", default=["1", "2", "3"],
                         choices=["1", "2", "3"], help="thesis presets (default 1 2 3)")
     parser.add_argument("--scenes", nargs="+", default=list(SCENES), choices=list(SCENES),
-                        help="free section, cyclic section, full dome (default all)")
+                        help="free section, cyclic section, full dome, full dome at mu 0.05 "
+                             "(default all)")
     parser.add_argument("--accuracy", nargs="+", default=list(ACCURACIES),
                         choices=ACCURACIES, help="accuracy presets (default all)")
     parser.add_argument("--solvers", nargs="+", default=[], choices=SOLVERS,
@@ -44,6 +46,9 @@ def handle(args, report):
                  overrides=None if args.p is None else {"p": args.p},
                  progress=None if args.quiet else _progress)
     markdown = table_markdown(rows)
+    pairs = ratios_markdown(rows)
+    if pairs:
+        markdown += "\ninfeasible against feasible (total_s):\n\n" + pairs
     # ru_maxrss is in kilobytes on Linux
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     with RunFolder(args.out, "bench") as folder:

@@ -57,6 +57,8 @@ def describe_error(error, args) -> str:
     if not option.startswith("--"):  # a positional argument: its value says it
         return f"{_typed(value)}: expected {expected}"
     typed = getattr(args, "typed", {})
+    if value is None and not _given(args, name):  # an option missing beside another
+        return f"{option}: expected {expected}"
     if name not in Params.__dataclass_fields__ or _given(args, name):
         return f"{option} {typed.get(option, _typed(value))}: expected {expected}"
     given = [r for r in error.related if _given(args, r)]
@@ -175,7 +177,8 @@ def add_analysis_options(parser, boundary=True):
                         "'masonry bench'")
     g.add_argument("--solver", choices=SOLVERS,
                    help="override the preset's QP solver: newton (semismooth Newton, "
-                        "friction-net), clarabel (interior point), osqp (ADMM), or "
+                        "friction-net), interior (own primal-dual interior point, "
+                        "friction+), clarabel (interior point), osqp (ADMM), or "
                         "clarabel-cvxpy / osqp-cvxpy (through cvxpy, the reference)")
     if not boundary:
         return
@@ -250,7 +253,7 @@ def params_from_args(args) -> Params:
 
 def check_print_size(args, params: Params):
     """Refuse ``--print-size`` beside ``--no-printable``: the 3MF is the printable body."""
-    if params.print_size is not None and not args.printable:
+    if params.print_size is not None and not getattr(args, "printable", True):
         raise ParameterError("print_size", params.print_size,
                              "no --no-printable beside it (dome.3mf is the printable body "
                              "at that size)")

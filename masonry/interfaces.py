@@ -81,6 +81,25 @@ class Interfaces:
         """Number of interfaces per kind name."""
         return {name: int((self.kind == i).sum()) for i, name in enumerate(INTERFACE_KINDS)}
 
+    def subset(self, mask, block_remap=None) -> "Interfaces":
+        """The interfaces selected by a boolean mask or index array, in their order.
+
+        Parameters
+        ----------
+        mask : (K,) bool or (k,) int
+        block_remap : (B,) int, optional
+            New index of every block (``pair`` is mapped through it); default unchanged.
+        """
+        index = np.arange(len(self))[mask]
+        count = self.vertex_count[index]
+        start = np.repeat(self.offsets[index] - (np.cumsum(count) - count), count)
+        vertex = start + np.arange(int(count.sum()))
+        pair = self.pair[index] if block_remap is None else block_remap[self.pair[index]]
+        return Interfaces(pair=pair, kind=self.kind[index], vertices=self.vertices[vertex],
+                          offsets=np.concatenate([[0], np.cumsum(count)]),
+                          area=self.area[index], centre=self.centre[index],
+                          normal=self.normal[index], t1=self.t1[index], t2=self.t2[index])
+
     @classmethod
     def empty(cls) -> "Interfaces":
         z3 = np.zeros((0, 3))

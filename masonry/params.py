@@ -15,7 +15,7 @@ SCENES = ("section", "wall", "dome", "assembly", "arch")
 FRICTIONS = ("net", "plus", "auto")
 BOUNDARIES = ("free", "rigid", "cyclic")
 # QP solvers (masonry.rbe.solvers.BACKENDS) and accuracy presets (masonry.rbe.solve.ACCURACY)
-SOLVERS = ("newton", "clarabel", "osqp", "clarabel-cvxpy", "osqp-cvxpy")
+SOLVERS = ("newton", "interior", "clarabel", "osqp", "clarabel-cvxpy", "osqp-cvxpy")
 ACCURACIES = ("fast", "balanced", "accurate")
 ARCH_SHAPES = ("semicircular", "pointed", "segmental")
 

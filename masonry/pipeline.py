@@ -173,17 +173,24 @@ def _geometry_key(params: Params) -> str:
     return hashlib.sha1(key.encode()).hexdigest()[:16]
 
 
-def _model(params: Params, out_root, timer: Timer):
+def cached_model(params: Params, out_root, timer: Timer, check=None):
     """Scene and analysis model (interfaces, boundary routing), from the geometry cache
-    when it holds them: ``(scene, model, 'reused' | 'computed')``."""
+    when it holds them: ``(scene, model, 'reused' | 'computed')``. ``check(scene)``, when
+    given, runs on the scene before the interfaces are detected (it raises on bad input).
+    A computed model is not cached here: :func:`write_cache` does it once the run's
+    folder is published."""
     cached = _read_cache(_cache_path(params, out_root))
     if cached is not None:
         with timer.stage("model (cached)"):
             # the cached scene carries the geometry; the rest of the inputs are this run's
             scene = dataclasses.replace(cached[0], params=params)
+        if check is not None:
+            check(scene)
         return scene, cached[1], "reused"
     with timer.stage("model"):
         scene = build(params)
+    if check is not None:
+        check(scene)
     with timer.stage("interfaces"):
         model = analysis_model(scene)
     return scene, model, "computed"
@@ -212,9 +219,12 @@ def _read_cache(path: Path):
     return content
 
 
-def _write_cache(path: Path, scene: Scene, model: Model):
-    """Cache a computed model; a cache that cannot be written only costs the next run
-    the rebuild (warned), never this run's results."""
+def write_cache(params: Params, out_root, scene: Scene, model: Model):
+    """Cache a model computed by :func:`cached_model` for ``params`` under ``out_root``;
+    called once the run's folder is published, so a failed run caches nothing. A cache
+    that cannot be written only costs the next run the rebuild (warned), never this
+    run's results."""
+    path = _cache_path(params, out_root)
     try:
         write_file_atomically(path, pickle.dumps((scene, model),
                                                  protocol=pickle.HIGHEST_PROTOCOL))
@@ -339,7 +349,7 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
 
     timer = Timer()
     if scene is None:
-        scene, model, cached = _model(params, out_root, timer)
+        scene, model, cached = cached_model(params, out_root, timer)
     else:
         scene, cached = dataclasses.replace(scene, params=params), "given"
         with timer.stage("interfaces"):
@@ -365,7 +375,7 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
         record["complete"] = True
         folder.write_json("run.json", record)
     if cached == "computed":  # only a model whose run completed is cached
-        _write_cache(_cache_path(params, out_root), scene, model)
+        write_cache(params, out_root, scene, model)
     record["path"] = str(folder.target)
     return record
 

@@ -20,6 +20,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 from mpl_toolkits.axes_grid1 import make_axes_locatable  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
@@ -249,6 +250,126 @@ def structure_pngs(scene, fast=False) -> dict:
                      f"bricks\n{scene_title(scene)}", fontsize=9)
         out["05_dome/3_structure.png"] = _png(fig, 70 if fast else 130)
     return out
+
+
+def _points(ax, view, points, **style):
+    """Markers at ``points`` ((m, 3) float, metres) in ``view``."""
+    points = np.asarray(points, dtype=float).reshape(-1, 3)
+    if view not in ELEVATIONS:
+        ax.scatter(*points.T, depthshade=False, **style)
+    else:
+        h, v, _, _ = ELEVATIONS[view]
+        ax.scatter(points[:, h], points[:, v], zorder=10, **style)
+
+
+NO_FILL = (0.0, 0.0, 0.0, 0.0)
+"""Face colour of polygons drawn as outlines only."""
+
+OUTLINE_COLOUR = "#ff00ff"
+"""Edge colour of the outlined blocks of :func:`marked_structure_pngs`."""
+
+MARK_DECADES = 2
+"""Decades of the colour scale of :func:`marked_structure_pngs`: blocks whose value is
+below ``10**-MARK_DECADES`` of the largest keep their class colour."""
+
+
+def marked_structure_pngs(scene, is_present, value, title, value_label="value",
+                          is_outlined=None, outline_label="outlined", fast=False) -> dict:
+    """The structure views of a part of ``scene`` (e.g. a construction stage): the blocks
+    of ``is_present`` ((B,) bool), coloured by ``value`` ((B,) float >= 0, e.g. the
+    tension a brick carries, newtons) on a logarithmic scale over
+    :data:`MARK_DECADES` decades, in their class colours below it; the blocks of
+    ``is_outlined`` ((B,) bool, e.g. the ones just laid) with thick red edges (legend
+    ``outline_label``); the rest of the scene's blocks as faint outlines. ``{view}.png``
+    per view, one view at lower resolution when ``fast``."""
+    from matplotlib.colors import LogNorm, to_rgba
+
+    blocks = scene.blocks
+    owner = blocks.face_block
+    shown = np.flatnonzero(is_present[owner])
+    ghost = np.flatnonzero(~is_present[owner] & ~blocks.block_is_support[owner])
+    top = max(float(np.max(value[is_present], initial=0.0)), 1e-300)
+    norm = LogNorm(top * 10.0**-MARK_DECADES, top)
+    cmap = plt.get_cmap("viridis_r")
+    face_value = value[owner[shown]]
+    is_marked = face_value >= norm.vmin
+    face_colours = np.array([to_rgba(CLASS_COLOURS[BLOCK_CLASSES[k]])
+                             for k in blocks.block_class[owner[shown]]])
+    face_colours[is_marked] = cmap(norm(face_value[is_marked]))
+    out = {}
+    for view in ["01_angle"] if fast else list(VIEWS):
+        fig, ax = _axes(blocks.bounds, view)
+        if view not in ELEVATIONS:
+            ax.computed_zorder = False  # draw in the order below: the rings on top
+        _outline(ax, view, scene)
+        if len(ghost):
+            _add_polygons(ax, view, [blocks.face_polygon(f) for f in ghost], NO_FILL,
+                          edgecolors="0.87", linewidths=0.1)
+        _add_polygons(ax, view, [blocks.face_polygon(f) for f in shown], face_colours,
+                      edgecolors="k", linewidths=0.1)
+        handles = [Patch(facecolor="none", edgecolor="0.7", label="not yet laid")]
+        if is_outlined is not None and is_outlined.any():
+            edged = np.flatnonzero(is_outlined[owner] & is_present[owner])
+            _add_polygons(ax, view, [blocks.face_polygon(f) for f in edged], NO_FILL,
+                          edgecolors=OUTLINE_COLOUR, linewidths=2.0)
+            # a ring around each, so that a single brick shows at any scale
+            centre = blocks.block_centroid[is_outlined & is_present]
+            _points(ax, view, centre, s=160, facecolors="none", edgecolors=OUTLINE_COLOUR,
+                    linewidths=1.5)
+            handles.append(Patch(facecolor="none", edgecolor=OUTLINE_COLOUR,
+                                 label=outline_label))
+        if is_marked.any():
+            bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
+                               shrink=0.6, pad=0.1)
+            bar.set_label(value_label)
+        ax.legend(handles=handles, loc="upper left", fontsize=8)
+        ax.set_title(title)
+        out[f"{view}.png"] = _png(fig, 60 if fast else 110)
+    return out
+
+
+def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="",
+                    xlabel="stage") -> bytes:
+    """MoI factor (and the collapse load factor, where given) against the construction
+    stage: stages that stand in green, those that need support in red, the first of
+    them marked by a dashed line.
+
+    Parameters
+    ----------
+    stage : (N,) int
+    moi_factor : (N,) float (NaN: not solved)
+    feasible : (N,) bool
+    load_factor : (N,) float or None (NaN: not computed)
+    """
+    stage = np.asarray(stage)
+    moi = np.asarray(moi_factor, dtype=float)
+    feasible = np.asarray(feasible, dtype=bool)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(stage, moi, color="0.6", linewidth=0.8, zorder=1)
+    ax.scatter(stage[feasible], moi[feasible], s=14, color="#2ca02c",
+               label=f"stands ({int(feasible.sum())})", zorder=2)
+    ax.scatter(stage[~feasible], moi[~feasible], s=14, color="#d62728",
+               label=f"needs support ({int((~feasible).sum())})", zorder=2)
+    if not feasible.all():
+        first = stage[np.argmin(feasible)]
+        ax.axvline(first, color="#d62728", linestyle="--", linewidth=0.8,
+                   label=f"first needs support: {first}")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("MoI factor (tension / weight)")
+    ax.set_ylim(bottom=min(-0.02 * max(np.nanmax(moi, initial=0), 0.05), 0))
+    handles, labels = ax.get_legend_handles_labels()
+    if load_factor is not None and np.isfinite(np.asarray(load_factor, float)).any():
+        right = ax.twinx()
+        right.plot(stage, np.asarray(load_factor, float), color="#1f77b4", marker=".",
+                   label="load factor")
+        right.set_ylabel("collapse load factor")
+        extra = right.get_legend_handles_labels()
+        handles, labels = handles + extra[0], labels + extra[1]
+    ax.legend(handles, labels, loc="best", fontsize=8)
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    return _png(fig, 110)
 
 
 def is_cyclic(scene) -> bool:

@@ -116,6 +116,8 @@ OTHER_COMMANDS = [
     ["arch-thickness", "--rtol", "nan"], ["arch-thickness", "--blocks", "1"],
     ["arch-thickness", "--mu", "0.01", "--blocks", "8"],  # slides at every thickness
     ["analyze", "missing.obj", "--ground"], ["--bogus"], [],
+    ["stages", "--by", "brick"], ["stages", "--by", "brick", "--course", "0"],
+    ["stages", "--n", "1000000"], ["stages", "--scene", "arch", "--by", "course"],
 ]
 
 
@@ -141,7 +143,7 @@ def test_a_bad_scheduler_address(tmp_path, address):
 
 
 @pytest.mark.parametrize("command", ["run", "build", "structures", "sweep", "bench",
-                                     "arch-thickness"])
+                                     "arch-thickness", "stages"])
 @pytest.mark.parametrize("where", ["file", "under_file", "proc", "empty", "long_name"])
 def test_output_locations(tmp_path, command, where):
     a_file = tmp_path / "a_file"

@@ -233,3 +233,17 @@ def test_a_long_stage_says_it_is_still_running(monkeypatch, caplog):
     caplog.clear()
     time.sleep(0.1)  # the heartbeat stopped with the stage
     assert not caplog.records
+
+
+def test_a_stage_study_without_plots_keeps_the_plots_of_one_with(tmp_path, capsys):
+    args = ["stages", "--scene", "arch", "--blocks", "6", "--out", str(tmp_path), "-q"]
+    assert main(args) == 0
+    (folder,) = [p for p in tmp_path.iterdir() if not p.name.startswith(".")]
+    before = snapshot(folder)
+    assert any(p.suffix == ".png" for p in before)
+    assert main([*args, "--no-plots"]) == 0
+    assert "up to date, reused" in capsys.readouterr().out
+    assert snapshot(folder) == before
+    assert main([*args, "--no-plots", "--force"]) == 0  # recomputed, the plots kept
+    assert set(snapshot(folder)) == set(before)
+    assert json.loads((folder / "run.json").read_text())["outputs"] == {"plots": True}

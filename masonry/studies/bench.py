@@ -37,8 +37,14 @@ SCENES = {
     "section": dict(scene="section", boundary="free"),
     "cyclic": dict(scene="section", boundary="cyclic"),
     "dome": dict(scene="dome"),
+    "dome-mu0.05": dict(scene="dome", mu=0.05),
 }
-"""Bench scene name -> :class:`~masonry.params.Params` fields."""
+"""Bench scene name -> :class:`~masonry.params.Params` fields (over the bench's ``mu``
+and ``density``). ``section`` (free-standing, the thesis's x.1) and ``dome-mu0.05`` are
+infeasible; ``cyclic`` and ``dome`` are their feasible counterparts of the same size."""
+
+PAIRS = (("section", "cyclic"), ("dome-mu0.05", "dome"))
+"""(infeasible, feasible) scenes of the same size, compared by :func:`ratios`."""
 
 STAGES = ("model", "interfaces", "assembly", "solve", "exports")
 
@@ -92,8 +98,8 @@ def bench(presets=("1", "2", "3"), scenes=tuple(SCENES), accuracies=tuple(ACCURA
     runs += [("balanced", solver) for solver in solvers]
     for preset in presets:
         for scene_name in scenes:
-            params = from_preset(preset, mu=mu, density=density,
-                                 **{**SCENES[scene_name], **(overrides or {})})
+            params = from_preset(preset, **{"mu": mu, "density": density,
+                                            **SCENES[scene_name], **(overrides or {})})
             reference = None
             if "accurate" not in accuracies:
                 reference = _run(params, "accurate", None, exports=False)[1]
@@ -171,6 +177,32 @@ def _row(preset, scene, accuracy, solver, times, result, counts, reference) -> d
     }
 
 
+def ratios(rows) -> list:
+    """Infeasible against feasible: for every preset, accuracy (and extra solver) and
+    :data:`PAIRS` pair measured, ``total_s`` of the infeasible scene over that of the
+    feasible one (the same web or dome, the same number of bricks).
+
+    Returns
+    -------
+    list of dict
+        ``preset``, ``accuracy``, ``solver``, ``infeasible``, ``feasible`` (scene names),
+        ``infeasible_s``, ``feasible_s``, ``ratio``.
+    """
+    by_key = {(r["preset"], r["scene"], r["accuracy"], r["solver"]): r for r in rows}
+    out = []
+    for (preset, scene, accuracy, solver), row in by_key.items():
+        for infeasible, feasible in PAIRS:
+            other = next((r for (p, sc, a, _), r in by_key.items()
+                          if (p, sc, a) == (preset, feasible, accuracy)), None)
+            if scene != infeasible or other is None:
+                continue
+            out.append({"preset": preset, "accuracy": accuracy, "solver": solver,
+                        "infeasible": infeasible, "feasible": feasible,
+                        "infeasible_s": row["total_s"], "feasible_s": other["total_s"],
+                        "ratio": row["total_s"] / other["total_s"]})
+    return out
+
+
 # ---------------------------------------------------------------------- formatting
 def _cell(key, value) -> str:
     if isinstance(value, float):
@@ -197,6 +229,20 @@ def table_markdown(rows, columns=MARKDOWN_COLUMNS) -> str:
              "|" + "|".join("---" for _ in columns) + "|"]
     for row in rows:
         lines.append("| " + " | ".join(_cell(c, row[c]) for c in columns) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def ratios_markdown(rows) -> str:
+    """A Markdown table of :func:`ratios` (empty when no pair was measured)."""
+    pairs = ratios(rows)
+    if not pairs:
+        return ""
+    lines = ["| preset | accuracy | infeasible | feasible | infeasible_s | feasible_s | ratio |",
+             "|---|---|---|---|---|---|---|"]
+    for r in pairs:
+        lines.append(f"| {r['preset']} | {r['accuracy']} | {r['infeasible']} | "
+                     f"{r['feasible']} | {r['infeasible_s']:.2f} | {r['feasible_s']:.2f} | "
+                     f"{r['ratio']:.2f} |")
     return "\n".join(lines) + "\n"
 
 
