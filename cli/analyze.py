@@ -5,10 +5,10 @@ from masonry.params import Params, validate
 from masonry.pipeline import run
 
 from .options import (add_analysis_options, add_live_load_options, add_output_options,
-                      collapse_summary, rbe_summary, summary)
+                      check_print_size, collapse_summary, rbe_summary, summary)
 
-ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast", "lateral",
-            "point_loads", "crown_load")
+ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast", "print_size",
+            "lateral", "point_loads", "crown_load")
 
 
 def register(subparsers):
@@ -37,6 +37,7 @@ def register(subparsers):
 def handle(args, report):
     given = {k: getattr(args, k) for k in ANALYSIS if getattr(args, k) is not None}
     params = validate(Params(**given))
+    check_print_size(args, params)
     scene, source = load_assembly(args.files, params, supports=args.support,
                                   support_below=args.support_below, ground=args.ground)
     record = run(scene.params, args.out, analyse=True, plots_wanted=args.plots,
@@ -44,7 +45,7 @@ def handle(args, report):
     report(f"read {scene.blocks.n_blocks} blocks ({source['supports']} supports) from "
            f"{len(source['files'])} file(s) in {source['read_s']:.3g} s")
     summary(record, report)
-    rbe_summary(record, report)
+    code = rbe_summary(record, report)
     if "collapse" in record:
         collapse_summary(record, report)
-    return 0
+    return code

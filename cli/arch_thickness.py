@@ -1,11 +1,15 @@
 """``masonry arch-thickness``: the minimum thickness t/R of an arch, by bisection on RBE
 feasibility, beside the thrust line's value."""
 
-from masonry.studies.thrust_line import thrust_line_minimum_thickness
-from masonry.params import SOLVERS, Params, validate
-from masonry.studies.thickness import minimum_thickness
+import dataclasses
 
-from .options import add_arch_options
+from masonry.params import SOLVERS, Params, validate
+from masonry.runfolder import RunFolder, check_output_root
+from masonry.studies.thickness import folder_name, minimum_thickness, steps_csv
+from masonry.studies.thrust_line import thrust_line_minimum_thickness
+from masonry.tolerances import THICKNESS_RTOL
+
+from .options import add_arch_options, add_material_options, add_verbosity
 
 ANALYSIS = ("arch_blocks", "arch_span", "arch_shape", "arch_rise", "arch_depth", "mu",
             "density", "solver")
@@ -17,22 +21,35 @@ def register(subparsers):
                                "bisection on rigid block equilibrium")
     add_arch_options(parser, thickness=False)
     g = parser.add_argument_group("analysis")
-    g.add_argument("--mu", type=float, help="friction coefficient (default 0.7)")
-    g.add_argument("--density", type=float, help="kg/m^3 (default 2000)")
+    add_material_options(g)
     g.add_argument("--solver", choices=SOLVERS,
-                   help="QP solver: clarabel (interior point, default) or osqp")
-    g.add_argument("--rtol", type=float, default=1e-4,
-                   help="relative width of the final bisection bracket (default 1e-4)")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+                   help=f"QP solver (default: the balanced preset's): {', '.join(SOLVERS)}")
+    g.add_argument("--rtol", type=float, default=THICKNESS_RTOL,
+                   help="relative width of the final bisection bracket (default %(default)g)")
+    parser.add_argument("--out", default="exports", metavar="DIR",
+                        help="output root: writes DIR/arch-thickness_<inputs>/ with "
+                             "result.json and steps.csv (default exports)")
+    add_verbosity(parser)
     parser.set_defaults(handler=handle)
 
 
 def handle(args, report):
     given = {k: getattr(args, k) for k in ANALYSIS if getattr(args, k) is not None}
     params = validate(Params(scene="arch", **given))
+    check_output_root(args.out)
     result = minimum_thickness(params, rtol=args.rtol)
     line = thrust_line_minimum_thickness(params.arch_shape, params.arch_blocks,
                                          params.arch_span, params.arch_rise, mu=params.mu)
+    record = {"params": dataclasses.asdict(params), "rtol": args.rtol,
+              "rbe": {"t_over_r": result.t_over_r, "lower": result.lower,
+                      "thickness_m": result.thickness, "radius_m": result.radius,
+                      "solves": len(result.steps), "time_s": result.time_s},
+              "thrust_line": {"t_over_r": line.t_over_r, "thrust": line.thrust,
+                              "extrados_hinges": list(line.extrados_hinges),
+                              "intrados_hinges": list(line.intrados_hinges)}}
+    with RunFolder(args.out, folder_name(params, args.rtol)) as folder:
+        folder.write_json("result.json", record)
+        folder.write("steps.csv", steps_csv(result))
     report(f"{params.arch_shape} arch, {params.arch_blocks} voussoirs, span "
            f"{params.arch_span:g} m, R = {result.radius:.6g} m, mu {params.mu:g}")
     report(f"minimum thickness (RBE bisection): t/R = {result.t_over_r:.6f} "
@@ -41,4 +58,5 @@ def handle(args, report):
     report(f"minimum thickness (thrust line):   t/R = {line.t_over_r:.6f}, hinges at joints "
            f"{list(line.extrados_hinges)} (extrados) and {list(line.intrados_hinges)} "
            f"(intrados), thrust {line.thrust:.4f} of the weight")
+    report(f"written: {folder.target}")
     return 0

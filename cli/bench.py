@@ -3,9 +3,11 @@
 import resource
 
 from masonry.studies.bench import (SCENES, bench, collapse_bench, collapse_markdown,
-                                   frontier_png, table_csv, table_markdown)
-from masonry.params import ACCURACIES, SOLVERS, Params, from_preset, validate
-from masonry.runfolder import RunFolder
+                                   frontier_png, ratios_markdown, table_csv, table_markdown)
+from masonry.params import ACCURACIES, SOLVERS, ParameterError, Params, from_preset, validate
+from masonry.runfolder import RunFolder, check_output_root
+
+from .options import add_verbosity
 
 
 def register(subparsers):
@@ -15,7 +17,8 @@ def register(subparsers):
     parser.add_argument("--presets", nargs="+", default=["1", "2", "3"],
                         choices=["1", "2", "3"], help="thesis presets (default 1 2 3)")
     parser.add_argument("--scenes", nargs="+", default=list(SCENES), choices=list(SCENES),
-                        help="free section, cyclic section, full dome (default all)")
+                        help="free section, cyclic section, full dome, full dome at mu 0.05 "
+                             "(default all)")
     parser.add_argument("--accuracy", nargs="+", default=list(ACCURACIES),
                         choices=ACCURACIES, help="accuracy presets (default all)")
     parser.add_argument("--solvers", nargs="+", default=[], choices=SOLVERS,
@@ -31,8 +34,9 @@ def register(subparsers):
                              "the azimuth search (--lateral all) on a small dome against "
                              "independent solves; writes DIR/bench_collapse/collapse.md")
     parser.add_argument("--out", default="exports", metavar="DIR",
-                        help="writes DIR/bench/bench.csv, bench.md and frontier.png")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+                        help="output root: writes DIR/bench/bench.csv, bench.md and "
+                             "frontier.png (default exports)")
+    add_verbosity(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -42,8 +46,10 @@ SMALL_DOME = dict(scene="dome", stretch=1.0, n=6, r=0, p=3, cut=0.5)
 
 def handle(args, report):
     if args.repeats < 1:
-        report("masonry: --repeats must be at least 1")
-        return 2
+        raise ParameterError("repeats", args.repeats, "an integer >= 1")
+    if args.p is not None and args.p < 1:
+        raise ParameterError("p", args.p, "an integer >= 1")
+    check_output_root(args.out)
     if args.collapse:
         return _collapse(args, report)
     rows = bench(presets=args.presets, scenes=args.scenes, accuracies=args.accuracy,
@@ -51,6 +57,9 @@ def handle(args, report):
                  overrides=None if args.p is None else {"p": args.p},
                  progress=None if args.quiet else _progress)
     markdown = table_markdown(rows)
+    pairs = ratios_markdown(rows)
+    if pairs:
+        markdown += "\ninfeasible against feasible (total_s):\n\n" + pairs
     # ru_maxrss is in kilobytes on Linux
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024**2
     with RunFolder(args.out, "bench") as folder:

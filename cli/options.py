@@ -1,69 +1,174 @@
 """Options shared by the subcommands, and their translation into ``Params``."""
 
 import argparse
+import math
+import shlex
 
+from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS
 from masonry.params import (ACCURACIES, ARCH_SHAPES, BOUNDARIES, FRICTIONS, PRESETS,
-                            SCENES, SOLVERS, Params, from_preset, load, validate)
+                            RANGES, SCENE_FIELDS, SCENES, SOLVERS, ParameterError, Params,
+                            from_preset, load, validate)
 
-GEOMETRY = ("stretch", "n", "r", "p", "cut", "unit", "min_fill", "wall_length",
-            "wall_courses")
+DEFAULTS = Params()
 
 
 class Parser(argparse.ArgumentParser):
     """argparse with one-line errors and exit code 2."""
 
     def error(self, message):
-        self.exit(2, f"masonry: error: {message}\n")
+        self.exit(2, f"masonry: error: {' '.join(message.split())}\n")
+
+
+def _preset_values(name) -> str:
+    """``default X; presets 1 / 2 / 3: a / b / c`` for a dome parameter."""
+    values = " / ".join(f"{PRESETS[k][name]:g}" for k in ("1", "2", "3"))
+    return f"default {getattr(DEFAULTS, name):g} (preset 1); presets 1 / 2 / 3: {values}"
+
+
+def _range(name) -> str:
+    low, high, _ = RANGES[name]
+    return f"{low:g} to {high:g}"
+
+
+def option_names(parser) -> dict:
+    """A parser's destinations -> the long option a user types (``arch_blocks`` ->
+    ``--blocks``)."""
+    names = {}
+    for action in parser._actions:
+        longs = [o for o in action.option_strings if o.startswith("--")]
+        if longs:
+            names.setdefault(action.dest, longs[0])
+        elif not action.option_strings:  # a positional argument: its metavar
+            names.setdefault(action.dest, action.metavar or action.dest.upper())
+    return names
+
+
+def describe_error(error, args) -> str:
+    """One line about a refused input, naming it as the user gave it: the option and
+    value typed, or the key and value of the file it came from, or the preset or default
+    it came from (and then the options the user gave that it depends on)."""
+    if not isinstance(error, ParameterError):
+        return " ".join(str(error).split())
+    name, value, expected = error.name, error.value, " ".join(str(error.expected).split())
+    names = getattr(args, "option_names", {})
+    option = names.get(name, f"--{name.replace('_', '-')}")
+    if error.where:
+        return f"{error.where}: {name} = {value!r}: expected {expected}"
+    if not option.startswith("--"):  # a positional argument: its value says it
+        return f"{_typed(value)}: expected {expected}"
+    typed = getattr(args, "typed", {})
+    if value is None and not _given(args, name):  # an option missing beside another
+        return f"{option}: expected {expected}"
+    if name not in Params.__dataclass_fields__ or _given(args, name):
+        return f"{option} {typed.get(option, _typed(value))}: expected {expected}"
+    given = [r for r in error.related if _given(args, r)]
+    origin = (f"from --params {args.params}" if getattr(args, "params", None) else
+              f"from --preset {args.preset}" if getattr(args, "preset", None) else
+              "the default")
+    subject = f"{option} {_typed(value)} ({origin})"
+    if given:
+        options = [names.get(r, r) for r in given]
+        these = ", ".join(f"{o} {typed.get(o, _typed(getattr(args, r)))}"
+                          for o, r in zip(options, given))
+        subject = f"{these} with {subject}"
+    return f"{subject}: expected {expected}"
+
+
+def typed_values(argv) -> dict:
+    """``--option`` -> the value as typed on the command line (the last one given), so an
+    error line repeats ``1e-9`` rather than Python's ``1e-09``."""
+    typed = {}
+    for i, token in enumerate(argv):
+        if not token.startswith("--"):
+            continue
+        if "=" in token:
+            option, value = token.split("=", 1)
+        elif i + 1 < len(argv):
+            option, value = token, argv[i + 1]
+        else:
+            continue
+        typed[option] = shlex.quote(value)
+    return typed
+
+
+def _given(args, name) -> bool:
+    return getattr(args, name, None) is not None
+
+
+def _typed(value) -> str:
+    if isinstance(value, float) and math.isfinite(value) and value == int(value):
+        return f"{value:g}"
+    return shlex.quote(str(value)) if isinstance(value, str) else str(value)
 
 
 def add_model_options(parser):
     g = parser.add_argument_group("model")
     g.add_argument("--preset", choices=list(PRESETS),
                    help="a thesis structure (1 spherical, 2 stretched, 3 compressed) or the "
-                        "validation wall; explicit options below override it")
-    g.add_argument("--params", metavar="FILE", help="parameters from a TOML file")
+                        "validation wall; explicit options below override it (default: "
+                        "preset 1's dome)")
+    g.add_argument("--params", metavar="FILE",
+                   help="parameters from a TOML file (Params fields, as in fixtures/presets); "
+                        "options given next to it override it")
     g.add_argument("--scene", choices=[s for s in SCENES if s != "assembly"],
                    help="section (one web, default), dome (all n webs), wall (validation), "
                         "arch (voussoirs, see the arch options)")
-    g.add_argument("--stretch", type=float, help="dome height / circumradius (> 0)")
-    g.add_argument("--n", type=int, help="walls of the polygonal dome (>= 3)")
-    g.add_argument("--r", type=int, help="full rhombi across the section (>= 0)")
-    g.add_argument("--p", type=int, help="pattern bricks per rhombus side (>= 1)")
-    g.add_argument("--cut", type=float, help="fraction of the height cut off, 0 <= cut < 1")
-    g.add_argument("--unit", type=float, help="brick unit in metres (default 0.1)")
-    g.add_argument("--min-fill", dest="min_fill", type=float,
-                   help="shortest fill-in brick in units (default 1)")
-    g.add_argument("--wall-length", dest="wall_length", type=float,
-                   help="wall scene: length in units (default 32)")
-    g.add_argument("--wall-courses", dest="wall_courses", type=int,
-                   help="wall scene: number of courses (default 10)")
+    g.add_argument("--stretch", type=float,
+                   help=f"dome height / circumradius ({_range('stretch')}; "
+                        f"{_preset_values('stretch')})")
+    g.add_argument("--n", type=int,
+                   help=f"walls of the polygonal dome (>= 3; {_preset_values('n')})")
+    g.add_argument("--r", type=int,
+                   help=f"full rhombi across the section (>= 0; {_preset_values('r')})")
+    g.add_argument("--p", type=int,
+                   help=f"pattern bricks per rhombus side (>= 1; {_preset_values('p')})")
+    g.add_argument("--cut", type=float,
+                   help=f"fraction of the height cut off, 0 <= cut < 1 "
+                        f"({_preset_values('cut')})")
+    g.add_argument("--unit", type=float,
+                   help=f"brick unit in metres ({_range('unit')}; default {DEFAULTS.unit:g})")
+    g.add_argument("--min-fill", dest="min_fill", type=float, metavar="F",
+                   help=f"shortest fill-in brick in units (0 < F <= 4; default "
+                        f"{DEFAULTS.min_fill:g})")
+    g.add_argument("--wall-length", dest="wall_length", type=float, metavar="L",
+                   help=f"wall scene: length in units (>= 4; default {DEFAULTS.wall_length:g})")
+    g.add_argument("--wall-courses", dest="wall_courses", type=int, metavar="K",
+                   help=f"wall scene: number of courses (>= 1; default "
+                        f"{DEFAULTS.wall_courses})")
     g.add_argument("--fast", action="store_true", default=None,
                    help="reduced output: one view, lower resolution")
+    g.add_argument("--max-bricks", dest="max_bricks", type=int, default=MAX_BRICKS,
+                   metavar="N", help=f"refuse a model estimated above N blocks before "
+                                     f"building it (default {MAX_BRICKS}, about "
+                                     f"{MAX_BRICKS * BYTES_PER_BRICK / 1e9:.0f} GB to solve)")
     add_arch_options(parser)
 
 
 def add_arch_options(parser, thickness=True):
     g = parser.add_argument_group("arch scene (metres; the span and rise of the centre line)")
-    g.add_argument("--blocks", dest="arch_blocks", type=int,
-                   help="number of voussoirs (default 16; even for a pointed arch)")
+    g.add_argument("--blocks", dest="arch_blocks", type=int, metavar="N",
+                   help=f"number of voussoirs (>= 2; default {DEFAULTS.arch_blocks}; even "
+                        "for a pointed arch)")
     if thickness:
-        g.add_argument("--thickness", dest="arch_thickness", type=float,
-                       help="thickness t along the joints (default 0.6)")
-    g.add_argument("--span", dest="arch_span", type=float, help="span (default 10)")
+        g.add_argument("--thickness", dest="arch_thickness", type=float, metavar="T",
+                       help=f"thickness t along the joints (at least 0.001 span; default "
+                            f"{DEFAULTS.arch_thickness:g})")
+    g.add_argument("--span", dest="arch_span", type=float, metavar="S",
+                   help=f"span ({_range('arch_span')}; default {DEFAULTS.arch_span:g})")
     g.add_argument("--shape", dest="arch_shape", choices=ARCH_SHAPES,
                    help="semicircular (default), pointed or segmental")
-    g.add_argument("--rise", dest="arch_rise", type=float,
+    g.add_argument("--rise", dest="arch_rise", type=float, metavar="H",
                    help="rise of a pointed (> span/2, default equilateral) or segmental "
-                        "(< span/2, default span/4) arch")
-    g.add_argument("--depth", dest="arch_depth", type=float,
-                   help="depth along y (default 1)")
+                        "(< span/2 and at least 0.01 span, default span/4) arch")
+    g.add_argument("--depth", dest="arch_depth", type=float, metavar="D",
+                   help=f"depth along y (0.001 to 1000 spans; default "
+                        f"{DEFAULTS.arch_depth:g})")
 
 
 def add_analysis_options(parser, boundary=True):
     """Friction, density and solver options; ``boundary`` adds a section's boundary."""
     g = parser.add_argument_group("analysis")
-    g.add_argument("--mu", type=float, help="friction coefficient (default 0.7)")
-    g.add_argument("--density", type=float, help="kg/m^3 (default 2000)")
+    add_material_options(g)
     g.add_argument("--friction", choices=FRICTIONS,
                    help="net, plus, or auto (net, then plus if infeasible; default)")
     g.add_argument("--accuracy", choices=ACCURACIES,
@@ -72,7 +177,8 @@ def add_analysis_options(parser, boundary=True):
                         "'masonry bench'")
     g.add_argument("--solver", choices=SOLVERS,
                    help="override the preset's QP solver: newton (semismooth Newton, "
-                        "friction-net), clarabel (interior point), osqp (ADMM), or "
+                        "friction-net), interior (own primal-dual interior point, "
+                        "friction+), clarabel (interior point), osqp (ADMM), or "
                         "clarabel-cvxpy / osqp-cvxpy (through cvxpy, the reference)")
     if not boundary:
         return
@@ -120,6 +226,14 @@ def collapse_summary(record, report):
         report(f"note: {c['note']}")
 
 
+def add_material_options(group):
+    """``--mu`` and ``--density``, with their ranges and defaults."""
+    group.add_argument("--mu", type=float, help=f"friction coefficient ({_range('mu')}; "
+                                                f"default {DEFAULTS.mu:g})")
+    group.add_argument("--density", type=float, help=f"kg/m^3 ({_range('density')}; "
+                                                     f"default {DEFAULTS.density:g})")
+
+
 def add_output_options(parser):
     g = parser.add_argument_group("output")
     g.add_argument("--out", default="exports", metavar="DIR",
@@ -127,24 +241,58 @@ def add_output_options(parser):
     g.add_argument("--no-plots", dest="plots", action="store_false", help="skip all plots")
     g.add_argument("--no-printable", dest="printable", action="store_false",
                    help="skip the printable body (dome.stl, dome.obj)")
+    g.add_argument("--print-size", dest="print_size", type=float, metavar="MM",
+                   help=f"also write dome.3mf for a slicer, in millimetres, its largest "
+                        f"dimension MM ({_range('print_size')}; default: no 3MF)")
     g.add_argument("--force", action="store_true",
                    help="recompute even if the run folder holds this input's results")
-    g.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    add_verbosity(g)
+
+
+def add_verbosity(parser):
+    """``-q`` (only warnings and errors) and ``-v`` (progress and solver choices even
+    when the output is redirected); by default progress shows on a terminal only."""
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("-q", "--quiet", action="store_true",
+                       help="no progress messages, only warnings and errors")
+    group.add_argument("-v", "--verbose", action="store_true",
+                       help="progress and the solvers' choices (fallbacks), also when "
+                            "the output is redirected")
 
 
 def params_from_args(args) -> Params:
-    """Preset or file first, then every option the user gave; validated."""
+    """Preset or file first, then every option the user gave; validated. Options that do
+    not apply to the resulting scene are refused (:data:`masonry.params.SCENE_FIELDS`)."""
     given = {k: v for k, v in vars(args).items()
              if k in Params.__dataclass_fields__ and v is not None}
-    if getattr(args, "dome", False) and "boundary" not in given:
-        given["boundary"] = "cyclic"
-    if args.params:
-        return load(args.params, **given)
-    if args.preset:
-        return from_preset(args.preset, **given)
-    if given.get("scene") == "wall":
-        return from_preset("wall", **given)
-    return validate(Params(**given))
+    if getattr(args, "dome", False):
+        given.setdefault("boundary", "cyclic")
+    if args.params is not None:
+        params = load(args.params, **given)
+    elif args.preset:
+        params = from_preset(args.preset, **given)
+    elif given.get("scene") == "wall":
+        params = from_preset("wall", **given)
+    else:
+        params = validate(Params(**given))
+    for name, value in given.items():
+        scenes = SCENE_FIELDS.get(name, (params.scene,))
+        if params.scene not in scenes:
+            raise ParameterError(name, value, f"an option of the {' or '.join(scenes)} "
+                                              f"scene, not of this {params.scene} scene")
+    if getattr(args, "dome", False) and params.scene != "section":
+        raise ParameterError("dome", True, f"an option of a section, not of this "
+                                           f"{params.scene} scene")
+    check_print_size(args, params)
+    return params
+
+
+def check_print_size(args, params: Params):
+    """Refuse ``--print-size`` beside ``--no-printable``: the 3MF is the printable body."""
+    if params.print_size is not None and not getattr(args, "printable", True):
+        raise ParameterError("print_size", params.print_size,
+                             "no --no-printable beside it (dome.3mf is the printable body "
+                             "at that size)")
 
 
 def summary(record, report):
@@ -160,10 +308,28 @@ def summary(record, report):
     report(f"{state}: {record['path']}")
 
 
-def rbe_summary(record, report):
-    """The line about the rigid block equilibrium of a run record."""
+def _verdict(rbe) -> str:
+    """The verdict of a record written without one: a friction+ result always has a
+    finite MoI, so one without is a solve that stopped short."""
+    if rbe.get("friction") == "plus" and not math.isfinite(rbe.get("moi", math.nan)):
+        return "not solved"
+    return "feasible" if rbe["feasible"] else "infeasible"
+
+
+def rbe_summary(record, report) -> int:
+    """The lines about the rigid block equilibrium of a run record; returns the exit code:
+    3 when the equilibrium was not solved (no verdict), else 0."""
     rbe = record["rbe"]
-    verdict = "feasible" if rbe["feasible"] else "infeasible"
+    verdict = rbe.get("verdict") or _verdict(rbe)
+    if verdict == "not solved":
+        report(f"RBE: not solved (friction-{rbe['friction']}, mu {rbe['mu']:g}): "
+               f"{rbe['solver']} stopped with status {rbe.get('status')!r}, residual "
+               f"{rbe['residual_eq']:.2g}; no verdict")
+        return 3
     report(f"RBE: {verdict} (friction-{rbe['friction']}, mu {rbe['mu']:g}), "
            f"MoI {rbe['moi']:.4g} N, MoI factor {rbe['moi_factor']:.4g}, "
            f"residual {rbe['residual_eq']:.2g}, {rbe['solver']} {rbe['time_s']:.3g} s")
+    if verdict == "infeasible" and record["params"].get("friction") == "net":
+        report("friction-net has no equilibrium for this structure, so it has no measure "
+               "of infeasibility: --friction auto (or plus) gives its MoI and forces")
+    return 0

@@ -19,9 +19,9 @@ def register(subparsers):
 
 def handle(args, report):
     record = run(params_from_args(args), args.out, analyse=True, plots_wanted=args.plots,
-                 printable=args.printable, force=args.force)
+                 printable=args.printable, force=args.force, max_bricks=args.max_bricks)
     summary(record, report)
-    rbe_summary(record, report)
+    code = rbe_summary(record, report)
     if "collapse" in record:
         collapse_summary(record, report)
-    return 0
+    return code

@@ -1,8 +1,10 @@
 """``masonry structures``: the thesis's table 4.1 and friction test, every boundary model
 side by side."""
 
-from masonry.runfolder import RunFolder
+from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.structures import structures_table, table_csv, table_markdown
+
+from .options import add_verbosity
 
 
 def register(subparsers):
@@ -10,7 +12,8 @@ def register(subparsers):
         "structures", help="reproduce the thesis's structures 1.1 to 3.2 and its friction "
                            "test, with free, rigid and cyclic sections and the full dome")
     parser.add_argument("--out", default="exports", metavar="DIR",
-                        help="output root: writes DIR/structures/table.csv and table.md")
+                        help="output root: writes DIR/structures/table.csv and table.md "
+                             "(default exports)")
     parser.add_argument("--no-full-dome", dest="full_dome", action="store_false",
                         help="leave out the full domes (the slowest rows)")
     parser.add_argument("--lp-check", action="store_true",
@@ -18,11 +21,12 @@ def register(subparsers):
     parser.add_argument("--lateral", action="store_true",
                         help="also the worst lateral load factor of each full dome (the "
                              "x.2 domes as a whole), over the azimuths its symmetry leaves")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress messages")
+    add_verbosity(parser)
     parser.set_defaults(handler=handle)
 
 
 def handle(args, report):
+    check_output_root(args.out)
     rows = structures_table(full_dome=args.full_dome, lp_check=args.lp_check,
                             lateral=args.lateral)
     markdown = table_markdown(rows)

@@ -1,18 +1,18 @@
 """``masonry sweep STUDY.toml``: a parameter study, serially or on a Dask cluster."""
 
 import logging
+import math
 import os
 import sys
-import tomllib
 from pathlib import Path
 
-from masonry.params import PRESETS, ParameterError
-from masonry.runfolder import RunFolder
+from masonry.params import PRESETS, ParameterError, read_toml
+from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.sweep import (Study, execute, summary_csv, summary_parquet, summary_pngs,
                            summary_rows)
 
 from . import run as run_command
-from .options import Parser
+from .options import Parser, add_verbosity
 
 log = logging.getLogger("masonry")
 
@@ -29,12 +29,13 @@ def register(subparsers):
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786")
     parser.add_argument("--out", default="exports", metavar="DIR",
-                        help="output root of the variants' run folders and the summary")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+                        help="output root of the variants' run folders and of "
+                             "sweep_<study>/ with the summary (default exports)")
+    add_verbosity(parser)
     parser.set_defaults(handler=handle)
 
 
-def option_names() -> dict:
+def run_option_names() -> dict:
     """``masonry run``'s long option names (dashes or underscores) -> Params fields."""
     parser = Parser(prog="masonry")
     run_command.register(parser.add_subparsers())
@@ -48,41 +49,86 @@ def option_names() -> dict:
     return names
 
 
+TABLES = ("base", "grid", "sample", "outputs")
+MAX_VARIANTS = 100_000
+"""Largest study (grid points times samples): a study file asking for more is refused."""
+
+
 def load_study(path) -> Study:
-    """Read a study file; names are 'masonry run' options without their dashes."""
-    try:
-        with open(path, "rb") as f:
-            data = tomllib.load(f)
-    except OSError as error:
-        raise ParameterError("study", str(path), f"a readable TOML file ({error.strerror})")
-    except tomllib.TOMLDecodeError as error:
-        raise ParameterError("study", str(path), f"valid TOML ({error})")
-    names = option_names()
+    """Read a study file; names are 'masonry run' options without their dashes.
 
-    def fields(table, where):
-        out = {}
-        for key, value in table.items():
-            if key not in names:
-                raise ParameterError(f"{where}.{key}", value, "a 'masonry run' option")
-            dest = names[key]
-            if dest == "dome":  # --dome: cyclic boundary
-                dest, value = "boundary", "cyclic" if value else "free"
-            out[dest] = value
-        return out
+    Raises
+    ------
+    ParameterError
+        Named ``study`` when the file cannot be read or is not TOML, else named after the
+        table and key at fault (``grid.mu``), with the file as ``where``.
+    """
+    data = read_toml(path, "study")
+    where = str(path)
 
-    base = dict(data.get("base", {}))
+    def refuse(key, value, expected):
+        raise ParameterError(key, value, expected, where=where)
+
+    for key, value in data.items():
+        if key not in TABLES:
+            refuse(key, value, f"one of the tables [{'], ['.join(TABLES)}]")
+        if not isinstance(value, dict):
+            refuse(key, value, f"a table [{key}]")
+    base, grid = dict(data.get("base", {})), dict(data.get("grid", {}))
+    sample, outputs = dict(data.get("sample", {})), data.get("outputs", {})
     preset = base.pop("preset", None)
     if preset is not None and str(preset) not in PRESETS:
-        raise ParameterError("base.preset", preset, f"one of {', '.join(PRESETS)}")
-    sample = dict(data.get("sample", {}))
+        refuse("base.preset", preset, f"one of {', '.join(PRESETS)}")
     count, seed = sample.pop("count", 0), sample.pop("seed", 0)
-    outputs = data.get("outputs", {})
+    for key, value, ok, expected in (
+            ("sample.count", count, isinstance(count, int) and not isinstance(count, bool)
+             and 0 <= count <= MAX_VARIANTS, f"an integer 1 to {MAX_VARIANTS}"),
+            ("sample.seed", seed, isinstance(seed, int) and not isinstance(seed, bool),
+             "an integer")):
+        if not ok:
+            refuse(key, value, expected)
+    for key, value in outputs.items():
+        if key not in ("plots", "printable") or not isinstance(value, bool):
+            refuse(f"outputs.{key}", value, "plots or printable = true or false")
+    for key, values in grid.items():
+        if not isinstance(values, list) or not values:
+            refuse(f"grid.{key}", values, "a non-empty list of values")
+    for key, bounds in sample.items():
+        if not (isinstance(bounds, list) and len(bounds) == 2
+                and all(isinstance(b, (int, float)) and not isinstance(b, bool)
+                        for b in bounds) and bounds[0] <= bounds[1]):
+            refuse(f"sample.{key}", bounds, "[low, high], two numbers with low <= high")
+    if sample and count < 1:
+        refuse("sample.count", count, f"an integer 1 to {MAX_VARIANTS}")
+    size = math.prod(len(v) for v in grid.values()) * max(count, 1)
+    if size > MAX_VARIANTS:
+        refuse("grid", f"{size} variants", f"at most {MAX_VARIANTS} variants")
+    names = run_option_names()
     return Study(
-        base={**(PRESETS[str(preset)] if preset is not None else {}), **fields(base, "base")},
-        grid=fields(data.get("grid", {}), "grid"),
-        sample=fields(sample, "sample"), count=count, seed=seed,
-        plots=bool(outputs.get("plots", False)),
-        printable=bool(outputs.get("printable", False)))
+        base={**(PRESETS[str(preset)] if preset is not None else {}),
+              **_fields(base, "base", names, where)},
+        grid=_fields(grid, "grid", names, where, lists=True),
+        sample=_fields(sample, "sample", names, where), count=count, seed=seed,
+        plots=outputs.get("plots", False), printable=outputs.get("printable", False))
+
+
+def _fields(table, name, names, where, lists=False) -> dict:
+    """A study table's 'masonry run' option names -> Params fields (``dome`` is the
+    boundary: true is cyclic); ``lists``: the values are lists of values."""
+    out = {}
+    for key, value in table.items():
+        if key not in names:
+            raise ParameterError(f"{name}.{key}", value, "a 'masonry run' option (without "
+                                 "its dashes)", where=where)
+        dest = names[key]
+        if dest == "dome":
+            def boundary(flag):
+                if not isinstance(flag, bool):
+                    raise ParameterError(f"{name}.{key}", value, "true or false", where=where)
+                return "cyclic" if flag else "free"
+            dest, value = "boundary", [boundary(v) for v in value] if lists else boundary(value)
+        out[dest] = value
+    return out
 
 
 def _progress(done, total, failed):
@@ -94,11 +140,12 @@ def _progress(done, total, failed):
 
 
 def handle(args, report):
-    study = load_study(args.study)
-    total = len(study.variants())  # validates the study before any run
     workers, scheduler = args.workers, args.scheduler
     if workers < 1:
         raise ParameterError("workers", workers, "an integer >= 1")
+    check_output_root(args.out)
+    study = load_study(args.study)
+    total = len(study.variants())  # validates the study before any run
     if workers > 1 or scheduler:
         try:
             import dask.distributed  # noqa: F401
@@ -107,15 +154,24 @@ def handle(args, report):
                         "cluster: pip install 'masonry[dask]'")
             workers, scheduler = 1, None
     logging.getLogger("distributed").setLevel(logging.ERROR)  # cluster start and stop
-    show = sys.stderr.isatty() and not args.quiet
+    # one display: on a terminal the bar replaces the variants' stage lines (warnings
+    # still show); --verbose shows the lines instead
+    show = sys.stderr.isatty() and not args.quiet and not args.verbose
     results, failed = [], 0
-    for i, inputs, row in execute(study, args.out, workers, scheduler):
-        results.append((i, inputs, row))
-        failed += row["status"] == "failed"
-        if show:
-            _progress(len(results), total, failed)
+    library = logging.getLogger("masonry")
+    level = library.level
     if show:
-        sys.stderr.write("\n")
+        library.setLevel(logging.WARNING)
+    try:
+        for i, inputs, row in execute(study, args.out, workers, scheduler):
+            results.append((i, inputs, row))
+            failed += row["status"] == "failed"
+            if show:
+                _progress(len(results), total, failed)
+    finally:
+        library.setLevel(level)
+        if show:
+            sys.stderr.write("\n")
     rows = summary_rows(study, results)
     name = f"sweep_{Path(args.study).stem}"
     with RunFolder(args.out, name) as folder:

@@ -17,11 +17,19 @@ from functools import cached_property
 
 import numpy as np
 
+from masonry.tolerances import HORIZONTAL_SIN, TIE_REL
+
 BLOCK_CLASSES = ("ground", "regular", "pattern", "fill_in", "block")
 """Names of the ``block_class`` codes. ``block`` is an imported or scene block (arch)."""
 
 GROUND = BLOCK_CLASSES.index("ground")
 """``block_class`` code of a ground slab or support block."""
+
+PATTERN = BLOCK_CLASSES.index("pattern")
+"""``block_class`` code of a pattern (herringbone) brick, two courses high."""
+
+BLOCK = BLOCK_CLASSES.index("block")
+"""``block_class`` code of an imported or scene block (an arch's voussoir)."""
 
 # Corner order of a hexahedral brick: index = ix + 2 * iy + 4 * iz, with local axes
 # x = through the wall (0 inner, 1 outer), y = along the wall, z = up the course.
@@ -63,7 +71,7 @@ def tangent_basis(normal, reference=None):
     """
     normal = np.asarray(normal, dtype=float).reshape(-1, 3)
     t1 = np.cross(np.array([0.0, 0.0, 1.0]), normal)
-    flat = np.linalg.norm(t1, axis=1) < 1e-6
+    flat = np.linalg.norm(t1, axis=1) < HORIZONTAL_SIN
     ref = (np.broadcast_to([1.0, 0.0, 0.0], normal.shape) if reference is None
            else np.asarray(reference, dtype=float).reshape(-1, 3))[flat]
     t1[flat] = ref - normal[flat] * np.einsum("ij,ij->i", normal[flat], ref)[:, None]
@@ -159,7 +167,7 @@ class Blocks:
         block_class = block_class.astype(np.int8)
         block_course = (np.zeros(count, int) if block_course is None
                         else np.asarray(block_course, dtype=int))
-        block_is_support = (block_class == BLOCK_CLASSES.index("ground")
+        block_is_support = (block_class == GROUND
                             if block_is_support is None
                             else np.asarray(block_is_support, dtype=bool))
         block_web = np.zeros(count, int) if block_web is None else np.asarray(block_web, int)
@@ -252,7 +260,7 @@ class Blocks:
         owner = np.repeat(np.arange(self.n_faces), self.face_polygon_count)
         # the first edge of maximal length (up to rounding) in each face
         longest = np.maximum.reduceat(length, self.face_offsets[:-1])
-        is_longest = length >= longest[owner] * (1 - 1e-9)
+        is_longest = length >= longest[owner] * (1 - TIE_REL)
         first = np.full(self.n_faces, len(fv))
         np.minimum.at(first, owner[is_longest], np.flatnonzero(is_longest))
         return edge[first]
@@ -419,5 +427,5 @@ def _newell(polygons):
 
 def _sum_by(index, values, n) -> np.ndarray:
     """(n, C) float: ``out[i]`` is the sum of the rows of ``values`` (N, C) whose ``index``
-    is ``i``; ``np.add.at`` in the same order, one bincount per column (5x faster)."""
+    is ``i``; ``np.add.at`` in the same order, one bincount per column (faster: docs/bench.md)."""
     return np.stack([np.bincount(index, column, minlength=n) for column in values.T], axis=1)

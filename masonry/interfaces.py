@@ -11,12 +11,10 @@ Why the polygons are clipped here and not by shapely (GEOS), unlike SPEC 5 step 
 every pair is a pair of convex polygons, and in masonry they share edges and corners as
 a rule. GEOS's overlay has no tolerance: it returned two points for two coincident
 quadrilaterals 3e-17 m apart, and a polygon plus a 1e-12 m line elsewhere, so it needed
-a snap-rounding retry wherever the result was not one polygon. On the 28,600 face pairs
-of preset 1's full dome that took 0.6 s (overlay 0.37 s, retries 0.1 s, building the
-shapely polygons 0.07 s), where issue 8 gives this whole stage 0.3 s. Convex clipping
-of all pairs at once (:func:`_clip_convex`, Sutherland-Hodgman with a point-on-line
-tolerance) takes 0.11 s there and has no degenerate cases. Shapely stays its reference
-in the tests (``test_convex_clipping_matches_shapely``).
+a snap-rounding retry wherever the result was not one polygon, and was several times
+slower (docs/bench.md). Convex clipping of all pairs at once (:func:`_clip_convex`,
+Sutherland-Hodgman with a point-on-line tolerance) has no degenerate cases. Shapely
+stays its reference in the tests (``test_convex_clipping_matches_shapely``).
 """
 
 from dataclasses import dataclass
@@ -26,7 +24,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from masonry.blocks import Blocks
-from masonry.tolerances import Tolerances
+from masonry.tolerances import BED_JOINT_ANGLE, Tolerances
 
 INTERFACE_KINDS = ("horizontal", "vertical", "support", "boundary")
 """Names of the ``kind`` codes. ``support``: one block is a fixed support (the ground);
@@ -82,6 +80,25 @@ class Interfaces:
     def counts(self) -> dict:
         """Number of interfaces per kind name."""
         return {name: int((self.kind == i).sum()) for i, name in enumerate(INTERFACE_KINDS)}
+
+    def subset(self, mask, block_remap=None) -> "Interfaces":
+        """The interfaces selected by a boolean mask or index array, in their order.
+
+        Parameters
+        ----------
+        mask : (K,) bool or (k,) int
+        block_remap : (B,) int, optional
+            New index of every block (``pair`` is mapped through it); default unchanged.
+        """
+        index = np.arange(len(self))[mask]
+        count = self.vertex_count[index]
+        start = np.repeat(self.offsets[index] - (np.cumsum(count) - count), count)
+        vertex = start + np.arange(int(count.sum()))
+        pair = self.pair[index] if block_remap is None else block_remap[self.pair[index]]
+        return Interfaces(pair=pair, kind=self.kind[index], vertices=self.vertices[vertex],
+                          offsets=np.concatenate([[0], np.cumsum(count)]),
+                          area=self.area[index], centre=self.centre[index],
+                          normal=self.normal[index], t1=self.t1[index], t2=self.t2[index])
 
     @classmethod
     def empty(cls) -> "Interfaces":
@@ -330,7 +347,7 @@ def _order_main(blocks, face_a, face_b, up):
     support_a = blocks.block_is_support[block_a]
     support_b = blocks.block_is_support[block_b]
     rise = np.einsum("ij,ij->i", blocks.face_normal[face_a], up[block_a])
-    is_bed = np.abs(rise) > np.cos(np.pi / 4)
+    is_bed = np.abs(rise) > np.cos(BED_JOINT_ANGLE)
     a_lower = np.where(is_bed, rise > 0, block_a < block_b)
     a_main = support_a | (~support_b & a_lower)
     return np.where(a_main, face_a, face_b), np.where(a_main, face_b, face_a)
@@ -384,7 +401,7 @@ def _intersect(blocks, main, comp, faces, tol, up):
     normal_k, t1_k, t2_k = normal[main], t1[main], t2[main]
 
     is_support = blocks.block_is_support[block_m] | blocks.block_is_support[block_c]
-    is_horizontal = np.abs(np.einsum("ij,ij->i", normal_k, up[block_m])) > np.cos(np.pi / 4)
+    is_horizontal = np.abs(np.einsum("ij,ij->i", normal_k, up[block_m])) > np.cos(BED_JOINT_ANGLE)
     kind = np.select([is_support, is_horizontal],
                      [INTERFACE_KINDS.index("support"), INTERFACE_KINDS.index("horizontal")],
                      INTERFACE_KINDS.index("vertical")).astype(np.int8)

@@ -7,18 +7,16 @@ parameter, the value and the valid range.
 
 import dataclasses
 import hashlib
-import logging
 import math
+import os
 import tomllib
 from dataclasses import dataclass
-
-log = logging.getLogger(__name__)
 
 SCENES = ("section", "wall", "dome", "assembly", "arch")
 FRICTIONS = ("net", "plus", "auto")
 BOUNDARIES = ("free", "rigid", "cyclic")
 # QP solvers (masonry.rbe.solvers.BACKENDS) and accuracy presets (masonry.rbe.solve.ACCURACY)
-SOLVERS = ("newton", "clarabel", "osqp", "clarabel-cvxpy", "osqp-cvxpy")
+SOLVERS = ("newton", "interior", "clarabel", "osqp", "clarabel-cvxpy", "osqp-cvxpy")
 ACCURACIES = ("fast", "balanced", "accurate")
 ARCH_SHAPES = ("semicircular", "pointed", "segmental")
 
@@ -32,14 +30,35 @@ PRESETS = {
 }
 
 
-class ParameterError(ValueError):
-    """A parameter is out of its valid range. The message names parameter, value, range."""
+SCENE_FIELDS = {
+    # a parameter -> the scenes it applies to; the others ignore it
+    **{name: ("section", "dome") for name in ("stretch", "n", "r", "p", "cut", "min_fill")},
+    "unit": ("section", "dome", "wall"),
+    "boundary": ("section",),
+    "wall_length": ("wall",),
+    "wall_courses": ("wall",),
+    **{name: ("arch",) for name in ("arch_blocks", "arch_span", "arch_thickness",
+                                    "arch_depth", "arch_shape", "arch_rise")},
+}
+"""The parameters that apply to some scenes only (a front end refuses them for others)."""
 
-    def __init__(self, name, value, expected):
-        super().__init__(f"invalid parameter {name}={value!r}: expected {expected}")
+
+class ParameterError(ValueError):
+    """A parameter is out of its valid range. The message names parameter, value, range.
+
+    ``related`` names the other parameters the check depends on (a front end names the
+    ones its user gave when ``name`` itself was not given); ``where`` says where the value
+    was read (a file), if not from the caller.
+    """
+
+    def __init__(self, name, value, expected, *, related=(), where=None):
+        super().__init__(f"invalid parameter {name}={value!r}: expected {expected}"
+                         + (f" ({where})" if where else ""))
         self.name = name
         self.value = value
         self.expected = expected
+        self.related = tuple(related)
+        self.where = where
 
 
 @dataclass(frozen=True)
@@ -59,7 +78,8 @@ class Params:
     Analysis: ``mu`` friction coefficient, ``density`` kg/m^3, ``friction`` net | plus |
     auto, ``accuracy`` solver preset (fast | balanced | accurate; None: fast in fast
     mode, else balanced, SPEC 3), ``solver`` (None: the preset's; a name overrides it).
-    Output: ``fast`` (one view, low resolution), ``cad_offset`` (units).
+    Output: ``fast`` (one view, low resolution), ``cad_offset`` (units), ``print_size``
+    (mm: the largest dimension of ``dome.3mf``; None writes no 3MF).
     Live loads (SPEC 6.8, :mod:`masonry.rbe.loads`), each making the run compute a collapse
     load factor: ``lateral`` azimuth in degrees from +x toward +y of a horizontal body
     force of each block's weight, or ``'all'`` for the worst azimuth; ``point_loads``
@@ -86,6 +106,7 @@ class Params:
     solver: str | None = None
     fast: bool = False
     cad_offset: float = 1.0
+    print_size: float | None = None
     arch_blocks: int = 16
     arch_span: float = 10.0
     arch_thickness: float = 0.6
@@ -139,14 +160,92 @@ def from_preset(name, **overrides) -> Params:
 
 
 def load(path, **overrides) -> Params:
-    """Parameters from a TOML file of ``Params`` fields (e.g. ``fixtures/presets/*.toml``)."""
-    with open(path, "rb") as f:
-        data = tomllib.load(f)
+    """Parameters from a TOML file of ``Params`` fields (e.g. ``fixtures/presets/*.toml``),
+    at the top level or in a ``[params]`` table; ``overrides`` win over the file.
+
+    Raises
+    ------
+    ParameterError
+        Named ``params`` when the file cannot be read or is not TOML; named after the key
+        (with ``where`` the file) when a key is unknown or its value invalid.
+    """
+    data = read_toml(path, "params")
     data = data.get("params", data)
-    unknown = set(data) - {f.name for f in dataclasses.fields(Params)}
-    if unknown:
-        raise ParameterError("file", str(path), f"only Params fields, not {sorted(unknown)}")
-    return validate(Params(**{**data, **overrides}))
+    if not isinstance(data, dict):
+        raise ParameterError("params", str(path), "a file whose [params] is a table")
+    known = [f.name for f in dataclasses.fields(Params)]
+    for key, value in data.items():
+        if key not in known:
+            raise ParameterError(key, value, f"a parameter name ({', '.join(known)})",
+                                 where=str(path))
+    try:
+        return validate(Params(**{**data, **overrides}))
+    except ParameterError as error:
+        if error.name not in data or error.name in overrides or error.where:
+            raise
+        raise ParameterError(error.name, error.value, error.expected,
+                             related=error.related, where=str(path)) from None
+
+
+MAX_TOML_BYTES = 2**20
+"""Parameter and study files are a few hundred bytes; a larger one is not one of them."""
+
+
+def read_toml(path, name) -> dict:
+    """The table of a TOML file (UTF-8, a byte order mark allowed).
+
+    Raises
+    ------
+    ParameterError
+        Named ``name`` (the option that gave the path): the path is empty, the file is
+        missing, unreadable or a folder, not UTF-8, or not TOML.
+    """
+    if str(path).strip() == "":
+        raise ParameterError(name, str(path), "a TOML file (an empty path names nothing)")
+    try:
+        if os.path.exists(path) and not os.path.isfile(path):
+            raise ParameterError(name, str(path), "a TOML file, not a folder or a device")
+        if os.path.getsize(path) > MAX_TOML_BYTES:
+            raise ParameterError(name, str(path), f"a TOML file of at most "
+                                                  f"{MAX_TOML_BYTES // 2**20} MiB")
+        with open(path, "rb") as f:
+            text = f.read().decode("utf-8-sig")
+        return tomllib.loads(text)
+    except OSError as error:
+        raise ParameterError(name, str(path), f"a readable TOML file "
+                                              f"({error.strerror or error})") from None
+    except UnicodeDecodeError as error:
+        raise ParameterError(name, str(path), f"a UTF-8 text file (byte {error.start} is "
+                                              f"not UTF-8)") from None
+    except tomllib.TOMLDecodeError as error:
+        raise ParameterError(name, str(path), f"a valid TOML file ({error})") from None
+
+
+RANGES = {
+    # name: (low, high, why); the extremes tests (tests/test_extremes.py) solve at the
+    # ends of each range with residuals below tolerance
+    "unit": (1e-3, 1e2, "metres: bricks of 1 mm to 100 m; forces scale with unit^3"),
+    "density": (1.0, 1e7, "kg/m^3: forces scale with it exactly; masonry is 1500 to 3000"),
+    "mu": (0.01, 10.0, "friction coefficients of masonry are 0.3 to 1; beyond these ends "
+                       "the friction cones are flat or closed to the solvers' precision"),
+    "stretch": (0.05, 20.0, "dome height / circumradius"),
+    "arch_span": (0.01, 1e4, "metres"),
+    "print_size": (1.0, 1e4, "millimetres, the largest dimension of dome.3mf: printers' "
+                             "beds are 100 to 1000 mm"),
+}
+"""Physically meaningful and numerically safe ranges, checked by :func:`validate`."""
+
+ARCH_RATIOS = {
+    # name: (low, high) as multiples of the span: the interface detector's tolerances are
+    # relative to the scene's size (1e-6), so a part 1e-9 of it would vanish in them
+    "arch_thickness": (1e-3, None),
+    "arch_depth": (1e-3, 1e3),
+    "arch_rise": (1e-2, 1e2),
+}
+
+
+MAX_INTEGER = 10**12
+"""No count of anything here comes near it; larger integers would overflow floats."""
 
 
 def _check(name, value, ok, expected):
@@ -160,23 +259,25 @@ def _number(name, value, integer=False):
         raise ParameterError(name, value, "an integer" if integer else "a number")
     if not math.isfinite(value):
         raise ParameterError(name, value, "a finite number")
+    if integer and abs(value) > MAX_INTEGER:
+        raise ParameterError(name, value, f"an integer of at most {MAX_INTEGER:.0e}")
     return value
 
 
 def parse_point_load(spec: str) -> tuple:
     """``'NAME_OR_PATTERN:FX,FY,FZ'`` -> ``(pattern, (fx, fy, fz))`` in newtons; raises
-    :class:`ParameterError` naming ``--point-load``."""
+    :class:`ParameterError` naming ``point_loads`` (``--point-load``)."""
     expected = "NAME_OR_PATTERN:FX,FY,FZ (a block name or fnmatch pattern, newtons)"
     pattern, colon, numbers = str(spec).rpartition(":")
     parts = numbers.split(",")
     if not colon or not pattern or len(parts) != 3:
-        raise ParameterError("--point-load", spec, expected)
+        raise ParameterError("point_loads", spec, expected)
     try:
         force = tuple(float(v) for v in parts)
     except ValueError:
-        raise ParameterError("--point-load", spec, expected) from None
+        raise ParameterError("point_loads", spec, expected) from None
     if not all(math.isfinite(v) for v in force) or not any(force):
-        raise ParameterError("--point-load", spec, "finite forces, not all zero")
+        raise ParameterError("point_loads", spec, "finite forces, not all zero")
     return pattern, force
 
 
@@ -188,63 +289,76 @@ def _live_loads(p: Params) -> Params:
         try:
             lateral = float(lateral)
         except ValueError:
-            raise ParameterError("--lateral", p.lateral,
+            raise ParameterError("lateral", p.lateral,
                                  "an azimuth in degrees or 'all'") from None
     if lateral is not None and lateral != "all":
-        lateral = float(_number("--lateral", lateral)) % 360.0
+        lateral = float(_number("lateral", lateral)) % 360.0
     specs = (p.point_loads,) if isinstance(p.point_loads, str) else tuple(p.point_loads)
     for spec in specs:
         parse_point_load(spec)
     if p.crown_load is not None:
-        _check("--crown-load", p.crown_load, _number("--crown-load", p.crown_load) > 0,
+        _check("crown_load", p.crown_load, _number("crown_load", p.crown_load) > 0,
                "> 0 (newtons, downward)")
-        _check("--crown-load", p.crown_load, p.scene in ("section", "dome"),
+        _check("crown_load", p.crown_load, p.scene in ("section", "dome"),
                "a dome: --scene section or dome")
     kinds = sum((lateral is not None, bool(specs), p.crown_load is not None))
-    _check("--lateral", p.lateral, kinds <= 1,
+    _check("lateral", p.lateral, kinds <= 1,
            "one live load per run: --lateral, --point-load or --crown-load")
     if p.scene == "section" and p.boundary == "cyclic" and (lateral is not None or specs):
         # one web with the load repeated in every web is not the asked load case
-        raise ParameterError("--lateral" if lateral is not None else "--point-load",
+        raise ParameterError("lateral" if lateral is not None else "point_loads",
                              p.lateral if lateral is not None else specs[0],
                              "a symmetric load on a cyclic section: this load breaks the "
                              "dome's rotational symmetry; use --scene dome")
     return dataclasses.replace(p, lateral=lateral, point_loads=specs)
 
 
+def _choice(name, value, choices, optional=False):
+    if optional and value is None:
+        return
+    if not isinstance(value, str) or value not in choices:
+        raise ParameterError(name, value, f"one of {', '.join(choices)}")
+
+
+def _in_range(p: Params, name):
+    low, high, why = RANGES[name]
+    value = _number(name, getattr(p, name))
+    _check(name, value, low <= value <= high, f"{low:g} to {high:g} ({why})")
+
+
 def validate(params: Params) -> Params:
     """Check every parameter; return ``params`` (live loads normalised) or raise
     :class:`ParameterError`."""
     p = _live_loads(params)
-    _check("scene", p.scene, p.scene in SCENES, f"one of {', '.join(SCENES)}")
-    _check("boundary", p.boundary, p.boundary in BOUNDARIES, f"one of {', '.join(BOUNDARIES)}")
-    _check("friction", p.friction, p.friction in FRICTIONS, f"one of {', '.join(FRICTIONS)}")
-    _check("solver", p.solver, p.solver is None or p.solver in SOLVERS,
-           f"one of {', '.join(SOLVERS)}")
-    _check("accuracy", p.accuracy, p.accuracy is None or p.accuracy in ACCURACIES,
-           f"one of {', '.join(ACCURACIES)}")
-    _check("stretch", p.stretch, _number("stretch", p.stretch) > 0, "> 0")
+    _choice("scene", p.scene, SCENES)
+    _choice("boundary", p.boundary, BOUNDARIES)
+    _choice("friction", p.friction, FRICTIONS)
+    _choice("solver", p.solver, SOLVERS, optional=True)
+    _choice("accuracy", p.accuracy, ACCURACIES, optional=True)
+    _choice("arch_shape", p.arch_shape, ARCH_SHAPES)
+    _check("fast", p.fast, isinstance(p.fast, bool), "true or false")
+    _check("assembly", p.assembly, isinstance(p.assembly, str), "a name")
+    for name in ("unit", "density", "mu", "stretch", "arch_span"):
+        _in_range(p, name)
     _check("n", p.n, _number("n", p.n, integer=True) >= 3, "an integer >= 3")
     _check("r", p.r, _number("r", p.r, integer=True) >= 0, "an integer >= 0")
     _check("p", p.p, _number("p", p.p, integer=True) >= 1, "an integer >= 1")
     _check("cut", p.cut, 0 <= _number("cut", p.cut) < 1, "0 <= cut < 1")
-    _check("unit", p.unit, _number("unit", p.unit) > 0, "> 0 (metres)")
     _check("min_fill", p.min_fill, 0 < _number("min_fill", p.min_fill) <= 4,
            "0 < min_fill <= 4 (units)")
-    _check("mu", p.mu, _number("mu", p.mu) > 0, "> 0")
-    _check("density", p.density, _number("density", p.density) > 0, "> 0 (kg/m^3)")
-    _check("cad_offset", p.cad_offset, _number("cad_offset", p.cad_offset) >= 0,
-           ">= 0 (units)")
+    _check("cad_offset", p.cad_offset, 0 <= _number("cad_offset", p.cad_offset) <= 4,
+           "0 to 4 (units)")
+    if p.print_size is not None:
+        _in_range(p, "print_size")
     _check("wall_length", p.wall_length, _number("wall_length", p.wall_length) >= 4,
            ">= 4 (units, one regular brick)")
     _check("wall_courses", p.wall_courses,
            _number("wall_courses", p.wall_courses, integer=True) >= 1, "an integer >= 1")
     _check("arch_blocks", p.arch_blocks,
-           _number("arch_blocks", p.arch_blocks, integer=True) >= 1, "an integer >= 1")
-    for name in ("arch_span", "arch_thickness", "arch_depth"):
+           _number("arch_blocks", p.arch_blocks, integer=True) >= 2,
+           "an integer >= 2 (one voussoir is no arch, and a semicircular one is not convex)")
+    for name in ("arch_thickness", "arch_depth"):
         _check(name, getattr(p, name), _number(name, getattr(p, name)) > 0, "> 0 (metres)")
-    _check("arch_shape", p.arch_shape, p.arch_shape in ARCH_SHAPES,
-           f"one of {', '.join(ARCH_SHAPES)}")
     if p.arch_rise is not None:
         _check("arch_rise", p.arch_rise, _number("arch_rise", p.arch_rise) > 0,
                "> 0 (metres) or none")
@@ -253,9 +367,6 @@ def validate(params: Params) -> Params:
     if p.scene == "assembly":
         _check("assembly", p.assembly, bool(p.assembly),
                "the name of an imported model (masonry analyze sets it)")
-    if p.scene in ("section", "dome") and not 0.2 <= p.stretch <= 5:
-        log.warning("stretch=%g is outside 0.2..5: the dome is unusually flat or tall",
-                    p.stretch)
     return p
 
 
@@ -278,31 +389,46 @@ def check_arch(params: Params) -> None:
     """Refuse arch parameters that make no arch (:class:`ParameterError`).
 
     The ranges that do not depend on the shape are checked by
-    :func:`masonry.params.validate`; here: the rise against the shape, an even number of
-    voussoirs for a pointed arch, and a thickness that leaves an intrados.
+    :func:`masonry.params.validate`; here: thickness, depth and rise against the span
+    (:data:`ARCH_RATIOS`), the rise against the shape, an even number of voussoirs for a
+    pointed arch, and a thickness that leaves an intrados.
     """
     p = params
     span, rise, t = p.arch_span, p.arch_rise, p.arch_thickness
+    for name, (low, high) in ARCH_RATIOS.items():
+        value = getattr(p, name)
+        if value is None:
+            continue
+        if value < low * span or (high is not None and value > high * span):
+            bounds = f"{low:g} to {high:g}" if high is not None else f"at least {low:g}"
+            raise ParameterError(name, value, f"{bounds} times the span ({span:g} m): the "
+                                              "contact tolerances are relative to the arch's "
+                                              "size", related=("arch_span",))
     if p.arch_shape == "semicircular" and rise is not None and rise != span / 2:
         raise ParameterError("arch_rise", rise, f"none for a semicircular arch (its rise is "
-                                                f"span / 2 = {span / 2:g} m)")
+                                                f"span / 2 = {span / 2:g} m)",
+                             related=("arch_shape",))
     if p.arch_shape == "segmental" and rise is not None and not 0 < rise < span / 2:
         raise ParameterError("arch_rise", rise, f"0 < rise < span / 2 = {span / 2:g} m for "
-                                                "a segmental arch")
+                                                "a segmental arch",
+                             related=("arch_span", "arch_shape"))
     if p.arch_shape == "pointed":
         if rise is not None and not rise > span / 2:
             raise ParameterError("arch_rise", rise, f"> span / 2 = {span / 2:g} m for a "
-                                                    "pointed arch")
+                                                    "pointed arch",
+                                 related=("arch_span", "arch_shape"))
         if p.arch_blocks % 2:
             raise ParameterError("arch_blocks", p.arch_blocks, "an even number for a "
-                                                               "pointed arch")
+                                                               "pointed arch",
+                                 related=("arch_shape",))
     radius, _ = arch_radius(p.arch_shape, span, rise)
     # the intrados must exist: radius R - t/2 > 0, and for a pointed arch it must still
     # reach the crown, R - t/2 > R - span/2
     limit = span if p.arch_shape == "pointed" else 2 * radius
     if not t < limit:
         raise ParameterError("arch_thickness", t, f"< {limit:g} m (the intrados of this "
-                                                  f"arch vanishes at t = {limit:g} m)")
+                                                  f"arch vanishes at t = {limit:g} m)",
+                             related=("arch_span", "arch_shape", "arch_rise"))
 
 
 def structure_id(params: Params) -> str:

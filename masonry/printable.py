@@ -18,8 +18,8 @@ method (SPEC 7):
    union is cleaned here: edges shorter than ``tol.contact`` are collapsed, then
    ``simplify(tol.contact)`` swaps away degenerate triangles and drops redundant
    coplanar vertices (a quarter of the triangles), repeated until no short edge is left.
-3. ``Manifold.decompose()`` is far too slow for a body count (110 s and 15.6 GB on
-   10,000 shells); bodies are counted on the mesh's connectivity (trimesh's
+3. ``Manifold.decompose()`` is far too slow and memory-hungry for a body count
+   (docs/bench.md); bodies are counted on the mesh's connectivity (trimesh's
    ``body_count``) instead.
 
 The result is verified, not assumed: watertight, consistently wound, one body, no
@@ -36,23 +36,13 @@ import numpy as np
 
 from masonry.blocks import Blocks, concatenate, rotated_web, rotation_z
 from masonry.meshing import merge_vertices
-from masonry.tolerances import Tolerances
+from masonry.tolerances import MIN_CORNER_DET, OVERLAP_REL, Tolerances
 
 log = logging.getLogger(__name__)
 
-OVERLAP_REL = 1e-5
-"""Default growth of every brick, relative to the scene size ``tol.scale`` (the bounding
-box diagonal): 80 micrometres for the CAD-offset section of preset 1 (8 m), 34 for the
-wall. Ten times the cleaning distance ``tol.contact`` (1e-6 of the size), so cleaning
-never undoes an overlap, and small against a brick (unit 0.1 m). The union grows by its
-exposed surface times the overlap: +0.15 to +0.16 % of the volume for the sections of
-presets 1 to 3, +0.04 % for the wall."""
-
 _CLEAN_ROUNDS = 4
-# A vertex lies on exactly three faces of a simple convex block (every box and mitered
-# box). Its three face normals are independent when |det| exceeds this; a corner of
-# nearly parallel faces goes to the halfspace path, which has no conditioning issue.
-_MIN_CORNER_DET = 1e-6
+"""Rounds of merging near vertices and dropping degenerate faces before the body must be
+clean."""
 
 
 class PrintableError(ValueError):
@@ -102,15 +92,31 @@ def grown_blocks(blocks: Blocks, overlap: float, tol: Tolerances | None = None):
         When qhull finds no intersection of a block's offset halfspaces (a block that is
         not convex, or flat).
     """
-    from scipy.spatial import HalfspaceIntersection, QhullError
-
     if tol is None:
         tol = Tolerances.for_points(blocks.vertices)
-    n_vertices = len(blocks.vertices)
-    vertex_count = np.diff(blocks.vertex_offsets)
-    vertex_block = np.repeat(np.arange(blocks.n_blocks), vertex_count)
-    normal = blocks.face_normal
+    points = _three_plane_corners(blocks, overlap)
+    is_simple = _inside_offset_planes(blocks, points, overlap, tol)
+    hulls = {i: _halfspace_corners(blocks, i, overlap) for i in np.flatnonzero(~is_simple)}
 
+    vertex_count = np.diff(blocks.vertex_offsets)
+    grown_count = vertex_count.copy()
+    for i, corners in hulls.items():
+        grown_count[i] = len(corners)
+    offsets = np.concatenate([[0], np.cumsum(grown_count)])
+    out = np.empty((offsets[-1], 3))
+    keep = np.repeat(is_simple, vertex_count)
+    shift = np.repeat(offsets[:-1] - blocks.vertex_offsets[:-1], vertex_count)
+    out[(np.arange(len(blocks.vertices)) + shift)[keep]] = points[keep]
+    for i, corners in hulls.items():
+        out[offsets[i]:offsets[i + 1]] = corners
+    return out, offsets, ~is_simple
+
+
+def _three_plane_corners(blocks: Blocks, overlap: float) -> np.ndarray:
+    """(V, 3) float, metres: every vertex on exactly three faces with independent
+    normals moved onto its three offset planes, ``v + N^-1 (overlap, overlap,
+    overlap)``; NaN for every other vertex."""
+    n_vertices = len(blocks.vertices)
     # faces incident to every vertex, ragged: entries sorted by vertex
     entry_face = np.repeat(np.arange(blocks.n_faces), blocks.face_polygon_count)
     order = np.argsort(blocks.face_vertices, kind="stable")
@@ -118,47 +124,47 @@ def grown_blocks(blocks: Blocks, overlap: float, tol: Tolerances | None = None):
     first = np.cumsum(degree) - degree
     corner = np.flatnonzero(degree == 3)
     corner_faces = entry_face[order[first[corner][:, None] + np.arange(3)]]
-    matrix = normal[corner_faces]  # (C, 3, 3): one face normal per row
-    solvable = np.abs(np.linalg.det(matrix)) > _MIN_CORNER_DET
+    matrix = blocks.face_normal[corner_faces]  # (C, 3, 3): one face normal per row
+    solvable = np.abs(np.linalg.det(matrix)) > MIN_CORNER_DET
     corner = corner[solvable]
     points = np.full((n_vertices, 3), np.nan)
     rhs = np.full((len(corner), 3, 1), float(overlap))
     points[corner] = blocks.vertices[corner] + np.linalg.solve(matrix[solvable], rhs)[..., 0]
+    return points
 
-    # feasibility of every moved vertex against every face plane of its block: one
-    # (face, vertex) pair per face and vertex of the same block
+
+def _inside_offset_planes(blocks: Blocks, points, overlap, tol: Tolerances) -> np.ndarray:
+    """(B,) bool: blocks with faces whose moved vertices ``points`` ((V, 3), NaN where
+    not moved) all lie inside every offset face plane of their block, within
+    ``tol.length``."""
+    # one (face, vertex) pair per face and vertex of the same block
+    vertex_count = np.diff(blocks.vertex_offsets)
     per_face = vertex_count[blocks.face_block]
     pair_face = np.repeat(np.arange(blocks.n_faces), per_face)
     pair_vertex = (np.repeat(blocks.vertex_offsets[blocks.face_block] - np.cumsum(per_face)
                              + per_face, per_face) + np.arange(len(pair_face)))
     excess = (np.einsum("ij,ij->i", points[pair_vertex] - blocks.face_centre[pair_face],
-                        normal[pair_face]) - overlap)
-    bad = ~(excess <= tol.length)  # NaN (a vertex not solved above) counts as bad
+                        blocks.face_normal[pair_face]) - overlap)
+    bad = ~(excess <= tol.length)  # NaN (a vertex not moved) counts as bad
     face_count = np.bincount(blocks.face_block, minlength=blocks.n_blocks)
-    is_simple = (face_count > 0) & (np.bincount(
+    return (face_count > 0) & (np.bincount(
         blocks.face_block[pair_face], bad, minlength=blocks.n_blocks) == 0)
 
-    grown_count = vertex_count.copy()
-    hulls = {}
-    face_start = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks + 1))
-    for i in np.flatnonzero(~is_simple):
-        faces = np.arange(face_start[i], face_start[i + 1])
-        plane = np.column_stack([normal[faces], -(np.einsum(
-            "ij,ij->i", normal[faces], blocks.face_centre[faces]) + overlap)])
-        try:
-            hulls[i] = HalfspaceIntersection(plane, blocks.block_vertex_mean[i]).intersections
-        except QhullError as error:
-            raise PrintableError(f"block {blocks.block_name[i]}: its grown halfspaces have "
-                                 "no intersection (is it convex and solid?)") from error
-        grown_count[i] = len(hulls[i])
-    offsets = np.concatenate([[0], np.cumsum(grown_count)])
-    out = np.empty((offsets[-1], 3))
-    keep = is_simple[vertex_block]
-    shift = np.repeat(offsets[:-1] - blocks.vertex_offsets[:-1], vertex_count)
-    out[(np.arange(n_vertices) + shift)[keep]] = points[keep]
-    for i, corners in hulls.items():
-        out[offsets[i]:offsets[i + 1]] = corners
-    return out, offsets, ~is_simple
+
+def _halfspace_corners(blocks: Blocks, i: int, overlap: float) -> np.ndarray:
+    """(n, 3) float, metres: corners of block ``i``'s offset halfspaces' intersection,
+    from qhull."""
+    from scipy.spatial import HalfspaceIntersection, QhullError
+
+    faces = np.flatnonzero(blocks.face_block == i)
+    normal = blocks.face_normal[faces]
+    plane = np.column_stack([normal, -(np.einsum(
+        "ij,ij->i", normal, blocks.face_centre[faces]) + overlap)])
+    try:
+        return HalfspaceIntersection(plane, blocks.block_vertex_mean[i]).intersections
+    except QhullError as error:
+        raise PrintableError(f"block {blocks.block_name[i]}: its grown halfspaces have "
+                             "no intersection (is it convex and solid?)") from error
 
 
 def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
@@ -211,9 +217,49 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
     """
     import manifold3d
     import trimesh
-    from scipy.spatial import cKDTree
 
     start = time.perf_counter()
+    blocks, overlap, tol = _checked_inputs(blocks, vertices, overlap, tol)
+    points, offsets, by_halfspaces = grown_blocks(blocks, overlap, tol)
+    parts = [manifold3d.Manifold.hull_points(points[lo:hi])
+             for lo, hi in itertools.pairwise(offsets)]
+    flat = [i for i, part in enumerate(parts) if part.is_empty()]
+    if flat:
+        raise PrintableError(f"{len(flat)} blocks have no volume, first "
+                             f"{blocks.block_name[flat[0]]}")
+
+    union_start = time.perf_counter()
+    union = manifold3d.Manifold.batch_boolean(parts, manifold3d.OpType.Add)
+    union_volume = union.volume()  # evaluates the lazy boolean
+    union_time = time.perf_counter() - union_start
+    _require_ok(union, "union")
+
+    body, collapsed = _cleaned(union, tol.contact)
+    mesh_data = body.to_mesh64()
+    mesh = trimesh.Trimesh(np.array(mesh_data.vert_properties)[:, :3],
+                           np.array(mesh_data.tri_verts), process=False)
+    report = _body_report(body, mesh, tol) | {
+        "union_volume_m3": float(union_volume),
+        "blocks_volume_m3": float(blocks.block_volume.sum()),
+        "grown_volume_m3": float(sum(part.volume() for part in parts)),
+        "overlap_m": float(overlap),
+        "halfspace_blocks": int(by_halfspaces.sum()),
+        "collapsed_edges": int(collapsed),
+        "union_time_s": round(union_time, 4),
+        "time_s": round(time.perf_counter() - start, 4),
+    }
+    problems = _failed_checks(report, tol)
+    if problems:
+        raise PrintableError("printable body failed its checks: " + "; ".join(problems),
+                             report)
+    log.info("printable body: %d triangles, %.6g m^3, union %.2f s", report["triangles"],
+             report["volume_m3"], union_time)
+    return mesh, report
+
+
+def _checked_inputs(blocks: Blocks, vertices, overlap, tol):
+    """``(blocks, overlap, tol)`` of :func:`printable_body`'s arguments: ``vertices`` put
+    in ``blocks``, the defaults filled in; raises ValueError on a bad argument."""
     if vertices is not None:
         vertices = np.asarray(vertices, dtype=float)
         if vertices.shape != blocks.vertices.shape:
@@ -228,51 +274,35 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
         raise ValueError(f"overlap must be a finite length >= 0 (metres), not {overlap!r}")
     if blocks.n_blocks == 0:
         raise ValueError("no blocks to unite")
+    return blocks, overlap, tol
 
-    points, offsets, by_halfspaces = grown_blocks(blocks, overlap, tol)
-    parts = [manifold3d.Manifold.hull_points(points[lo:hi])
-             for lo, hi in itertools.pairwise(offsets)]
-    flat = [i for i, part in enumerate(parts) if part.is_empty()]
-    if flat:
-        raise PrintableError(f"{len(flat)} blocks have no volume, first "
-                             f"{blocks.block_name[flat[0]]}")
-    grown_volume = float(sum(part.volume() for part in parts))
 
-    union_start = time.perf_counter()
-    union = manifold3d.Manifold.batch_boolean(parts, manifold3d.OpType.Add)
-    union_volume = union.volume()  # evaluates the lazy boolean
-    union_time = time.perf_counter() - union_start
-    _require_ok(union, "union")
+def _body_report(body, mesh, tol: Tolerances) -> dict:
+    """The measured checks of the cleaned ``body`` (a ``Manifold``) and its ``mesh``
+    (trimesh): see :func:`printable_body`'s ``report``."""
+    from scipy.spatial import cKDTree
 
-    body, collapsed = _cleaned(union, tol.contact)
-    mesh_data = body.to_mesh64()
-    mesh = trimesh.Trimesh(np.array(mesh_data.vert_properties)[:, :3],
-                           np.array(mesh_data.tri_verts), process=False)
     edge_length = mesh.edges_unique_length
-    report = {
+    return {
         "manifold_status": _status_name(body),
         "watertight": bool(mesh.is_watertight),
         "winding_consistent": bool(mesh.is_winding_consistent),
         "bodies": int(mesh.body_count),
         "genus": int(body.genus()),
         "volume_m3": float(body.volume()),
-        "union_volume_m3": float(union_volume),
-        "blocks_volume_m3": float(blocks.block_volume.sum()),
-        "grown_volume_m3": grown_volume,
         "triangles": len(mesh.faces),
         "vertices": len(mesh.vertices),
         "zero_area_faces": int((mesh.area_faces <= 0).sum()),
         "close_vertex_pairs": len(cKDTree(mesh.vertices).query_pairs(
             tol.contact, output_type="ndarray")),
         "min_edge_m": float(edge_length.min()) if len(edge_length) else 0.0,
-        "overlap_m": float(overlap),
-        "halfspace_blocks": int(by_halfspaces.sum()),
         "clean_distance_m": float(tol.contact),
-        "collapsed_edges": int(collapsed),
-        "union_time_s": round(union_time, 4),
-        "time_s": round(time.perf_counter() - start, 4),
     }
-    problems = [
+
+
+def _failed_checks(report: dict, tol: Tolerances) -> list:
+    """One line for every check of a body ``report`` that fails (empty: printable)."""
+    return [
         text for text, failed in (
             (f"manifold3d status {report['manifold_status']}",
              report["manifold_status"] != "NoError"),
@@ -285,12 +315,6 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
              report["close_vertex_pairs"]),
             ("no volume", not report["volume_m3"] > 0),
         ) if failed]
-    if problems:
-        raise PrintableError("printable body failed its checks: " + "; ".join(problems),
-                             report)
-    log.info("printable body: %d triangles, %.6g m^3, union %.2f s", report["triangles"],
-             report["volume_m3"], union_time)
-    return mesh, report
 
 
 def _cleaned(body, distance):

@@ -4,21 +4,187 @@ A run writes into a hidden temporary folder beside its target and swaps it into 
 only when everything is written. A failed or interrupted run removes its temporary folder
 and leaves the previous output exactly as it was. Single files outside a run folder (the
 geometry cache) are written the same way by :func:`write_file_atomically`.
+
+Temporary names carry the host and process id of their writer
+(``.<name>.tmp-<host>-<pid>-<tag>``), so the next run into the same root removes the
+leftovers of a killed run (its process is gone) and never those of a run still going.
+Publishing happens under an exclusive lock on the output root, so two commands writing
+into the same root at once never see a half-swapped folder; a caller may ask to keep the
+folder already there (see :meth:`RunFolder.publish`).
 """
 
 import json
+import logging
 import os
+import re
 import shutil
+import socket
+import tempfile
 import uuid
+from contextlib import contextmanager
 from pathlib import Path
+
+from masonry.params import ParameterError
+
+try:
+    import fcntl
+except ImportError:  # Windows: no advisory locks; publishing stays two renames
+    fcntl = None
+
+log = logging.getLogger(__name__)
+
+_HOST = re.sub(r"[^A-Za-z0-9]", "_", socket.gethostname()) or "host"
+_LEFTOVER = re.compile(r"^\..+\.(tmp|old)-(?P<host>[A-Za-z0-9_]+)-(?P<pid>\d+)-[0-9a-f]{8}$")
+_LEGACY = re.compile(r"^\..+\.(tmp|old)-[0-9a-f]{8}$")  # masonry 0.1: no writer in the name
+
+
+NAME_MAX = 200
+"""Longest folder name accepted in an output root (bytes): file systems allow 255, and
+the run folders' temporary names add up to about 50 to a structure id."""
+
+
+def _tag() -> str:
+    """``<host>-<pid>-<random>``: who writes a temporary file, and a unique suffix."""
+    return f"{_HOST}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
+
+
+def check_output_root(root, option="out") -> Path:
+    """Refuse an output root that cannot hold run folders, before anything is written.
+
+    The root may not exist yet; its nearest existing ancestor must be a folder this
+    process can create entries in (probed with a temporary folder, removed at once).
+
+    Parameters
+    ----------
+    root : str or Path
+        The output root as the user gave it.
+    option : str
+        The parameter named in the error (the front end shows it as typed, ``--out``).
+
+    Returns
+    -------
+    Path
+        ``root``.
+
+    Raises
+    ------
+    ParameterError
+        Named ``option``: the root is empty, is (or lies under) a file, or is not writable.
+    """
+    if str(root).strip() == "":
+        raise ParameterError(option, str(root), "a folder path (an empty one names nothing)")
+    path = Path(root)
+    longest = max((len(os.fsencode(part)) for part in path.parts), default=0)
+    if longest > NAME_MAX:
+        raise ParameterError(option, str(root), f"a folder path whose names are at most "
+                                                f"{NAME_MAX} bytes long (one has {longest})")
+    existing = path
+    while not os.path.lexists(existing) and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        what = "is a file" if existing == path else f"lies under the file {existing}"
+        raise ParameterError(option, str(root), f"a folder, but it {what}")
+    try:
+        os.rmdir(tempfile.mkdtemp(prefix=".masonry-probe-", dir=existing))
+    except OSError as error:
+        raise ParameterError(option, str(root), f"a folder masonry can write in ({existing}: "
+                                                f"{error.strerror or error})") from None
+    return path
+
+
+def remove_leftovers(folder) -> list:
+    """Remove the temporary files and folders that killed runs left in ``folder``.
+
+    Only names of this host whose process no longer exists are removed. A previous folder
+    set aside by a publish that was killed before the new one took its name is put back.
+
+    Parameters
+    ----------
+    folder : str or Path
+        An output root (or the folder of a single file written atomically); a missing
+        or unreadable one holds no leftovers.
+
+    Returns
+    -------
+    list of Path
+        What was removed.
+    """
+    removed = []
+    try:
+        entries = list(Path(folder).iterdir())
+    except OSError:
+        return removed
+    for entry in entries:
+        match = _LEFTOVER.match(entry.name)
+        if match is None:
+            if not _LEGACY.match(entry.name):
+                continue
+        elif match["host"] != _HOST or _alive(int(match["pid"])):
+            continue
+        original = entry.with_name(entry.name[1:].rsplit(".old-", 1)[0])
+        if ".old-" in entry.name and not os.path.lexists(original):
+            # killed between the two renames of a publish: the previous folder goes back
+            os.rename(entry, original)
+            log.warning("restored %s, set aside by a run that was killed", original)
+            continue
+        if entry.is_dir() and not entry.is_symlink():
+            shutil.rmtree(entry, ignore_errors=True)
+        else:
+            entry.unlink(missing_ok=True)
+        removed.append(entry)
+    if removed:
+        log.info("removed %d leftover(s) of interrupted runs in %s", len(removed), folder)
+    return removed
+
+
+def _alive(pid: int) -> bool:
+    if pid == os.getpid() or os.name == "nt":  # Windows' os.kill(pid, 0) would kill it
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process
+        return True
+    return True
+
+
+@contextmanager
+def locked(folder):
+    """Hold an exclusive lock on ``folder`` (an existing directory) for the block (POSIX
+    advisory lock; nothing on systems without one)."""
+    if fcntl is None:
+        yield
+        return
+    fd = os.open(folder, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
 
 
 def write_file_atomically(path, data: bytes):
     """Write ``data`` to ``path`` through a hidden temporary file beside it, renamed into
-    place when complete: a reader sees the old file or the whole new one, never a part."""
+    place when complete: a reader sees the old file or the whole new one, never a part.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write; missing parent folders are created.
+    data : bytes
+        The whole content.
+
+    Raises
+    ------
+    OSError
+        When the file cannot be written; the temporary file is removed and ``path`` is
+        left as it was.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp-{uuid.uuid4().hex[:8]}")
+    remove_leftovers(path.parent)
+    tmp = path.with_name(f".{path.name}.tmp-{_tag()}")
     try:
         with open(tmp, "wb") as f:
             f.write(data)
@@ -31,18 +197,48 @@ class RunFolder:
     """Collects a run's files and publishes them as ``root/name`` in one step.
 
     Use as a context manager: the folder is published when the block ends normally and
-    discarded when it raises (including ``KeyboardInterrupt``).
+    discarded when it raises (including ``KeyboardInterrupt``). Entering it removes the
+    leftovers of killed runs in ``root``.
+
+    Parameters
+    ----------
+    root : str or Path
+        The output root (created on entry when missing).
+    name : str
+        The run folder's name inside ``root`` (the structure id).
+    keep : callable, optional
+        ``keep(target) -> bool``, asked under the root's lock just before publishing: True
+        keeps the folder already at ``target`` and discards this one (it holds at least
+        what this one would write; see :func:`masonry.pipeline.run`).
+
+    Attributes
+    ----------
+    target : Path
+        ``root/name``, where the folder is published.
+    tmp : Path
+        The hidden temporary folder the files are written into until then.
+    kept : bool
+        True when ``keep`` kept the folder already at ``target`` (this one was discarded).
+
+    Examples
+    --------
+    >>> with RunFolder("exports", "wall_L32") as folder:  # doctest: +SKIP
+    ...     folder.write("notes.txt", "text")
+    ...     folder.write_json("run.json", {"complete": True})
     """
 
-    def __init__(self, root, name):
+    def __init__(self, root, name, keep=None):
         self.root = Path(root)
         self.target = self.root / name
-        tag = uuid.uuid4().hex[:8]
+        tag = _tag()
         self.tmp = self.root / f".{name}.tmp-{tag}"
         self._old = self.root / f".{name}.old-{tag}"
+        self._keep = keep
+        self.kept = False
 
     def __enter__(self):
         self.root.mkdir(parents=True, exist_ok=True)
+        remove_leftovers(self.root)
         self.tmp.mkdir()
         return self
 
@@ -54,28 +250,47 @@ class RunFolder:
         return False
 
     def path(self, relative) -> Path:
-        """Where ``relative`` lives in the temporary folder (for writers that need a path)."""
+        """Where ``relative`` (a path inside the run folder, ``/``-separated) lives in the
+        temporary folder, its parent folders created: for writers that need a path."""
         path = self.tmp / relative
         path.parent.mkdir(parents=True, exist_ok=True)
         return path
 
     def write(self, relative, data):
-        """Write bytes or text to ``relative`` inside the run folder."""
-        mode = "wb" if isinstance(data, bytes) else "w"
-        with open(self.path(relative), mode) as f:
-            f.write(data)
+        """Write ``data`` (bytes, or text, written as UTF-8) to ``relative``, a path
+        inside the run folder."""
+        self.path(relative).write_bytes(data if isinstance(data, bytes)
+                                        else data.encode("utf-8"))
 
     def write_json(self, relative, record):
-        """Write ``record`` as indented JSON (numpy scalars and arrays as plain values)."""
+        """Write ``record`` (a dict of JSON values, numpy scalars and arrays) to
+        ``relative`` as indented JSON; numpy values become plain numbers and lists.
+
+        Raises
+        ------
+        TypeError
+            For a value JSON cannot hold (not a number, string, list, dict or numpy
+            value).
+        """
         self.write(relative, json.dumps(record, indent=2, sort_keys=False, default=_jsonable)
                    + "\n")
 
     def publish(self):
-        # two renames: the old folder moves aside, the new one takes its name, then the
-        # old one is removed; at no moment is a half-written folder under the target name
-        if self.target.exists():
-            os.rename(self.target, self._old)
-        os.rename(self.tmp, self.target)
+        """Swap the temporary folder into place as :attr:`target` (called on a normal
+        exit of the ``with`` block), under the root's lock; a previous folder of that name
+        is removed, unless ``keep`` keeps it (then this one is discarded).
+
+        Two renames: the old folder moves aside, the new one takes its name, then the old
+        one is removed; at no moment is a half-written folder under the target name.
+        """
+        with locked(self.root):
+            if self._keep is not None and self.target.is_dir() and self._keep(self.target):
+                shutil.rmtree(self.tmp, ignore_errors=True)
+                self.kept = True
+                return
+            if os.path.lexists(self.target):
+                os.rename(self.target, self._old)
+            os.rename(self.tmp, self.target)
         shutil.rmtree(self._old, ignore_errors=True)
 
 

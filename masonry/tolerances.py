@@ -1,8 +1,13 @@
-"""The one place for tolerances and physical constants.
+"""The one place for tolerances, thresholds and physical constants.
 
 Every length tolerance is relative to the scene's size (the diagonal of its bounding box),
 so a model built with ``unit=0.001`` and one built with ``unit=100`` are treated alike.
 Pass a :class:`Tolerances` explicitly; never hard-code a tolerance in a stage.
+
+The module constants below are thresholds that are not lengths (angles, sines, ratios,
+positions counted in brick units), so they do not scale with the scene; each says which
+stage compares against it. Solver settings live with their solver
+(:mod:`masonry.rbe.solve`, :mod:`masonry.rbe.solvers`).
 """
 
 from dataclasses import dataclass
@@ -11,6 +16,25 @@ import numpy as np
 
 G = 9.81
 """Gravitational acceleration, m/s^2 (SPEC 2)."""
+
+MAX_BRICKS = 50_000
+"""Largest model built without being asked (``--max-bricks``): solving takes about
+:data:`BYTES_PER_BRICK` each, so the default stays within 10 GB."""
+
+BYTES_PER_BRICK = 200e3
+"""Peak memory of a run per brick, accurate preset: 4.2 GiB for the 21,648 bricks of
+preset 1's full dome with ``--p 21`` (docs/bench.md; balanced takes half)."""
+
+UNITS_PER_BRICK = 2.7
+"""Intrados area of a dome section per brick, in square units, for the size estimate
+made before building (:func:`masonry.scenes.estimate_bricks`): 2.0 to 3.3 on the presets
+and their extremes (pattern and fill-in bricks are smaller than regular ones)."""
+
+TENSION_REPORTED_REL = 1e-6
+"""An interface's tension counts as tension in ``RBE/tension_top.csv`` above this fraction
+of the structure's weight; below, it is the solver's tolerance (a feasible structure's
+tensions are of the order of its residual, 1e-5 relative in the balanced preset, spread
+over thousands of interfaces)."""
 
 
 @dataclass(frozen=True)
@@ -62,3 +86,147 @@ class Tolerances:
         points = np.asarray(points, dtype=float).reshape(-1, 3)
         scale = float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
         return cls(scale=scale if scale > 0 else 1.0, **kwargs)
+
+
+# ---------------------------------------------------------------------- inputs
+STRETCH_USUAL_RANGE = (0.2, 5.0)
+"""Dome height over circumradius outside this range is accepted with a warning, logged
+once when such a dome is built (:func:`masonry.scenes.section.build_section`): the
+thesis's structures have 0.8 to 2.0, and beyond the range the dome is unusually flat or
+tall. (:data:`masonry.params.RANGES` holds the range refused outright.)"""
+
+# ---------------------------------------------------------------------- model (dome/)
+UNIT_SLACK = 1e-9
+"""Brick units. Positions along the flattened section (pattern cells, joints, the
+course half widths ``W_k``, piece lengths) that are equal in exact arithmetic are
+compared with this slack: a pattern brick fits a course, a piece is a regular brick
+(4 units), a sequence is empty or shorter than ``min_fill``, a joint repeats the one
+below (:mod:`masonry.dome.pattern`, :mod:`masonry.dome.courses`). Rounding of sums of a
+few dozen units is about 1e-14, and real differences are whole or half units or
+``min_fill``, so any value between those works."""
+
+LEVEL_TOP_REL = 1e-12
+"""A contact point up to ``(1 + LEVEL_TOP_REL) z_max`` still counts as below the cut
+(:func:`masonry.dome.levels.level_table`): a top level that lands on ``z_max`` exactly
+is kept whatever the rounding of the ellipse."""
+
+LEVEL_ANGLE_XTOL = 1e-15
+"""Radians: absolute tolerance of the root finder for the ellipse angle of each contact
+point (:func:`masonry.dome.levels.level_table`; ``brentq``'s ``xtol``, with ``rtol``
+four machine epsilons): contact points exact to rounding."""
+
+# ---------------------------------------------------------------------- blocks
+HORIZONTAL_SIN = 1e-6
+"""A face is horizontal when ``|z x n|`` (the sine of its tilt) is below this; its
+in-plane basis then follows a direction of the face's own
+(:func:`masonry.blocks.tangent_basis`)."""
+
+TIE_REL = 1e-9
+"""Two lengths within this fraction of each other are equal: the first of the longest
+edges of a face is taken (:attr:`masonry.blocks.Blocks.face_longest_edge`), whatever
+the rounding of the edge lengths of a square face."""
+
+# ---------------------------------------------------------------------- imported meshes
+CONVEXITY_REL = 1e-4
+"""A block read from a mesh is convex when its volume falls short of its convex hull's by
+at most this fraction of the hull's (:mod:`masonry.scenes.imported`). Float32 rounding
+(binary STL) of a brick 20 m from the origin moves its corners by about 1e-6 m and its
+volume by about 1e-5 of a 0.2 m brick; a real concavity (an L-shaped block, a notch) is a
+few percent or more. The hull's merged faces must give the hull's volume within the
+same fraction."""
+
+COINCIDENT_ANGLE = 1e-6
+"""Radians. Two triangles around an edge whose half-planes are closer than this lie on
+top of each other: the faces of two blocks in contact, never the two faces of one block's
+edge (no block has a dihedral angle that small; :mod:`masonry.scenes.imported`)."""
+
+COLLINEAR_SIN = 1e-9
+"""A point of a hull face's ring where the ring turns by less than this sine (or turns
+back) lies inside an edge or inside the face and is dropped
+(:mod:`masonry.scenes.imported`)."""
+
+INTERPENETRATION_REL = 1e-3
+"""Two blocks of an imported assembly overlap when they interpenetrate by more than this
+fraction of the smaller one's size (its bounding box diagonal): overlapping solids are
+not a structure (:func:`masonry.scenes.imported.overlapping_pairs`). Less is taken for
+the imprecision of a drawing (the interface detector closes such gaps)."""
+
+PARALLEL_SIN = 1e-9
+"""Two unit edge directions whose cross product is shorter than this (the sine of their
+angle) are parallel: their cross product is no separating axis, and the blocks' face
+normals already test that direction (:func:`masonry.scenes.imported.overlapping_pairs`)."""
+
+GROUND_MARGIN_REL = 0.05
+"""The ground slab that ``masonry analyze --ground`` adds reaches past the footprint of
+the lowest blocks by this fraction of the footprint's larger side on every side, and is
+as thick as that margin (:func:`masonry.scenes.imported.with_ground`)."""
+
+# ---------------------------------------------------------------------- interfaces
+BED_JOINT_ANGLE = float(np.pi / 4)
+"""Radians. A face whose normal is within this angle of its block's course direction
+(``up``) is a bed face: the lower block's face is then the main one, and the interface
+is ``horizontal``, else ``vertical`` (a head joint; :mod:`masonry.interfaces`)."""
+
+# ---------------------------------------------------------------------- equilibrium
+COEFFICIENT_NOISE = 1e-12
+"""Scaled ``A_eq`` coefficients (unit directions, arms per ``L_ref``: of order one) at or
+below this are floating-point noise of exact zeros and are not stored
+(:func:`masonry.rbe.equilibrium.assemble`)."""
+
+# ---------------------------------------------------------------------- printable body
+OVERLAP_REL = 1e-5
+"""Default growth of every brick of the printable body, relative to the scene size
+``Tolerances.scale`` (:func:`masonry.printable.printable_body`): 80 micrometres for the
+CAD-offset section of preset 1 (8 m), 34 for the wall. Ten times the cleaning distance
+``Tolerances.contact`` (1e-6 of the size), so cleaning never undoes an overlap, and small
+against a brick (unit 0.1 m). The union grows by its exposed surface times the overlap:
++0.15 to +0.16 % of the volume for the sections of presets 1 to 3, +0.04 % for the
+wall."""
+
+MIN_CORNER_DET = 1e-6
+"""A vertex lies on exactly three faces of a simple convex block (every box and mitered
+box). Its three unit face normals are independent when the absolute determinant of
+their matrix exceeds this; a corner of nearly parallel faces goes to the halfspace path,
+which has no conditioning issue (:func:`masonry.printable.grown_blocks`)."""
+
+# ---------------------------------------------------------------------- exports
+READBACK_VOLUME_RTOL = 1e-5
+"""The printable body read back from its STL as a slicer would (float32 vertices, merged)
+must keep the union's volume within this fraction
+(:func:`masonry.export.stl.readback_check`). Float32 rounding moves a vertex of an 8 m
+dome by about 5e-7 m; the measured changes are -8.3e-8 (section of preset 1), -3.5e-8
+(preset 3) and -7.8e-8 (the wall)."""
+
+# ---------------------------------------------------------------------- studies
+THICKNESS_BRACKET = (0.01, 0.8)
+"""Default starting ``(infeasible, feasible)`` thickness ratios ``t/R`` of the arch's
+minimum-thickness bisection (:func:`masonry.studies.thickness.minimum_thickness`)."""
+
+THICKNESS_RTOL = 1e-4
+"""Default relative width of the final bracket of the arch's minimum-thickness
+bisection (:func:`masonry.studies.thickness.minimum_thickness`, ``masonry
+arch-thickness --rtol``)."""
+
+THICKNESS_LIMIT_FRACTION = 0.99
+"""The thickest arch the bisection starts from is at most this fraction of the
+thickness at which the shape's intrados vanishes
+(:func:`masonry.studies.thickness.minimum_thickness`)."""
+
+THRUST_SCAN = (1e-3, 0.999, 60)
+"""The thrust-line minimum thickness scans ``t/R`` on a geometric grid of 60 points
+from 1e-3 up to 0.999 of the ratio at which the intrados vanishes, for the first
+thickness a thrust line fits, before refining it by root finding
+(:func:`masonry.studies.thrust_line.thrust_line_minimum_thickness`)."""
+
+THRUST_XTOL = 1e-12
+"""Default absolute tolerance on ``t/R`` of that refinement (Brent's ``xtol``)."""
+
+THRUST_MARGIN_XATOL_REL = 1e-13
+"""Absolute tolerance of the bounded search for the thrust ``H`` that maximises the
+thrust line's margin, relative to the half arch's total weight
+(:func:`masonry.studies.thrust_line.thrust_line_margin`)."""
+
+THRUST_ACTIVE_REL = 1e-7
+"""A joint's intrados or extrados bound is active at the best thrust line when the line
+passes within this fraction of (total weight x R) of it
+(:func:`masonry.studies.thrust_line.thrust_line_margin`)."""

@@ -107,7 +107,7 @@ def test_pointed_arch_minimum_thickness_matches_the_thrust_line():
 
 def test_low_friction_arch_slides_at_its_springings():
     # at the springings the thrust leans H / V = 0.4 from the vertical: more than mu
-    with pytest.raises(ValueError, match="sliding"):
+    with pytest.raises(ValueError, match="voussoirs slide"):
         minimum_thickness(arch_params(mu=0.3))
     with pytest.raises(ValueError, match="no thrust line"):
         thrust_line_minimum_thickness("semicircular", 16, 10.0, mu=0.3)
@@ -131,6 +131,20 @@ def test_run_arch_stands_above_and_falls_below_its_minimum(tmp_path):
             rows = [r for r in csv.DictReader(f) if r["kind"] == "support"]
         assert len(rows) == 2
         assert -sum(float(r["normal_N"]) for r in rows) == pytest.approx(weight, rel=1e-6)
+        # where it fails: nothing when it stands; else the joints in tension, largest
+        # first; no thrust line fits, so some resultant lies outside its joint
+        with open(tmp_path / name / "RBE" / "tension_top.csv") as f:
+            top = list(csv.DictReader(f))
+        with open(tmp_path / name / "RBE" / "forces.csv") as f:
+            forces = {r["id"]: r for r in csv.DictReader(f)}
+        assert (len(top) == 0) is feasible
+        tension = [float(r["tension_N"]) for r in top]
+        assert tension == sorted(tension, reverse=True)
+        for r in top:
+            assert float(forces[r["id"]]["tension_N"]) == float(r["tension_N"])
+            assert r["name_a"] and r["course_a"].isdigit()
+        outside = max(float(r["eccentricity"]) for r in forces.values())
+        assert (outside <= 1 + 1e-6) is feasible
 
 
 def test_arch_thickness_command(capsys):

@@ -52,7 +52,7 @@ def test_dome_section_round_trips_through_bricks_obj(tmp_path, capsys):
     assert a.keys() == b.keys() and len(a) == 273
     for key, row in a.items():
         assert b[key]["kind"] == row["kind"], key
-        for column in ("area_m2", "centre_x", "centre_y", "centre_z", "normal_x",
+        for column in ("area_m2", "centre_x_m", "centre_y_m", "centre_z_m", "normal_x",
                        "normal_y", "normal_z"):
             assert float(b[key][column]) == pytest.approx(float(row[column]), abs=1e-9)
 
@@ -252,3 +252,40 @@ def test_bad_file_on_the_command_line_exits_2_and_writes_nothing(tmp_path, fixtu
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and err[0].startswith("masonry: error: ") and words[0] in err[0]
     assert not out.exists()
+
+
+def test_overlapping_pairs_agree_with_the_intersection_volume():
+    # random boxes, turned and moved: a pair overlaps when manifold3d's intersection of
+    # the two solids has volume; the separating axis test must find exactly those pairs
+    # (pairs whose intersection is a sliver of the threshold's order are not judged)
+    import manifold3d
+
+    from masonry.blocks import Blocks
+    from masonry.scenes.imported import overlapping_pairs
+    from masonry.tolerances import INTERPENETRATION_REL
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(7)
+    unit = np.array([[x, y, z] for z in (0, 1) for y in (0, 1) for x in (0, 1)], float)
+    judged = {True: 0, False: 0}
+    for trial in range(150):
+        sizes = rng.uniform(0.5, 2.0, (2, 3))
+        turns = Rotation.random(2, random_state=rng.integers(1 << 30)).as_matrix()
+        moves = np.array([[0, 0, 0], rng.uniform(-1.5, 2.0, 3)])
+        corners = np.stack([(unit * sizes[k]) @ turns[k].T + moves[k] for k in range(2)])
+        blocks = Blocks.from_hexahedra(corners, block_class=[0, 0])
+        solids = [manifold3d.Manifold.hull_points(c) for c in corners]
+        volume = (solids[0] ^ solids[1]).volume()
+        found = len(overlapping_pairs(blocks)) == 1
+        smaller = min(np.linalg.norm(s) for s in sizes)
+        # the intersection lies in a slab as wide as the overlap along any axis, and its
+        # sections are no larger than smaller^2 (smaller: the smaller box's diagonal), so
+        # volume > INTERPENETRATION_REL * smaller^3 means a penetration deeper than the
+        # threshold
+        if volume > INTERPENETRATION_REL * smaller**3:
+            assert found, (trial, volume)
+            judged[True] += 1
+        elif volume == 0.0:
+            assert not found, trial
+            judged[False] += 1
+    assert judged[True] > 30 and judged[False] > 30, judged

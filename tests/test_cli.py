@@ -47,22 +47,17 @@ def test_bricks_obj_splits_into_one_mesh_per_brick(tmp_path):
     assert volume == pytest.approx(0.64 + 0.1 * 0.2 * 3.2, rel=1e-9)  # bricks + ground
 
 
-@pytest.mark.parametrize("args, name", [
-    (["--n", "2"], "n"),
-    (["--stretch", "0"], "stretch"),
-    (["--stretch", "nan"], "stretch"),
-    (["--r", "-1"], "r"),
-    (["--p", "0"], "p"),
-    (["--cut", "1"], "cut"),
-    (["--cut", "-0.1"], "cut"),
-    (["--unit", "0"], "unit"),
-    (["--min-fill", "0"], "min_fill"),
-    (["--wall-courses", "0", "--scene", "wall"], "wall_courses"),
+@pytest.mark.parametrize("args", [
+    ["--n", "2"], ["--stretch", "0"], ["--stretch", "nan"], ["--r", "-1"], ["--p", "0"],
+    ["--cut", "1"], ["--cut", "-0.1"], ["--unit", "0"], ["--min-fill", "0"],
+    ["--wall-courses", "0", "--scene", "wall"],
 ])
-def test_bad_parameter_gets_one_line_and_writes_nothing(tmp_path, capsys, args, name):
+def test_bad_parameter_gets_one_line_and_writes_nothing(tmp_path, capsys, args):
     assert main(["build", *args, "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and f"{name}=" in err[0] and "expected" in err[0]
+    # the option as typed, then the value
+    assert len(err) == 1 and err[0].startswith(f"masonry: error: {args[0]} {args[1]}: "
+                                               "expected ")
     assert not (tmp_path / "out").exists()
 
 
@@ -90,9 +85,9 @@ def test_failed_run_leaves_previous_output(tmp_path, monkeypatch):
         raise RuntimeError("injected failure")
 
     monkeypatch.setattr("masonry.export.obj.blocks_obj", broken)
-    with pytest.raises(RuntimeError):
-        main(["build", "--preset", "wall", "--no-plots", "--force", "--out", str(tmp_path),
-              "-q"])
+    monkeypatch.setenv("MASONRY_LOG_DIR", str(tmp_path.parent / "logs"))
+    assert main(["build", "--preset", "wall", "--no-plots", "--force", "--out",
+                 str(tmp_path), "-q"]) == 1
     after = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
     assert after == before
     assert [p.name for p in tmp_path.iterdir() if ".tmp-" in p.name] == []  # none left
@@ -106,3 +101,51 @@ def test_cad_offset_moves_bricks_inward(tmp_path):
     moved = scene.cad_vertices() - scene.blocks.vertices
     np.testing.assert_allclose(np.linalg.norm(moved, axis=1), 0.1, rtol=1e-12)
     assert np.all(moved[:, 0] < 0)  # the section faces +x: inward is -x
+    # run.json says which files are moved and by how much
+    from masonry.pipeline import coordinates_record
+
+    record = coordinates_record(scene)
+    assert record["cad_offset_m"] == pytest.approx(0.1, rel=1e-12)
+    assert {"locations.csv", "dome.stl"} <= set(record["moved_inward"])
+    assert {"bricks.obj", "bricks.3dm", "RBE/forces.csv"} <= set(record["model"])
+
+
+def test_print_size_writes_a_3mf_and_rejects_bad_sizes(tmp_path, capsys):
+    assert main(["run", "--preset", "wall", "--fast", "--no-plots", "--print-size", "120",
+                 "--out", str(tmp_path), "-q"]) == 0
+    folder = next(tmp_path.glob("wall_*"))
+    record = json.loads((folder / "run.json").read_text())
+    assert (folder / "dome.3mf").is_file()
+    assert record["printable"]["print"]["readback"]["unit"] == "millimeter"
+    assert max(record["printable"]["print"]["readback"]["extents_mm"]) == pytest.approx(120)
+    for bad in (["--print-size", "-5"], ["--print-size", "1e5"],
+                ["--print-size", "120", "--no-printable"]):
+        assert main(["run", "--preset", "wall", *bad, "--out", str(tmp_path / "bad"),
+                     "-q"]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"masonry: error: --print-size {bad[1]}: expected "), err
+        assert err.count("\n") == 1
+    assert not (tmp_path / "bad").exists()
+
+
+def test_analyze_writes_the_3mf_it_is_asked_for(tmp_path):
+    # two unit cubes stacked, the lower one a support: the 3MF's height is the size asked
+    path = tmp_path / "tower.obj"
+    boxes = [trimesh.creation.box(extents=(1, 1, 1)) for _ in range(2)]
+    for k, box in enumerate(boxes):
+        box.apply_translation((0.5, 0.5, 0.5 + k))
+    lines, offset = [], 0
+    for k, box in enumerate(boxes):
+        lines += [f"o block{k}"] + [f"v {x:g} {y:g} {z:g}" for x, y, z in box.vertices]
+        lines += ["f " + " ".join(str(offset + 1 + i) for i in f) for f in box.faces]
+        offset += len(box.vertices)
+    path.write_text("\n".join(lines) + "\n")
+    assert main(["analyze", str(path), "--support", "block0", "--no-plots",
+                 "--print-size", "50", "--out", str(tmp_path / "out"), "-q"]) == 0
+    (folder,) = run_folders(tmp_path / "out")
+    record = json.loads((folder / "run.json").read_text())
+    assert (folder / "dome.3mf").is_file()
+    extents = record["printable"]["print"]["readback"]["extents_mm"]
+    assert extents[2] == pytest.approx(50, rel=1e-9)
+    # the printable body grows each block by OVERLAP_REL (1e-5) of the scene's size
+    assert extents[:2] == pytest.approx([25, 25], rel=1e-4)

@@ -9,9 +9,10 @@ import pytest
 from conftest import scene_of
 
 from masonry.blocks import BLOCK_CLASSES
-from masonry.export.rhino import blocks_3dm
+from masonry.export.rhino import SUPPORT_LAYER, block_user_text, blocks_3dm
 from masonry.export.vtu import interfaces_vtu
 from masonry.interfaces import INTERFACE_KINDS, Interfaces, detect
+from masonry.rbe.boundary import Model
 
 # binary VTU stores float64 as is
 VTU_RTOL = 1e-12
@@ -60,8 +61,9 @@ def check_vtu_round_trip(interfaces, forces, tmp_path):
     assert sum(len(block.data) for block in mesh.cells) == len(interfaces)
     data = {name: np.concatenate(arrays) for name, arrays in mesh.cell_data.items()}
     row = data["interface"]
-    np.testing.assert_array_equal(np.sort(row), np.arange(len(interfaces)))
-    expected = dict(forces, kind=interfaces.kind, area=interfaces.area,
+    # cells in interface order: the rows of interfaces.csv and forces.csv
+    np.testing.assert_array_equal(row, np.arange(len(interfaces)))
+    expected = dict(forces, kind=interfaces.kind, area_m2=interfaces.area,
                     frame_normal=interfaces.normal, frame_t1=interfaces.t1,
                     frame_t2=interfaces.t2)
     assert set(data) == set(expected) | {"interface"}
@@ -91,12 +93,20 @@ def test_vtu_round_trips_the_interfaces_of_preset_1(tmp_path):
     check_vtu_round_trip(interfaces, random_forces(len(interfaces), seed=1), tmp_path)
 
 
-def test_vtu_names_the_kinds_and_is_binary():
+def test_vtu_names_the_kinds_in_field_data_and_is_binary(tmp_path):
     data = interfaces_vtu(polygon_interfaces(), {})
-    legend = ", ".join(f"{code} {name}" for code, name in enumerate(INTERFACE_KINDS))
-    assert f"<!--masonry interfaces, kind: {legend}-->".encode() in data
+    mesh = read_vtu(data, tmp_path)
+    assert {name: int(value[0]) for name, value in mesh.field_data.items()} == {
+        f"kind_{name}": code for code, name in enumerate(INTERFACE_KINDS)}
     # binary, not compressed (zlib was most of a run's export time)
     assert b'format="binary"' in data and b"compressor" not in data
+
+
+def test_vtu_takes_vector_cell_data(tmp_path):
+    interfaces = polygon_interfaces()
+    shear = np.random.default_rng(2).normal(size=(len(interfaces), 3))
+    mesh = read_vtu(interfaces_vtu(interfaces, {"shear": shear}), tmp_path)
+    np.testing.assert_array_equal(np.concatenate(mesh.cell_data["shear"]), shear)
 
 
 def test_vtu_rejects_bad_forces():
@@ -110,23 +120,61 @@ def test_vtu_rejects_bad_forces():
 
 
 # ---------------------------------------------------------------------- 3dm
-def test_3dm_has_one_named_closed_mesh_per_brick_on_its_class_layer():
+def test_3dm_has_one_named_closed_unwelded_mesh_per_brick_with_user_text():
     rhino3dm = pytest.importorskip("rhino3dm")
     blocks = scene_of("1").blocks
-    model = rhino3dm.File3dm.FromByteArray(blocks_3dm(blocks))
+    model = rhino3dm.File3dm.FromByteArray(blocks_3dm(blocks,
+                                                      user_text=block_user_text(blocks)))
     assert model.Settings.ModelUnitSystem == rhino3dm.UnitSystem.Meters
     layers = [layer.Name for layer in model.Layers]
-    assert layers == [BLOCK_CLASSES[c] for c in np.unique(blocks.block_class)]
+    free = ~blocks.block_is_support
+    assert layers == [BLOCK_CLASSES[c] for c in np.unique(blocks.block_class[free])] + [
+        SUPPORT_LAYER]
     assert len(model.Objects) == blocks.n_blocks
     for i, item in enumerate(model.Objects):
-        assert item.Attributes.Name == blocks.block_name[i]
-        assert layers[item.Attributes.LayerIndex] == BLOCK_CLASSES[blocks.block_class[i]]
+        attributes = item.Attributes
+        assert attributes.Name == blocks.block_name[i]
+        layer = layers[attributes.LayerIndex]
+        assert layer == (BLOCK_CLASSES[blocks.block_class[i]] if free[i] else SUPPORT_LAYER)
+        assert attributes.GetUserString("course") == str(blocks.block_course[i])
+        assert attributes.GetUserString("class") == BLOCK_CLASSES[blocks.block_class[i]]
+        assert attributes.GetUserString("web") == "0"
         mesh = item.Geometry
-        assert mesh.IsClosed
-        assert len(mesh.Faces) == len(blocks.block_faces(i))  # hexahedra: six quads
+        assert mesh.IsClosed and mesh.IsValid
+        faces = blocks.block_faces(i)
+        assert len(mesh.Faces) == len(faces)  # hexahedra: six quads
+        # unwelded: every face has its own four vertices, and their normals are the
+        # face's outward normal (flat shading)
         points = np.array([[p.X, p.Y, p.Z] for p in mesh.Vertices.ToPoint3dArray()])
-        # double-precision vertices: exact
-        np.testing.assert_array_equal(points, blocks.block_vertices(i))
+        normals = np.array([[n.X, n.Y, n.Z] for n in mesh.Normals])
+        assert len(points) == 4 * len(faces)
+        for k, f in enumerate(faces):
+            corners = blocks.face_vertices[blocks.face_offsets[f]:blocks.face_offsets[f + 1]]
+            # double-precision vertices: exact
+            np.testing.assert_array_equal(points[4 * k:4 * k + 4],
+                                          blocks.vertices[corners])
+            np.testing.assert_allclose(normals[4 * k:4 * k + 4],
+                                       np.tile(blocks.face_normal[f], (4, 1)), atol=1e-6)
+
+
+def test_3dm_user_text_carries_each_bricks_largest_forces():
+    """Two interfaces of a three-block stack by hand: block 1 bears on both, so its
+    largest compression is the larger of the two; the ground support on the first."""
+    from test_rbe import stack
+
+    rhino3dm = pytest.importorskip("rhino3dm")
+    blocks, interfaces = stack(2)
+    model = Model(blocks, interfaces)
+    forces = {"compression": np.array([300.0, 120.0]), "tension": np.array([0.0, 2.5])}
+    text = block_user_text(blocks, model, forces)
+    assert text["max_compression_N"].tolist() == ["300", "300", "120"]
+    assert text["max_tension_N"].tolist() == ["0", "2.5", "2.5"]
+    assert text["support"].tolist() == ["yes", "no", "no"]
+    file = rhino3dm.File3dm.FromByteArray(blocks_3dm(blocks, user_text=text))
+    assert [o.Attributes.GetUserString("max_tension_N") for o in file.Objects] == [
+        "0", "2.5", "2.5"]
+    assert [file.Layers[o.Attributes.LayerIndex].Name for o in file.Objects] == [
+        SUPPORT_LAYER, "block", "block"]
 
 
 def test_3dm_without_rhino3dm_names_the_extra(monkeypatch):

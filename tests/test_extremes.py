@@ -122,30 +122,35 @@ def test_the_command_line_reports_a_refused_input_in_one_line(capsys, tmp_path):
                  "-q"])
     captured = capsys.readouterr()
     assert code == 2
-    assert captured.err.count("\n") == 1 and "invalid parameter p=1" in captured.err
+    assert captured.err.count("\n") == 1 and "--p 1" in captured.err
     assert "Traceback" not in captured.err
     assert not any(tmp_path.iterdir())
 
 
-@pytest.mark.parametrize("mu", [0.05, 0.3, 5.0])
+@pytest.mark.parametrize("mu", [0.01, 0.05, 0.3, 5.0, 10.0])  # the ends of RANGES["mu"]
 @pytest.mark.parametrize("boundary", ["free", "cyclic"])
 def test_friction_coefficient_extremes(mu, boundary):
     _, _, result = analyse(mu=mu, boundary=boundary)
-    if mu == 0.05:
-        # almost no friction: the inclined courses slide
+    if mu <= 0.05 or boundary == "free":
+        # almost no friction: the inclined courses slide; a free web overhangs its base
+        # whatever the friction
         assert not result.feasible and result.moi > 0
+    else:
+        # between its neighbours the web stands, with no tension at all
+        assert result.feasible and result.moi_factor <= 1e-9
 
 
-def test_friction_raises_the_measure_of_infeasibility_monotonically():
+def test_friction_lowers_the_measure_of_infeasibility_strictly():
     moi = [analyse(mu=mu, boundary="free")[2].moi_factor for mu in (0.05, 0.3, 1.0, 5.0)]
-    assert all(a >= b for a, b in zip(moi, moi[1:]))
+    assert all(a > b for a, b in zip(moi, moi[1:])), moi
 
 
 def test_density_over_six_decades_only_scales_the_forces():
+    # the ends of RANGES["density"]
     results = {rho: analyse(density=rho, boundary=b)[2]
-               for rho in (2.0, 2.0e3, 2.0e6) for b in ("free",)}
+               for rho in (1.0, 2.0e3, 1.0e7) for b in ("free",)}
     reference = results[2.0e3]
-    for rho in (2.0, 2.0e6):
+    for rho in (1.0, 1.0e7):
         result = results[rho]
         assert result.feasible == reference.feasible
         assert result.moi_factor == pytest.approx(reference.moi_factor, rel=1e-9)

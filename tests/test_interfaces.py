@@ -1,5 +1,6 @@
 """Contact interface detection (SPEC 5, thesis 3.2.4) on boxes built by hand."""
 
+import dataclasses
 import itertools
 
 import numpy as np
@@ -15,6 +16,8 @@ from masonry.interfaces import (
     candidate_pairs,
     detect,
 )
+from masonry.params import from_preset
+from masonry.scenes import build
 from masonry.tolerances import Tolerances
 
 KIND = {name: code for code, name in enumerate(INTERFACE_KINDS)}
@@ -24,9 +27,22 @@ REL = 1e-9  # relative tolerance on areas of exact geometry
 # half + 3 full + half; every brick is 2 thick and 1 high, on a ground slab
 WALL_COURSES = 5
 WALL_FULL = 4
+
+
+def bond_counts(courses, n_full):
+    """Interfaces of a running-bond wall counted from its bond pattern: courses of
+    ``n_full`` full bricks (the first, third, ...) alternate with courses of ``n_full - 1``
+    full bricks and a half brick at each end. Every full brick overlaps two bricks of the
+    next course by half its length (2 n_full bed joints per course transition); a course
+    of m bricks has m - 1 head joints; the first course's bricks stand on the slab."""
+    full, halved = (courses + 1) // 2, courses // 2
+    return {"horizontal": 2 * n_full * (courses - 1),
+            "vertical": full * (n_full - 1) + halved * n_full,
+            "support": n_full, "boundary": 0}
+
+
 # 4 bricks of course 1 stand on the slab; head joints: 3 per 4-brick course (x3) plus
 # 4 per 5-brick course (x2); every one of the 4 course transitions has 8 bed joints
-# (each full brick overlaps two bricks of the next course by half its length)
 WALL_COUNTS = {"horizontal": 4 * 8, "vertical": 3 * 3 + 2 * 4, "support": 4, "boundary": 0}
 
 
@@ -169,12 +185,58 @@ def test_wall_polygons_are_consistent_frames():
         np.testing.assert_allclose(found.centre[k], polygon.mean(axis=0), atol=1e-12)
 
 
-def test_default_tolerances_match_explicit():
-    blocks, _ = running_bond_wall()
-    default = detect(blocks)
-    explicit = detect(blocks, Tolerances.for_points(blocks.vertices))
-    assert np.array_equal(default.pair, explicit.pair)
-    assert np.array_equal(default.area, explicit.area)
+def test_bond_counts_formula_matches_the_hand_count():
+    assert bond_counts(WALL_COURSES, WALL_FULL) == WALL_COUNTS
+
+
+@pytest.mark.parametrize("courses, n_full", [(2, 1), (3, 7), (6, 5)])
+def test_wall_counts_follow_the_bond_pattern(courses, n_full):
+    blocks, _ = running_bond_wall(courses, n_full)
+    assert detect(blocks, Tolerances(scale=4.0 * n_full)).counts() == bond_counts(
+        courses, n_full)
+
+
+def test_wall_preset_counts_follow_its_bond_pattern():
+    """The ``wall`` scene (courses of 4-unit bricks along ``wall_length`` units, half
+    bricks at the ends of every second course) has the interfaces its bond implies."""
+    params = from_preset("wall")
+    scene = build(params)
+    n_full = params.wall_length / 4.0
+    assert n_full == int(n_full)
+    assert (detect(scene.blocks, up=scene.block_up).counts()
+            == bond_counts(params.wall_courses, int(n_full)))
+
+
+@pytest.mark.parametrize("size", [1e-3, 1.0, 1e3])
+def test_default_tolerances_follow_the_scene_size(size):
+    """Without explicit tolerances, detection scales with the model: the wall built in
+    millimetres or kilometres has the hand-counted interfaces and areas, and a gap of
+    1e-8 of the wall's size between courses 2 and 3 is closed, one of 1e-4 is not."""
+    blocks, boxes = running_bond_wall()
+    scaled = dataclasses.replace(blocks, vertices=size * blocks.vertices)
+    found = detect(scaled)
+    assert found.counts() == WALL_COUNTS
+    assert found.area.sum() == pytest.approx(size**2 * hand_area_sum(boxes), rel=REL)
+
+    span = size * np.linalg.norm(np.ptp(blocks.vertices, axis=0))
+    # every vertex of the bricks of courses 3 to 5 (boxes from z = 2 up)
+    lifted = np.repeat(boxes[:, 0, 2] >= 2.0, np.diff(blocks.vertex_offsets))
+    above = lifted[:, None] * np.array([0.0, 0.0, 1.0])
+    closed = dataclasses.replace(blocks, vertices=size * blocks.vertices + 1e-8 * span * above)
+    assert detect(closed).counts() == WALL_COUNTS
+    opened = dataclasses.replace(blocks, vertices=size * blocks.vertices + 1e-4 * span * above)
+    # the 8 bed joints between courses 2 and 3 open
+    assert detect(opened).counts() == WALL_COUNTS | {"horizontal": WALL_COUNTS["horizontal"] - 8}
+
+
+def hand_area_sum(boxes):
+    """Sum of the contact areas of all touching pairs of axis-aligned ``boxes``."""
+    total = 0.0
+    for i, j in itertools.combinations(range(len(boxes)), 2):
+        area, overlap = box_contact_area(boxes[i], boxes[j])
+        if np.sum(overlap == 0.0) == 1 and np.all(overlap >= 0.0):
+            total += area
+    return total
 
 
 # ---------------------------------------------------------------------- invariance
@@ -353,7 +415,9 @@ def test_candidate_pairs_grow_linearly(n_full):
     blocks, _ = running_bond_wall(courses=6, n_full=n_full)
     pairs = candidate_pairs(blocks, Tolerances.for_points(blocks.vertices))
     assert len(pairs) <= 3 * blocks.n_blocks
-    assert len(detect(blocks)) == len(pairs)
+    found = detect(blocks)
+    assert found.counts() == bond_counts(6, n_full)
+    assert len(found) <= len(pairs)
 
 
 # ---------------------------------------------------------------------- polygon clipping

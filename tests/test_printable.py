@@ -10,9 +10,10 @@ import trimesh
 from conftest import scene_of
 
 from masonry.blocks import Blocks
-from masonry.export.stl import obj_body_bytes, readback_check, stl_bytes
-from masonry.printable import OVERLAP_REL, PrintableError, grown_blocks, printable_body
-from masonry.tolerances import Tolerances
+from masonry.export.stl import (STL_RECORD, obj_body_bytes, readback_check, stl_bytes,
+                                stored_normal_errors)
+from masonry.printable import PrintableError, grown_blocks, printable_body
+from masonry.tolerances import OVERLAP_REL, Tolerances
 
 SCENES = ("1", "2", "3", "wall")
 # float32 STL: 24-bit mantissa at coordinates up to 7 m is 5e-7 m, so volumes read back
@@ -122,6 +123,38 @@ def test_stl_read_back_is_printable(name):
     assert back["volume_m3"] == pytest.approx(report["volume_m3"], rel=READBACK_RTOL)
     assert back["triangles"] == report["triangles"]
     assert len(stl) == 84 + 50 * report["triangles"]  # binary STL layout
+    # every stored normal is the unit normal of its float32 facet (what admesh checks)
+    assert back["normal_errors"] == stored_normal_errors(stl) == 0
+
+
+def facets(stl):
+    return np.frombuffer(stl, dtype=STL_RECORD, offset=84)
+
+
+def test_stl_normals_of_a_box_point_outward():
+    box = trimesh.creation.box(extents=(1.0, 2.0, 3.0))
+    packed = facets(stl_bytes(box))
+    # each facet's normal is the axis its centre lies out along
+    centre = packed["vertices"].mean(axis=1)
+    axis = np.argmax(np.abs(centre) / [0.5, 1.0, 1.5], axis=1)
+    expected = np.zeros((len(packed), 3))
+    expected[np.arange(len(packed)), axis] = np.sign(centre[np.arange(len(packed)), axis])
+    np.testing.assert_array_equal(packed["normal"], expected)
+
+
+def test_stl_normal_of_a_sliver_follows_its_float32_vertices():
+    """A facet 3e-7 m thin at 5 m (float32 spacing there: 4.8e-7 m): rounding turns it;
+    the stored normal turns with it, where trimesh stores the float64 normal."""
+    vertices = np.array([[5.0, 5, 5], [5.001, 5 + 3e-7, 5], [5.002, 5, 5 + 2e-7]])
+    sliver = trimesh.Trimesh(vertices, [[0, 1, 2]], process=False)
+    data = stl_bytes(sliver)
+    assert stored_normal_errors(data) == 0
+    v = facets(data)["vertices"][0].astype(float)
+    cross = np.cross(v[1] - v[0], v[2] - v[0])
+    np.testing.assert_allclose(facets(data)["normal"][0], cross / np.linalg.norm(cross),
+                               atol=1e-7)
+    from trimesh.exchange.stl import export_stl
+    assert stored_normal_errors(export_stl(sliver)) == 1
 
 
 @pytest.mark.parametrize("name", SCENES)
@@ -190,3 +223,18 @@ def test_obj_body_round_trips():
     assert back.is_watertight and back.body_count == 1
     # 8 decimals in metres
     assert back.volume == pytest.approx(report["volume_m3"], rel=1e-7)
+
+
+# ---------------------------------------------------------------------- 3MF
+@pytest.mark.parametrize("name, size_mm", [("wall", 150.0), ("1", 180.0)])
+def test_3mf_reads_back_in_millimetres_at_the_print_size(name, size_mm):
+    from masonry.export.threemf import readback_3mf, threemf_bytes
+
+    mesh, report, _, _ = body_of(name)
+    back = readback_3mf(threemf_bytes(mesh, size_mm))
+    assert back["unit"] == "millimeter" and back["objects"] == 1 and back["watertight"]
+    assert max(back["extents_mm"]) == pytest.approx(size_mm, rel=1e-6)
+    scale = size_mm / np.ptp(mesh.vertices, axis=0).max()  # mm per metre
+    np.testing.assert_allclose(back["extents_mm"], np.ptp(mesh.vertices, axis=0) * scale,
+                               rtol=1e-6)
+    assert back["volume_mm3"] == pytest.approx(report["volume_m3"] * scale ** 3, rel=1e-5)

@@ -1,10 +1,11 @@
 """Rigid block equilibrium on the thesis's structures (SPEC 8, thesis 3.3.6)."""
 
 import functools
+import json
 
 import numpy as np
 import pytest
-from conftest import PRESETS, scene_of, support_force
+from conftest import FIXTURES, PRESETS, scene_of, support_force
 
 from masonry.interfaces import INTERFACE_KINDS, detect
 from masonry.rbe.solve import solve_rbe
@@ -66,6 +67,16 @@ def test_free_sections_solve_to_tolerance(preset):
     assert result.friction_violation <= RESIDUAL
     # the free-standing webs overhang their base: infeasible without their neighbours
     assert not result.feasible and result.moi_factor > 0.1
+
+
+@pytest.mark.parametrize("preset", (*PRESETS, "wall"))
+def test_golden_interface_counts_and_moi_factor(preset):
+    """fixtures/golden_model.json (see fixtures/README.md for where the numbers came
+    from): interfaces by kind, and the MoI factor at mu 0.7, friction auto."""
+    golden = json.loads((FIXTURES / "golden_model.json").read_text())[preset]
+    assert model(preset)[1].counts() == golden["interfaces"]
+    assert solved(preset).moi_factor == pytest.approx(golden["moi_factor"], rel=1e-5,
+                                                      abs=1e-9)
 
 
 def test_infeasible_structure_is_reported_infeasible_by_net():

@@ -8,7 +8,11 @@ import numpy as np
 import pytest
 import trimesh
 
-from masonry.params import from_preset
+from masonry.export import EXPORTERS, RunOutputs
+from masonry.params import from_preset, validate
+from masonry.pipeline import Timer, write_exports
+from masonry.rbe.boundary import analysis_model
+from masonry.rbe.solve import RBEProblem
 from masonry.scenes import build
 from masonry_cli.main import main
 
@@ -37,9 +41,58 @@ def test_run_writes_every_output(wall_run):
     assert record["counts"]["interfaces"] == {"horizontal": 144, "vertical": 75,
                                               "support": 8, "boundary": 0}
     assert record["printable"]["readback"]["watertight"]
+    # the record says by how much locations.csv is moved from the model's bricks
+    scene = build(from_preset("wall"))
+    shift = np.linalg.norm(scene.cad_vertices() - scene.blocks.vertices, axis=1)
+    assert record["coordinates"]["cad_offset_m"] == pytest.approx(shift.max(), rel=1e-12)
+    assert "locations.csv" in record["coordinates"]["moved_inward"]
     assert record["printable"]["readback"]["bodies"] == 1
     text = (folder / "RBE/00_objective.txt").read_text()
     assert "feasible" in text and "MoI factor" in text and "friction-net" in text
+
+
+def wall_outputs(plots, printable):
+    """What ``masonry run --preset wall --fast`` makes, built here step by step."""
+    params = validate(from_preset("wall", fast=True))
+    scene = build(params)
+    model = analysis_model(scene)
+    result = RBEProblem(model.blocks, model.interfaces).solve(
+        mu=params.mu, density=params.density, friction=params.friction,
+        solver=params.solver, accuracy=params.solver_accuracy)
+    return RunOutputs(scene, model, result, result.per_interface(), plots=plots,
+                      printable=printable)
+
+
+class RecordingFolder:
+    """Stands in for a RunFolder: keeps what is written."""
+
+    def __init__(self):
+        self.files = {}
+
+    def write(self, relative, data):
+        assert relative not in self.files, f"{relative} written twice"
+        self.files[relative] = data
+
+
+def test_the_run_writes_what_the_registry_makes(wall_run):
+    """The expected files come from the registry's exporters themselves: each one the
+    run wants writes exactly its files, the others none, and the CLI's run folder holds
+    the same files (byte for byte where no time is recorded in them)."""
+    _, folder = wall_run
+    made = wall_outputs(plots=False, printable=False)
+    wanted = [e for e in EXPORTERS if e.wanted(made)]
+    assert {e.stage for e in wanted} == {"exports"}  # plots and the printable body are off
+    expected = {}
+    for exporter in wanted:
+        expected.update(exporter.make(made).files)
+    recorder, record = RecordingFolder(), {}
+    write_exports(recorder, made, record, Timer())
+    assert recorder.files.keys() == expected.keys()
+    for name, data in expected.items():
+        assert (folder / name).is_file(), name
+        if name.endswith((".csv", ".obj", ".vtu")):
+            data = data.encode() if isinstance(data, str) else data
+            assert (folder / name).read_bytes() == data, name
 
 
 def _forces_table(folder):
@@ -56,8 +109,51 @@ def test_interfaces_vtu_round_trips_with_the_forces(wall_run):
     order = np.concatenate(mesh.cell_data["interface"]).astype(int)
     assert sorted(order) == list(range(len(table["compression_N"])))
     for name in ("compression", "tension", "normal", "t1", "t2", "friction"):
-        values = np.concatenate(mesh.cell_data[name])
+        values = np.concatenate(mesh.cell_data[f"{name}_N"])
         np.testing.assert_allclose(values, table[f"{name}_N"][order], rtol=1e-9, atol=1e-9)
+
+
+# every column of interfaces.csv and forces.csv and its pandas type: the same in every run
+INTEGER_COLUMNS = ("id", "block_a", "block_b", "course_a", "course_b", "vertices")
+TEXT_COLUMNS = ("name_a", "name_b", "kind")
+
+
+def test_tables_keep_their_column_types_and_vtu_order(wall_run):
+    """A wall carries no tension: its tension column is all zeros and must still read as
+    floats; forces.csv, interfaces.csv and the VTU cells are in the same order."""
+    pandas = pytest.importorskip("pandas")
+    _, folder = wall_run
+    forces = pandas.read_csv(folder / "RBE/forces.csv")
+    interfaces = pandas.read_csv(folder / "interfaces.csv")
+    assert (forces["tension_N"].abs() < 1e-6 * forces["compression_N"].max()).all()
+    for table in (forces, interfaces):
+        for column, dtype in table.dtypes.items():
+            expected = ("i" if column in INTEGER_COLUMNS else
+                        "O" if column in TEXT_COLUMNS else "f")
+            assert (dtype.kind if expected != "O" else dtype.kind in "OT"
+                    and "O") == expected, (column, dtype)
+    shared = [c for c in interfaces.columns if c != "vertices"]
+    pandas.testing.assert_frame_equal(forces[shared], interfaces[shared])
+    np.testing.assert_array_equal(forces["id"], np.arange(len(forces)))
+    mesh = meshio.read(folder / "RBE/interfaces.vtu")
+    np.testing.assert_array_equal(np.concatenate(mesh.cell_data["interface"]), forces["id"])
+    for name in ("compression_N", "tension_N", "normal_N", "friction_N", "eccentricity",
+                 "torsion_Nm"):
+        np.testing.assert_allclose(np.concatenate(mesh.cell_data[name]), forces[name],
+                                   rtol=1e-11, atol=1e-9)
+    np.testing.assert_allclose(np.concatenate(mesh.cell_data["shear_N"]),
+                               forces[["shear_x_N", "shear_y_N", "shear_z_N"]], rtol=1e-11,
+                               atol=1e-9)
+    # every force column says its unit; the resultant carries the normal force
+    assert all(c.endswith(("_N", "_Nm")) for c in forces.columns if c.startswith(
+        ("compression", "tension", "t1_N", "t2_N", "friction", "shear", "torsion")))
+    shear = forces[["shear_x_N", "shear_y_N", "shear_z_N"]].to_numpy()
+    np.testing.assert_allclose(np.linalg.norm(shear, axis=1), forces["friction_N"],
+                               rtol=1e-9, atol=1e-9)
+    # no tension: every resultant within its joint; none where no force passes
+    e = forces["eccentricity"]
+    assert ((e.dropna() >= 0) & (e.dropna() <= 1 + 1e-9)).all()
+    assert (forces["compression_N"][e.isna()] <= 1e-9 * forces["compression_N"].max()).all()
 
 
 def test_bricks_obj_round_trips(wall_run):
@@ -103,5 +199,5 @@ def test_run_failing_midway_leaves_the_earlier_folder(wall_run, monkeypatch):
 
 def test_invalid_mu_writes_nothing(tmp_path, capsys):
     assert main(["run", "--mu", "-1", "--out", str(tmp_path / "x")]) == 2
-    assert "mu=-1.0" in capsys.readouterr().err
+    assert "--mu -1: expected" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()

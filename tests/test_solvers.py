@@ -11,16 +11,22 @@ import functools
 import numpy as np
 import pytest
 
-from masonry.studies.bench import COLUMNS, bench, frontier_png, table_csv, table_markdown
+import scipy.linalg
+
+from masonry.studies.bench import (COLUMNS, bench, frontier_png, ratios, ratios_markdown,
+                                   table_csv, table_markdown)
 from masonry.rbe.boundary import analysis_model
 from masonry.rbe.equilibrium import assemble
 from masonry.params import ACCURACIES, SOLVERS, ParameterError, Params, from_preset, structure_id
 from masonry.scenes import build
 from masonry.rbe.solve import ACCURACY, RBEProblem, solve_rbe
 from masonry.rbe.solvers import BACKENDS
+from masonry.rbe.solvers import cholesky
 from masonry.rbe.solvers.cholesky import BlockCholesky
-from masonry.rbe.solvers.newton import NewtonSystem, project_pyramid
+from masonry.rbe.solvers.interior import vertex_constraints, vertex_inverse
+from masonry.rbe.solvers.newton import COMPONENTS, NewtonSystem, project_pyramid
 from masonry.rbe.solvers.standard_form import standard_form
+from masonry.tolerances import Tolerances
 from masonry_cli.main import main
 
 
@@ -110,6 +116,66 @@ def test_block_cholesky_solves_and_refuses_indefinite_matrices():
         sym.factor(values)
 
 
+def _dense_factor(factor, n_scalar):
+    """The factor ``L`` of a :class:`BlockFactor` as a dense matrix (factor order)."""
+    low = np.zeros((n_scalar, n_scalar))
+    for (columns, rows), pivot, below in zip(factor.symbolic._solve_slices,
+                                             factor._pivots, factor._below):
+        low[columns, columns] = np.tril(pivot)
+        if below is not None:
+            low[rows, columns] = below
+    return low
+
+
+@pytest.mark.parametrize("small_update, parallel", [(0, False), (10**9, False), (0, True)])
+def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_update, parallel):
+    # the Cholesky factor of an SPD matrix is unique: every entry of the multifrontal
+    # factor (assembly, extend-add of the children's updates, relaxed supernodes) must
+    # equal LAPACK's dense factor of the same permuted matrix; small_update forces every
+    # extend-add through the run-by-run path (0) or the flat-position path (huge);
+    # parallel: subtrees on two threads whatever the size
+    monkeypatch.setattr(cholesky, "SMALL_UPDATE", small_update)
+    monkeypatch.setattr(cholesky, "PARALLEL_FLOPS", 0.0 if parallel else np.inf)
+    rng = np.random.default_rng(7)
+    n, bs = 40, 3
+    # a 2D grid graph with a few long-range edges: fronts with several children
+    grid = [(i, i + 1) for i in range(n - 1) if (i + 1) % 8] + [(i, i + 8) for i in range(n - 8)]
+    edges = np.array(grid + [(0, 37), (5, 30), (12, 39)])
+    sym = BlockCholesky(n, edges, block_size=bs)
+    assert any(len(children) > 1 for children in sym._children)
+    if parallel:
+        threads, top = sym._parallel_schedule()
+        assert len(threads) == 2 and all(threads) and top
+    values = rng.normal(size=(len(sym.lower_rows), bs, bs))
+    dense = np.zeros((bs * n, bs * n))
+    for k, (i, j) in enumerate(zip(sym.lower_rows, sym.lower_cols)):
+        if i == j:
+            values[k] = values[k] @ values[k].T
+        dense[bs * i:bs * i + bs, bs * j:bs * j + bs] = values[k]
+        dense[bs * j:bs * j + bs, bs * i:bs * i + bs] = values[k].T
+    shift = np.abs(dense).sum(axis=1).max()
+    diagonal = sym.block_index(np.arange(n), np.arange(n))
+    values[diagonal] += shift * np.eye(bs)
+    dense += shift * np.eye(bs * n)
+    order = sym._scalar_order
+    expected = scipy.linalg.cholesky(dense[np.ix_(order, order)], lower=True)
+    factor = sym.factor(values)
+    np.testing.assert_allclose(_dense_factor(factor, bs * n), expected, rtol=0,
+                               atol=1e-12 * np.abs(expected).max())
+
+
+@pytest.mark.parametrize("method", ["net", "plus"])
+def test_interior_point_vertex_blocks_are_the_inverse(method):
+    components = COMPONENTS[method]
+    rng = np.random.default_rng(5)
+    G = vertex_constraints(components, 0.6)
+    h = rng.uniform(0.5, 2.0, size=(200, len(components)))
+    w = np.exp(rng.uniform(-6.0, 6.0, size=(200, len(G))))
+    stiffness = h[:, :, None] * np.eye(len(components)) + np.einsum("ki,vk,kj->vij", G, w, G)
+    np.testing.assert_allclose(vertex_inverse(h, w, 0.6, components),
+                               np.linalg.inv(stiffness), rtol=0, atol=1e-12)
+
+
 def test_newton_matrices_equal_the_sparse_products():
     m = small("cyclic")
     system = assemble(m.blocks, m.interfaces, side_block=m.side_block,
@@ -155,10 +221,11 @@ def solved(boundary, solver, accuracy="accurate"):
     return problem(small(boundary)).solve(solver=solver, accuracy=accuracy, lp_check=False)
 
 
-@pytest.mark.parametrize("solver", ["clarabel", "clarabel-cvxpy", "osqp", "osqp-cvxpy",
-                                    "newton"])
+@pytest.mark.parametrize("solver", ["clarabel-cvxpy", "osqp", "osqp-cvxpy", "newton",
+                                    "interior"])
 def test_every_solver_finds_the_same_feasible_optimum(solver):
-    # H is positive definite: the minimiser is unique, every path must find it
+    # H is positive definite: the minimiser is unique, every path must find the one of
+    # Clarabel (an independent interior point implementation)
     reference = solved("cyclic", "clarabel")
     result = solved("cyclic", solver)
     assert result.feasible and result.friction == "net"
@@ -168,17 +235,46 @@ def test_every_solver_finds_the_same_feasible_optimum(solver):
     assert result.objective == pytest.approx(reference.objective, rel=tolerance)
 
 
-@pytest.mark.parametrize("solver", ["clarabel", "clarabel-cvxpy", None])
+@pytest.mark.parametrize("solver", ["interior", "clarabel-cvxpy", None])
 def test_solvers_agree_on_an_infeasible_section(solver):
+    # Clarabel (accurate preset) is the reference for this project's interior point
+    # method, the cvxpy path, and the balanced preset (Newton certificate, then the
+    # interior point method on friction+, polished)
     reference = solved("free", "clarabel")
     result = solved("free", solver, "balanced")
     assert not result.feasible and result.friction == "plus"
+    assert result.verdict == "infeasible"
     # the cvxpy path returns no multipliers, so it is not polished: an interior point
     # at gap 1e-8, whose vertex forces were measured 1.8e-5 of the largest from the optimum
     tolerance = 1e-4 if solver == "clarabel-cvxpy" else 1e-8
     assert result.moi_factor == pytest.approx(reference.moi_factor, rel=tolerance / 10)
     np.testing.assert_allclose(result.x, reference.x, rtol=0,
                                atol=tolerance * scale(reference))
+
+
+@pytest.mark.parametrize("mu", [0.3, 1.5])
+def test_the_fast_path_agrees_with_clarabel_on_infeasible_structures(mu):
+    # the presets' friction+ path (interior point on the Newton system, Newton polish)
+    # against Clarabel: MoI and every vertex force
+    prepared = problem(small("free"))
+    reference = prepared.solve(mu=mu, solver="clarabel", accuracy="accurate", lp_check=False)
+    result = prepared.solve(mu=mu, accuracy="balanced")
+    assert [a["solver"] for a in result.attempts][-2:] == ["interior", "newton-polish"]
+    assert result.verdict == reference.verdict == "infeasible"
+    assert result.moi_factor == pytest.approx(reference.moi_factor, rel=1e-8)
+    np.testing.assert_allclose(result.x, reference.x, rtol=0, atol=1e-8 * scale(reference))
+
+
+def test_verdicts_and_run_json_fields():
+    feasible = solved("cyclic", None, "balanced")
+    assert feasible.verdict == "feasible" and feasible.to_dict()["verdict"] == "feasible"
+    # friction-net alone on an infeasible section: Newton's certificate, no forces
+    certified = problem(small("free")).solve(friction="net", solver="newton")
+    assert certified.x is None and certified.verdict == "infeasible"
+    # a tolerance no point meets: no answer, and no certificate either
+    unsolved = problem(small("cyclic")).solve(friction="net", solver="newton",
+                                              tol=Tolerances(residual=0.0))
+    assert unsolved.x is None and unsolved.verdict == "not solved"
 
 
 def test_direct_and_cvxpy_paths_agree_without_polish():
@@ -276,6 +372,16 @@ def test_bench_rows_tables_and_frontier(tmp_path):
     assert markdown.count("\n") == len(rows) + 2
     assert table_csv(rows).decode().splitlines()[0].split(",") == list(COLUMNS)
     assert frontier_png(rows)[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_infeasible_against_feasible_ratios():
+    rows = [{"preset": "1", "scene": scene, "accuracy": "balanced", "solver": "newton",
+             "total_s": seconds}
+            for scene, seconds in (("section", 0.6), ("cyclic", 0.4), ("dome", 4.0))]
+    (pair,) = ratios(rows)  # no low-mu dome measured: one pair
+    assert (pair["infeasible"], pair["feasible"]) == ("section", "cyclic")
+    assert pair["ratio"] == pytest.approx(1.5)
+    assert "| 1 | balanced | section | cyclic | 0.60 | 0.40 | 1.50 |" in ratios_markdown(rows)
 
 
 def test_bench_command_writes_its_files(tmp_path, capsys):

@@ -17,9 +17,9 @@ import numpy as np
 
 from masonry.blocks import BLOCK_CLASSES
 from masonry.dome.pattern import Pattern
+from masonry.tolerances import UNIT_SLACK
 
 REGULAR = 4.0  # regular brick length, units
-_EPS = 1e-9
 
 REG, PAT, FILL = (BLOCK_CLASSES.index(c) for c in ("regular", "pattern", "fill_in"))
 
@@ -61,9 +61,9 @@ class Layout:
 
 def _split(length, min_fill):
     """Regular count and remainder of a sequence, the remainder >= min_fill or zero."""
-    m = int(np.floor(length / REGULAR + _EPS))
+    m = int(np.floor(length / REGULAR + UNIT_SLACK))
     rem = length - REGULAR * m
-    if rem < _EPS * max(length, 1.0):
+    if rem < UNIT_SLACK * max(length, 1.0):
         return m, 0.0
     if rem < min_fill and m > 0:
         return m - 1, rem + REGULAR
@@ -82,7 +82,7 @@ def _side_candidates(length, min_fill):
     if m >= 1:  # two fill-ins at the ends, one regular brick fewer
         total = rem + REGULAR
         for left in {total / 2, REGULAR / 2, total - REGULAR / 2}:
-            if min(left, total - left) >= min_fill - _EPS:
+            if min(left, total - left) >= min_fill - UNIT_SLACK:
                 out.append([left] + [REGULAR] * (m - 1) + [total - left])
     return out
 
@@ -99,17 +99,17 @@ def _centre_candidates(length, min_fill):
     out = []
     # a joint on the centre line
     side = _half_fill(half, min_fill)
-    if side and min(side) >= min_fill - _EPS:
+    if side and min(side) >= min_fill - UNIT_SLACK:
         out.append(side[::-1] + side)
     # a regular brick across the centre line
-    if half >= REGULAR / 2 - _EPS:
+    if half >= REGULAR / 2 - UNIT_SLACK:
         side = _half_fill(half - REGULAR / 2, min_fill)
-        if not side or min(side) >= min_fill - _EPS:
+        if not side or min(side) >= min_fill - UNIT_SLACK:
             out.append(side[::-1] + [REGULAR] + side)
     # a fill-in across the centre line, regular bricks to both ends
-    j = int(np.floor((length - min_fill) / (2 * REGULAR) + _EPS))
+    j = int(np.floor((length - min_fill) / (2 * REGULAR) + UNIT_SLACK))
     middle = length - 2 * REGULAR * max(j, 0)
-    if j >= 0 and min_fill - _EPS <= middle < REGULAR + min_fill:
+    if j >= 0 and min_fill - UNIT_SLACK <= middle < REGULAR + min_fill:
         out.append([REGULAR] * j + [middle] + [REGULAR] * j)
     return out or [[length]]
 
@@ -119,17 +119,24 @@ def _joints(start, pieces):
 
 
 def _score(joints, below):
-    """(repeated joints, -closest distance, fill-ins): smaller is better."""
+    """(repeated joints, -closest distance) of ``joints`` against the joints ``below``:
+    smaller is better."""
     if len(joints) == 0 or len(below) == 0:
         return 0, 0.0
     d = np.abs(joints[:, None] - below[None, :]).min(axis=1)
-    return int((d < 1 - _EPS).sum()), -float(d.min())
+    return int((d < 1 - UNIT_SLACK).sum()), -float(d.min())
+
+
+def _is_regular(length) -> bool:
+    return abs(length - REGULAR) <= UNIT_SLACK
 
 
 def _choose(candidates, start, below):
+    """The candidate whose joints repeat fewest joints below, then with the fewest
+    fill-ins, then whose joints keep farthest from those below."""
     def key(pieces):
         repeated, closest = _score(_joints(start, pieces), below)
-        fill_ins = sum(abs(x - REGULAR) > _EPS for x in pieces)
+        fill_ins = sum(not _is_regular(x) for x in pieces)
         return repeated, fill_ins, closest
     return min(candidates, key=key)
 
@@ -139,10 +146,83 @@ def _lay(rows, course, start, pieces, miter_first, miter_last) -> list:
     joints between them."""
     edges = start + np.concatenate([[0.0], np.cumsum(pieces)])
     for i, (a, b) in enumerate(zip(edges[:-1], edges[1:])):
-        klass = REG if abs(b - a - REGULAR) < 1e-6 else FILL
+        klass = REG if _is_regular(b - a) else FILL
         rows.append((course, a, b, klass, miter_first and i == 0,
                      miter_last and i == len(pieces) - 1))
     return list(edges[1:-1])
+
+
+def _lay_pattern(rows, pattern: Pattern, cells, half_width, min_fill, miter) -> set:
+    """Append the pattern bricks to ``rows``; return the ``(course, 'left' | 'right')``
+    ends that a pattern brick takes as the mitered end brick.
+
+    The outermost pattern brick on both its courses, within ``min_fill`` of the boundary
+    on its upper course, becomes the mitered end brick of both courses.
+    """
+    n_courses = len(half_width)
+    lo = [c[0] if c else np.inf for c in cells]
+    hi = [c[-1] if c else -np.inf for c in cells]
+    ends = set()
+    for k, s in zip(pattern.course, pattern.s):
+        upper = min(k + 1, n_courses)
+        w = half_width[upper - 1]
+        left = miter and s == lo[k - 1] == lo[upper - 1] and s + w < min_fill - UNIT_SLACK
+        right = (miter and s == hi[k - 1] == hi[upper - 1]
+                 and w - (s + 1) < min_fill - UNIT_SLACK)
+        rows.append((k, float(s), float(s + 1), PAT, left, right))
+        for c in {k, upper}:
+            if left:
+                ends.add((c, "left"))
+            if right:
+                ends.add((c, "right"))
+    return ends
+
+
+def _sequences(course, w, cells, pattern_ends) -> list:
+    """The gaps of one course between its boundaries ``-w, w`` and its pattern cells
+    (left edges ``cells``), as ``(start, end, at_left_boundary, at_right_boundary)``;
+    a boundary gap taken by a mitered pattern brick is left out."""
+    edges = [(-w, True)]
+    for c in sorted(cells):
+        edges += [(float(c), False), (float(c + 1), False)]
+    edges.append((w, True))
+    out = []
+    for (u, u_bound), (v, v_bound) in zip(edges[0::2], edges[1::2]):
+        if ((u_bound and (course, "left") in pattern_ends)
+                or (v_bound and (course, "right") in pattern_ends)):
+            continue  # absorbed by the mitered pattern brick
+        if v - u > UNIT_SLACK:
+            out.append((u, v, u_bound, v_bound))
+    return out
+
+
+def _pieces(candidates, start, length, below, min_fill):
+    """The pieces of a sequence of ``length`` units from ``start``: the best of
+    ``candidates(length, min_fill)`` against the joints ``below``, or one piece shorter
+    than ``min_fill`` (then True) when the sequence is that short."""
+    if length < min_fill - UNIT_SLACK:
+        return [length], True
+    return _choose(candidates(length, min_fill), start, below), False
+
+
+def _fill_course(rows, course, sequences, below, min_fill, miter):
+    """Append the regular and fill-in bricks of one course's ``sequences`` to ``rows``,
+    mirror-symmetric about ``s = 0``; return its sorted joints and the number of fill-ins
+    shorter than ``min_fill`` it could not avoid."""
+    joints, short = [], 0
+    for u, v, u_bound, v_bound in sequences:
+        if v <= UNIT_SLACK:  # left half: fill, then mirror
+            pieces, too_short = _pieces(_side_candidates, u, v - u, below, min_fill)
+            short += 2 * too_short
+            joints += _lay(rows, course, u, pieces, miter and u_bound, miter and v_bound)
+            if u < -UNIT_SLACK or v < -UNIT_SLACK:  # its mirror image on the right
+                joints += _lay(rows, course, -v, pieces[::-1], miter and v_bound,
+                               miter and u_bound)
+        elif u < -UNIT_SLACK:  # the centre sequence
+            pieces, too_short = _pieces(_centre_candidates, u, v - u, below, min_fill)
+            short += too_short
+            joints += _lay(rows, course, u, pieces, miter and u_bound, miter and v_bound)
+    return np.sort(np.array(joints)), short
 
 
 def fill_courses(half_width, pattern: Pattern, min_fill: float = 1.0,
@@ -158,71 +238,33 @@ def fill_courses(half_width, pattern: Pattern, min_fill: float = 1.0,
         Shortest fill-in, units (SPEC 4.4).
     miter : bool
         End bricks are clipped by the corner planes (a dome web); False for a straight wall.
+
+    Returns
+    -------
+    Layout
+        Every brick, sorted by course and position.
     """
     half_width = np.asarray(half_width, dtype=float)
     n_courses = len(half_width)
     rows = []  # (course, s0, s1, class, miter_left, miter_right)
-
-    # pattern bricks: the outermost one on both its courses, within min_fill of the
-    # boundary on its upper course, becomes the mitered end brick of both courses
     cells = pattern.cells(n_courses)
-    lo = [c[0] if c else np.inf for c in cells]
-    hi = [c[-1] if c else -np.inf for c in cells]
-    pattern_end = {}
-    for k, s in zip(pattern.course, pattern.s):
-        upper = min(k + 1, n_courses)
-        w = half_width[upper - 1]
-        left = miter and s == lo[k - 1] == lo[upper - 1] and s + w < min_fill - _EPS
-        right = miter and s == hi[k - 1] == hi[upper - 1] and w - (s + 1) < min_fill - _EPS
-        rows.append((k, float(s), float(s + 1), PAT, left, right))
-        for c in {k, upper}:
-            if left:
-                pattern_end[(c, "left")] = True
-            if right:
-                pattern_end[(c, "right")] = True
-
+    pattern_ends = _lay_pattern(rows, pattern, cells, half_width, min_fill, miter)
     repeated = np.zeros(n_courses, int)
     short = 0
     below = np.zeros(0)
     for k in range(1, n_courses + 1):
-        w = half_width[k - 1]
-        occupied = sorted(cells[k - 1])
-        # sequences between boundaries and pattern cells, as (start, end, at_left, at_right)
-        edges = [(-w, True)]
-        for c in occupied:
-            edges += [(float(c), False), (float(c + 1), False)]
-        edges.append((w, True))
-        seqs = []
-        for (u, u_bound), (v, v_bound) in zip(edges[0::2], edges[1::2]):
-            if (u_bound and pattern_end.get((k, "left"))) or (
-                    v_bound and pattern_end.get((k, "right"))):
-                continue  # absorbed by the mitered pattern brick
-            if v - u > _EPS:
-                seqs.append((u, v, u_bound, v_bound))
-        joints = []
-        for u, v, u_bound, v_bound in seqs:
-            if v <= _EPS:  # left half: fill, then mirror
-                if v - u < min_fill - _EPS:
-                    pieces = [v - u]
-                    short += 2
-                else:
-                    pieces = _choose(_side_candidates(v - u, min_fill), u, below)
-                joints += _lay(rows, k, u, pieces, miter and u_bound, miter and v_bound)
-                if u < -_EPS or v < -_EPS:  # its mirror image on the right
-                    joints += _lay(rows, k, -v, pieces[::-1], miter and v_bound,
-                                   miter and u_bound)
-            elif u < -_EPS:  # the centre sequence
-                if v - u < min_fill - _EPS:
-                    pieces = [v - u]
-                    short += 1
-                else:
-                    pieces = _choose(_centre_candidates(v - u, min_fill), u, below)
-                joints += _lay(rows, k, u, pieces, miter and u_bound, miter and v_bound)
-        joints = np.sort(np.array(joints))
+        sequences = _sequences(k, half_width[k - 1], cells[k - 1], pattern_ends)
+        joints, course_short = _fill_course(rows, k, sequences, below, min_fill, miter)
         repeated[k - 1] = _score(joints, below)[0]
+        short += course_short
         below = joints
+    return _layout(rows, repeated, short)
 
-    rows.sort(key=lambda row: (row[0], row[1]))
+
+def _layout(rows, repeated, short) -> Layout:
+    """The :class:`Layout` of brick ``rows`` ``(course, s0, s1, class, miter_left,
+    miter_right)``, sorted by course and position."""
+    rows = sorted(rows, key=lambda row: (row[0], row[1]))
     arr = list(zip(*rows)) if rows else [[]] * 6
     return Layout(
         course=np.array(arr[0], dtype=int),

@@ -15,6 +15,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from masonry.params import Params
+from masonry.tolerances import LEVEL_ANGLE_XTOL, LEVEL_TOP_REL
 
 
 @dataclass(frozen=True)
@@ -108,7 +109,7 @@ def _next_theta(a, c, theta0, radius):
 
     if gap(np.pi / 2) < 0:
         return None
-    return brentq(gap, theta0, np.pi / 2, xtol=1e-15, rtol=4 * np.finfo(float).eps)
+    return brentq(gap, theta0, np.pi / 2, xtol=LEVEL_ANGLE_XTOL, rtol=4 * np.finfo(float).eps)
 
 
 def _inclination(p0, p1):
@@ -125,7 +126,7 @@ def level_table(params: Params, dims: Dimensions | None = None) -> LevelTable:
     a, c, h = dims.a, dims.c, params.unit
     tan = np.tan(np.pi / params.n)
     thetas = [0.0]
-    z_limit = dims.z_max * (1 + 1e-12)
+    z_limit = dims.z_max * (1 + LEVEL_TOP_REL)
     while True:
         theta0 = thetas[-1]
         theta1 = _next_theta(a, c, theta0, h)

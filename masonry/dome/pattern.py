@@ -19,8 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# slack for comparing positions in units against the section's half widths
-_EPS = 1e-9
+from masonry.tolerances import UNIT_SLACK
 
 
 @dataclass(frozen=True)
@@ -72,7 +71,7 @@ class Pattern:
 
 
 def _fits(s, half_width):
-    return (s >= -half_width - _EPS) & (s + 1 <= half_width + _EPS)
+    return (s >= -half_width - UNIT_SLACK) & (s + 1 <= half_width + UNIT_SLACK)
 
 
 def _conflicts(old, new):
@@ -85,6 +84,36 @@ def _conflicts(old, new):
         crossing = np.sign(old[i] - old[others]) * np.sign(new[i] - new[others]) < 0
         bad[i] = (same | onto_old | crossing).any()
     return bad
+
+
+def _ground_lines(p: int, r: int, w: float):
+    """``(pos, step)``, (n,) int each: first-course cell and direction (+-1) of every
+    diagonal line, starting from the rhombus nodes on the ground, clamped inside the
+    first two courses (half width ``w`` of course 2; the brick spans both)."""
+    y0 = (p + 1) * (r + 1)
+    pos, step = [], []
+    for node in (-y0 + 2 * j * (p + 1) for j in range(r + 2)):
+        if node > -y0:
+            pos.append(node - 1)
+            step.append(-1)
+        if node < y0:
+            pos.append(node)
+            step.append(+1)
+    pos = np.clip(np.array(pos), np.ceil(-w - UNIT_SLACK), np.floor(w + UNIT_SLACK) - 1)
+    return pos.astype(int), np.array(step)
+
+
+def _record_meetings(nodes, near, course, old, step, clash):
+    """Append where two clashing lines of ``course`` met, as ``(course, s)``: adjacent
+    bricks to ``nodes``, bricks one unit apart to ``near``."""
+    order = np.argsort(old)
+    for a, b in zip(order[:-1], order[1:]):
+        if clash[a] and clash[b] and step[a] > 0 > step[b]:
+            gap = old[b] - old[a] - 1
+            if gap == 0:
+                nodes.append((course, old[b]))
+            elif gap == 1:
+                near.append((course, old[a] + 1))
 
 
 def build_pattern(half_width, p: int, r: int) -> Pattern:
@@ -109,20 +138,7 @@ def build_pattern(half_width, p: int, r: int) -> Pattern:
     if n_courses < 2:
         return Pattern(np.zeros(0, int), np.zeros(0, int), np.zeros(0, int),
                        empty, empty, empty, empty)
-    y0 = (p + 1) * (r + 1)
-    nodes_ground = [-y0 + 2 * j * (p + 1) for j in range(r + 2)]
-    pos, step = [], []
-    for node in nodes_ground:
-        if node > -y0:
-            pos.append(node - 1)
-            step.append(-1)
-        if node < y0:
-            pos.append(node)
-            step.append(+1)
-    pos, step = np.array(pos), np.array(step)
-    # clamp the corner lines inside the first two courses (the brick spans both)
-    w = half_width[1]
-    pos = np.clip(pos, np.ceil(-w - _EPS), np.floor(w + _EPS) - 1).astype(int)
+    pos, step = _ground_lines(p, r, half_width[1])
     alive = np.ones(len(pos), bool)
 
     course, s, line = [], [], []
@@ -145,15 +161,7 @@ def build_pattern(half_width, p: int, r: int) -> Pattern:
         for i in np.flatnonzero(turn):
             bounces.append((k - 1, old[i]))
         clash = _conflicts(old, new) & ~turn
-        # record where two lines met: adjacent bricks (a node) or one unit apart
-        order = np.argsort(old)
-        for a, b in zip(order[:-1], order[1:]):
-            if clash[a] and clash[b] and step[idx[a]] > 0 > step[idx[b]]:
-                gap = old[b] - old[a] - 1
-                if gap == 0:
-                    nodes.append((k - 1, old[b]))
-                elif gap == 1:
-                    near.append((k - 1, old[a] + 1))
+        _record_meetings(nodes, near, k - 1, old, step[idx], clash)
         turn |= clash
         new[turn] = old[turn] - step[idx][turn]
         step[idx[turn]] *= -1

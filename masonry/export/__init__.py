@@ -6,13 +6,19 @@ writes them. An exporter may also return a record for ``run.json`` (the printabl
 checks). A new format is a module and one :class:`Exporter` row in :data:`EXPORTERS`.
 """
 
+import functools
 import logging
+from functools import cache
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from masonry import plots
-from masonry.export import csv, obj, rhino, stl, summaries, vtu
+from masonry.export import csv, obj, rhino, stl, summaries, threemf, vtu
 from masonry.printable import printable_blocks, printable_body
+from masonry.rbe.equilibrium import VariableLayout
+from masonry.rbe.resultants import interface_resultants
 
 log = logging.getLogger(__name__)
 
@@ -85,20 +91,74 @@ def _model_files(made: RunOutputs) -> Export:
     })
 
 
+@cache
+def _say_rhino_missing():
+    """Once per process (a sweep runs many variants in one)."""
+    log.info("bricks.3dm skipped: pip install 'masonry[rhino]' to write it")
+
+
 def _rhino_files(made: RunOutputs) -> Export:
     if not rhino.available():
-        log.info("bricks.3dm skipped: pip install 'masonry[rhino]' to write it")
+        _say_rhino_missing()
         return Export({})
-    return Export({"bricks.3dm": rhino.blocks_3dm(made.scene.blocks)})
+    blocks = made.scene.blocks
+    text = rhino.block_user_text(blocks, made.model, made.forces)
+    return Export({"bricks.3dm": rhino.blocks_3dm(blocks, user_text=text)})
+
+
+@functools.lru_cache(maxsize=1)
+def _resultants(made: RunOutputs) -> dict:
+    """The interface resultants of a run with forces, computed once for all exporters."""
+    return interface_resultants(made.model.interfaces, made.result.layout, made.result.x)
+
+
+def force_tables(blocks, interfaces, result, forces: dict, resultants=None,
+                 folder="RBE", flags=None, weight_N=None) -> dict:
+    """The per-interface files of a solve: ``RBE/forces.csv``, ``RBE/tension_top.csv``
+    and ``RBE/interfaces.vtu`` (path -> bytes), as a run writes them; the collapse load
+    factor's forces at collapse go through it too (``folder="collapse"``).
+
+    Parameters
+    ----------
+    blocks, interfaces : the analysed model's
+    result : masonry.rbe.solve.RBEResult or masonry.rbe.collapse.CollapseResult
+        With a solution (``x``) in the layout of ``interfaces``.
+    forces : dict str -> (K,) float, N
+        ``result.per_interface()`` (a collapse result's ``forces``).
+    resultants : dict, optional
+        :func:`~masonry.rbe.resultants.interface_resultants`, computed when None.
+    folder : str
+        The folder of the files in the run folder.
+    flags : dict str -> (K,) bool, optional
+        More cell data for the VTU (the collapse mechanism's ``opens``, ``slides``,
+        ``hinge``; written as 0/1).
+    weight_N : float, optional, N
+        The reference weight of ``tension_top.csv``; None: ``result.weight_N``.
+    """
+    if resultants is None:
+        resultants = interface_resultants(
+            interfaces, VariableLayout.from_interfaces(interfaces), result.x)
+    top = csv.tension_top(forces, result.weight_N if weight_N is None else weight_N)
+    files = {f"{folder}/forces.csv": csv.forces_csv(blocks, interfaces, forces, resultants),
+             f"{folder}/tension_top.csv": csv.tension_top_csv(blocks, interfaces, forces,
+                                                              resultants, top)}
+    if len(interfaces):
+        # named as the columns of forces.csv, units included
+        cell_data = {**{f"{name}_N": value for name, value in forces.items()},
+                     "shear_N": resultants["shear"], "point_m": resultants["point"],
+                     "eccentricity": resultants["eccentricity"],
+                     "torsion_Nm": resultants["torsion"],
+                     **{name: np.asarray(value, dtype=float)
+                        for name, value in (flags or {}).items()}}
+        files[f"{folder}/interfaces.vtu"] = vtu.interfaces_vtu(interfaces, cell_data)
+    return files
 
 
 def _rbe_files(made: RunOutputs) -> Export:
     files = {"RBE/00_objective.txt": summaries.objective_text(made.result)}
     if made.forces is not None:
-        blocks, interfaces = made.model.blocks, made.model.interfaces
-        files["RBE/forces.csv"] = csv.forces_csv(blocks, interfaces, made.forces)
-        if len(interfaces):
-            files["RBE/interfaces.vtu"] = vtu.interfaces_vtu(interfaces, made.forces)
+        files.update(force_tables(made.model.blocks, made.model.interfaces, made.result,
+                                  made.forces, _resultants(made)))
     return Export(files)
 
 
@@ -109,11 +169,10 @@ def _collapse_files(made: RunOutputs) -> Export:
         files["collapse/azimuths.csv"] = csv.azimuths_csv(result.azimuths)
     if result.forces is not None and result.load_factor is not None:
         blocks, interfaces = made.model.blocks, made.model.interfaces
-        files["collapse/forces.csv"] = csv.forces_csv(blocks, interfaces, result.forces)
-        flags = {name: getattr(result, name).astype(float)
-                 for name in ("opens", "slides", "hinge")}
-        files["collapse/interfaces.vtu"] = vtu.interfaces_vtu(
-            interfaces, {**result.forces, **flags})
+        flags = {name: getattr(result, name) for name in ("opens", "slides", "hinge")}
+        files.update(force_tables(blocks, interfaces, result, result.forces,
+                                  folder="collapse", flags=flags,
+                                  weight_N=made.result.weight_N))
         files["collapse/mechanism.csv"] = csv.mechanism_csv(blocks, result.mechanism)
         files["collapse/mechanism.vtu"] = vtu.mechanism_vtu(blocks, result.mechanism)
     return Export(files)
@@ -122,8 +181,26 @@ def _collapse_files(made: RunOutputs) -> Export:
 def _printable_files(made: RunOutputs) -> Export:
     body, report = printable_body(*printable_blocks(made.scene))
     data = stl.stl_bytes(body)
-    report["readback"] = stl.readback_check(data, report["volume_m3"], rtol=1e-5)
-    return Export({"dome.stl": data, "dome.obj": stl.obj_body_bytes(body)}, report)
+    report["readback"] = stl.readback_check(data, report["volume_m3"])
+    files = {"dome.stl": data, "dome.obj": stl.obj_body_bytes(body)}
+    size = made.scene.params.print_size
+    if size is not None:
+        files["dome.3mf"] = threemf.threemf_bytes(body, size)
+        report["print"] = {"size_mm": size, "mm_per_m": threemf.print_scale(body, size),
+                           "readback": threemf.readback_3mf(files["dome.3mf"])}
+    return Export(files, report)
+
+
+def _mechanism_plots(made: RunOutputs) -> dict:
+    collapse, model = made.collapse, made.model
+    if collapse is None or collapse.mechanism is None or not collapse.load_factor:
+        return {}
+    title = (f"collapse mechanism: lambda = {collapse.load_factor:.4g}, "
+             f"{collapse.live.description['kind']} load"
+             + ("" if collapse.azimuth_deg is None else f" at {collapse.azimuth_deg:g} deg"))
+    return plots.mechanism_pngs(made.scene, model.blocks, model.interfaces,
+                                collapse.mechanism, collapse.hinge, collapse.slides, title,
+                                made.scene.params.fast)
 
 
 def _plot_files(made: RunOutputs) -> Export:
@@ -132,19 +209,20 @@ def _plot_files(made: RunOutputs) -> Export:
     if scene.layout is not None:
         files["00_pattern.png"] = plots.pattern_png(scene, fast)
     files.update(plots.structure_pngs(scene, fast))
-    files.update(plots.interface_pngs(model.blocks, model.interfaces, fast))
-    if made.forces is not None:
-        pngs = plots.force_pngs(model.blocks, model.interfaces, made.forces, fast)
-        files.update({f"RBE/{name}": png for name, png in pngs.items()})
-    collapse = made.collapse
-    if collapse is not None and collapse.mechanism is not None and collapse.load_factor:
-        title = (f"collapse mechanism: lambda = {collapse.load_factor:.4g}, "
-                 f"{collapse.live.description['kind']} load"
-                 + ("" if collapse.azimuth_deg is None
-                    else f" at {collapse.azimuth_deg:g} deg"))
-        files.update(plots.mechanism_pngs(model.blocks, model.interfaces,
-                                          collapse.mechanism, collapse.hinge,
-                                          collapse.slides, title, fast))
+    files.update(plots.interface_pngs(scene, model.blocks, model.interfaces, fast))
+    files.update(_mechanism_plots(made))
+    if made.forces is None:
+        return Export(files)
+    pngs = plots.force_pngs(scene, model.blocks, model.interfaces, made.forces, fast)
+    files.update({f"RBE/{name}": png for name, png in pngs.items()})
+    if scene.params.scene in ("arch", "section", "dome"):
+        png = plots.thrust_line_png(scene, model.interfaces, _resultants(made), fast)
+        if png is not None:
+            files["RBE/thrust_line.png"] = png
+    top = csv.tension_top(made.forces, made.result.weight_N)
+    if len(top):
+        files["RBE/where_it_fails.png"] = plots.failure_png(
+            scene, model.blocks, model.interfaces, top, made.forces, fast)
     return Export(files)
 
 

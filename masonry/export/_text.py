@@ -4,7 +4,8 @@ import numpy as np
 
 FLOAT_FORMAT = "%.12g"
 """How the text exporters print a float: 12 significant digits, what ``f"{x:.12g}"``
-prints."""
+prints, with ``.0`` added to a whole number (``0.0``, not ``0``) so that a column of floats
+reads as floats whatever its values (pandas, spreadsheets)."""
 
 
 def format_floats(values) -> np.ndarray:
@@ -30,4 +31,5 @@ def format_floats(values) -> np.ndarray:
     distinct = bits.view(np.float64).tolist()
     # one % over a long format string: twice as fast as a % per value
     text = ((FLOAT_FORMAT + "\n") * len(distinct) % tuple(distinct)).split("\n")[:-1]
+    text = [t if any(c in t for c in ".en") else t + ".0" for t in text]  # e, nan, inf
     return np.array(text, dtype=object)[inverse].reshape(values.shape)

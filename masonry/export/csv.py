@@ -4,6 +4,10 @@ import numpy as np
 
 from masonry.blocks import BLOCK_CLASSES, Blocks
 from masonry.export._text import format_floats
+from masonry.tolerances import TENSION_REPORTED_REL
+
+TENSION_TOP_COUNT = 20
+"""Rows of ``RBE/tension_top.csv``: the interfaces with the largest tension."""
 
 
 def _table(columns) -> bytes:
@@ -17,8 +21,7 @@ def _table(columns) -> bytes:
 
     Notes
     -----
-    Columns are printed whole and joined once: formatting row by row in Python took
-    about 1 s for the dome of preset 1 (17,728 interfaces, 50,624 vertices).
+    Columns are printed whole and joined once, not row by row in Python (docs/bench.md).
     """
     names, texts = [], []
     for name, value in columns:
@@ -49,6 +52,12 @@ def locations_csv(blocks: Blocks, vertices=None) -> bytes:
                    ("y", y), ("z", z)])
 
 
+def _xyz(name, values, unit=""):
+    """Three columns ``name_x``, ``name_y``, ``name_z`` (with ``_unit`` if given)."""
+    suffix = f"_{unit}" if unit else ""
+    return [(f"{name}_{axis}{suffix}", v) for axis, v in zip("xyz", np.asarray(values).T)]
+
+
 def _interface_columns(blocks: Blocks, interfaces) -> list:
     from masonry.interfaces import INTERFACE_KINDS
 
@@ -56,25 +65,82 @@ def _interface_columns(blocks: Blocks, interfaces) -> list:
     kind = np.array(INTERFACE_KINDS, dtype=object)[interfaces.kind]
     return [("id", np.arange(len(interfaces))), ("block_a", a), ("block_b", b),
             ("name_a", blocks.block_name[a]), ("name_b", blocks.block_name[b]),
+            ("course_a", blocks.block_course[a]), ("course_b", blocks.block_course[b]),
             ("kind", kind), ("area_m2", interfaces.area),
-            *((f"centre_{axis}", v) for axis, v in zip("xyz", interfaces.centre.T)),
-            *((f"normal_{axis}", v) for axis, v in zip("xyz", interfaces.normal.T))]
+            *_xyz("centre", interfaces.centre, "m"), *_xyz("normal", interfaces.normal),
+            *_xyz("t1", interfaces.t1), *_xyz("t2", interfaces.t2)]
 
 
 def interfaces_csv(blocks: Blocks, interfaces) -> bytes:
-    """``interfaces.csv``: one row per interface (SPEC 5): blocks (main first), kind,
-    area, centre, normal (from the main block into the other), vertex count."""
+    """``interfaces.csv``: one row per interface (SPEC 5), in id order: blocks (main
+    first), their names and courses, kind, area, centre, the frame (unit normal from the
+    main block into the other, t1, t2), vertex count. README "Columns" names each one."""
     return _table(_interface_columns(blocks, interfaces)
                   + [("vertices", interfaces.vertex_count)])
 
 
-def forces_csv(blocks: Blocks, interfaces, forces: dict) -> bytes:
-    """``RBE/forces.csv``: one row per interface (SPEC 7): blocks, kind, area, centre,
-    normal and the interface's resultants in newtons (compression, tension, normal force
-    = tension - compression, t1, t2, friction)."""
-    names = ("compression", "tension", "normal", "t1", "t2", "friction")
+FORCE_SUMS = ("compression", "tension", "normal", "t1", "t2", "friction")
+"""The per-interface sums of :func:`masonry.rbe.solve.interface_forces`, in column order."""
+
+
+def forces_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict) -> bytes:
+    """``RBE/forces.csv``: one row per interface (SPEC 7), in id order (the rows of
+    ``interfaces.csv`` and the cells of ``RBE/interfaces.vtu``).
+
+    Parameters
+    ----------
+    forces : dict str -> (K,) float, N
+        The sums over each interface's vertices (:data:`FORCE_SUMS`).
+    resultants : dict
+        :func:`masonry.rbe.resultants.interface_resultants`: the shear vector (N), the
+        point of application (m), its eccentricity (1) and the torsion about the normal
+        there (N m).
+
+    Notes
+    -----
+    Forces act on the other block ``block_b``; ``block_a`` receives their opposite.
+    README "Columns" names each column with its unit and sign.
+    """
     return _table(_interface_columns(blocks, interfaces)
-                  + [(f"{n}_N", np.asarray(forces[n], dtype=float)) for n in names])
+                  + [(f"{n}_N", np.asarray(forces[n], dtype=float)) for n in FORCE_SUMS]
+                  + _xyz("shear", resultants["shear"], "N")
+                  + _xyz("point", resultants["point"], "m")
+                  + [("eccentricity", resultants["eccentricity"]),
+                     ("torsion_Nm", resultants["torsion"])])
+
+
+def tension_top(forces: dict, weight_N: float, count=TENSION_TOP_COUNT) -> np.ndarray:
+    """Interfaces with the largest tension, largest first: at most ``count``, each above
+    :data:`~masonry.tolerances.TENSION_REPORTED_REL` of ``weight_N``.
+
+    Returns
+    -------
+    (m,) int
+        Interface ids, ``m <= count`` (none for a feasible structure).
+    """
+    tension = np.asarray(forces["tension"], dtype=float)
+    order = np.argsort(-tension, kind="stable")[:count]
+    return order[tension[order] > TENSION_REPORTED_REL * weight_N]
+
+
+def tension_top_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict,
+                    top) -> bytes:
+    """``RBE/tension_top.csv``: where the structure fails, one row per interface of
+    ``top`` (:func:`tension_top`): rank, the interface's columns of ``forces.csv``
+    (blocks, their names and courses, kind, centre), its tension, compression, normal
+    force and eccentricity. Only the header when nothing is in tension."""
+    from masonry.interfaces import INTERFACE_KINDS
+
+    top = np.asarray(top, dtype=np.int64)
+    a, b = interfaces.pair[top, 0], interfaces.pair[top, 1]
+    return _table([("rank", np.arange(1, len(top) + 1)), ("id", top),
+                   ("name_a", blocks.block_name[a]), ("name_b", blocks.block_name[b]),
+                   ("course_a", blocks.block_course[a]), ("course_b", blocks.block_course[b]),
+                   ("kind", np.array(INTERFACE_KINDS, dtype=object)[interfaces.kind[top]]),
+                   *((f"{n}_N", np.asarray(forces[n], dtype=float)[top])
+                     for n in ("tension", "compression", "normal")),
+                   ("eccentricity", resultants["eccentricity"][top]),
+                   *_xyz("centre", interfaces.centre[top], "m")])
 
 
 def mechanism_csv(blocks: Blocks, mechanism) -> bytes:

@@ -1,8 +1,14 @@
-"""Rhino 3DM of blocks: one named mesh object per block, on a layer per block class
-(optional extra ``rhino``: rhino3dm).
+"""Rhino 3DM of blocks: one named, closed, unwelded mesh per block, on a layer per block
+class and a ``supports`` layer, with user text (optional extra ``rhino``: rhino3dm).
 
 Names are the OBJ object names (``blocks.block_name``); layers are the
-:data:`~masonry.blocks.BLOCK_CLASSES` present in the scene. Units are metres.
+:data:`~masonry.blocks.BLOCK_CLASSES` of the free blocks and :data:`SUPPORT_LAYER` for the
+fixed ones. Units are metres, in model coordinates (not moved by ``cad_offset``).
+
+Each face has its own vertices (an unwelded mesh), so its vertex normals are the face's
+normal and a brick shades flat; a welded mesh averages the normals at the corners and
+shades as if rounded. rhino3dm 8 can make a Brep from a mesh, but its edges carry no
+tolerance (``IsValid`` is False), which Rhino reports as a bad object.
 """
 
 import os
@@ -15,6 +21,8 @@ from masonry.blocks import BLOCK_CLASSES, Blocks
 # layer colours (RGBA), one per block class, in BLOCK_CLASSES order
 _LAYER_COLOURS = ((128, 128, 128, 255), (200, 120, 80, 255), (200, 40, 40, 255),
                   (80, 120, 200, 255), (120, 180, 90, 255))
+SUPPORT_LAYER = "supports"
+_SUPPORT_COLOUR = (60, 60, 60, 255)
 
 
 def available() -> bool:
@@ -26,8 +34,43 @@ def available() -> bool:
     return True
 
 
-def blocks_3dm(blocks: Blocks, vertices=None) -> bytes:
-    """3DM bytes (Rhino 8 file format) with one closed mesh per block.
+def block_user_text(blocks: Blocks, model=None, forces=None) -> dict:
+    """Per-block user text for :func:`blocks_3dm`: ``class``, ``course``, ``web``,
+    ``support``, and with forces ``max_compression_N`` and ``max_tension_N``, the largest
+    compression and tension sum of any interface the block bears on.
+
+    Parameters
+    ----------
+    blocks : Blocks
+        ``B`` blocks: the scene's.
+    model : masonry.rbe.boundary.Model, optional
+        Its blocks start with ``blocks``; interface sides routed elsewhere
+        (``side_block``, cyclic symmetry) count for the block they act on.
+    forces : dict str -> (K,) float, N, optional
+        ``compression`` and ``tension`` per interface of ``model``.
+
+    Returns
+    -------
+    dict str -> (B,) str
+    """
+    text = {"class": np.array(BLOCK_CLASSES, dtype=object)[blocks.block_class],
+            "course": blocks.block_course.astype(str),
+            "web": blocks.block_web.astype(str),
+            "support": np.where(blocks.block_is_support, "yes", "no")}
+    if model is None or forces is None:
+        return text
+    sides = model.interfaces.pair if model.side_block is None else model.side_block
+    for name in ("compression", "tension"):
+        largest = np.zeros(model.blocks.n_blocks)
+        value = np.asarray(forces[name], dtype=float)
+        for side in (0, 1):
+            np.maximum.at(largest, sides[:, side], value)
+        text[f"max_{name}_N"] = np.array([f"{v:.6g}" for v in largest[:blocks.n_blocks]])
+    return text
+
+
+def blocks_3dm(blocks: Blocks, vertices=None, user_text=None) -> bytes:
+    """3DM bytes (Rhino 8 file format) with one closed, unwelded mesh per block.
 
     Faces of 3 and 4 vertices become mesh triangles and quads; larger faces are fanned
     from their first vertex (Rhino meshes have no n-gon faces). Vertices are stored in
@@ -38,6 +81,8 @@ def blocks_3dm(blocks: Blocks, vertices=None) -> bytes:
     blocks : Blocks
     vertices : (V, 3) float, metres, optional
         Positions to write instead of ``blocks.vertices`` (e.g. the CAD-offset ones).
+    user_text : dict str -> (B,) str, optional
+        Per-block user text (Rhino: Properties > Attribute User Text), key -> values.
 
     Raises
     ------
@@ -51,33 +96,27 @@ def blocks_3dm(blocks: Blocks, vertices=None) -> bytes:
                           "(or pip install rhino3dm)") from error
 
     vertices = blocks.vertices if vertices is None else np.asarray(vertices, dtype=float)
+    user_text = {} if user_text is None else user_text
     model = rhino3dm.File3dm()
     model.Settings.ModelUnitSystem = rhino3dm.UnitSystem.Meters
+    free = ~blocks.block_is_support
     layer = {code: model.Layers.AddLayer(BLOCK_CLASSES[code], _LAYER_COLOURS[code])
-             for code in np.unique(blocks.block_class)}
+             for code in np.unique(blocks.block_class[free])}
+    if blocks.block_is_support.any():
+        support_layer = model.Layers.AddLayer(SUPPORT_LAYER, _SUPPORT_COLOUR)
 
     face_start = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks + 1))
+    corner_start = blocks.face_offsets[face_start].tolist()
+    corners = vertices[blocks.face_vertices].tolist()  # every face's corners, in order
+    sizes = np.diff(blocks.face_offsets).tolist()
     for i in range(blocks.n_blocks):
-        lo, hi = blocks.vertex_offsets[i], blocks.vertex_offsets[i + 1]
-        mesh = rhino3dm.Mesh()
-        # rhino3dm 8: Vertices.Add stores float32; AddPoint3d stores doubles, which the
-        # file keeps when the flag is set after the vertices exist (set on an empty
-        # list, it stays False)
-        for x, y, z in vertices[lo:hi].tolist():
-            mesh.Vertices.AddPoint3d(x, y, z)
-        mesh.Vertices.UseDoublePrecisionVertices = True
-        for f in range(face_start[i], face_start[i + 1]):
-            ids = (blocks.face_vertices[blocks.face_offsets[f]:blocks.face_offsets[f + 1]]
-                   - lo).tolist()
-            if len(ids) == 4:
-                mesh.Faces.AddFace(*ids)
-            else:
-                for k in range(1, len(ids) - 1):
-                    mesh.Faces.AddFace(ids[0], ids[k], ids[k + 1])
-        mesh.Normals.ComputeNormals()
+        mesh = _unwelded_mesh(rhino3dm, corners[corner_start[i]:corner_start[i + 1]],
+                              sizes[face_start[i]:face_start[i + 1]])
         attributes = rhino3dm.ObjectAttributes()
         attributes.Name = str(blocks.block_name[i])
-        attributes.LayerIndex = layer[blocks.block_class[i]]
+        attributes.LayerIndex = (layer[blocks.block_class[i]] if free[i] else support_layer)
+        for key, values in user_text.items():
+            attributes.SetUserString(key, str(values[i]))
         model.Objects.AddMesh(mesh, attributes)
 
     # rhino3dm writes to paths only
@@ -87,3 +126,26 @@ def blocks_3dm(blocks: Blocks, vertices=None) -> bytes:
             raise OSError("rhino3dm could not write the 3dm file")
         with open(path, "rb") as f:
             return f.read()
+
+
+def _unwelded_mesh(rhino3dm, corners, sizes):
+    """A rhino3dm Mesh whose faces have their own vertices: ``corners`` (list of (x, y, z),
+    metres) holds the faces' corners face after face, ``sizes`` their counts."""
+    mesh = rhino3dm.Mesh()
+    add_point, add_face = mesh.Vertices.AddPoint3d, mesh.Faces.AddFace
+    # rhino3dm 8: Vertices.Add stores float32; AddPoint3d stores doubles, which the file
+    # keeps when the flag is set after the vertices exist (set on an empty list, it
+    # stays False)
+    for x, y, z in corners:
+        add_point(x, y, z)
+    start = 0
+    for size in sizes:
+        if size == 4:
+            add_face(start, start + 1, start + 2, start + 3)
+        else:
+            for k in range(1, size - 1):
+                add_face(start, start + k, start + k + 1)
+        start += size
+    mesh.Vertices.UseDoublePrecisionVertices = True
+    mesh.Normals.ComputeNormals()
+    return mesh

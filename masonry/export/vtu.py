@@ -2,10 +2,13 @@
 for ParaView), written with meshio.
 
 Interface polygons have 3 to 8 vertices. meshio stores a cell block as one
-(cells, vertices per cell) array, so the interfaces go into one block per vertex count:
-``triangle``, ``quad``, then ``polygon`` blocks of 5, 6, ... vertices (meshio 5.3 writes
-and reads these back in order). The cell data ``interface`` gives every cell's row in
-``RBE/forces.csv``.
+(cells, vertices per cell) array, so every run of consecutive interfaces with the same
+vertex count becomes one block (``triangle``, ``quad`` or ``polygon``): the file's cells
+are the interfaces in id order, the rows of ``interfaces.csv`` and ``RBE/forces.csv``
+(the cell data ``interface`` repeats the id). Array names carry their unit as the CSV
+columns do (``compression_N``), since ParaView titles a colour bar with the array's name.
+The ``kind`` codes are named in the file's field data (``kind_horizontal = 0``, ...),
+which ParaView lists in its Information panel.
 """
 
 import os
@@ -16,15 +19,15 @@ import numpy as np
 from masonry.interfaces import INTERFACE_KINDS
 
 _CELL_TYPES = {3: "triangle", 4: "quad"}
-_RESERVED = ("interface", "kind", "area", "frame_normal", "frame_t1", "frame_t2")
+_RESERVED = ("interface", "kind", "area_m2", "frame_normal", "frame_t1", "frame_t2")
 
 
 def _vtu_bytes(mesh, name) -> bytes:
-    """meshio writes to paths only: write into a temporary folder and read back."""
+    """meshio writes to paths only (and drops field data in VTU): write into a temporary
+    folder and read back. Not compressed: zlib would take most of the export's time
+    (docs/bench.md)."""
     import meshio
 
-    # not compressed: zlib took 0.2 s of a dome's 0.25 s (17,728 interfaces), for a file
-    # 4 times smaller (1.8 MB against 6.8 MB)
     with tempfile.TemporaryDirectory() as folder:
         path = os.path.join(folder, name)
         meshio.write(path, mesh, file_format="vtu", binary=True, compression=None)
@@ -67,19 +70,22 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
     ----------
     interfaces : Interfaces
         ``K`` interfaces; their polygon vertices become the points (metres).
-    forces : dict of str to (K,) float
-        Per-interface resultants in newtons, e.g. ``compression``, ``tension``,
-        ``normal``, ``t1``, ``t2``, ``friction`` (:func:`masonry.rbe.solve.interface_forces`).
+    forces : dict of str to (K,) or (K, 3) float
+        Per-interface values, e.g. the sums ``compression``, ``tension``, ``normal``,
+        ``t1``, ``t2``, ``friction`` in newtons (:func:`masonry.rbe.solve.interface_forces`)
+        and the resultants' ``shear`` (K, 3), ``eccentricity``
+        (:func:`masonry.rbe.resultants.interface_resultants`).
     kind_names : sequence of str
-        Names of the ``kind`` codes, written into the file's header comment.
+        Names of the ``kind`` codes, written into the file's field data.
 
     Returns
     -------
     bytes
-        Binary VTU (base64, not compressed). Cell data: every entry of ``forces``
-        (float64), ``interface`` (int64, row in ``forces.csv``), ``kind`` (int8 code),
-        ``area`` (m^2), ``frame_normal``, ``frame_t1``, ``frame_t2`` ((K, 3) unit
-        vectors: the directions of the normal, t1 and t2 forces).
+        Binary VTU (base64, not compressed), cells in interface order. Cell data: every
+        entry of ``forces`` (float64), ``interface`` (int64, row in ``forces.csv``),
+        ``kind`` (int8 code), ``area_m2``, ``frame_normal``, ``frame_t1``, ``frame_t2``
+        ((K, 3) unit vectors: the directions of the normal, t1 and t2 forces). Field data:
+        ``kind_<name>`` (the code of every kind name).
 
     Raises
     ------
@@ -97,27 +103,41 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
         if name in _RESERVED:
             raise ValueError(f"force name {name!r} is reserved for {_RESERVED}")
         value = np.asarray(value, dtype=float)
-        if value.shape != (count,):
-            raise ValueError(f"forces[{name!r}] has shape {value.shape}, expected ({count},)")
+        if value.shape not in ((count,), (count, 3)):
+            raise ValueError(f"forces[{name!r}] has shape {value.shape}, expected "
+                             f"({count},) or ({count}, 3)")
         values[name] = value
     values.update(interface=np.arange(count, dtype=np.int64),
-                  kind=np.asarray(interfaces.kind, dtype=np.int8), area=interfaces.area,
+                  kind=np.asarray(interfaces.kind, dtype=np.int8), area_m2=interfaces.area,
                   frame_normal=interfaces.normal, frame_t1=interfaces.t1,
                   frame_t2=interfaces.t2)
 
     vertex_count = interfaces.vertex_count
+    # runs of equal vertex count, in id order
+    starts = np.flatnonzero(np.diff(vertex_count, prepend=-1))
+    ends = np.append(starts[1:], count)
     cells, cell_data = [], {name: [] for name in values}
-    for size in np.unique(vertex_count):
-        rows = np.flatnonzero(vertex_count == size)
+    for lo, hi in zip(starts.tolist(), ends.tolist()):
+        size = int(vertex_count[lo])
         cells.append((_CELL_TYPES.get(size, "polygon"),
-                      interfaces.offsets[rows][:, None] + np.arange(size)))
+                      interfaces.offsets[lo:hi, None] + np.arange(size)))
         for name, value in values.items():
-            cell_data[name].append(value[rows])
+            cell_data[name].append(value[lo:hi])
     mesh = meshio.Mesh(np.asarray(interfaces.vertices, dtype=float).reshape(-1, 3), cells,
                        cell_data=cell_data)
 
-    # meshio drops field data in VTU: the kind legend goes into a comment
-    data = _vtu_bytes(mesh, "interfaces.vtu")
-    legend = ", ".join(f"{code} {name}" for code, name in enumerate(kind_names))
-    head, sep, tail = data.partition(b"?>\n")  # after the XML declaration
-    return head + sep + f"<!--masonry interfaces, kind: {legend}-->\n".encode() + tail
+    return _with_field_data(_vtu_bytes(mesh, "interfaces.vtu"),
+                            {f"kind_{name}": code
+                             for code, name in enumerate(kind_names)})
+
+
+def _with_field_data(data: bytes, integers: dict) -> bytes:
+    """VTU bytes with a ``<FieldData>`` of one-value Int32 arrays (name -> int) as the
+    grid's first child, where VTK's XML reader looks for it."""
+    arrays = "".join(f'<DataArray type="Int32" Name="{name}" NumberOfTuples="1" '
+                     f'format="ascii">{int(value)}</DataArray>'
+                     for name, value in integers.items())
+    head, tag, tail = data.partition(b"<UnstructuredGrid>")
+    if not tag:
+        raise ValueError("meshio wrote no <UnstructuredGrid> element")
+    return head + tag + f"\n<FieldData>{arrays}</FieldData>".encode() + tail

@@ -23,6 +23,8 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.sparse import coo_array
+from scipy.sparse.csgraph import connected_components
 
 from masonry.blocks import Blocks, concatenate, rotated_web, rotation_z
 from masonry.interfaces import INTERFACE_KINDS, Interfaces, detect
@@ -44,16 +46,55 @@ class Model:
         Block that receives each side's force (see :func:`masonry.rbe.equilibrium.assemble`).
     side_rotation : (K, 2, 3, 3) float or None
         Rotation applied to each side's force and lever arm.
+    block_source : (B,) int or None
+        The scene block each block is (the scene's blocks) or copies (an image); None:
+        every block is the scene's own (no images).
     """
 
     blocks: Blocks
     interfaces: Interfaces
     side_block: np.ndarray | None = None
     side_rotation: np.ndarray | None = None
+    block_source: np.ndarray | None = None
 
     @property
     def boundary_count(self) -> int:
         return int((self.interfaces.kind == BOUNDARY).sum())
+
+
+class UnsupportedError(ValueError):
+    """Some blocks have no path of contacts to a support: nothing can carry them, and no
+    equilibrium (not even friction+) exists. The message names them."""
+
+
+def unsupported_blocks(blocks: Blocks, interfaces: Interfaces) -> np.ndarray:
+    """Indices of the free blocks that no chain of interfaces joins to a support.
+
+    Returns
+    -------
+    (k,) int
+    """
+    n = blocks.n_blocks
+    pair = interfaces.pair
+    graph = coo_array((np.ones(len(pair)), (pair[:, 0], pair[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    carried = np.isin(label, label[blocks.block_is_support])
+    return np.flatnonzero(~carried)
+
+
+def check_supported(model: "Model") -> None:
+    """Raise :class:`UnsupportedError` naming the blocks of ``model`` that no chain of
+    interfaces joins to a support (before any solve)."""
+    lost = unsupported_blocks(model.blocks, model.interfaces)
+    if len(lost) == 0:
+        return
+    names = model.blocks.block_name
+    shown = ", ".join(repr(str(names[i])) if names is not None else str(i) for i in lost[:5])
+    more = f" and {len(lost) - 5} more" if len(lost) > 5 else ""
+    raise UnsupportedError(
+        f"{len(lost)} of {model.blocks.n_blocks} blocks have no path of contacts to a "
+        f"support: {shown}{more}. Nothing can carry them: a block floating, touching only "
+        f"along an edge or at a point, or with a gap wider than the contact tolerance")
 
 
 def _end_masks(scene):
@@ -71,7 +112,19 @@ def _mark_web_boundaries(interfaces: Interfaces, blocks: Blocks) -> Interfaces:
 
 
 def analysis_model(scene) -> Model:
-    """Blocks, interfaces and routing for the scene and its boundary mode."""
+    """Blocks, interfaces and routing for the scene and its boundary mode.
+
+    Raises
+    ------
+    UnsupportedError
+        Some block has no path of contacts to a support (:func:`check_supported`).
+    """
+    model = _model(scene)
+    check_supported(model)
+    return model
+
+
+def _model(scene) -> Model:
     params = scene.params
     mode = params.boundary if params.scene == "section" else "free"
     if mode == "free":
@@ -90,14 +143,49 @@ def analysis_model(scene) -> Model:
         ups.append(scene.block_up[mask] @ rotation_z(2 * np.pi * web / n).T)
     blocks = concatenate(parts)
     interfaces = _mark_web_boundaries(detect(blocks, up=np.concatenate(ups)), blocks)
-    if mode == "rigid":
-        return Model(blocks, interfaces)
-
-    # cyclic: an image's side acts on the brick it copies, rotated back by -2 pi/n
     count = scene.blocks.n_blocks
     source = np.concatenate([np.arange(count), *sources])
+    if mode == "rigid":
+        return Model(blocks, interfaces, block_source=source)
+
+    # cyclic: an image's side acts on the brick it copies, rotated back by -2 pi/n
     side_block = source[interfaces.pair]
     is_image = interfaces.pair >= count
     side_rotation = np.broadcast_to(np.eye(3), (len(interfaces), 2, 3, 3)).copy()
     side_rotation[is_image] = rotation_z(-2 * np.pi / n)
-    return Model(blocks, interfaces, side_block, side_rotation)
+    return Model(blocks, interfaces, side_block, side_rotation, block_source=source)
+
+
+def restrict(model: Model, is_present) -> Model:
+    """The model of a part of the scene: the blocks present, the images of those present,
+    and the interfaces of ``model`` whose two blocks are both kept (SPEC 4.7: a stage of
+    construction; interfaces are filtered, never detected again).
+
+    Parameters
+    ----------
+    model : Model
+        Of the whole scene (:func:`analysis_model`).
+    is_present : (S,) bool
+        Per scene block (the first ``S`` blocks of ``model``): present. Supports are
+        kept whatever it says.
+
+    Returns
+    -------
+    Model
+        Blocks in their order in ``model``; ``block_source`` still indexes the scene's
+        blocks, so results map back to them. The routing of a kept interface is
+        unchanged: a cyclic image is kept only with the brick it copies.
+    """
+    blocks = model.blocks
+    source = (np.arange(blocks.n_blocks) if model.block_source is None
+              else model.block_source)
+    is_present = np.asarray(is_present, dtype=bool)
+    keep = is_present[source] | blocks.block_is_support & (source == np.arange(len(source)))
+    index = np.flatnonzero(keep)
+    remap = np.full(blocks.n_blocks, -1)
+    remap[index] = np.arange(len(index))
+    chosen = keep[model.interfaces.pair].all(axis=1)
+    side_block = None if model.side_block is None else remap[model.side_block[chosen]]
+    side_rotation = None if model.side_rotation is None else model.side_rotation[chosen]
+    return Model(blocks.subset(index), model.interfaces.subset(chosen, remap), side_block,
+                 side_rotation, block_source=source[index])

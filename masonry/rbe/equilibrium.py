@@ -46,17 +46,13 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
-from masonry.tolerances import G
+from masonry.tolerances import COEFFICIENT_NOISE, G
 
 TENSION_WEIGHT = 1.0
 """Diagonal of ``H`` for tension (thesis eq. 3.27)."""
 
 OTHER_WEIGHT = 1e-3
 """Diagonal of ``H`` for compression and friction (thesis eq. 3.27)."""
-
-COEFFICIENT_NOISE = 1e-12
-"""Scaled ``A_eq`` coefficients (unit directions, arms per ``L_ref``: of order one) at or
-below this are floating-point noise of exact zeros and are not stored."""
 
 FRICTION_METHODS = ("net", "plus")
 """``net``: friction-net, ``|f1|, |f2| <= mu (c - t)`` (thesis eq. 3.26);
@@ -85,18 +81,22 @@ class VariableLayout:
 
     @classmethod
     def from_interfaces(cls, interfaces) -> "VariableLayout":
+        """The layout of ``interfaces`` (:class:`masonry.interfaces.Interfaces`)."""
         return cls(np.asarray(interfaces.offsets, dtype=np.int64))
 
     @property
     def n_interfaces(self) -> int:
+        """``K``, the number of interfaces."""
         return len(self.offsets) - 1
 
     @property
     def n_vertices(self) -> int:
+        """``IV``, the number of interface vertices (all interfaces)."""
         return int(self.offsets[-1])
 
     @property
     def n_columns(self) -> int:
+        """``n = 4 IV``, the length of ``x``."""
         return self.WIDTH * self.n_vertices
 
     @cached_property
@@ -109,7 +109,7 @@ class VariableLayout:
         return self.WIDTH * np.arange(self.n_vertices) + self.COMPONENTS.index(component)
 
     def vertex_columns(self, vertex: int) -> slice:
-        """Columns ``(c, t, f1, f2)`` of one vertex."""
+        """Columns ``(c, t, f1, f2)`` of vertex ``vertex`` (int), as a slice of ``x``."""
         return slice(self.WIDTH * vertex, self.WIDTH * (vertex + 1))
 
     def component(self, x, component: str) -> np.ndarray:
@@ -192,7 +192,20 @@ class EquilibriumSystem:
         """The same scene with another friction coefficient or density, without
         assembling again: ``mu`` changes only the pyramids, and ``density`` only the
         newtons per solver unit (the scaled ``A_eq`` and ``f_ext`` depend on neither,
-        since the reference weight grows with the density)."""
+        since the reference weight grows with the density).
+
+        Parameters
+        ----------
+        mu : float, optional
+            Friction coefficient; default unchanged.
+        density : float, kg/m^3, optional
+            Default unchanged.
+
+        Returns
+        -------
+        EquilibriumSystem
+            ``self`` when nothing changes.
+        """
         out = self
         if mu is not None and float(mu) != self.mu:
             out = dataclasses.replace(out, mu=float(mu))
@@ -230,11 +243,11 @@ class EquilibriumSystem:
         return self.h / OTHER_WEIGHT
 
     def to_scaled(self, x) -> np.ndarray:
-        """Variables in newtons -> solver units."""
+        """(n,) float: variables ``x`` in newtons ((n,) float) -> solver units."""
         return np.asarray(x, dtype=float) / self.weight_ref
 
     def to_newtons(self, x_scaled) -> np.ndarray:
-        """Solver units -> newtons."""
+        """(n,) float: variables in solver units ((n,) float) -> newtons."""
         return np.asarray(x_scaled, dtype=float) * self.weight_ref
 
     def contact_wrench(self, x) -> np.ndarray:
@@ -249,12 +262,15 @@ class EquilibriumSystem:
 
 def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
              side_rotation=None) -> EquilibriumSystem:
-    """Assemble the scaled RBE matrices (vectorized: ``A_eq`` built column by column in CSC form).
+    """Assemble the scaled RBE matrices (vectorized: ``A_eq`` built column by column in
+    CSC form).
 
     Parameters
     ----------
     blocks : masonry.blocks.Blocks
+        ``B`` blocks, metres; supports (``block_is_support``) get no equilibrium rows.
     interfaces : masonry.interfaces.Interfaces
+        ``K`` interfaces with ``IV`` vertices in all, metres.
     mu : float
         Friction coefficient (thesis ``alpha``).
     density : float, kg/m^3
@@ -271,6 +287,12 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     Returns
     -------
     EquilibriumSystem
+        ``A_eq`` (6 F, 4 IV) and ``f_ext`` (6 F,) scaled, for the ``F`` free blocks.
+
+    Raises
+    ------
+    ValueError
+        When every block is a support.
     """
     layout = VariableLayout.from_interfaces(interfaces)
     n_vertices = layout.n_vertices
@@ -286,9 +308,31 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
 
     block_row = np.full(blocks.n_blocks, -1)
     block_row[free_block] = np.arange(len(free_block))
-
     side_block = (np.asarray(interfaces.pair, dtype=np.int64) if side_block is None
                   else np.asarray(side_block, dtype=np.int64))
+    coefficients = _vertex_coefficients(blocks, interfaces, layout, side_block[
+        layout.vertex_interface], side_rotation, block_row, length_ref)
+    side_rows = np.maximum(block_row[side_block[layout.vertex_interface]], 0)
+    A_eq = _equilibrium_matrix(coefficients, side_rows, 6 * len(free_block), layout)
+
+    f_ext = np.zeros((len(free_block), 6))
+    f_ext[:, 2] = -block_weight[free_block] / weight_ref
+    lower = np.tile([0.0, 0.0, -np.inf, -np.inf], n_vertices)
+    h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], n_vertices)
+    return EquilibriumSystem(layout=layout, free_block=free_block, A_eq=A_eq,
+                             f_ext=f_ext.ravel(),
+                             lower=lower, h=h, mu=float(mu), block_weight=block_weight,
+                             weight_ref=weight_ref, length_ref=length_ref,
+                             side_row=block_row[side_block],
+                             vertex_coefficients=coefficients, density=float(density))
+
+
+def _vertex_coefficients(blocks, interfaces, layout: VariableLayout, vertex_side_block,
+                         side_rotation, block_row, length_ref: float) -> np.ndarray:
+    """(IV, 2, 6, 4) float: the scaled ``A_eq`` rows (force, moment per ``length_ref``)
+    that every vertex's ``(c, t, f1, f2)`` give the block of each side,
+    ``vertex_side_block`` ((IV, 2) int); zero for a support side (``block_row`` -1) and
+    for coefficients at or below :data:`~masonry.tolerances.COEFFICIENT_NOISE`."""
     vertex_interface = layout.vertex_interface
     point = np.asarray(interfaces.vertices, dtype=float)
     # direction of each variable's unit force on the other block: c -> n, t -> -n,
@@ -296,12 +340,9 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     normal = interfaces.normal[vertex_interface]
     direction = np.stack([normal, -normal, interfaces.t1[vertex_interface],
                           interfaces.t2[vertex_interface]], axis=1)
-
-    # every column (a vertex's c, t, f1 or f2) has six rows on each side's block: build
-    # A_eq column by column in CSC form, no triplet sort (0.1 s on preset 1's full dome)
-    side_rows, side_coefficients = [], []
+    out = []
     for side, sign in ((0, -1.0), (1, 1.0)):
-        block = side_block[vertex_interface, side]
+        block = vertex_side_block[:, side]
         side_direction, side_point = sign * direction, point
         if side_rotation is not None:
             rotation = np.asarray(side_rotation, dtype=float)[vertex_interface, side]
@@ -314,44 +355,55 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
         # (about 40% of the triplets of a wall; HiGHS warns about them and every solver
         # would carry them)
         keep = (block_row[block] >= 0)[:, None, None] & (np.abs(coeff) > COEFFICIENT_NOISE)
-        side_coefficients.append(np.where(keep, coeff, 0.0).transpose(0, 2, 1))
-        side_rows.append(np.maximum(block_row[block], 0))
+        out.append(np.where(keep, coeff, 0.0).transpose(0, 2, 1))
+    return np.stack(out, axis=1)
+
+
+def _equilibrium_matrix(coefficients, side_rows, n_rows: int,
+                        layout: VariableLayout) -> sp.csr_array:
+    """``A_eq`` ((n_rows, n) csr) from the per-vertex ``coefficients`` ((IV, 2, 6, 4))
+    and the free-block row of each side ``side_rows`` ((IV, 2) int).
+
+    Every column (a vertex's c, t, f1 or f2) has six rows on each side's block, so the
+    matrix is built column by column in CSC form, with no triplet sort.
+    """
     # rows of a column in increasing order: the side on the lower block first
-    swap = side_rows[0] > side_rows[1]
-    first = np.where(swap, side_rows[1], side_rows[0])
-    second = np.where(swap, side_rows[0], side_rows[1])
+    swap = side_rows[:, 0] > side_rows[:, 1]
+    first = np.where(swap, side_rows[:, 1], side_rows[:, 0])
+    second = np.where(swap, side_rows[:, 0], side_rows[:, 1])
     offsets = np.arange(6)
     indices = np.concatenate([6 * first[:, None] + offsets, 6 * second[:, None] + offsets],
                              axis=1)                                     # (IV, 12)
-    low = np.where(swap[:, None, None], side_coefficients[1], side_coefficients[0])
-    high = np.where(swap[:, None, None], side_coefficients[0], side_coefficients[1])
+    low = np.where(swap[:, None, None], coefficients[:, 1], coefficients[:, 0])
+    high = np.where(swap[:, None, None], coefficients[:, 0], coefficients[:, 1])
     data = np.concatenate([low, high], axis=1).transpose(0, 2, 1)       # (IV, 4, 12)
-    shape = (6 * len(free_block), layout.n_columns)
     # both sides on one block (cyclic symmetry routes an image onto the brick it copies)
     # add up; then the dropped coefficients go
     A_eq = sp.csc_array((data.ravel(), np.repeat(indices[:, None, :], layout.WIDTH, axis=1)
-                         .ravel(), np.arange(0, 12 * layout.n_columns + 1, 12)), shape=shape)
+                         .ravel(), np.arange(0, 12 * layout.n_columns + 1, 12)),
+                        shape=(n_rows, layout.n_columns))
     A_eq.sum_duplicates()
     A_eq.eliminate_zeros()
-    A_eq = A_eq.tocsr()
-
-    f_ext = np.zeros((len(free_block), 6))
-    f_ext[:, 2] = -block_weight[free_block] / weight_ref
-
-    lower = np.tile([0.0, 0.0, -np.inf, -np.inf], n_vertices)
-    h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], n_vertices)
-    return EquilibriumSystem(layout=layout, free_block=free_block, A_eq=A_eq,
-                             f_ext=f_ext.ravel(),
-                             lower=lower, h=h, mu=float(mu), block_weight=block_weight,
-                             weight_ref=weight_ref, length_ref=length_ref,
-                             side_row=block_row[side_block],
-                             vertex_coefficients=np.stack(side_coefficients, axis=1),
-                             density=float(density))
+    return A_eq.tocsr()
 
 
 def friction_pyramids(n_vertices: int, mu: float) -> dict:
     """``A_fr['net']`` and ``A_fr['plus']`` (thesis eq. 3.26, 3.25): 4 rows per vertex,
-    ``A_fr x <= 0``, rows ``+f1, -f1, +f2, -f2`` over columns ``(c, t, f1, f2)``."""
+    ``A_fr x <= 0``, rows ``+f1, -f1, +f2, -f2`` over columns ``(c, t, f1, f2)``.
+
+    Parameters
+    ----------
+    n_vertices : int
+        ``IV``, interface vertices.
+    mu : float
+        Friction coefficient (thesis ``alpha``), dimensionless.
+
+    Returns
+    -------
+    dict str -> (4 IV, 4 IV) scipy.sparse.csr_array
+        ``'net'``: ``|f1|, |f2| <= mu (c - t)``; ``'plus'``: ``|f1|, |f2| <= mu c``.
+        Dimensionless, so valid for ``x`` in newtons or in solver units.
+    """
     pyramid_net = np.array([[-mu, mu, 1.0, 0.0],
                             [-mu, mu, -1.0, 0.0],
                             [-mu, mu, 0.0, 1.0],

@@ -55,7 +55,7 @@ class AccuracyPreset:
         (Clarabel at 1e-10 left 1e-6 of the weight as tension on a feasible section).
         Kept only if it converges within :data:`POLISH_STEPS`.
     options : dict
-        Solver settings per family (``newton``, ``clarabel``, ``osqp``).
+        Solver settings per family (``newton``, ``interior``, ``clarabel``, ``osqp``).
     """
 
     name: str
@@ -74,37 +74,41 @@ sections, friction+ included; preset 2's full dome took 6 from Clarabel at 1e-10
 
 
 ACCURACY = {
-    # Newton for friction-net: its steps are exact once the active pyramid faces are
-    # found, so a looser stop saves little; the savings are Clarabel's last iterations
-    # on friction+ and the acceptance of OSQP's ADMM points at 1e-4.
+    # Newton for friction-net, the interior point method on the Newton system for
+    # friction+ (both factor the 6-rows-per-block matrix): Newton's steps are exact once
+    # the active pyramid faces are found, so a looser stop saves little; the savings are
+    # the interior point's last iterations and the acceptance of OSQP's ADMM points.
     "fast": AccuracyPreset(
-        "fast", "newton", "clarabel", residual=1e-4, lp_check=False, polish=False,
+        "fast", "newton", "interior", residual=1e-4, lp_check=False, polish=False,
         options={"newton": {"tol": 1e-6},
+                 "interior": {"tol": 1e-6},
                  "clarabel": {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-6},
                  "osqp": {"eps_abs": 1e-4, "eps_rel": 1e-4, "max_iter": 100_000,
                           "polishing": False}}),
     # the default: friction-net by Newton (preset 1's full dome: 10 factorizations
     # of a 38,000-row system where Clarabel factors a 790,000-row one 16 times);
-    # friction+ by Clarabel with its default tolerances (Newton's dual of friction+ is
-    # ill-conditioned by the 1,000:1 tension weight: 60 steps without convergence on
-    # preset 1's free section).
+    # friction+ by the interior point method on the same system, polished by Newton
+    # (Newton alone on friction+ is slowed by the 1,000:1 tension weight: more than 100
+    # steps on preset 1's free section). Clarabel takes over when either fails.
     "balanced": AccuracyPreset(
-        "balanced", "newton", "clarabel", residual=1e-5, lp_check=False, polish=True,
+        "balanced", "newton", "interior", residual=1e-5, lp_check=False, polish=True,
         options={"newton": {"tol": 1e-9},
+                 "interior": {"tol": 1e-10},
                  "clarabel": {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8},
                  # cvxpy's defaults (eps 1e-5, 10,000 iterations) leave residuals near
                  # the acceptance tolerance; 1e-6 keeps a margin
                  "osqp": {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iter": 100_000,
                           "polishing": True}}),
-    # the reference: interior point with tight gaps for both models, polished, and the
-    # LP's second opinion on an infeasible verdict (on feasible ones it took 19 s for
-    # the cyclic section of preset 1 and ran out of its minute on every full dome).
-    # Clarabel's default gaps (1e-8) leave 2.6e-6 of the weight as interior-point
-    # tension on the straight wall; 1e-10 leaves 2.4e-7 at the same cost.
+    # the reference: Clarabel (an independent implementation) with tight gaps for both
+    # models, polished, and the LP's second opinion on an infeasible verdict (on
+    # feasible ones it took 19 s for the cyclic section of preset 1 and ran out of its
+    # minute on every full dome). Clarabel's default gaps (1e-8) leave 2.6e-6 of the
+    # weight as interior-point tension on the straight wall; 1e-10 leaves 2.4e-7.
     "accurate": AccuracyPreset(
         "accurate", "clarabel", "clarabel", residual=1e-6, lp_check="infeasible",
         polish=True,
         options={"newton": {"tol": 1e-12},
+                 "interior": {"tol": 1e-10},
                  "clarabel": {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10,
                               "tol_feas": 1e-10},
                  "osqp": {"eps_abs": 1e-8, "eps_rel": 1e-8, "max_iter": 200_000,
@@ -115,7 +119,11 @@ ACCURACY = {
 SOLVERS = tuple(BACKENDS)
 """Every solver name :func:`solve_rbe` accepts."""
 
-RESULT_KEYS = ("feasible", "friction", "mu", "objective", "moi", "moi_factor", "weight_N",
+VERDICTS = ("feasible", "infeasible", "not solved")
+"""Values of :attr:`RBEResult.verdict`."""
+
+RESULT_KEYS = ("verdict", "feasible", "friction", "mu", "objective", "moi", "moi_factor",
+               "weight_N",
                "solver", "status", "iterations", "residual_eq", "friction_violation",
                "net_friction_violation", "time_s", "lp_feasible", "accuracy", "lp_time_s")
 """Scalar fields of :class:`RBEResult` written to run.json, in order."""
@@ -173,6 +181,12 @@ class RBEResult:
     attempts : tuple of dict
         Every QP solved, in order: friction model, solver, status, iterations, setup and
         solve seconds (a fallback shows as a second attempt of the same model).
+    verdict : {'feasible', 'infeasible', 'not solved'}
+        ``'feasible'``: ``feasible`` is True. ``'infeasible'``: friction-net has no
+        accepted point, and either a solver certified that (a Farkas certificate, an
+        infeasibility status, the LP) or an accepted friction+ point carries the
+        tension it needs. ``'not solved'``: no solver returned an accepted point and
+        none certified infeasibility; the residuals say how far the last point was.
     """
 
     feasible: bool
@@ -195,6 +209,7 @@ class RBEResult:
     accuracy: str = "balanced"
     lp_time_s: float = 0.0
     attempts: tuple = ()
+    verdict: str = "not solved"
 
     def to_dict(self) -> dict:
         """The scalar fields (:data:`RESULT_KEYS`) as plain Python values, for run.json."""
@@ -252,70 +267,82 @@ class RBEProblem:
     def __init__(self, blocks, interfaces, *, side_block=None, side_rotation=None):
         if len(interfaces) == 0:
             raise ValueError("no interfaces: nothing can carry the blocks")
-        start = time.perf_counter()
         self.system = assemble(blocks, interfaces, side_block=side_block,
                                side_rotation=side_rotation)
-        self.assembly_time = time.perf_counter() - start
         self._workspaces = {}
 
     def solve(self, mu=0.7, density=2000.0, friction="auto", solver=None, tol=None, *,
               accuracy="balanced", lp_check=None, lp_time_limit=60.0) -> RBEResult:
         """Solve at ``mu`` and ``density``; see :func:`solve_rbe` for the parameters."""
         start = time.perf_counter()
-        if friction not in ("auto",) + FRICTION_METHODS:
-            raise ValueError(f"friction must be 'auto', 'net' or 'plus', not {friction!r}")
-        if accuracy not in ACCURACY:
-            raise ValueError(f"unknown accuracy {accuracy!r}; choose from {list(ACCURACY)}")
-        if isinstance(lp_check, str) and lp_check != "infeasible":
-            raise ValueError(f"lp_check must be a bool or 'infeasible', not {lp_check!r}")
-        if solver is not None and solver not in BACKENDS:
-            raise ValueError(f"unknown solver {solver!r}; choose from {list(BACKENDS)}")
-        preset = ACCURACY[accuracy]
-        if tol is None:
-            tol = Tolerances(residual=preset.residual)
-        if lp_check is None:
-            lp_check = preset.lp_check
+        preset, tol, lp_check = _settings(friction, solver, tol, accuracy, lp_check)
         system = self.system.with_material(mu=mu, density=density)
-
         attempts = []
         for method in ("net", "plus") if friction == "auto" else (friction,):
-            chosen = solver or (preset.net_solver if method == "net" else preset.plus_solver)
-            names = [chosen]
-            # Newton is the presets' fast path; when it neither converges nor certifies
-            # infeasibility, Clarabel decides (logged and kept in ``attempts``)
-            if solver is None and chosen == "newton":
-                names.append("clarabel")
-            for name in names:
-                outcome = self._run(system, method, name, preset)
-                checks = _check(system, outcome.x, method)
-                accepted = checks is not None and max(checks[0], checks[1]) <= tol.residual
-                attempts.append({"friction": method, "solver": name,
-                                 "status": outcome.status, "iterations": outcome.iterations,
-                                 "setup_s": round(outcome.setup_time, 4),
-                                 "solve_s": round(outcome.solve_time, 4)})
-                if outcome.x is not None and not accepted:
-                    log.warning("%s rejected the %s solution with status %r: equilibrium "
-                                "residual %.2e, friction violation %.2e (tolerance %.1e)",
-                                name, method, outcome.status, checks[0], checks[1],
-                                tol.residual)
-                if accepted and preset.polish and name != "newton" and outcome.y is not None:
-                    polished = self._polish(system, method, outcome, tol)
-                    attempts.append(polished[1])
-                    if polished[0] is not None:
-                        outcome, checks = polished[0], _check(system, polished[0].x, method)
-                        name = f"{name}+newton"
-                if accepted or outcome.status == INFEASIBLE:
-                    break
-                if name != names[-1]:
-                    # Newton neither converged nor certified infeasibility (it certifies
-                    # the thesis's infeasible sections in one step): a fallback warns
-                    log.warning("%s found no %s solution (%s); trying %s", name, method,
-                                outcome.status, names[-1])
-            if method == "net":
-                net_status = outcome.status
-            if accepted:
+            log.info("solving friction-%s (mu %.3g, %d unknowns)", method, mu,
+                     system.layout.n_columns)
+            solved = self._solve_model(system, method, _candidates(method, solver, preset),
+                                       preset, tol, attempts)
+            if solved.accepted:
                 break
+            if method == "net" and friction == "auto":
+                log.info("friction-net has no solution (%s from %s): friction+ measures the "
+                         "tension needed", solved.outcome.status, solved.name)
+        result = self._result(system, solved, tol, lp_check, lp_time_limit, accuracy,
+                              attempts, friction)
+        log.info("%s: %s, MoI factor %.4g, residual %.1e, %.2f s", result.solver,
+                 result.verdict, result.moi_factor, result.residual_eq,
+                 time.perf_counter() - start)
+        return dataclasses.replace(result, time_s=time.perf_counter() - start)
 
+    def _solve_model(self, system, method, names, preset, tol, attempts) -> "_Solved":
+        """One friction model: the candidate solvers in turn until one returns an
+        accepted point (polished if the preset says so) or certifies infeasibility.
+        Every QP solved is appended to ``attempts``."""
+        for index, name in enumerate(names):
+            outcome = self._run(system, method, name, preset)
+            checks = _check(system, outcome.x, method)
+            accepted = _accepted(checks, tol)
+            attempts.append(_record(method, name, outcome))
+            if outcome.x is not None and not accepted:
+                log.warning("%s rejected the %s solution with status %r: equilibrium "
+                            "residual %.2e, friction violation %.2e (tolerance %.1e)",
+                            name, method, outcome.status, checks[0], checks[1],
+                            tol.residual)
+            if accepted and preset.polish and name != "newton" and outcome.y is not None:
+                polished = self._polish(system, method, outcome, tol, attempts)
+                if polished is not None:
+                    outcome, checks, name = polished, _check(system, polished.x, method), \
+                        f"{name}+newton"
+            if accepted or outcome.status == INFEASIBLE:
+                if outcome.status == INFEASIBLE:
+                    log.info("%s certified friction-%s infeasible", name, method)
+                return _Solved(method, name, outcome, checks, accepted)
+            if index + 1 < len(names):
+                # no silent fallback (STYLE): it warns and stays in ``attempts``
+                log.warning("%s found no %s solution (%s); trying %s", name, method,
+                            outcome.status, names[index + 1])
+        return _Solved(method, name, outcome, checks, False)
+
+    def _polish(self, system, method, outcome, tol, attempts):
+        """Newton steps from ``outcome``'s multipliers: the polished outcome, or None when
+        they do not converge within :data:`POLISH_STEPS` (its record joins ``attempts``
+        either way)."""
+        workspace = self._workspace("newton")
+        options = {"tol": min(tol.residual, 1e-9), "max_iter": POLISH_STEPS}
+        polished = BACKENDS["newton"](system, method, options, workspace, y0=outcome.y)
+        attempts.append(_record(method, "newton-polish", polished))
+        if polished.status == OPTIMAL and _accepted(_check(system, polished.x, method), tol):
+            return polished
+        log.info("Newton polish of the %s solution did not converge in %d steps (%s); "
+                 "the unpolished point is kept", method, POLISH_STEPS, polished.status)
+        return None
+
+    def _result(self, system, solved, tol, lp_check, lp_time_limit, accuracy, attempts,
+                friction) -> RBEResult:
+        """Pack the last model's outcome: residuals, forces in newtons, the verdict and
+        the LP's second opinion."""
+        checks, accepted, outcome = solved.checks, solved.accepted, solved.outcome
         residual_eq, violation, net_violation = (np.nan,) * 3 if checks is None else checks
         # a rejected point is no solution: its residuals are reported, its forces are not
         x = system.to_newtons(outcome.x) if accepted else None
@@ -325,51 +352,98 @@ class RBEProblem:
         lp_start = time.perf_counter()
         lp_feasible = _lp_feasible(system, lp_time_limit) if run_lp else None
         lp_time = time.perf_counter() - lp_start if run_lp else 0.0
-        if feasible and friction == "auto" and method == "plus":
-            log.warning("friction-net was not solved (%s), yet the friction+ solution meets "
-                        "the friction-net pyramid: reported feasible", net_status)
+        if feasible and solved.method == "plus" and friction == "auto":
+            log.warning("friction-net was not solved, yet the friction+ solution meets the "
+                        "friction-net pyramid: reported feasible")
         if lp_feasible is not None and lp_feasible != feasible:
             log.warning("the friction-net LP says %s, the %s QP says %s (status %r)",
-                        "feasible" if lp_feasible else "infeasible", name,
+                        "feasible" if lp_feasible else "infeasible", solved.name,
                         "feasible" if feasible else "infeasible", outcome.status)
-
         weight = system.total_weight
-        if x is None:
-            objective = moi = np.nan
-        else:
+        objective = moi = np.nan
+        if x is not None:
             objective = float(0.5 * np.sum(system.h * x**2))
             moi = float(system.layout.component(x, "t").sum())
         return RBEResult(
-            feasible=feasible, friction=method, mu=float(mu), objective=objective, moi=moi,
-            moi_factor=moi / weight, weight_N=weight, solver=name, status=outcome.status,
-            iterations=outcome.iterations, residual_eq=float(residual_eq),
-            friction_violation=float(violation), net_friction_violation=float(net_violation),
-            time_s=time.perf_counter() - start, lp_feasible=lp_feasible, x=x,
-            layout=system.layout, accuracy=accuracy, lp_time_s=lp_time,
-            attempts=tuple(attempts))
+            feasible=feasible, friction=solved.method, mu=float(system.mu),
+            objective=objective, moi=moi, moi_factor=moi / weight, weight_N=weight,
+            solver=solved.name, status=outcome.status, iterations=outcome.iterations,
+            residual_eq=float(residual_eq), friction_violation=float(violation),
+            net_friction_violation=float(net_violation), time_s=0.0,
+            lp_feasible=lp_feasible, x=x, layout=system.layout, accuracy=accuracy,
+            lp_time_s=lp_time, attempts=tuple(attempts),
+            verdict=_verdict(feasible, x, attempts, lp_feasible))
 
-    def _polish(self, system, method, outcome, tol):
-        """Newton steps from ``outcome``'s multipliers: (the polished outcome or None,
-        its attempt record)."""
-        workspace = self._workspaces.setdefault("newton", {})
-        options = {"tol": min(tol.residual, 1e-9), "max_iter": POLISH_STEPS}
-        polished = BACKENDS["newton"](system, method, options, workspace, y0=outcome.y)
-        checks = _check(system, polished.x, method)
-        kept = (polished.status == OPTIMAL and checks is not None
-                and max(checks[0], checks[1]) <= tol.residual)
-        if not kept:
-            log.info("Newton polish of the %s solution did not converge in %d steps (%s); "
-                     "the unpolished point is kept", method, POLISH_STEPS, polished.status)
-        record = {"friction": method, "solver": "newton-polish", "status": polished.status,
-                  "iterations": polished.iterations,
-                  "setup_s": round(polished.setup_time, 4),
-                  "solve_s": round(polished.solve_time, 4)}
-        return (polished if kept else None), record
+    def _workspace(self, name):
+        """The workspace of a backend; the Newton-system backends (semismooth Newton,
+        interior point) share one: the symbolic factorization and prepared matrices."""
+        return self._workspaces.setdefault(WORKSPACE.get(name, name), {})
 
     def _run(self, system, method, name, preset):
         options = preset.options.get(FAMILY[name], {})
-        workspace = self._workspaces.setdefault(name, {})
-        return BACKENDS[name](system, method, dict(options), workspace)
+        return BACKENDS[name](system, method, dict(options), self._workspace(name))
+
+
+@dataclass(frozen=True)
+class _Solved:
+    """The last outcome for one friction model: its solver's name (``+newton`` when
+    polished), the outcome, its residual checks, and whether the point was accepted."""
+
+    method: str
+    name: str
+    outcome: object
+    checks: tuple | None
+    accepted: bool
+
+
+WORKSPACE = {"interior": "newton"}
+"""Backends that share another's workspace (see :meth:`RBEProblem._workspace`)."""
+
+
+def _settings(friction, solver, tol, accuracy, lp_check):
+    """Validate the arguments of :meth:`RBEProblem.solve`: (preset, tolerances, LP
+    check)."""
+    if friction not in ("auto",) + FRICTION_METHODS:
+        raise ValueError(f"friction must be 'auto', 'net' or 'plus', not {friction!r}")
+    if accuracy not in ACCURACY:
+        raise ValueError(f"unknown accuracy {accuracy!r}; choose from {list(ACCURACY)}")
+    if isinstance(lp_check, str) and lp_check != "infeasible":
+        raise ValueError(f"lp_check must be a bool or 'infeasible', not {lp_check!r}")
+    if solver is not None and solver not in BACKENDS:
+        raise ValueError(f"unknown solver {solver!r}; choose from {list(BACKENDS)}")
+    preset = ACCURACY[accuracy]
+    tol = Tolerances(residual=preset.residual) if tol is None else tol
+    return preset, tol, preset.lp_check if lp_check is None else lp_check
+
+
+def _candidates(method, solver, preset) -> list:
+    """Solvers to try for ``method``, in order: the explicit ``solver`` alone, else the
+    preset's, followed by Clarabel when the preset's is one of the fast methods on the
+    Newton system (they neither converge nor certify on every structure)."""
+    if solver is not None:
+        return [solver]
+    chosen = preset.net_solver if method == "net" else preset.plus_solver
+    return [chosen, "clarabel"] if chosen in ("newton", "interior") else [chosen]
+
+
+def _accepted(checks, tol) -> bool:
+    return checks is not None and max(checks[0], checks[1]) <= tol.residual
+
+
+def _record(method, name, outcome) -> dict:
+    """One QP solve, as kept in :attr:`RBEResult.attempts`."""
+    return {"friction": method, "solver": name, "status": outcome.status,
+            "iterations": outcome.iterations, "setup_s": round(outcome.setup_time, 4),
+            "solve_s": round(outcome.solve_time, 4)}
+
+
+def _verdict(feasible, x, attempts, lp_feasible) -> str:
+    """See :attr:`RBEResult.verdict`."""
+    if feasible:
+        return "feasible"
+    certified = lp_feasible is False or any(
+        a["friction"] == "net" and a["status"] == INFEASIBLE for a in attempts)
+    return "infeasible" if certified or x is not None else "not solved"
 
 
 def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solver=None,

@@ -24,11 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.blocks import BLOCK_CLASSES, GROUND, Blocks
+from masonry.blocks import BLOCK, GROUND, Blocks
 from masonry.params import Params, arch_radius, check_arch
 from masonry.scenes.base import Scene
-
-BLOCK = BLOCK_CLASSES.index("block")
 
 
 @dataclass(frozen=True)

@@ -13,10 +13,11 @@ turns mesh files into :class:`~masonry.blocks.Blocks`:
   works too.
 
 Every block must be a closed convex solid. A block that is open, non-manifold, inside
-out, flat, or concave beyond :data:`CONVEXITY_REL` raises :class:`AssemblyError` naming
-the block and its file; so does a file that cannot be read. Each accepted block is
-replaced by its convex hull, whose coplanar triangles are merged into whole planar
-polygons, so an interface is a whole face and not a triangle of it.
+out, flat, or concave beyond :data:`~masonry.tolerances.CONVEXITY_REL` raises
+:class:`AssemblyError` naming the block and its file; so does a file that cannot be
+read. Each accepted block is replaced by its convex hull, whose coplanar triangles are
+merged into whole planar polygons, so an interface is a whole face and not a triangle
+of it.
 
 Bodies in one STL or PLY that touch each other share vertices and edges: an edge where
 two blocks touch belongs to four triangles. Connectivity therefore pairs the triangles
@@ -38,27 +39,18 @@ from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
-from masonry.blocks import BLOCK_CLASSES, Blocks, concatenate, tangent_basis
+from masonry.blocks import BLOCK, BLOCK_CLASSES, Blocks, concatenate, tangent_basis
 from masonry.meshing import merge_vertices
 from masonry.params import validate
 from masonry.scenes.base import Scene
-from masonry.tolerances import Tolerances
+from masonry.tolerances import (COINCIDENT_ANGLE, COLLINEAR_SIN, CONVEXITY_REL,
+                                GROUND_MARGIN_REL, INTERPENETRATION_REL, PARALLEL_SIN,
+                                Tolerances)
 
 log = logging.getLogger(__name__)
 
 FORMATS = (".obj", ".stl", ".ply")
 """File suffixes :func:`read_blocks` reads (case-insensitive)."""
-
-CONVEXITY_REL = 1e-4
-"""A block is convex when its volume falls short of its convex hull's by at most this
-fraction of the hull's. Float32 rounding (binary STL) of a brick 20 m from the origin
-moves its corners by about 1e-6 m and its volume by about 1e-5 of a 0.2 m brick; a real
-concavity (an L-shaped block, a notch) is a few percent or more."""
-
-COINCIDENT_ANGLE = 1e-6
-"""Radians. Two triangles around an edge whose half-planes are closer than this lie on
-top of each other: the faces of two blocks in contact, never the two faces of one block's
-edge (no block has a dihedral angle that small)."""
 
 OUR_NAME = re.compile(r"^b\d+_(" + "|".join(BLOCK_CLASSES) + r")_c(\d+)$")
 """Block names written by :func:`masonry.export.obj.blocks_obj`: class and course."""
@@ -163,8 +155,9 @@ def with_ground(blocks: Blocks, tol: Tolerances | None = None) -> Blocks:
     """``blocks`` with a ground slab (class ``ground``, a support) added as block 0.
 
     The slab's top is the plane of the lowest vertex; it reaches under every block that
-    comes within ``tol.contact`` of that plane, with a margin of 5% of that footprint's
-    larger side on every side, and is as thick as the margin. Only those lowest blocks
+    comes within ``tol.contact`` of that plane, with a margin of
+    :data:`~masonry.tolerances.GROUND_MARGIN_REL` (5%) of that footprint's larger side
+    on every side, and is as thick as the margin. Only those lowest blocks
     touch it; what else rests on what is left to the interface detector.
     """
     if "ground" in set(blocks.block_name):
@@ -175,7 +168,7 @@ def with_ground(blocks: Blocks, tol: Tolerances | None = None) -> Blocks:
     top = float(lo[:, 2].min())
     lowest = lo[:, 2] <= top + tol.contact
     foot_lo, foot_hi = lo[lowest, :2].min(axis=0), hi[lowest, :2].max(axis=0)
-    margin = 0.05 * float((foot_hi - foot_lo).max())
+    margin = GROUND_MARGIN_REL * float((foot_hi - foot_lo).max())
     x0, y0 = foot_lo - margin
     x1, y1 = foot_hi + margin
     corners = np.array([[x, y, z] for z in (top - margin, top) for y in (y0, y1)
@@ -225,7 +218,8 @@ def load_assembly(paths, params, *, supports=(), support_below=None, ground=Fals
     ------
     AssemblyError
         A file or a block is bad (:func:`read_blocks`), a support pattern matches
-        nothing, or no block (or every block) is a support.
+        nothing, no block (or every block) is a support, or two blocks overlap
+        (:func:`overlapping_pairs`).
     """
     start = time.perf_counter()
     blocks = read_blocks(paths)
@@ -239,6 +233,7 @@ def load_assembly(paths, params, *, supports=(), support_below=None, ground=Fals
     if is_support.all():
         raise AssemblyError(f"every one of the {len(is_support)} blocks is a support: "
                             "nothing is left to analyse")
+    _refuse_overlaps(blocks, paths)
     blocks = dataclasses.replace(blocks, block_is_support=is_support)
     params = validate(params.replace(scene="assembly", assembly=assembly_name(paths, blocks)))
     source = {"files": [str(p) for p in paths], "support": list(supports),
@@ -248,6 +243,18 @@ def load_assembly(paths, params, *, supports=(), support_below=None, ground=Fals
     log.info("read %d blocks (%d supports) in %.3g s", blocks.n_blocks, source["supports"],
              source["read_s"])
     return Scene(params, blocks), source
+
+
+def _refuse_overlaps(blocks: Blocks, paths):
+    """Raise :class:`AssemblyError` naming the first pair of :func:`overlapping_pairs`."""
+    overlaps = overlapping_pairs(blocks)
+    if len(overlaps):
+        a, b = blocks.block_name[overlaps[0, 0]], blocks.block_name[overlaps[0, 1]]
+        more = f" ({len(overlaps) - 1} more pairs)" if len(overlaps) > 1 else ""
+        files = ", ".join(str(p) for p in paths)
+        raise AssemblyError(f"{files}: blocks {a!r} and {b!r} overlap{more}: interpenetrating "
+                            "solids are not a structure (a block given twice, or the same "
+                            "file twice?)")
 
 
 # ---------------------------------------------------------------------- triangle soups
@@ -312,7 +319,8 @@ def _body_labels(vertices, triangles):
     shared by more than two triangles (blocks in contact share it) joins each triangle
     that opens a solid wedge about the edge with the nearest triangle, turning the same
     way, that closes it; triangles lying on top of each other (within
-    :data:`COINCIDENT_ANGLE`) bound two touching blocks and are never partners.
+    :data:`~masonry.tolerances.COINCIDENT_ANGLE`) bound two touching blocks and are never
+    partners.
     """
     n_tri = len(triangles)
     if n_tri == 0:
@@ -369,12 +377,108 @@ def _pair_about_edge(vertices, lo, hi, third, forward, tri):
     return np.stack([tri[opening[ok]], tri[closing[partner[ok]]]], axis=1)
 
 
+def overlapping_pairs(blocks: Blocks) -> np.ndarray:
+    """Pairs of convex blocks that interpenetrate by more than
+    :data:`~masonry.tolerances.INTERPENETRATION_REL` of the smaller one's size (its
+    bounding box diagonal).
+
+    Decided by the separating axis theorem: pairs whose bounding boxes overlap are
+    projected on the face normals of both blocks, all at once (blocks in contact are
+    separated by their common face's normal); the few left are projected on the cross
+    products of their edges too, which makes the test exact.
+
+    Parameters
+    ----------
+    blocks : Blocks
+        Convex blocks (metres).
+
+    Returns
+    -------
+    (P, 2) int
+        Block index pairs, lower index first, sorted.
+    """
+    lo, hi = blocks.block_bounds[:, 0], blocks.block_bounds[:, 1]
+    size = np.linalg.norm(hi - lo, axis=1)
+    a, b = _box_pairs(lo, hi)
+    depth = INTERPENETRATION_REL * np.minimum(size[a], size[b])
+    boxes = (np.minimum(hi[a], hi[b]) - np.maximum(lo[a], lo[b])).min(axis=1) > depth
+    a, b, depth = a[boxes], b[boxes], depth[boxes]
+    points, normals = _padded(blocks)
+    deep = np.zeros(len(a), bool)
+    chunk = 4096  # pairs at a time: bounded memory
+    for start in range(0, len(a), chunk):
+        i, j = a[start:start + chunk], b[start:start + chunk]
+        axes = np.concatenate([normals[i], normals[j]], axis=1)
+        pa = np.einsum("pvk,pfk->pvf", points[i], axes)
+        pb = np.einsum("pvk,pfk->pvf", points[j], axes)
+        overlap = np.minimum(pa.max(axis=1) - pb.min(axis=1), pb.max(axis=1) - pa.min(axis=1))
+        deep[start:start + chunk] = overlap.min(axis=1) > depth[start:start + chunk]
+    found = [(min(i, j), max(i, j)) for i, j, d in zip(a[deep], b[deep], depth[deep])
+             if _overlap_on_edge_axes(blocks, i, j) > d]
+    return np.array(sorted(found), int).reshape(-1, 2)
+
+
+def _box_pairs(lo, hi):
+    """Index pairs ``(a, b)`` of boxes whose x ranges overlap (a sweep along x)."""
+    n = len(lo)
+    order = np.argsort(lo[:, 0], kind="stable")
+    start = lo[order, 0]
+    end = np.searchsorted(start, hi[order, 0], side="left")
+    counts = np.maximum(end - np.arange(n) - 1, 0)
+    first = np.repeat(np.arange(n), counts)
+    offset = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    return order[first], order[first + 1 + offset]
+
+
+def _padded(blocks: Blocks):
+    """``(B, V, 3)`` vertices and ``(B, F, 3)`` face normals per block, each padded with
+    its block's first one (which changes no projection's range)."""
+    vertex_counts = np.diff(blocks.vertex_offsets)
+    rank = np.arange(len(blocks.vertices)) - np.repeat(blocks.vertex_offsets[:-1],
+                                                       vertex_counts)
+    points = np.repeat(blocks.vertices[blocks.vertex_offsets[:-1], None, :],
+                       vertex_counts.max(), axis=1)
+    points[np.repeat(np.arange(blocks.n_blocks), vertex_counts), rank] = blocks.vertices
+    face_counts = np.bincount(blocks.face_block, minlength=blocks.n_blocks)
+    first_face = np.concatenate([[0], np.cumsum(face_counts)[:-1]])
+    rank = np.arange(blocks.n_faces) - first_face[blocks.face_block]
+    normals = np.repeat(blocks.face_normal[first_face, None, :], face_counts.max(), axis=1)
+    normals[blocks.face_block, rank] = blocks.face_normal
+    return points, normals
+
+
+def _overlap_on_edge_axes(blocks: Blocks, a: int, b: int) -> float:
+    """Smallest overlap of two blocks along the cross products of their edges."""
+    edges_a, edges_b = _block_edges(blocks, a), _block_edges(blocks, b)
+    cross = np.cross(edges_a[:, None, :], edges_b[None, :, :]).reshape(-1, 3)
+    length = np.linalg.norm(cross, axis=1)
+    axes = cross[length > PARALLEL_SIN] / length[length > PARALLEL_SIN, None]
+    if len(axes) == 0:
+        return np.inf
+    pa, pb = blocks.block_vertices(a) @ axes.T, blocks.block_vertices(b) @ axes.T
+    return float(np.minimum(pa.max(axis=0) - pb.min(axis=0),
+                            pb.max(axis=0) - pa.min(axis=0)).min())
+
+
+def _block_edges(blocks: Blocks, block: int) -> np.ndarray:
+    """(E, 3) unit edge directions of one block (each edge once per face using it)."""
+    edges = []
+    for face in blocks.block_faces(block):
+        polygon = blocks.face_polygon(face)
+        edges.append(np.roll(polygon, -1, axis=0) - polygon)
+    edges = np.vstack(edges)
+    length = np.linalg.norm(edges, axis=1)
+    return edges[length > 0] / length[length > 0, None]
+
+
 # ---------------------------------------------------------------------- readers
 def _read_file(path: Path) -> _Soup:
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise AssemblyError(f"{path}: unknown format {path.suffix!r}; masonry reads "
                             f"{', '.join(FORMATS)}")
+    if path.exists() and not path.is_file():  # a folder, FIFO or device never ends well
+        raise AssemblyError(f"{path}: not a regular file")
     try:
         data = path.read_bytes()
     except OSError as error:
@@ -391,6 +495,10 @@ def _read_file(path: Path) -> _Soup:
                             f"({type(error).__name__}: {error})") from None
     if len(soup.triangles) == 0:
         raise AssemblyError(f"{path}: no faces, so no block")
+    bad = ~np.isfinite(soup.vertices).all(axis=1)
+    if bad.any():
+        raise AssemblyError(f"{path}: {bad.sum()} vertices are not finite numbers (nan or "
+                            f"inf), the first at {soup.vertices[bad][0].tolist()}")
     return soup
 
 
@@ -471,7 +579,8 @@ def _read_stl(data: bytes) -> _Soup:
         count = int.from_bytes(data[80:84], "little")
         if len(data) == 84 + 50 * count:
             points = np.frombuffer(data, _STL_RECORD, count=count, offset=84)["points"]
-            return _soup_of_triangles(points.astype(float))
+            with np.errstate(invalid="ignore"):  # NaNs are refused after reading
+                return _soup_of_triangles(points.astype(float))
     text = data.decode("ascii", errors="replace")
     if not text.lstrip().startswith("solid"):
         raise AssemblyError(f"not an STL file: {len(data)} bytes is not 84 + 50 n (binary "
@@ -502,19 +611,58 @@ def _soup_of_triangles(points):
 
 # ---------------------------------------------------------------------- checks, hulls
 def _convex_blocks(soup: _Soup, path: Path, tol: Tolerances) -> Blocks:
-    """Check every block of a merged soup and rebuild it as its hull's planar faces."""
+    """Check every block of a merged soup and rebuild it as its hull's planar faces.
+
+    Raises
+    ------
+    AssemblyError
+        Naming ``path`` and the first bad block: too few triangles, open, not manifold,
+        inconsistently oriented, inside out, flat, several bodies, not convex, or faces
+        that do not merge into planar polygons.
+    """
+    vstart = _vertex_ranges(soup)
+    volume = _signed_volumes(soup, vstart)
+    problem = _surface_problem(soup) or _volume_problem(volume, soup, vstart, tol)
+    if problem is not None:
+        raise AssemblyError(f"{path}: block {soup.names[problem[0]]!r} {problem[1]}")
+    hulls = []
+    for b in range(len(soup.names)):
+        points = soup.vertices[vstart[b]:vstart[b + 1]]
+        hull, why = _convex_hull(points, volume[b],
+                                 soup.triangles[soup.triangle_block == b] - vstart[b])
+        if why is not None:
+            raise AssemblyError(f"{path}: block {soup.names[b]!r} {why}")
+        hulls.append((points, _hull_faces(points, hull, tol.contact), hull.volume))
+    blocks = _blocks_from_hulls(soup.names, [h[0] for h in hulls], [h[1] for h in hulls],
+                                path)
+    # the merged polygons must enclose the hull: faces that overlap or leave holes (a
+    # surface too curved for tol.contact to tell its facets apart) change the volume
+    mismatch = np.abs(blocks.block_volume / np.array([h[2] for h in hulls]) - 1.0)
+    if (mismatch > CONVEXITY_REL).any():
+        bad = int(np.argmax(mismatch > CONVEXITY_REL))
+        raise AssemblyError(f"{path}: block {soup.names[bad]!r} has faces that cannot be "
+                            "merged into planar polygons (nearly coplanar facets: a curved "
+                            "surface?)")
+    return blocks
+
+
+def _vertex_ranges(soup: _Soup) -> np.ndarray:
+    """(B + 1,) int: block ``b`` owns vertices ``vstart[b]:vstart[b + 1]`` (blocks own
+    contiguous vertex ranges after :meth:`_Soup.merged`)."""
+    vertex_block = np.empty(len(soup.vertices), int)
+    vertex_block[soup.triangles.reshape(-1)] = np.repeat(soup.triangle_block, 3)
+    return np.searchsorted(vertex_block, np.arange(len(soup.names) + 1))
+
+
+def _surface_problem(soup: _Soup):
+    """``(block, why)`` of the first block that is not a closed, manifold, consistently
+    oriented surface of at least four triangles (every edge used by exactly two
+    triangles, once in each direction), else None."""
     n_blocks = len(soup.names)
     tri_block = soup.triangle_block
-
-    def fail(block, why):
-        raise AssemblyError(f"{path}: block {soup.names[block]!r} {why}")
-
     present = np.bincount(tri_block, minlength=n_blocks)
-    for block in np.flatnonzero(present < 4):
-        fail(block, f"has {present[block]} triangles: too few for a solid")
-
-    # closed, manifold, consistently oriented: every edge used by exactly two triangles,
-    # once in each direction
+    for block in np.flatnonzero(present < 4)[:1]:
+        return block, f"has {present[block]} triangles: too few for a solid"
     t = soup.triangles
     start, end = t.reshape(-1), np.roll(t, -1, axis=1).reshape(-1)
     lo, hi = np.minimum(start, end), np.maximum(start, end)
@@ -529,62 +677,60 @@ def _convex_blocks(soup: _Soup, path: Path, tol: Tolerances) -> Blocks:
         ((count == 2) & (forward != 1),
          "is not consistently oriented: {n} edges are run twice in the same direction"),
     ]
-    bad_block = n_blocks
-    for bad, _ in problems:
-        if bad.any():
-            bad_block = min(bad_block, int(edge_block[bad].min()))
+    bad_block = min([int(edge_block[bad].min()) for bad, _ in problems if bad.any()],
+                    default=n_blocks)
     for bad, why in problems:
         n = int((bad & (edge_block == bad_block)).sum())
         if n:
             # a cut-off file leaves its last block open
             last = (" (the last block in the file: is the file truncated?)"
                     if bad_block == n_blocks - 1 else "")
-            fail(bad_block, why.format(n=n, last=last))
+            return bad_block, why.format(n=n, last=last)
+    return None
 
-    # blocks own contiguous vertex ranges (_Soup.merged)
-    vertex_block = np.empty(len(soup.vertices), int)
-    vertex_block[t.reshape(-1)] = np.repeat(tri_block, 3)
-    vstart = np.searchsorted(vertex_block, np.arange(n_blocks + 1))
-    # signed volume by the divergence theorem about each block's first vertex
-    tri = soup.vertices[t]
+
+def _signed_volumes(soup: _Soup, vstart) -> np.ndarray:
+    """(B,) float, m^3: signed volume of every block, by the divergence theorem about
+    the block's first vertex (which keeps the sum free of cancellation far from the
+    origin); negative for a block whose faces point inward."""
+    tri_block = soup.triangle_block
+    tri = soup.vertices[soup.triangles]
     ref = soup.vertices[vstart[tri_block]]
     six = np.einsum("ij,ij->i", tri[:, 0] - ref, np.cross(tri[:, 1] - ref, tri[:, 2] - ref))
-    volume = np.bincount(tri_block, six, minlength=n_blocks) / 6.0
+    return np.bincount(tri_block, six, minlength=len(soup.names)) / 6.0
+
+
+def _volume_problem(volume, soup: _Soup, vstart, tol: Tolerances):
+    """``(block, why)`` of the first block that is inside out, then of the first that is
+    flat (no ``volume`` within ``tol.length`` times its size squared), else None."""
     size = np.linalg.norm(np.maximum.reduceat(soup.vertices, vstart[:-1])
                           - np.minimum.reduceat(soup.vertices, vstart[:-1]), axis=1)
     flat = np.abs(volume) <= tol.length * size**2
     for b in np.flatnonzero((volume < 0) & ~flat)[:1]:
-        fail(b, f"is inside out: its faces point inward (volume {volume[b]:.4g} m^3)")
+        return b, f"is inside out: its faces point inward (volume {volume[b]:.4g} m^3)"
     for b in np.flatnonzero(flat)[:1]:
-        fail(b, "is flat: it has no volume")
+        return b, "is flat: it has no volume"
+    return None
 
-    hull_points, hull_faces, hull_volume = [], [], np.zeros(n_blocks)
-    for b in range(n_blocks):
-        points = soup.vertices[vstart[b]:vstart[b + 1]]
-        try:
-            hull = ConvexHull(points)
-        except QhullError:
-            fail(b, "is flat: it has no volume")
-        deficit = 1.0 - volume[b] / hull.volume
-        if deficit > CONVEXITY_REL:
-            bodies = int(_body_labels(points, soup.triangles[tri_block == b]
-                                      - vstart[b]).max()) + 1
-            why = (f"holds {bodies} separate bodies" if bodies > 1
-                   else f"is not convex: its volume is {100 * deficit:.3g}% below its convex "
-                        f"hull's (tolerance {100 * CONVEXITY_REL:g}%)")
-            fail(b, why)
-        hull_points.append(points)
-        hull_faces.append(_hull_faces(points, hull, tol.contact))
-        hull_volume[b] = hull.volume
-    blocks = _blocks_from_hulls(soup.names, hull_points, hull_faces, path)
-    # the merged polygons must enclose the hull: faces that overlap or leave holes (a
-    # surface too curved for tol.contact to tell its facets apart) change the volume
-    mismatch = np.abs(blocks.block_volume / hull_volume - 1.0)
-    if (mismatch > CONVEXITY_REL).any():
-        fail(int(np.argmax(mismatch > CONVEXITY_REL)),
-             "has faces that cannot be merged into planar polygons (nearly coplanar "
-             "facets: a curved surface?)")
-    return blocks
+
+def _convex_hull(points, volume, triangles):
+    """``(hull, None)``: the convex hull of a closed block's ``points`` ((n, 3) float),
+    or ``(None, why)`` when the block is flat, or its ``volume`` (m^3) falls short of
+    the hull's by more than :data:`~masonry.tolerances.CONVEXITY_REL`: it holds several
+    bodies (its ``triangles``, (T, 3) int into ``points``, fall apart) or is not
+    convex."""
+    try:
+        hull = ConvexHull(points)
+    except QhullError:
+        return None, "is flat: it has no volume"
+    deficit = 1.0 - volume / hull.volume
+    if not deficit > CONVEXITY_REL:
+        return hull, None
+    bodies = int(_body_labels(points, triangles).max()) + 1
+    if bodies > 1:
+        return None, f"holds {bodies} separate bodies"
+    return None, (f"is not convex: its volume is {100 * deficit:.3g}% below its convex "
+                  f"hull's (tolerance {100 * CONVEXITY_REL:g}%)")
 
 
 def _hull_faces(points, hull, distance):
@@ -644,7 +790,7 @@ def _blocks_from_hulls(names, hull_points, hull_faces, path) -> Blocks:
         a, b = p - p[prev], p[nxt] - p
         turn = np.einsum("ij,ij->i", np.cross(a, b), normal[entry_face])
         scale = np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1)
-        straight = turn <= 1e-9 * scale
+        straight = turn <= COLLINEAR_SIN * scale
         if not straight.any():
             break
         entry_face, entry_point = entry_face[~straight], entry_point[~straight]
@@ -678,7 +824,7 @@ def _unique_names(names):
 def _classes_from_names(names):
     """(B,) class and course from our own names (``b0042_regular_c12``), else ``block``
     and 0."""
-    block_class = np.full(len(names), BLOCK_CLASSES.index("block"), dtype=np.int8)
+    block_class = np.full(len(names), BLOCK, dtype=np.int8)
     block_course = np.zeros(len(names), int)
     for i, name in enumerate(names):
         match = OUR_NAME.match(name)

@@ -7,6 +7,7 @@ copies close into the whole dome face to face (SPEC 4.6).
 """
 
 import dataclasses
+import logging
 
 import numpy as np
 
@@ -17,8 +18,9 @@ from masonry.dome.pattern import build_pattern
 from masonry.params import ParameterError, Params
 from masonry.scenes.base import Scene, hexahedra_frames
 from masonry.scenes.bricks import blocks_from_layout, posed_corners
-from masonry.tolerances import Tolerances
+from masonry.tolerances import STRETCH_USUAL_RANGE, Tolerances
 
+log = logging.getLogger(__name__)
 
 def build_section(params: Params) -> Scene:
     """One web of the dome (SPEC 4.2 to 4.5) on its ground slab (block 0).
@@ -31,7 +33,8 @@ def build_section(params: Params) -> Scene:
     levels = level_table(params, dims)
     if levels.n_courses < 2:
         raise ParameterError("cut", params.cut, "a dome at least two courses high "
-                             f"(this one holds {levels.n_courses}); lower cut or unit")
+                             f"(this one holds {levels.n_courses}); lower cut or unit",
+                             related=("unit", "stretch", "p", "r"))
     widest = float(levels.wedge_angles.max())
     limit = Tolerances().max_gap_angle
     if widest > limit:
@@ -39,7 +42,12 @@ def build_section(params: Params) -> Scene:
             "p", params.p,
             f"a dome large enough for its bricks: its courses meet in wedges of up to "
             f"{np.degrees(widest):.1f} degrees, more than the {np.degrees(limit):g} "
-            f"degrees whose gaps can be closed; raise p or r, or the stretch")
+            f"degrees whose gaps can be closed; raise p or r, or the stretch",
+            related=("stretch", "r", "n", "unit"))
+    low, high = STRETCH_USUAL_RANGE
+    if not low <= params.stretch <= high:
+        log.warning("stretch=%g is outside %g..%g: the dome is unusually flat or tall",
+                    params.stretch, low, high)
     half_width = levels.y[1:] / params.unit
     pattern = build_pattern(half_width, params.p, params.r)
     layout = fill_courses(half_width, pattern, params.min_fill, miter=True)

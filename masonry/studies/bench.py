@@ -24,7 +24,8 @@ import time
 import numpy as np
 
 from masonry.rbe.boundary import analysis_model
-from masonry.export.csv import forces_csv, interfaces_csv, locations_csv
+from masonry.export import force_tables
+from masonry.export.csv import interfaces_csv, locations_csv
 from masonry.export.obj import blocks_obj
 from masonry.params import from_preset
 from masonry.scenes import build
@@ -38,8 +39,14 @@ SCENES = {
     "section": dict(scene="section", boundary="free"),
     "cyclic": dict(scene="section", boundary="cyclic"),
     "dome": dict(scene="dome"),
+    "dome-mu0.05": dict(scene="dome", mu=0.05),
 }
-"""Bench scene name -> :class:`~masonry.params.Params` fields."""
+"""Bench scene name -> :class:`~masonry.params.Params` fields (over the bench's ``mu``
+and ``density``). ``section`` (free-standing, the thesis's x.1) and ``dome-mu0.05`` are
+infeasible; ``cyclic`` and ``dome`` are their feasible counterparts of the same size."""
+
+PAIRS = (("section", "cyclic"), ("dome-mu0.05", "dome"))
+"""(infeasible, feasible) scenes of the same size, compared by :func:`ratios`."""
 
 STAGES = ("model", "interfaces", "assembly", "solve", "exports")
 
@@ -93,8 +100,8 @@ def bench(presets=("1", "2", "3"), scenes=tuple(SCENES), accuracies=tuple(ACCURA
     runs += [("balanced", solver) for solver in solvers]
     for preset in presets:
         for scene_name in scenes:
-            params = from_preset(preset, mu=mu, density=density,
-                                 **{**SCENES[scene_name], **(overrides or {})})
+            params = from_preset(preset, **{"mu": mu, "density": density,
+                                            **SCENES[scene_name], **(overrides or {})})
             reference = None
             if "accurate" not in accuracies:
                 reference = _run(params, "accurate", None, exports=False)[1]
@@ -142,11 +149,7 @@ def _run(params, accuracy, solver, exports=True):
         blocks_obj(scene.blocks)
         interfaces_csv(model.blocks, model.interfaces)
         if result.x is not None:
-            from masonry.export.vtu import interfaces_vtu
-
-            forces = result.per_interface()
-            forces_csv(model.blocks, model.interfaces, forces)
-            interfaces_vtu(model.interfaces, forces)
+            force_tables(model.blocks, model.interfaces, result, result.per_interface())
     seconds["exports"] = time.perf_counter() - start
     counts = {"bricks": int((~scene.blocks.block_is_support).sum()),
               "unknowns": problem.system.layout.n_columns}
@@ -176,6 +179,32 @@ def _row(preset, scene, accuracy, solver, times, result, counts, reference) -> d
     }
 
 
+def ratios(rows) -> list:
+    """Infeasible against feasible: for every preset, accuracy (and extra solver) and
+    :data:`PAIRS` pair measured, ``total_s`` of the infeasible scene over that of the
+    feasible one (the same web or dome, the same number of bricks).
+
+    Returns
+    -------
+    list of dict
+        ``preset``, ``accuracy``, ``solver``, ``infeasible``, ``feasible`` (scene names),
+        ``infeasible_s``, ``feasible_s``, ``ratio``.
+    """
+    by_key = {(r["preset"], r["scene"], r["accuracy"], r["solver"]): r for r in rows}
+    out = []
+    for (preset, scene, accuracy, solver), row in by_key.items():
+        for infeasible, feasible in PAIRS:
+            other = next((r for (p, sc, a, _), r in by_key.items()
+                          if (p, sc, a) == (preset, feasible, accuracy)), None)
+            if scene != infeasible or other is None:
+                continue
+            out.append({"preset": preset, "accuracy": accuracy, "solver": solver,
+                        "infeasible": infeasible, "feasible": feasible,
+                        "infeasible_s": row["total_s"], "feasible_s": other["total_s"],
+                        "ratio": row["total_s"] / other["total_s"]})
+    return out
+
+
 # ---------------------------------------------------------------------- formatting
 def _cell(key, value) -> str:
     if isinstance(value, float):
@@ -202,6 +231,20 @@ def table_markdown(rows, columns=MARKDOWN_COLUMNS) -> str:
              "|" + "|".join("---" for _ in columns) + "|"]
     for row in rows:
         lines.append("| " + " | ".join(_cell(c, row[c]) for c in columns) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def ratios_markdown(rows) -> str:
+    """A Markdown table of :func:`ratios` (empty when no pair was measured)."""
+    pairs = ratios(rows)
+    if not pairs:
+        return ""
+    lines = ["| preset | accuracy | infeasible | feasible | infeasible_s | feasible_s | ratio |",
+             "|---|---|---|---|---|---|---|"]
+    for r in pairs:
+        lines.append(f"| {r['preset']} | {r['accuracy']} | {r['infeasible']} | "
+                     f"{r['feasible']} | {r['infeasible_s']:.2f} | {r['feasible_s']:.2f} | "
+                     f"{r['ratio']:.2f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -234,19 +277,24 @@ def frontier_png(rows) -> bytes:
         x = [r["solve_s"] for r in own]
         y = [max(r["force_deviation"] if r["force_deviation"] > 0 else r["residual_eq"],
                  floor) if np.isfinite(r["force_deviation"]) else np.nan for r in own]
-        ax.plot(x, y, "-", color=colour, alpha=0.5)
+        ax.plot(x, y, "-", color=colour, alpha=0.5, label=f"preset {preset}, {scene}")
         for r, xi, yi in zip(own, x, y):
-            ax.plot(xi, yi, markers.get(r["accuracy"], "x"), color=colour,
-                    label=f"{preset} {scene}" if r is own[0] else None)
-    for name, marker in markers.items():
-        ax.plot([], [], marker, color="black", label=name)
+            ax.plot(xi, yi, markers.get(r["accuracy"], "x"), color=colour)
+    # two legends: colour = structure, marker = accuracy preset (only those run)
+    structures_legend = ax.legend(fontsize=7, loc="upper right", title="structure",
+                                  title_fontsize=7)
+    ax.add_artist(structures_legend)
+    ran = dict.fromkeys(r["accuracy"] for r in rows)
+    handles = [ax.plot([], [], markers.get(name, "x"), color="black", label=name)[0]
+               for name in ran]
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("solve time, s (median)")
     ax.set_ylabel("force deviation from the accurate solution")
     ax.set_title("speed / accuracy frontier (lower left is better)")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
+    ax.legend(handles=handles, fontsize=7, loc="lower left", title="accuracy",
+              title_fontsize=7)
     buffer = io.BytesIO()
     fig.tight_layout()
     fig.savefig(buffer, format="png")

@@ -15,6 +15,7 @@ import numpy as np
 
 from masonry.rbe.boundary import analysis_model
 from masonry.rbe.collapse import worst_lateral
+from masonry.rbe.equilibrium import VariableLayout
 from masonry.params import from_preset
 from masonry.scenes import build
 
@@ -88,11 +89,28 @@ def lateral_record(model, params, count=3) -> dict:
 def structures_table(rows=ROWS, full_dome=True, lp_check=False, lateral=False):
     """Solve every row; return a list of dicts with :data:`COLUMNS`.
 
-    ``full_dome=False`` leaves the full-dome rows out (they are the slowest: every web
-    explicit). The LP check is off by default: the table reports the QP's verdict with its
-    recomputed residuals. ``lateral=True`` adds :data:`LATERAL_COLUMNS` to the full-dome
-    rows (the x.2 domes as a whole: a lateral load breaks the symmetry a cyclic section
-    assumes), searched over :func:`symmetric_azimuths`.
+    Parameters
+    ----------
+    rows : sequence of (str, str, str, str, str, float)
+        ``(structure, preset, scene, boundary, friction, mu)``; default :data:`ROWS`
+        (thesis tables 4.1 and 4.3, every boundary model).
+    full_dome : bool
+        False leaves the full-dome rows out (they are the slowest: every web explicit).
+    lp_check : bool
+        Confirm infeasible verdicts with the LP. Off by default: the table reports the
+        QP's verdict with its recomputed residuals.
+    lateral : bool
+        Add :data:`LATERAL_COLUMNS` to the full-dome rows (the x.2 domes as a whole: a
+        lateral load breaks the symmetry a cyclic section assumes), searched over
+        :func:`symmetric_azimuths`.
+
+    Returns
+    -------
+    list of dict
+        One dict per solved row, keys :data:`COLUMNS` (and :data:`LATERAL_COLUMNS`): the verdict, ``objective``
+        (N^2), ``moi`` and ``weight_N`` (N), ``moi_factor`` (dimensionless), counts,
+        the relative equilibrium residual, ``time_s`` (wall clock, s) and what the
+        thesis printed (:data:`THESIS`; None where it printed nothing).
     """
     from masonry.rbe.solve import solve_rbe
 
@@ -119,7 +137,7 @@ def structures_table(rows=ROWS, full_dome=True, lp_check=False, lateral=False):
             "objective": d["objective"], "moi": d["moi"], "weight_N": d["weight_N"],
             "moi_factor": d["moi_factor"], "bricks": int((~scene.blocks.block_is_support).sum()),
             "interfaces": len(model.interfaces),
-            "unknowns": 4 * int(model.interfaces.vertex_count.sum()),
+            "unknowns": VariableLayout.from_interfaces(model.interfaces).n_columns,
             "residual_eq": d["residual_eq"], "time_s": round(time.perf_counter() - start, 2),
             "thesis_feasible": thesis[0], "thesis_moi_factor": thesis[1],
         })
@@ -136,6 +154,9 @@ def _cell(value):
 
 
 def table_csv(rows) -> bytes:
+    """The rows of :func:`structures_table` as CSV (UTF-8 bytes): a header of
+    :data:`COLUMNS` (and :data:`LATERAL_COLUMNS` when a row has them), floats to 4
+    significant digits, None as an empty cell."""
     columns = COLUMNS + (LATERAL_COLUMNS if any("lateral_factor" in r for r in rows) else ())
     lines = [",".join(columns)]
     lines += [",".join(_cell(row.get(c)) for c in columns) for row in rows]
@@ -143,6 +164,8 @@ def table_csv(rows) -> bytes:
 
 
 def table_markdown(rows) -> str:
+    """The rows of :func:`structures_table` as a Markdown table, followed by a table of
+    each preset's boundary models side by side (verdict and MoI factor at ``mu = 0.7``)."""
     shown = ("structure", "scene", "boundary", "friction", "mu", "feasible", "objective",
              "moi", "weight_N", "moi_factor", "bricks", "unknowns", "time_s",
              "thesis_feasible", "thesis_moi_factor")

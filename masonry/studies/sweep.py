@@ -14,13 +14,18 @@ import dataclasses
 import itertools
 import json
 import logging
+import signal
 import time
 import traceback
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.params import Params, ParameterError
+from masonry.params import Params, ParameterError, validate
+from masonry.pipeline import run
+from masonry.plots import _png, plt
+from masonry.rbe.solvers.newton import use_one_blas_thread
 
 log = logging.getLogger(__name__)
 
@@ -66,7 +71,20 @@ class Study:
         return list(self.grid) + [k for k in self.sample if k not in self.grid]
 
     def variants(self) -> list:
-        """One dict of inputs per variant (base, then grid point, then sample)."""
+        """One dict of inputs per variant (base, then grid point, then sample).
+
+        Returns
+        -------
+        list of dict
+            ``Params`` fields of every variant: the grid's Cartesian product, each point
+            combined with every one of the ``count`` seeded draws.
+
+        Raises
+        ------
+        ParameterError
+            For inputs that are not ``Params`` fields, a grid entry that is not a
+            non-empty list, or samples with ``count < 1``.
+        """
         fields = {f.name for f in dataclasses.fields(Params)}
         unknown = (set(self.base) | set(self.grid) | set(self.sample)) - fields
         if unknown:
@@ -95,11 +113,25 @@ class Study:
 
 
 def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=False) -> dict:
-    """Run one variant; never raises: a failure becomes a row with its error."""
-    from masonry.params import validate
-    from masonry.pipeline import run
-    from masonry.rbe.solvers.newton import use_one_blas_thread
+    """Run one variant; never raises: a failure becomes a row with its error.
 
+    Parameters
+    ----------
+    inputs : dict
+        ``Params`` fields of the variant.
+    out_root : str or Path
+        The study's output root; the variant's run folder is named by its structure id.
+    analyse, plots, printable : bool
+        What the run does and writes (:func:`masonry.pipeline.run`).
+
+    Returns
+    -------
+    dict
+        ``status`` (``'computed'``, ``'reused'`` or ``'failed'``), ``error`` (str, empty
+        unless failed), ``time_s`` (wall clock, s) and, for a run that did not fail, the
+        result columns of :data:`SUMMARY_COLUMNS` (``moi`` and ``weight_N`` in N,
+        ``objective`` in N^2, ``moi_factor`` and ``residual_eq`` dimensionless).
+    """
     use_one_blas_thread()  # in a Dask worker process too
     start = time.perf_counter()
     row = {"status": "failed", "error": ""}
@@ -128,12 +160,28 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
 
 def run_after(previous, inputs: dict, out_root, **options) -> dict:
     """:func:`run_variant` once ``previous`` (the row of the variant that built the shared
-    geometry) is done: Dask passes the finished result in, which orders the two."""
+    geometry) is done: Dask passes the finished result in, which orders the two.
+
+    ``previous`` is not used otherwise; ``inputs``, ``out_root`` and ``options`` are
+    :func:`run_variant`'s, and so is the returned row.
+    """
     return run_variant(inputs, out_root, **options)
 
 
 def geometry_group(inputs: dict) -> str:
-    """Variants with the same group share their geometry and interfaces (the cache key)."""
+    """Variants with the same group share their geometry and interfaces (the cache key).
+
+    Parameters
+    ----------
+    inputs : dict
+        ``Params`` fields of a variant.
+
+    Returns
+    -------
+    str
+        JSON of the variant's geometric inputs; of all its inputs when they are not valid
+        ``Params`` (such a variant is a group of its own and fails on its own).
+    """
     try:
         return json.dumps(Params(**inputs).geometry_key, sort_keys=True, default=str)
     except (TypeError, ValueError):  # an invalid variant: alone, to fail on its own
@@ -143,9 +191,34 @@ def geometry_group(inputs: dict) -> str:
 def execute(study: Study, out_root, workers=1, scheduler=None):
     """Run every variant; yield ``(index, inputs, row)`` as each finishes.
 
-    ``workers=1`` and no ``scheduler``: serially, in this process. Otherwise on Dask: a
-    ``LocalCluster`` of ``workers`` single-threaded processes, or the scheduler at
-    ``scheduler`` (``tcp://host:port``). A variant whose worker dies is recorded as failed.
+    Parameters
+    ----------
+    study : Study
+    out_root : str or Path
+        Where every variant's run folder goes.
+    workers : int
+        1 and no ``scheduler``: serially, in this process. More: on a Dask
+        ``LocalCluster`` of ``workers`` single-threaded processes (which ignore Ctrl-C:
+        this process stops them).
+    scheduler : str, optional
+        The address of a running Dask scheduler (``tcp://host:port``), used instead of a
+        local cluster.
+
+    Yields
+    ------
+    index : int
+        The variant's position in ``study.variants()``.
+    inputs : dict
+        Its inputs.
+    row : dict
+        :func:`run_variant`'s row; a variant whose worker dies is recorded as failed.
+
+    Raises
+    ------
+    ParameterError
+        When the study's inputs are not ``Params`` fields or its grid or sample is
+        malformed (before any variant runs); named ``scheduler`` when no Dask scheduler
+        answers at that address.
     """
     variants = study.variants()
     options = dict(analyse=study.analyse, plots=study.plots, printable=study.printable)
@@ -157,9 +230,18 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
 
     cluster = None
     if scheduler is None:
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                               host="127.0.0.1", dashboard_address=None)
-    client = Client(cluster if cluster is not None else scheduler)
+        with _children_ignore_ctrl_c():
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   host="127.0.0.1", dashboard_address=None,
+                                   silence_logs=logging.ERROR)
+    try:
+        client = Client(cluster if cluster is not None else scheduler)
+    except (OSError, ValueError, TypeError) as error:  # no scheduler there
+        if cluster is not None:
+            cluster.close()
+            raise
+        raise ParameterError("scheduler", scheduler, f"the address of a running Dask "
+                                                     f"scheduler ({error})") from None
     try:
         # the first variant of each geometry builds it; the others of its group wait for
         # it and reuse the cached geometry instead of building it again in parallel
@@ -187,8 +269,37 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
             cluster.close()
 
 
+@contextmanager
+def _children_ignore_ctrl_c():
+    """Processes started inside the block ignore SIGINT (an ignored signal stays ignored
+    in a child): Ctrl-C in a terminal reaches every process of its group, and the worker
+    processes would each print a traceback. This process alone gets it, and stops them
+    as it unwinds."""
+    try:
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except ValueError:  # not the main thread: nothing to change
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def summary_rows(study: Study, results) -> list:
-    """Rows of the summary table in variant order: swept inputs, then results."""
+    """Rows of the summary table in variant order: swept inputs, then results.
+
+    Parameters
+    ----------
+    study : Study
+    results : iterable of (int, dict, dict)
+        ``(index, inputs, row)`` as :func:`execute` yields them, in any order.
+
+    Returns
+    -------
+    list of dict
+        One dict per variant, keys ``study.swept`` then :data:`SUMMARY_COLUMNS`.
+    """
     rows = []
     for i, inputs, row in sorted(results, key=lambda r: r[0]):
         rows.append({**{k: inputs.get(k) for k in study.swept}, "variant": i,
@@ -197,6 +308,8 @@ def summary_rows(study: Study, results) -> list:
 
 
 def summary_csv(study: Study, rows) -> bytes:
+    """CSV (UTF-8 bytes) of :func:`summary_rows`: swept inputs, then
+    :data:`SUMMARY_COLUMNS`; floats to 6 significant digits, None as an empty cell."""
     columns = study.swept + list(SUMMARY_COLUMNS)
     lines = [",".join(columns)]
     for row in rows:
@@ -210,7 +323,8 @@ def summary_csv(study: Study, rows) -> bytes:
 
 
 def summary_parquet(study: Study, rows):
-    """Parquet bytes of the summary, or None when pyarrow is not installed."""
+    """Parquet bytes of :func:`summary_rows` (same columns as :func:`summary_csv`), or
+    None when pyarrow is not installed."""
     try:
         import pyarrow as pa
         import pyarrow.parquet as pq
@@ -228,20 +342,42 @@ def summary_parquet(study: Study, rows):
 
 
 def summary_pngs(study: Study, rows) -> dict:
-    """MoI factor and feasibility against each swept input (one figure per input)."""
-    from masonry.plots import _png, plt
+    """MoI factor and feasibility against each swept input (one figure per input); with
+    a second swept input, one colour per value of it (the first other swept input).
 
+    Returns
+    -------
+    dict str -> bytes
+        ``moi_factor_<input>.png`` -> PNG bytes, one per name of ``study.swept``; failed
+        variants are left out of the points and counted in the title.
+    """
     out = {}
     done = [r for r in rows if r["status"] != "failed"]
     for name in study.swept:
+        others = [other for other in study.swept if other != name]
+        group = others[0] if others else None
         fig, (top, bottom) = plt.subplots(2, 1, figsize=(6, 6), sharex=True)
         x = [r[name] for r in done]
         numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in x)
         labels = sorted({str(v) for v in x}) if not numeric else None
-        xs = x if numeric else [labels.index(str(v)) for v in x]
-        top.scatter(xs, [r["moi_factor"] for r in done], c="C3", s=18)
+        xs = np.array(x if numeric else [labels.index(str(v)) for v in x], dtype=float)
+        keys = [None] if group is None else sorted({r[group] for r in done}, key=str)
+        if len(keys) > 8:  # e.g. a sampled input: too many values to tell apart
+            group, keys = None, [None]
+        # feasibility points of the groups side by side, not on top of each other
+        offsets = 0.06 * (np.arange(len(keys)) - (len(keys) - 1) / 2)
+        for colour, key, offset in zip(plt.cm.viridis(np.linspace(0, 0.9, len(keys))), keys,
+                                       offsets):
+            mine = [i for i, r in enumerate(done) if group is None or r[group] == key]
+            mine.sort(key=lambda i: xs[i])
+            label = None if group is None else f"{group} = {key}"
+            top.plot(xs[mine], [done[i]["moi_factor"] for i in mine], "-o", color=colour,
+                     markersize=4, linewidth=1, label=label)
+            bottom.plot(xs[mine], [(1 if done[i]["feasible"] else 0) + offset for i in mine],
+                        "o", color=colour, markersize=4)
+        if group is not None:
+            top.legend(fontsize=7, frameon=False)
         top.set_ylabel("MoI factor")
-        bottom.scatter(xs, [1 if r["feasible"] else 0 for r in done], c="C0", s=18)
         bottom.set_yticks([0, 1], ["infeasible", "feasible"])
         bottom.set_xlabel(name)
         if labels is not None:

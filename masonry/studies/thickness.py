@@ -14,9 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonry.interfaces import detect
-from masonry.params import Params, arch_radius, validate
+from masonry.params import ParameterError, Params, arch_radius, validate
 from masonry.rbe.solve import solve_rbe
 from masonry.scenes.arch import build_arch
+from masonry.tolerances import THICKNESS_BRACKET, THICKNESS_LIMIT_FRACTION, THICKNESS_RTOL
 
 log = logging.getLogger(__name__)
 
@@ -56,7 +57,8 @@ def is_feasible(params: Params) -> bool:
     return bool(result.feasible)
 
 
-def minimum_thickness(params: Params, rtol=1e-4, bracket=(0.01, 0.8)) -> ThicknessResult:
+def minimum_thickness(params: Params, rtol=THICKNESS_RTOL,
+                      bracket=THICKNESS_BRACKET) -> ThicknessResult:
     """The minimum thickness of the arch of ``params`` (its ``arch_thickness`` is
     ignored), by bisection on :func:`is_feasible`.
 
@@ -72,20 +74,25 @@ def minimum_thickness(params: Params, rtol=1e-4, bracket=(0.01, 0.8)) -> Thickne
     rtol : float
         Relative width of the final bracket.
     bracket : (float, float)
-        Starting ``(infeasible, feasible)`` t/R; the upper end is cut to 0.99 of the
+        Starting ``(infeasible, feasible)`` t/R; the upper end is cut to
+        :data:`~masonry.tolerances.THICKNESS_LIMIT_FRACTION` (0.99) of the
         largest thickness the shape allows (the intrados vanishes there).
 
     Raises
     ------
+    ParameterError
+        ``rtol`` is not in (0, 1); or the upper end is infeasible (the arch slides at
+        every thickness: named ``mu``).
     ValueError
-        The upper end is infeasible (e.g. the arch slides at every thickness: raise
-        ``mu``) or the lower end is feasible (lower it).
+        The lower end of ``bracket`` is feasible (lower it).
     """
+    if not (isinstance(rtol, float | int) and 0 < rtol < 1):
+        raise ParameterError("rtol", rtol, "a relative width between 0 and 1 (exclusive)")
     start = time.perf_counter()
     params = params.replace(scene="arch")
     radius, _ = arch_radius(params.arch_shape, params.arch_span, params.arch_rise)
     most = (params.arch_span if params.arch_shape == "pointed" else 2 * radius) / radius
-    lo, hi = bracket[0], min(bracket[1], 0.99 * most)
+    lo, hi = bracket[0], min(bracket[1], THICKNESS_LIMIT_FRACTION * most)
     steps = []
 
     def feasible(ratio):
@@ -95,8 +102,9 @@ def minimum_thickness(params: Params, rtol=1e-4, bracket=(0.01, 0.8)) -> Thickne
         return verdict
 
     if not feasible(hi):
-        raise ValueError(f"the arch does not stand even at t/R = {hi:g} (with mu = "
-                         f"{params.mu:g}: sliding?)")
+        raise ParameterError("mu", params.mu, f"a friction coefficient at which the arch "
+                                              f"stands: it falls even at t/R = {hi:g}, so "
+                                              "its voussoirs slide")
     if feasible(lo):
         raise ValueError(f"the arch stands already at t/R = {lo:g}: lower the bracket")
     while hi / lo - 1 > rtol:
@@ -107,3 +115,20 @@ def minimum_thickness(params: Params, rtol=1e-4, bracket=(0.01, 0.8)) -> Thickne
             lo = mid
     return ThicknessResult(t_over_r=hi, lower=lo, thickness=hi * radius, radius=radius,
                            steps=tuple(steps), time_s=time.perf_counter() - start)
+
+
+def folder_name(params: Params, rtol: float) -> str:
+    """The run folder of a minimum-thickness search: every input but the thickness."""
+    p = params
+    name = (f"arch-thickness_{p.arch_shape}_N{p.arch_blocks}_s{p.arch_span:g}"
+            f"_d{p.arch_depth:g}" + ("" if p.arch_rise is None else f"_h{p.arch_rise:g}")
+            + f"_mu{p.mu:g}_rho{p.density:g}_rtol{rtol:g}")
+    return name + ("" if p.solver is None else f"_{p.solver}")
+
+
+def steps_csv(result: ThicknessResult) -> bytes:
+    """One row per bisection step: t/R, thickness (metres), whether the arch stands."""
+    lines = ["step,t_over_r,thickness_m,stands"]
+    lines += [f"{i},{ratio:.9g},{ratio * result.radius:.9g},{int(stands)}"
+              for i, (ratio, stands) in enumerate(result.steps)]
+    return ("\n".join(lines) + "\n").encode()

@@ -14,6 +14,8 @@ from scipy.optimize import brentq, minimize_scalar
 
 from masonry.params import arch_radius
 from masonry.scenes.arch import ArchProfile, arch_profile, polygon_area_centroid
+from masonry.tolerances import (THRUST_ACTIVE_REL, THRUST_MARGIN_XATOL_REL, THRUST_SCAN,
+                                THRUST_XTOL)
 
 
 @dataclass(frozen=True)
@@ -99,7 +101,7 @@ def thrust_line_margin(profile: ArchProfile, mu=np.inf):
         The thrust at the maximum, per unit weight density and depth (NaN if none).
     lower_active, upper_active : (J,) bool or None
         The joints whose intrados (lower) or extrados (upper) bound is active there,
-        within 1e-7 of the margin's scale.
+        within :data:`~masonry.tolerances.THRUST_ACTIVE_REL` of the margin's scale.
     """
     A, B, V, M, total = _half_arch(profile)
     d = B - A
@@ -130,20 +132,21 @@ def thrust_line_margin(profile: ArchProfile, mu=np.inf):
         top *= 2
     top = min(2 * top, h_hi)
     found = minimize_scalar(lambda H: -gap(H), bounds=(h_lo, top), method="bounded",
-                            options={"xatol": 1e-13 * total})
+                            options={"xatol": THRUST_MARGIN_XATOL_REL * total})
     H = float(found.x)
     low, high = lines(H)
-    scale = 1e-7 * total * profile.radius
+    scale = THRUST_ACTIVE_REL * total * profile.radius
     return (float(gap(H) / (total * profile.radius)), H,
             low >= low.max() - scale, high <= high.min() + scale)
 
 
 def thrust_line_minimum_thickness(shape: str, n_blocks: int, span: float, rise=None,
-                                  mu=np.inf, xtol=1e-12) -> ThrustLine:
+                                  mu=np.inf, xtol=THRUST_XTOL) -> ThrustLine:
     """The thinnest arch of this shape that a thrust line fits (Heyman's minimum
     thickness), by root finding on :func:`thrust_line_margin` in ``t``.
 
-    ``t/R`` is scanned on a grid from 1e-3 up to the intrados's limit for the first
+    ``t/R`` is scanned on a grid up to the intrados's limit
+    (:data:`~masonry.tolerances.THRUST_SCAN`) for the first
     thickness with a thrust line, then refined with Brent's method (``xtol`` in t/R):
     the smallest feasible thickness even if the margin were not monotonic in ``t``.
 
@@ -159,7 +162,8 @@ def thrust_line_minimum_thickness(shape: str, n_blocks: int, span: float, rise=N
         profile = arch_profile(shape, n_blocks, span, ratio * radius, rise)
         return thrust_line_margin(profile, mu)[0]
 
-    grid = np.geomspace(1e-3, 0.999 * limit, 60)
+    first, last, count = THRUST_SCAN
+    grid = np.geomspace(first, last * limit, count)
     for lo, hi in itertools.pairwise(grid):
         if margin(hi) >= 0:
             break

@@ -7,18 +7,21 @@ whatever it can reuse (factorizations, solver objects, warm starts) in ``workspa
 dict that :class:`masonry.rbe.solve.RBEProblem` keeps per scene and backend. Adding a solver
 is adding a module and a line here.
 
-- ``newton``: semismooth Newton on the dual (:mod:`.newton`); friction-net only in the
-  presets (friction+ goes to Clarabel).
+- ``newton``: semismooth Newton on the dual (:mod:`.newton`); friction-net in the
+  presets, and the polish of every other solver's point.
+- ``interior``: a primal-dual interior point method on the same reduced system
+  (:mod:`.interior`); friction+ in the presets.
 - ``clarabel``, ``osqp``: the solvers called directly on sparse matrices
   (:mod:`.standard_form`).
 - ``clarabel-cvxpy``, ``osqp-cvxpy``: the same through cvxpy, the readable reference.
 """
 
-from masonry.rbe.solvers import direct_clarabel, direct_osqp, newton, via_cvxpy
+from masonry.rbe.solvers import direct_clarabel, direct_osqp, interior, newton, via_cvxpy
 from masonry.rbe.solvers.base import QPOutcome
 
 BACKENDS = {
     "newton": newton.backend,
+    "interior": interior.backend,
     "clarabel": direct_clarabel.solve,
     "osqp": direct_osqp.solve,
     "clarabel-cvxpy": via_cvxpy.solver_for("CLARABEL"),
@@ -26,7 +29,7 @@ BACKENDS = {
 }
 """Solver name -> backend function."""
 
-FAMILY = {"newton": "newton", "clarabel": "clarabel", "osqp": "osqp",
+FAMILY = {"newton": "newton", "interior": "interior", "clarabel": "clarabel", "osqp": "osqp",
           "clarabel-cvxpy": "clarabel", "osqp-cvxpy": "osqp"}
 """Solver name -> whose options it takes (the accuracy presets set them per family)."""
 

@@ -12,9 +12,6 @@ INFEASIBLE_INACCURATE = "infeasible_inaccurate"
 USER_LIMIT = "user_limit"
 SOLVER_ERROR = "solver_error"
 
-WITH_POINT = (OPTIMAL, OPTIMAL_INACCURATE, USER_LIMIT)
-"""Statuses that come with a point worth checking."""
-
 
 @dataclass(frozen=True, eq=False)
 class QPOutcome:

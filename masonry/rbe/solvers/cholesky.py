@@ -7,10 +7,14 @@ positive definite matrix of dense 6 x 6 blocks whose block pattern is the contac
 for a scene while the values change at every Newton step, so the ordering and the
 symbolic analysis are done once and reused.
 
-Why not a library: scipy has no sparse Cholesky; ``qdldl`` (simplicial LDL^T, through
-cvxpy) took 1.1 s for the 38,000-row matrix of preset 1's full dome, SuperLU 23 s.
-Dense 6 x 6 blocks and supernodes let LAPACK and BLAS do the arithmetic
-(``dpotrf``, ``dtrsm``, ``dsyrk``): 0.3 s for the same matrix on one core.
+Why our own: scipy has no sparse Cholesky. Its SuperLU (``splu``, an LU that ignores
+the symmetry) and ``qdldl`` (a simplicial LDL^T, already a dependency for its AMD
+ordering) are several times slower on the Newton matrix of a full dome; CHOLMOD
+(scikit-sparse, cvxopt) and MKL PARDISO (pypardiso) are faster but bring a GPL/LGPL
+library or a 200 MB binary that would become the default install of every user. Dense
+6 x 6 blocks and supernodes let LAPACK and BLAS do the arithmetic (``dpotrf``,
+``dtrsm``, ``dsyrk``) from scipy alone. The measurements are in ``docs/bench.md``
+("The sparse Cholesky against libraries").
 
 Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1992):
 
@@ -28,6 +32,8 @@ Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1
 """
 
 import logging
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,16 +47,22 @@ RELAX_ZEROS = 0.2
 the merged supernode's stored entries are explicit zeros ..."""
 
 RELAX_COLUMNS = 8
-"""... or if the merged supernode has at most this many block columns. Measured on
-preset 1's full dome: 0.38 s per factorization against 0.50 s for fundamental
-supernodes only (1,888 against 4,438 supernodes; 2.9 against 2.1 GFlop)."""
+"""... or if the merged supernode has at most this many block columns (fewer, larger
+fronts: more flops, far fewer Python-level steps; measured in ``docs/bench.md``)."""
 
 
 SMALL_UPDATE = 120
 """Update matrices up to this size are added to their parent's front by one add at
-precomputed flat positions, larger ones run by run (run-by-run adds took 0.077 s of
-0.28 s per factorization of preset 1's full dome with all updates run by run; 60, 120,
-240 and 480 measured 0.25, 0.235, 0.24 and 0.265 s)."""
+precomputed flat positions, larger ones run by run (the fastest of 60, 120, 240 and
+480 on preset 1's full dome; ``docs/bench.md``)."""
+
+
+FACTOR_THREADS = 2
+"""Threads of a numeric factorization (at most the cores this process may use)."""
+
+PARALLEL_FLOPS = 5e7
+"""Factorizations of fewer flops run on one thread (thread start and the GIL-bound
+Python steps of small fronts outweigh the gain)."""
 
 
 def _amd_order(graph: sp.csr_array) -> np.ndarray:
@@ -184,7 +196,8 @@ class BlockCholesky:
                                (bs * sn.rows[:, None] + np.arange(bs)).ravel())
                               for sn in self.supernodes]
         self._scalar_order = (bs * order[:, None] + np.arange(bs)).ravel()
-        self._front_buffer = None
+        self._front_buffers = []
+        self._schedule = None
         self._steps = self._numeric_plan()
 
         self.flops = 0.0
@@ -348,6 +361,11 @@ class BlockCholesky:
     def factor(self, values) -> "BlockFactor":
         """Numeric Cholesky factorization.
 
+        Independent subtrees of the supernodal elimination tree are factored on
+        :data:`FACTOR_THREADS` threads when the factorization is large enough
+        (:data:`PARALLEL_FLOPS`): LAPACK and BLAS release the GIL, and each thread
+        works on its own fronts; the supernodes above the subtrees follow on one thread.
+
         Parameters
         ----------
         values : (NB, b, b) float
@@ -360,16 +378,82 @@ class BlockCholesky:
             If the matrix is not (numerically) positive definite.
         """
         values = np.asarray(values, dtype=float)[self._entry_order].reshape(-1)
+        n = len(self._steps)
+        state = ([None] * n, [None] * n, [None] * n)  # updates, pivots, below
+        if self._schedule is None:
+            self._schedule = self._parallel_schedule()
+        bins, top = self._schedule
+        if len(bins) > 1:
+            with ThreadPoolExecutor(max_workers=len(bins) - 1) as pool:
+                others = [pool.submit(self._factor_steps, part, values, state, k + 1)
+                          for k, part in enumerate(bins[1:])]
+                self._factor_steps(bins[0], values, state, 0)
+                for other in others:
+                    other.result()
+        else:
+            top = range(n)
+        self._factor_steps(top, values, state, 0)
+        return BlockFactor(self, state[1], state[2])
+
+    def _parallel_schedule(self):
+        """Subtrees for the threads: (one list of supernodes per thread, in postorder;
+        the supernodes above them). Split the heaviest subtree at its root until it
+        holds at most a thread's share of the flops, then deal the subtrees out,
+        heaviest first, to the least loaded thread (longest processing time first)."""
+        bs = self.block_size
+        n = len(self.supernodes)
+        work = np.empty(n)
+        for s, sn in enumerate(self.supernodes):
+            k, r = bs * (sn.last - sn.first + 1), bs * len(sn.rows)
+            work[s] = k**3 / 3 + k * k * r + k * r * r
+        subtree = work.copy()
+        for s, sn in enumerate(self.supernodes):  # postorder: children first
+            if sn.parent >= 0:
+                subtree[sn.parent] += subtree[s]
+        threads = min(FACTOR_THREADS, len(os.sched_getaffinity(0)))
+        if threads < 2 or work.sum() < PARALLEL_FLOPS:
+            return [], range(n)
+        share = work.sum() / threads
+        frontier = [s for s, sn in enumerate(self.supernodes) if sn.parent < 0]
+        top = set()
+        for _ in range(n):
+            heaviest = max(frontier, key=lambda s: subtree[s])
+            if subtree[heaviest] <= share or not self._children[heaviest]:
+                break
+            frontier.remove(heaviest)
+            top.add(heaviest)
+            frontier.extend(self._children[heaviest])
+        load, bins = np.zeros(threads), [[] for _ in range(threads)]
+        for s in sorted(frontier, key=lambda s: -subtree[s]):
+            k = int(np.argmin(load))
+            load[k] += subtree[s]
+            bins[k].append(s)
+        members = [self._subtree_members(roots) for roots in bins]
+        return members, sorted(top)
+
+    def _subtree_members(self, roots):
+        """Every supernode under ``roots`` (themselves included), in postorder."""
+        members, stack = [], list(roots)
+        while stack:
+            s = stack.pop()
+            members.append(s)
+            stack.extend(self._children[s])
+        return sorted(members)
+
+    def _factor_steps(self, supernodes, values, state, worker):
+        """Factor ``supernodes`` (postorder; their children already done or among
+        them) with front buffer ``worker``."""
+        updates, pivots, below = state
         steps = self._steps
-        updates = [None] * len(steps)
-        pivots, below = [None] * len(steps), [None] * len(steps)
-        # one buffer for every front (LAPACK and BLAS return new arrays, nothing keeps a
-        # view of it): fresh fronts cost 10% of a factorization in page faults
-        if self._front_buffer is None:
-            self._front_buffer = np.empty(max(step[0] for step in steps) ** 2)
-        buffer = self._front_buffer
+        # one buffer per thread for every front (LAPACK and BLAS return new arrays,
+        # nothing keeps a view of it): fresh fronts cost 10% of a factorization in page
+        # faults
+        while len(self._front_buffers) <= worker:
+            self._front_buffers.append(np.empty(max(step[0] for step in steps) ** 2))
+        buffer = self._front_buffers[worker]
         entry = self.block_size ** 2
-        for s, (size, k, entries, positions, children, _) in enumerate(steps):
+        for s in supernodes:
+            size, k, entries, positions, children, _ = steps[s]
             flat = buffer[:size * size]
             flat.fill(0.0)
             flat[positions] = values[entry * entries.start:entry * entries.stop]
@@ -393,7 +477,6 @@ class BlockCholesky:
                 l21 = blas.dtrsm(1.0, l11, front[k:, :k], side=1, lower=1, trans_a=1)
                 below[s] = l21
                 updates[s] = blas.dsyrk(-1.0, l21, beta=1.0, c=front[k:, k:], lower=1)
-        return BlockFactor(self, pivots, below)
 
 
 class BlockFactor:

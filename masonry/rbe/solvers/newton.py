@@ -24,10 +24,11 @@ generalized Hessian ``-(A J A^T + eps I)``, ``J`` the Jacobian of the projection
 (Armijo) line search on ``g`` globalizes them. Once the set of active pyramid faces is
 found the step is exact, so the method ends with residuals near rounding.
 
-Why (measured on preset 1's full dome, 6,328 blocks, 299,000 unknowns, one core):
-Clarabel took 37 s (16 interior-point iterations, each factoring a 790,000-row KKT
-system), OSQP 30 s for eps 1e-3 (575 iterations, friction violation 9e-3); this method
-took 9 Newton steps on a 38,000-row system of 6 x 6 blocks.
+Why: an interior point solver (Clarabel) factors the whole KKT system, one row per
+unknown and constraint (790,000 rows on preset 1's full dome), at every iteration, and
+ADMM (OSQP) needs hundreds of iterations for a loose friction tolerance; this method
+factors a system of six rows per block (38,000 rows), about ten times on a feasible
+full dome (``docs/bench.md``).
 
 When friction-net is infeasible the dual is unbounded: the iterates run off along a
 Farkas direction ``d`` with ``b^T d > 0`` and ``A^T d`` in the polar cone of ``K``. The
@@ -45,16 +46,21 @@ import numpy as np
 import scipy.sparse as sp
 from threadpoolctl import ThreadpoolController
 
-from masonry.rbe.solvers.base import QPOutcome
+from masonry.rbe.equilibrium import VariableLayout
+from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
 from masonry.rbe.solvers.cholesky import BlockCholesky
 
 log = logging.getLogger(__name__)
 
-# columns of a vertex, (c, t, f1, f2), used by each friction model
-COMPONENTS = {"net": (0, 2, 3), "plus": (0, 1, 2, 3)}
+MODEL_COMPONENTS = {"net": ("c", "f1", "f2"), "plus": ("c", "t", "f1", "f2")}
+"""The vertex unknowns each friction model solves for (friction-net has ``t = 0`` at
+its optimum, see above)."""
 
-DAMPING_CEILING = 1e-2
-"""Largest shift of the Newton matrix, relative to its mean diagonal."""
+COMPONENTS = {method: tuple(VariableLayout.COMPONENTS.index(name) for name in names)
+              for method, names in MODEL_COMPONENTS.items()}
+"""Their columns in a vertex's :class:`~masonry.rbe.equilibrium.VariableLayout` block."""
+
+TENSION = VariableLayout.COMPONENTS.index("t")
 
 VERTEX_CHUNK = 32768
 """Vertices per stacked product when forming Newton matrices (bounds the buffers)."""
@@ -74,7 +80,7 @@ class NewtonOptions:
         Give up when the residual has not halved in this many steps; an interior-point
         method takes over. The residual wanders before the active set settles: preset
         1's full dome went 4 steps without halving it, with p = 19 (18,000 blocks) 19
-        steps (then converged at step 25, 55 s, where Clarabel took 455 s).
+        steps (then converged at step 25).
     divergence : float
         Give up when the dual point has grown this many times larger than the first one:
         the iterates run off along a direction of infeasibility without certifying it
@@ -83,10 +89,20 @@ class NewtonOptions:
         ``eps`` of the Newton matrix, relative to the mean of its first diagonal: keeps
         it positive definite when a block has no active contact.
     infeasibility_tol : float
-        A step ``d`` certifies friction-net infeasibility when ``b^T d > 0`` and the
-        largest per-vertex part of ``A^T d`` outside the polar cone is below
+        A direction ``d`` certifies friction-net infeasibility when ``b^T d > 0`` and
+        the largest per-vertex part of ``A^T d`` outside the polar cone is below
         ``infeasibility_tol * b^T d / ||b||_1``: then no forces with ``||x||_1`` up to
         ``||b||_1 / infeasibility_tol`` (in reference weights) can balance the loads.
+    sufficient_increase : float
+        Armijo constant of the backtracking line search on the dual.
+    backtracks : int
+        Step halvings before the line search counts as stalled.
+    short_step : float
+        Damping (Levenberg-Marquardt): a step shorter than this raises the shift of the
+        Newton matrix by ``damping_raise``; a full step lowers it by ``damping_lower``.
+    damping_raise, damping_lower : float
+    damping_ceiling : float
+        Largest shift, relative to the mean diagonal.
     """
 
     tol: float = 1e-9
@@ -95,6 +111,12 @@ class NewtonOptions:
     divergence: float = 1e6
     regularization: float = 1e-10
     infeasibility_tol: float = 1e-4
+    sufficient_increase: float = 1e-4
+    backtracks: int = 50
+    short_step: float = 0.25
+    damping_raise: float = 100.0
+    damping_lower: float = 10.0
+    damping_ceiling: float = 1e-2
 
 
 def project_pyramid(p, mu):
@@ -165,9 +187,9 @@ class NewtonSystem:
         width = len(columns)
         self.width = width
         self.h = system.h_solver.reshape(-1, layout.WIDTH)[:, columns]
-        pyramid = [i for i, c in enumerate(columns) if c != 1]
+        pyramid = [i for i, c in enumerate(columns) if c != TENSION]
         self.pyramid = np.asarray(pyramid)
-        self.tension = [i for i, c in enumerate(columns) if c == 1]
+        self.tension = [i for i, c in enumerate(columns) if c == TENSION]
         if np.ptp(self.h[:, self.pyramid]) != 0:
             raise ValueError("the pyramid projection needs equal weights on c, f1, f2")
         keep = (layout.WIDTH * np.arange(layout.n_vertices)[:, None] + columns).ravel()
@@ -240,14 +262,15 @@ class NewtonSystem:
     def dual_value(self, y, x):
         return float(self.b @ y - 0.5 * np.sum(self.h * x * x))
 
-    def newton_blocks(self, jacobian, shift):
+    def newton_blocks(self, jacobian, shift, incremental=True):
         """Stored blocks of ``A J A^T + shift I``.
 
         The Jacobian is piecewise constant: from one Newton step to the next only the
         vertices that moved to another face of their cone change it (preset 1's full
         dome: 18,000 of 75,000 vertices at the second step, 500 at the ninth), so the
-        per-interface sums of the last call are updated with those vertices alone."""
-        if self._last is None:
+        per-interface sums of the last call are updated with those vertices alone, unless
+        ``incremental`` is False (the interior point method changes every vertex)."""
+        if self._last is None or not incremental:
             vertices, delta = np.arange(len(jacobian)), jacobian
             sums = np.zeros((self._vertex_sum.shape[0], 144))
         else:
@@ -268,6 +291,23 @@ class NewtonSystem:
         blocks[self._diagonal] += shift * np.eye(6)
         return blocks
 
+    def diagonal_scale(self) -> float:
+        """Mean diagonal entry of ``A H^-1 A^T``: the scale of the Newton matrix, which
+        the regularization and the damping are relative to."""
+        base = np.zeros((len(self.h), self.width, self.width))
+        base[:, np.arange(self.width), np.arange(self.width)] = 1.0 / self.h
+        blocks = self.newton_blocks(base, 0.0, incremental=False)
+        return float(np.mean(np.trace(blocks[self._diagonal], axis1=1, axis2=2)) / 6.0)
+
+    def full_vector(self, x, layout):
+        """(IV, width) forces in this system's columns -> the (4 IV,) vector of
+        ``layout`` (zero in the columns not solved for); None stays None."""
+        if x is None:
+            return None
+        full = np.zeros(layout.n_columns)
+        full.reshape(-1, layout.WIDTH)[:, list(self.components)] = x
+        return full
+
     def polar_excess(self, w):
         """Per vertex, the norm of the part of ``w`` that is not in the polar cone of K
         (the projection of ``H^-1 w`` onto K, in the metric of H)."""
@@ -286,18 +326,16 @@ def use_one_blas_thread():
     workers call this first).
 
     A factorization makes thousands of small BLAS calls; with a BLAS thread per core
-    every call waits for its threads, and while another process kept one of this
-    machine's two cores busy, one factorization of preset 1's full dome took 5 to 10 s
-    instead of 0.35 s (21,648 blocks: 15 to 38 s instead of 1.8 s). On an idle machine
-    the full dome from parameters to forces took 5.7 s with a BLAS thread per core and
-    4.4 s with one (``masonry bench --presets 1 --scenes dome``, median of 5): idle
-    BLAS threads spin on the other core. Nothing here does dense algebra large enough
-    to gain from more (Clarabel, OSQP and HiGHS have their own threads).
+    every call waits for its threads (15 to 30 times slower while another process
+    keeps a core busy), and idle BLAS threads spin on the other cores (measured in
+    ``docs/bench.md``). The cores are used by factoring independent subtrees on
+    threads instead (:meth:`masonry.rbe.solvers.cholesky.BlockCholesky.factor`).
+    Clarabel, OSQP and HiGHS have their own threads.
     """
     _blas_controller().limit(limits=1, user_api="blas")
 
 
-def _one_blas_thread(function):
+def one_blas_thread(function):
     """Run ``function`` with BLAS on one thread (see :func:`use_one_blas_thread`): the
     Newton method's factorizations, when the library is used without the command line."""
     @functools.wraps(function)
@@ -307,7 +345,7 @@ def _one_blas_thread(function):
     return limited
 
 
-@_one_blas_thread
+@one_blas_thread
 def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOutcome:
     """Solve the scaled RBE QP of ``system`` for ``method`` (``'net'`` or ``'plus'``).
 
@@ -334,105 +372,145 @@ def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOut
     start = time.perf_counter()
     ns = NewtonSystem(system, method) if newton_system is None else newton_system
     setup = time.perf_counter() - start
-    A, AT, b = ns.A, ns.AT, ns.b
-    b_inf, b_one = np.abs(b).max(), np.abs(b).sum()
-    n_vertices = len(ns.coefficients)
-
-    # first point: the dual of the QP without cones (J = H^-1), or the given one
-    base = np.zeros((n_vertices, ns.width, ns.width))
-    base[:, np.arange(ns.width), np.arange(ns.width)] = 1.0 / ns.h
-    first = ns.newton_blocks(base, 0.0)
-    diagonal_scale = float(np.mean(np.trace(first[ns._diagonal], axis1=1, axis2=2)) / 6.0)
-    floor = options.regularization * diagonal_scale
-    shift = floor
-    factorizations = 0
+    scale = ns.diagonal_scale()
     if y0 is None:
-        first[ns._diagonal] += shift * np.eye(6)
-        y = ns.symbolic.factor(first).solve(b)
-        factorizations += 1
+        y = _unconstrained_dual(ns, options.regularization * scale)
     else:
         y = np.asarray(y0, dtype=float).copy()
+    run = _Run(ns, y, options, scale)
+    status = run.iterate(certify=method == "net")
+    return QPOutcome(status=status,
+                     x=None if status == INFEASIBLE else ns.full_vector(run.x, system.layout),
+                     iterations=run.steps, y=run.y, setup_time=setup,
+                     solve_time=time.perf_counter() - start - setup,
+                     info={"factorizations": run.factorizations + (y0 is None)})
 
-    y_scale = max(float(np.abs(y).max()), np.finfo(float).tiny)
-    w = (AT @ y).reshape(n_vertices, ns.width)
-    x, jacobian = ns.project(w)
-    value = ns.dual_value(y, x)
-    status, iterations = "user_limit", 0
-    best, best_at, previous = np.inf, 0, np.inf
-    for iterations in range(1, options.max_iter + 1):
-        residual = b - A @ x.ravel()
-        size = np.abs(residual).max()
-        if size <= options.tol * b_inf:
-            status = "optimal"
-            iterations -= 1
-            break
-        if size < 0.5 * best:
-            best, best_at = size, iterations
-        elif iterations - best_at >= options.stall:
-            log.info("Newton stalled: residual %.2e, no halving in %d steps",
-                     size / b_inf, options.stall)
-            iterations -= 1
-            break
-        if np.abs(y).max() > options.divergence * y_scale:
-            log.info("Newton diverging (the dual point grew %.0e times): likely infeasible",
-                     options.divergence)
-            iterations -= 1
-            break
-        try:
-            factor = ns.symbolic.factor(ns.newton_blocks(jacobian, shift))
-        except np.linalg.LinAlgError as error:
-            log.warning("Newton matrix not positive definite: %s", error)
-            status = "solver_error"
-            break
-        factorizations += 1
-        step = factor.solve(residual)
-        w_step = (AT @ step).reshape(n_vertices, ns.width)
-        # a Farkas direction shows up as a step that does not shrink: test only those
-        growing = iterations == 1 or size >= previous
-        previous = size
-        if method == "net" and growing and _certifies_infeasibility(
-                ns, step, w_step, b_one, options.infeasibility_tol):
-            status = "infeasible"
-            break
-        slope = float(residual @ step)
+
+def _unconstrained_dual(ns, shift):
+    """The dual point of the QP without cones: ``A H^-1 A^T y = b``."""
+    base = np.zeros((len(ns.h), ns.width, ns.width))
+    base[:, np.arange(ns.width), np.arange(ns.width)] = 1.0 / ns.h
+    return ns.symbolic.factor(ns.newton_blocks(base, shift)).solve(ns.b)
+
+
+class _Run:
+    """The state of Newton's iterations on the dual ``g(y)``: the point, its forces and
+    Jacobian, the damping shift, and the counts."""
+
+    def __init__(self, ns, y, options, scale):
+        self.ns, self.options, self.scale = ns, options, scale
+        self.b_inf, self.b_one = np.abs(ns.b).max(), np.abs(ns.b).sum()
+        self.floor = options.regularization * scale
+        self.shift = self.floor
+        self.steps = self.factorizations = 0
+        self.y_scale = max(float(np.abs(y).max()), np.finfo(float).tiny)
+        self._move_to(y, (ns.AT @ y).reshape(len(ns.h), ns.width))
+
+    def _move_to(self, y, w, projected=None):
+        self.y, self.w = y, w
+        self.x, self.jacobian = self.ns.project(w) if projected is None else projected
+        self.value = self._value(y, self.x)
+
+    def _value(self, y, x):
+        return self.ns.dual_value(y, x)
+
+    def gradient(self):
+        """``b - A x(y)``, the equilibrium residual."""
+        return self.ns.b - self.ns.A @ self.x.ravel()
+
+    def iterate(self, certify) -> str:
+        """Newton steps until converged (``optimal``), certified infeasible (``certify``
+        and a step is a Farkas certificate: ``infeasible``), stalled, diverging or out
+        of steps (``user_limit``), or a matrix that is not positive definite."""
+        options = self.options
+        best, best_at, previous = np.inf, 0, np.inf
+        for step in range(1, options.max_iter + 1):
+            residual = self.gradient()
+            size = np.abs(residual).max()
+            if size <= options.tol * self.b_inf:
+                return OPTIMAL
+            if size < 0.5 * best:
+                best, best_at = size, step
+            elif step - best_at >= options.stall:
+                log.info("Newton stalled: residual %.2e, no halving in %d steps",
+                         size / self.b_inf, options.stall)
+                return USER_LIMIT
+            if np.abs(self.y).max() > options.divergence * self.y_scale:
+                log.info("Newton diverging (the dual point grew %.0e times): likely "
+                         "infeasible", options.divergence)
+                return USER_LIMIT
+            try:
+                direction = self._direction(residual)
+            except np.linalg.LinAlgError as error:
+                log.warning("Newton matrix not positive definite: %s", error)
+                return SOLVER_ERROR
+            self.steps += 1
+            w_step = (self.ns.AT @ direction).reshape(self.w.shape)
+            # a Farkas direction shows up as a step that does not shrink: test only those
+            if certify and (step == 1 or size >= previous) and certifies_infeasibility(
+                    self.ns, direction, w_step, self.b_one, options.infeasibility_tol):
+                return INFEASIBLE
+            previous = size
+            if not self._line_search(residual, direction, w_step):
+                log.info("Newton line search stalled at step %d", step)
+                return USER_LIMIT
+        return USER_LIMIT
+
+    def _direction(self, residual):
+        """Solve the generalized Newton system ``(A J A^T + shift I) d = r``."""
+        blocks = self.ns.newton_blocks(self.jacobian, self.shift)
+        self.factorizations += 1
+        return self.ns.symbolic.factor(blocks).solve(residual)
+
+    def _line_search(self, residual, direction, w_step) -> bool:
+        """Backtracking (Armijo) along ``direction``, then the damping update; False
+        when no step length gives a sufficient increase."""
+        options = self.options
+        slope = float(residual @ direction)
         length = 1.0
-        for _ in range(50):
-            x_new, jacobian_new = ns.project(w + length * w_step)
-            value_new = ns.dual_value(y + length * step, x_new)
-            if value_new >= value + 1e-4 * length * slope:
+        for _ in range(options.backtracks):
+            projected = self.ns.project(self.w + length * w_step)
+            y_new = self.y + length * direction
+            if (self._value(y_new, projected[0])
+                    >= self.value + options.sufficient_increase * length * slope):
                 break
             length *= 0.5
         else:
-            log.info("Newton line search stalled at step %d", iterations)
-            break
-        log.debug("Newton step %d: residual %.3e, step length %.3g, shift %.1e",
-                  iterations, np.abs(residual).max() / b_inf, length, shift / diagonal_scale)
+            return False
+        log.debug("Newton step %d: residual %.3e, step length %.3g, shift %.1e", self.steps,
+                  np.abs(residual).max() / self.b_inf, length, self.shift / self.scale)
         # damping (Levenberg-Marquardt): a block whose contacts all opened has no
         # curvature but the shift, its step is huge and the line search cuts every
         # other block's step with it; short steps raise the shift, full steps lower it
-        if length < 0.25:
-            shift = min(shift * 100.0, DAMPING_CEILING * diagonal_scale)
+        if length < options.short_step:
+            self.shift = min(self.shift * options.damping_raise,
+                             options.damping_ceiling * self.scale)
         elif length == 1.0:
-            shift = max(shift / 10.0, floor)
-        y = y + length * step
-        w = w + length * w_step
-        x, jacobian, value = x_new, jacobian_new, value_new
-
-    x_full = np.zeros(system.layout.n_columns)
-    x_full.reshape(-1, system.layout.WIDTH)[:, list(ns.components)] = x
-    return QPOutcome(status=status, x=None if status == "infeasible" else x_full,
-                     iterations=iterations, y=y, setup_time=setup,
-                     solve_time=time.perf_counter() - start - setup,
-                     info={"factorizations": factorizations})
+            self.shift = max(self.shift / options.damping_lower, self.floor)
+        self._move_to(y_new, self.w + length * w_step, projected)
+        return True
 
 
-def _certifies_infeasibility(ns, step, w_step, b_one, tol) -> bool:
-    """Whether the direction ``step`` is a Farkas certificate within ``tol``: ``b^T d > 0``
-    and ``A^T d`` nearly in the polar cone of K (see :class:`NewtonOptions`)."""
-    gain = float(ns.b @ step)
+def certifies_infeasibility(ns, d, w_d, b_one, tol) -> bool:
+    """Whether the direction ``d`` ((6 F,) float, ``w_d = A^T d`` per vertex) is a
+    Farkas certificate within ``tol``: ``b^T d > 0`` and ``A^T d`` nearly in the polar
+    cone of K (see :class:`NewtonOptions`)."""
+    gain = float(ns.b @ d)
     if gain <= 0:
         return False
-    return float(ns.polar_excess(w_step).max()) <= tol * gain / b_one
+    return float(ns.polar_excess(w_d).max()) <= tol * gain / b_one
+
+
+def prepared_system(system, method, workspace) -> NewtonSystem:
+    """The :class:`NewtonSystem` of ``method`` kept in ``workspace`` (made on first use;
+    the friction models share one symbolic factorization), set to ``system.mu``."""
+    prepared = workspace.setdefault("systems", {})
+    if method not in prepared:
+        symbolic = next((s.symbolic for s in prepared.values()), None)
+        prepared[method] = NewtonSystem(system, method, symbolic=symbolic)
+    ns = prepared[method]
+    ns.mu = system.mu
+    return ns
 
 
 def backend(system, method, options, workspace, y0=None) -> QPOutcome:
@@ -441,13 +519,8 @@ def backend(system, method, options, workspace, y0=None) -> QPOutcome:
     shared by both friction models) and the last dual point per model, which starts the
     next solve of that model (another ``mu``) unless ``y0`` is given (a polish)."""
     start = time.perf_counter()
-    prepared = workspace.setdefault("systems", {})
-    if method not in prepared:
-        symbolic = next((s.symbolic for s in prepared.values()), None)
-        prepared[method] = NewtonSystem(system, method, symbolic=symbolic)
-    ns = prepared[method]
+    ns = prepared_system(system, method, workspace)
     preparation = time.perf_counter() - start
-    ns.mu = system.mu
     warm = workspace.setdefault("warm", {}).get(method)
     warm = warm if y0 is None else y0
     outcome = solve(system, method, NewtonOptions(**options), y0=warm, newton_system=ns)

@@ -1,0 +1,81 @@
+"""``masonry stages``: does the structure stand at every stage of its laying (SPEC 4.7)?"""
+
+from masonry.params import Params, validate
+from masonry.scenes.imported import load_assembly
+from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS, run_stages
+
+from .options import add_analysis_options, add_model_options, add_verbosity, params_from_args
+
+ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast")
+
+
+def register(subparsers):
+    parser = subparsers.add_parser(
+        "stages", help="construction stages without centering: the rigid block "
+                       "equilibrium of every stage, by course, brick by brick, or block by "
+                       "block for imported assemblies")
+    parser.add_argument("files", nargs="*", metavar="FILE",
+                        help="an assembly from OBJ, STL or PLY files (as 'masonry "
+                             "analyze'), laid block by block; without files, the dome "
+                             "of the model options")
+    g = parser.add_argument_group("stages")
+    g.add_argument("--by", choices=("course", "brick", "block"),
+                   help="course: stage k holds courses 1..k (default for a dome or "
+                        "wall); brick: the bricks of --course K one at a time; block: "
+                        "one block at a time (default with FILE)")
+    g.add_argument("--course", type=int, metavar="K", help="the course of --by brick")
+    g.add_argument("--order", choices=(*BRICK_ORDERS, *BLOCK_ORDERS),
+                   help="laying order: pattern-first (default) or along for --by brick; "
+                        "z (bottom up, default) or names for --by block")
+    g = parser.add_argument_group("supports of FILE (as 'masonry analyze')")
+    g.add_argument("--support", action="append", default=[], metavar="NAME_OR_PATTERN",
+                   help="blocks fixed in place, by name or shell pattern; repeat for more")
+    g.add_argument("--support-below", dest="support_below", type=float, metavar="Z",
+                   help="every block reaching down to z <= Z (metres) is a support")
+    g.add_argument("--ground", action="store_true",
+                   help="add a ground slab (a support) under the lowest blocks")
+    add_model_options(parser)
+    add_analysis_options(parser)
+    g = parser.add_argument_group("output")
+    g.add_argument("--out", default="exports", metavar="DIR",
+                   help="output root; the run folder is DIR/<structure id>_stages_<plan>")
+    g.add_argument("--no-plots", dest="plots", action="store_false", help="skip all plots")
+    g.add_argument("--force", action="store_true",
+                   help="recompute even if the run folder holds this input's results")
+    add_verbosity(g)
+    parser.set_defaults(handler=handle)
+
+
+def handle(args, report):
+    if args.files:
+        given = {k: getattr(args, k) for k in ANALYSIS if getattr(args, k) is not None}
+        scene, source = load_assembly(args.files, validate(Params(**given)),
+                                      supports=args.support,
+                                      support_below=args.support_below, ground=args.ground)
+        params, by = scene.params, args.by or "block"
+    else:
+        scene = source = None
+        params, by = params_from_args(args), args.by or "course"
+        if params.scene == "arch" and args.by is None:
+            by = "block"
+        # a stage of the dome, not of a free-standing web: the section is cyclic unless
+        # the user says otherwise
+        if params.scene == "section" and args.boundary is None and not args.dome:
+            params = validate(params.replace(boundary="cyclic"))
+    record = run_stages(params, args.out, by=by, order=args.order, course=args.course,
+                        plots_wanted=args.plots, force=args.force, scene=scene,
+                        source=source, max_bricks=args.max_bricks)
+    stages = record["stages"]
+    state = "up to date, reused" if record.get("reused") else "written"
+    report(f"{record['structure_id']}: {record['plan']['described']}")
+    report(f"{stages['standing']} of {stages['count']} stages stand without support "
+           f"(mu {params.mu:g}, friction {params.friction}); stage solves "
+           f"{stages['solve_s']:.3g} s")
+    first = stages["first_unsupported"]
+    if first is not None:
+        largest = ", ".join(f"{h['name']} ({h['tension_N']:.3g} N)" for h in first["held"][:3])
+        report(f"first stage that needs support: {first['stage']} ({first['bricks']} "
+               f"bricks, MoI factor {first['moi_factor']:.3g}); most tension in {largest}; "
+               f"{len(first['held'])} bricks carry some (first_unsupported/held.csv)")
+    report(f"{state}: {record['path']}")
+    return 0

@@ -1,0 +1,566 @@
+"""Construction stages: does the structure stand at every stage of its laying (SPEC 4.7)?
+
+Brunelleschi's dome was built without centering; the herringbone pattern bricks are
+believed to hold each course while it is laid. A finished dome standing says nothing
+about that, so this study solves the rigid block equilibrium of every stage.
+
+A stage is the set of blocks laid so far. Its model (:func:`masonry.rbe.boundary.restrict`)
+holds those blocks, the supports, the images of the laid bricks (cyclic and rigid
+boundaries) and the interfaces of the whole structure whose two blocks are both present:
+interfaces are detected once, never per stage. Each stage is solved as an ordinary run
+(friction auto: friction-net, then friction+ where the stage cannot stand). The first
+stage that cannot stand, and the bricks that carry tension there, are what a mason would
+have to hold.
+
+A :class:`StagePlan` says when each block is laid:
+
+- :func:`course_plan`: stage ``k`` holds every brick that starts on courses ``1..k`` (a
+  pattern brick belongs to the course it starts on), in every web.
+- :func:`brick_plan`: courses ``1..K-1`` complete, then the bricks of course ``K`` one at
+  a time, the same step in every web (``pattern-first`` or ``along``, see
+  :data:`BRICK_ORDERS`).
+- :func:`block_plan`: any assembly, one block at a time by name (``names``) or from the
+  bottom up (``z``: blocks whose centroids lie at one height are laid together, so a
+  symmetric arch rises from both springings at once).
+
+A stage laid the same in every web is rotationally symmetric, so the cyclic section
+(SPEC 6.4) models it exactly.
+"""
+
+import csv
+import dataclasses
+import io
+import json
+import logging
+import re
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from masonry import plots
+from masonry.blocks import BLOCK_CLASSES
+from masonry.export.summaries import parameters_text
+from masonry.params import ParameterError, structure_id, validate
+from masonry.pipeline import Timer, cached_model, model_record, versions, write_cache
+from masonry.rbe.boundary import Model, analysis_model, restrict
+from masonry.rbe.solve import ACCURACY, RBEProblem
+from masonry.runfolder import RunFolder, check_output_root
+from masonry.scenes import check_size
+from masonry.tolerances import MAX_BRICKS, Tolerances
+
+log = logging.getLogger(__name__)
+
+BRICK_ORDERS = {
+    "pattern-first": "the pattern bricks that start on the course, from one corner to "
+                     "the other; then the regular and fill-in bricks, nearest to a pattern "
+                     "brick first (each next to one already laid), ties from one corner",
+    "along": "every brick of the course by its position along the course, from the "
+             "corner at -pi/n to the corner at +pi/n",
+}
+"""Laying orders of :func:`brick_plan` (SPEC 4.7)."""
+
+BLOCK_ORDERS = {
+    "names": "one block at a time, by name (digits compared as numbers)",
+    "z": "from the bottom up by centroid height; blocks at one height together",
+}
+"""Laying orders of :func:`block_plan`."""
+
+STAGE_COLUMNS = ("stage", "course", "bricks", "feasible", "moi", "moi_factor",
+                 "load_factor", "solve_s")
+"""Columns of ``stages.csv``, one row per stage. ``load_factor`` (the collapse load
+factor of the stage under a lateral load) is empty: the collapse analysis is not part of
+this package yet, and :func:`analyse_stage` is the one place that will fill it."""
+
+NOT_LAID = -1
+"""``StagePlan.block_stage`` of a block the plan never lays."""
+
+_PAT = BLOCK_CLASSES.index("pattern")
+
+
+@dataclass(frozen=True)
+class StagePlan:
+    """When each block of a scene is laid.
+
+    Parameters
+    ----------
+    block_stage : (S,) int
+        Per scene block: 0 present from the start (supports; the courses below a brick
+        plan's course), ``k >= 1`` laid at stage ``k``, :data:`NOT_LAID` never.
+    stage_course : (N,) int
+        The course each stage lays (0: the blocks have no course).
+    by : str
+        ``course``, ``brick`` or ``block``.
+    order : str or None
+        A :data:`BRICK_ORDERS` or :data:`BLOCK_ORDERS` name.
+    course : int or None
+        The course of a brick plan.
+    """
+
+    block_stage: np.ndarray
+    stage_course: np.ndarray
+    by: str
+    order: str | None = None
+    course: int | None = None
+
+    @property
+    def n_stages(self) -> int:
+        return len(self.stage_course)
+
+    @property
+    def tag(self) -> str:
+        """The plan's part of the run folder's name."""
+        if self.by == "brick":
+            return f"brick{self.course}_{self.order}"
+        return self.by if self.by == "course" else self.order
+
+    def is_present(self, stage: int) -> np.ndarray:
+        """(S,) bool: the scene blocks present at ``stage`` (1..N)."""
+        return (self.block_stage >= 0) & (self.block_stage <= stage)
+
+    def record(self) -> dict:
+        return {"by": self.by, "order": self.order, "course": self.course,
+                "stages": self.n_stages}
+
+
+def course_plan(blocks) -> StagePlan:
+    """Stage ``k``: every brick starting on courses ``1..k`` (``block_course``).
+
+    Raises
+    ------
+    ParameterError
+        A free block has no course (an arch, an imported assembly): lay it by ``names``
+        or ``z`` instead.
+    """
+    course = np.asarray(blocks.block_course)
+    free = ~blocks.block_is_support
+    if (course[free] < 1).any():
+        raise ParameterError("by", "course", "a model built in courses (a dome or a wall); "
+                                             "lay other blocks by --order names or z")
+    stage = np.where(free, course, 0)
+    return StagePlan(stage, np.arange(1, stage.max() + 1), by="course")
+
+
+def brick_plan(scene, course: int, order: str = "pattern-first") -> StagePlan:
+    """Courses ``1..course-1`` complete, then the bricks of ``course`` one at a time in
+    ``order`` (:data:`BRICK_ORDERS`), the same step in every web of a ``dome`` scene.
+
+    Raises
+    ------
+    ParameterError
+        The scene has no course layout, ``course`` is not one of its courses, or
+        ``order`` is unknown.
+    """
+    layout = scene.layout
+    if layout is None:
+        raise ParameterError("by", "brick", "a dome model (scene section or dome)")
+    if order not in BRICK_ORDERS:
+        raise ParameterError("order", order, f"one of {', '.join(BRICK_ORDERS)}")
+    courses = int(layout.course.max())
+    if not isinstance(course, (int, np.integer)) or not 1 <= course <= courses:
+        raise ParameterError("course", course, f"a course of this model, 1..{courses}")
+    rank = _laying_rank(layout, course, order)
+    per_web = np.concatenate([[0], rank])  # the web's ground slab first (SPEC 4.4)
+    webs, rest = divmod(scene.blocks.n_blocks, len(per_web))
+    if rest:
+        raise ValueError("the scene's blocks are not whole webs of its layout")
+    stage = np.tile(per_web, webs)
+    count = int(rank.max())
+    return StagePlan(stage, np.full(count, course), by="brick", order=order, course=course)
+
+
+def _laying_rank(layout, course, order) -> np.ndarray:
+    """(L,) int per layout brick: 0 below ``course`` (and the pattern bricks that start
+    on the course below and reach into it), 1.. its laying rank on it, NOT_LAID above."""
+    on = layout.course == course
+    rank = np.where(layout.course < course, 0, NOT_LAID)
+    if order == "along":
+        sequence = np.flatnonzero(on)[np.argsort(layout.s0[on], kind="stable")]
+    else:
+        # the course's occupants along the wall: its own bricks and the pattern bricks
+        # of the course below, which already stand there
+        below = (layout.klass == _PAT) & (layout.course == course - 1)
+        occupant = np.flatnonzero(on | below)
+        occupant = occupant[np.argsort(layout.s0[occupant], kind="stable")]
+        anchor = np.flatnonzero(layout.klass[occupant] == _PAT)
+        if len(anchor) == 0:  # no pattern brick on the course: work in from the corners
+            anchor = np.array([0, len(occupant) - 1])
+        position = np.arange(len(occupant))
+        distance = np.abs(position[:, None] - anchor[None, :]).min(axis=1)
+        new = on[occupant]
+        occupant, distance = occupant[new], distance[new]
+        sequence = occupant[np.lexsort((layout.s0[occupant], distance))]
+    rank[sequence] = np.arange(1, len(sequence) + 1)
+    return rank
+
+
+def block_plan(blocks, order: str = "z", tol: Tolerances | None = None) -> StagePlan:
+    """Any assembly laid block by block: by name, or from the bottom up (:data:`BLOCK_ORDERS`).
+
+    Parameters
+    ----------
+    blocks : Blocks
+    order : {'names', 'z'}
+    tol : Tolerances, optional
+        ``length`` decides which centroids lie at one height (``z``). Default
+        ``Tolerances.for_points(blocks.vertices)``.
+    """
+    if order not in BLOCK_ORDERS:
+        raise ParameterError("order", order, f"one of {', '.join(BLOCK_ORDERS)}")
+    if tol is None:
+        tol = Tolerances.for_points(blocks.vertices)
+    free = np.flatnonzero(~blocks.block_is_support)
+    stage = np.zeros(blocks.n_blocks, int)
+    if order == "names":
+        key = [_natural_key(str(blocks.block_name[i])) for i in free]
+        free = free[sorted(range(len(free)), key=key.__getitem__)]
+        stage[free] = np.arange(1, len(free) + 1)
+    else:
+        height = blocks.block_centroid[free, 2]
+        free = free[np.argsort(height, kind="stable")]
+        step = np.diff(blocks.block_centroid[free, 2]) > tol.length
+        stage[free] = 1 + np.concatenate([[0], np.cumsum(step)])
+    count = int(stage.max())
+    stage_course = np.zeros(count, int)
+    np.maximum.at(stage_course, stage[free] - 1, blocks.block_course[free])
+    return StagePlan(stage, stage_course, by="block", order=order)
+
+
+def _natural_key(name):
+    return [(0, int(part), "") if part.isdigit() else (1, 0, part)
+            for part in re.split(r"(\d+)", name) if part]
+
+
+# ---------------------------------------------------------------------- one stage
+def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
+    """The rigid block equilibrium of one stage, as a row of ``stages.csv``.
+
+    Parameters
+    ----------
+    model : Model
+        The whole structure's analysis model (:func:`masonry.rbe.boundary.analysis_model`).
+    params : masonry.params.Params
+        ``mu``, ``density``, ``friction``, ``solver`` and the accuracy preset.
+    plan : StagePlan
+    stage : int
+        1..``plan.n_stages``.
+
+    Returns
+    -------
+    dict
+        :data:`STAGE_COLUMNS` (``moi`` in newtons; ``solve_s`` the stage's wall time:
+        model, assembly and solve; ``load_factor`` None: no live load), and ``tension``:
+        scene block -> newtons of tension it carries (see :func:`tension_by_block`).
+    """
+    start = time.perf_counter()
+    part = restrict(model, plan.is_present(stage))
+    # load_factor: the collapse load factor of ``part`` under a lateral load goes here
+    # once the collapse analysis exists; until then it is not computed (empty)
+    row = {"stage": stage, "course": int(plan.stage_course[stage - 1]) or None,
+           "bricks": int((~part.blocks.block_is_support).sum()), "load_factor": None}
+    if len(part.interfaces) == 0:
+        log.warning("stage %d: no block touches another or a support", stage)
+        row.update(feasible=False, moi=None, moi_factor=None, tension={})
+    else:
+        problem = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
+                             side_rotation=part.side_rotation)
+        result = problem.solve(mu=params.mu, density=params.density,
+                               friction=params.friction, solver=params.solver,
+                               accuracy=params.solver_accuracy)
+        floor = ACCURACY[params.solver_accuracy].residual * result.weight_N / row["bricks"]
+        row.update(feasible=result.feasible, moi=_number(result.moi),
+                   moi_factor=_number(result.moi_factor),
+                   tension=tension_by_block(part, result, plan, floor))
+    row["solve_s"] = round(time.perf_counter() - start, 4)
+    return row
+
+
+def tension_by_block(part: Model, result, plan: StagePlan, floor: float) -> dict:
+    """Tension per brick: each interface's tension is charged to the later laid of its two
+    blocks (both when laid at one stage), the brick a mason would have to hold.
+
+    Parameters
+    ----------
+    part : Model
+        A stage's model (:func:`masonry.rbe.boundary.restrict`).
+    result : masonry.rbe.solve.RBEResult
+    plan : StagePlan
+    floor : float, newtons
+        Interface tension at or below this is solver noise, not tension.
+
+    Returns
+    -------
+    dict int -> float
+        Scene block index -> newtons, largest first; empty without a solution.
+    """
+    if result.x is None:
+        return {}
+    tension = result.per_interface()["tension"]
+    carried = np.flatnonzero(tension > floor)
+    side = part.interfaces.pair if part.side_block is None else part.side_block
+    block = part.block_source[side[carried]]                   # (k, 2) scene blocks
+    when = np.where(part.blocks.block_is_support[side[carried]], -1,
+                    plan.block_stage[block])
+    held = when == when.max(axis=1, keepdims=True)
+    total = np.zeros(len(plan.block_stage))
+    np.add.at(total, block[held], np.broadcast_to(tension[carried, None], held.shape)[held])
+    order = np.argsort(-total, kind="stable")
+    return {int(b): float(total[b]) for b in order if total[b] > 0}
+
+
+def _number(value):
+    return None if value is None or not np.isfinite(value) else float(value)
+
+
+# ---------------------------------------------------------------------- every stage
+def make_plan(scene, by: str = "course", order: str | None = None,
+              course: int | None = None) -> StagePlan:
+    """The stage plan of ``scene``: ``by`` course, brick (of ``course``, in ``order``,
+    default ``pattern-first``) or block (in ``order``, default ``z``).
+
+    Raises
+    ------
+    ParameterError
+        An option that does not fit ``by`` or the scene (named ``by``, ``order`` or
+        ``course``, as the front end's options).
+    """
+    if by == "course":
+        if order is not None:
+            raise ParameterError("order", order, "no laying order with --by course "
+                                                   "(one for --by brick or --by block)")
+        if course is not None:
+            raise ParameterError("course", course, "no course with --by course "
+                                                     "(--by brick --course K)")
+        return course_plan(scene.blocks)
+    if by == "brick":
+        if course is None:
+            raise ParameterError("course", None, "the course laid brick by brick "
+                                                   "(--by brick --course K)")
+        return brick_plan(scene, course, order or "pattern-first")
+    if by == "block":
+        if course is not None:
+            raise ParameterError("course", course, "no course with --by block")
+        return block_plan(scene.blocks, order or "z")
+    raise ParameterError("by", by, "course, brick or block")
+
+
+def analyse_stages(model: Model, params, plan: StagePlan) -> list:
+    """:func:`analyse_stage` of stages ``1..N`` in order, logging ``stage k of N``."""
+    rows = []
+    for stage in range(1, plan.n_stages + 1):
+        row = analyse_stage(model, params, plan, stage)
+        log.info("stage %d of %d: %d bricks, %s, MoI factor %s, %.2f s", stage,
+                 plan.n_stages, row["bricks"], "stands" if row["feasible"] else "needs support",
+                 "-" if row["moi_factor"] is None else f"{row['moi_factor']:.3g}",
+                 row["solve_s"])
+        rows.append(row)
+    return rows
+
+
+def first_unsupported(rows) -> dict | None:
+    """The row of the first stage that does not stand, None when every stage stands."""
+    return next((row for row in rows if not row["feasible"]), None)
+
+
+def stages_csv(rows) -> bytes:
+    """``stages.csv``: :data:`STAGE_COLUMNS`, one row per stage; empty cells for None."""
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(STAGE_COLUMNS)
+    for row in rows:
+        writer.writerow(["" if row[c] is None else
+                         f"{row[c]:.6g}" if isinstance(row[c], float) else row[c]
+                         for c in STAGE_COLUMNS])
+    return buf.getvalue().encode()
+
+
+def held_csv(scene, row) -> bytes:
+    """``first_unsupported/held.csv``: the bricks that carry tension at the first stage
+    that needs support (block, name, class, course, tension in newtons), largest first."""
+    blocks = scene.blocks
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(("block", "name", "class", "course", "tension_N"))
+    for block, newtons in row["tension"].items():
+        writer.writerow((block, blocks.block_name[block],
+                         BLOCK_CLASSES[blocks.block_class[block]],
+                         int(blocks.block_course[block]), f"{newtons:.6g}"))
+    return buf.getvalue().encode()
+
+
+# ---------------------------------------------------------------------- the run
+def stages_folder_name(params, plan: StagePlan) -> str:
+    """The run folder of a stage study: the structure id and the plan, so it never
+    replaces the folder of ``masonry run`` or of another plan."""
+    return f"{structure_id(params)}_stages_{plan.tag}"
+
+
+def run_stages(params, out_root="exports", *, by="course", order=None, course=None,
+               plots_wanted=True, force=False, scene=None, source=None,
+               max_bricks=MAX_BRICKS) -> dict:
+    """Every construction stage of ``params`` (or of ``scene``) into its own run folder.
+
+    Parameters
+    ----------
+    params : masonry.params.Params
+        The structure and the analysis inputs, as for :func:`masonry.pipeline.run`.
+    out_root : str or Path
+        The run folder is ``out_root/<structure id>_stages_<plan>``.
+    by, order, course
+        The stage plan, see :func:`make_plan`.
+    plots_wanted, force : bool
+        Write the plots; recompute when the folder holds this input's complete study. A
+        folder holding the study with plots is reused by a study without; one without
+        plots gets them (the study is computed again), also with ``force``: a run folder
+        only grows.
+    scene : Scene, optional
+        An already built scene (imported blocks, :func:`masonry.scenes.imported.load_assembly`).
+    source : dict, optional
+        Where such a scene came from, recorded in run.json.
+    max_bricks : int
+        A model estimated larger (:func:`masonry.scenes.check_size`) is refused before
+        anything is built.
+
+    Returns
+    -------
+    dict
+        The record written as ``run.json``, its ``path``, and ``rows`` (one dict per
+        stage, :data:`STAGE_COLUMNS` and ``tension``).
+    """
+    params = validate(params)
+    check_output_root(out_root)
+    if scene is None:
+        check_size(params, max_bricks)
+    timer = Timer()
+    plan = None
+
+    def check(built):  # bad plan options are refused before anything is written
+        nonlocal plan
+        plan = make_plan(built, by, order, course)
+
+    if scene is None:
+        scene, model, cached = cached_model(params, out_root, timer, check=check)
+    else:
+        scene, cached = dataclasses.replace(scene, params=params), "given"
+        check(scene)
+        with timer.stage("interfaces"):
+            model = analysis_model(scene)
+    target = Path(out_root) / stages_folder_name(params, plan)
+    previous = _previous(target, params, plan)
+    if previous is not None:
+        had_plots = (previous.get("outputs") or {}).get("plots") is True
+        if not force and (had_plots or not plots_wanted):
+            log.info("%s is up to date (use --force to recompute)", target.name)
+            return {**previous, "path": str(target), "reused": True}
+        plots_wanted = plots_wanted or had_plots  # a run folder only grows
+    outputs = {"plots": plots_wanted}
+
+    with timer.stage("stages"):
+        rows = analyse_stages(model, params, plan)
+    record = _record(scene, model, plan, rows, outputs, cached, source)
+    with RunFolder(out_root, target.name) as folder:
+        folder.write("00_parameters.txt", parameters_text(params))
+        folder.write("stages.csv", stages_csv(rows))
+        first = first_unsupported(rows)
+        if first is not None:
+            folder.write("first_unsupported/held.csv", held_csv(scene, first))
+        if plots_wanted:
+            with timer.stage("plots"):
+                for name, png in stage_pngs(scene, plan, rows).items():
+                    folder.write(name, png)
+        record["timings_s"] = timer.seconds
+        record["versions"] = versions()
+        record["complete"] = True
+        folder.write_json("run.json", record)
+    if cached == "computed":  # only a model whose study completed is cached
+        write_cache(params, out_root, scene, model)
+    return {**record, "path": str(folder.target), "rows": rows}
+
+
+def _record(scene, model, plan, rows, outputs, cached, source) -> dict:
+    """run.json of a stage study, before timings."""
+    params = scene.params
+    first = first_unsupported(rows)
+    held = [] if first is None else [
+        {"block": block, "name": str(scene.blocks.block_name[block]), "tension_N": newtons}
+        for block, newtons in first["tension"].items()]
+    record = {
+        "structure_id": structure_id(params),
+        "scene": params.scene,
+        "params": dataclasses.asdict(params),
+        "outputs": outputs,
+        "plan": {**plan.record(), "described": _described(plan)},
+        **model_record(scene),
+        "cache": {"geometry": cached},
+        "stages": {
+            "count": plan.n_stages,
+            "standing": int(sum(bool(row["feasible"]) for row in rows)),
+            "first_unsupported": None if first is None else {
+                "stage": first["stage"], "course": first["course"],
+                "bricks": first["bricks"], "moi_factor": first["moi_factor"],
+                "laid": [str(name) for name in scene.blocks.block_name[
+                    plan.block_stage == first["stage"]]],
+                "held": held},
+            "solve_s": round(sum(row["solve_s"] for row in rows), 4),
+        },
+    }
+    record["counts"]["interfaces"] = model.interfaces.counts()
+    if source is not None:
+        record["source"] = source
+    return record
+
+
+def _described(plan: StagePlan) -> str:
+    if plan.by == "course":
+        return "stage k: every brick starting on courses 1..k"
+    if plan.by == "brick":
+        return f"courses 1..{plan.course - 1}, then course {plan.course}: " + \
+            BRICK_ORDERS[plan.order]
+    return BLOCK_ORDERS[plan.order]
+
+
+def _previous(target: Path, params, plan):
+    """The record of a complete earlier study of the same input and plan, else None."""
+    try:
+        record = json.loads((target / "run.json").read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(record, dict):
+        return None
+    same = (record.get("params") == json.loads(json.dumps(dataclasses.asdict(params)))
+            and record.get("plan", {}).get("stages") == plan.n_stages
+            and {k: record.get("plan", {}).get(k) for k in ("by", "order", "course")}
+            == {k: plan.record()[k] for k in ("by", "order", "course")}
+            and record.get("complete") is True)
+    return record if same else None
+
+
+def stage_pngs(scene, plan: StagePlan, rows) -> dict:
+    """``stages.png`` (MoI factor of every stage, which stand) and, when a stage needs
+    support, ``first_unsupported/<view>.png``: that stage with its held bricks marked."""
+    params = scene.params
+    what = {"course": "course stages", "brick": f"course {plan.course} brick by brick "
+            f"({plan.order})", "block": f"block by block ({plan.order})"}[plan.by]
+    title = f"{structure_id(params)}: {what}, {sum(bool(r['feasible']) for r in rows)} of " \
+            f"{len(rows)} stages stand (mu {params.mu:g})"
+    out = {"stages.png": plots.stage_chart_png(
+        [r["stage"] for r in rows],
+        [np.nan if r["moi_factor"] is None else r["moi_factor"] for r in rows],
+        [bool(r["feasible"]) for r in rows],
+        [np.nan if r["load_factor"] is None else r["load_factor"] for r in rows],
+        title=title, xlabel={"course": "stage (courses laid)", "brick": f"stage (bricks "
+                             f"of course {plan.course} laid, per web)"}.get(plan.by, "stage"))}
+    first = first_unsupported(rows)
+    if first is None:
+        return out
+    tension = np.zeros(scene.blocks.n_blocks)
+    tension[list(first["tension"])] = list(first["tension"].values())
+    views = plots.marked_structure_pngs(
+        scene, plan.is_present(first["stage"]), tension,
+        f"stage {first['stage']} of {plan.n_stages}: {first['bricks']} bricks, "
+        f"{len(first['tension'])} carry tension", value_label="tension the brick carries "
+        "[N] (hold it)", is_outlined=plan.block_stage == first["stage"],
+        outline_label=f"laid at stage {first['stage']}", fast=params.fast)
+    out.update({f"first_unsupported/{name}": png for name, png in views.items()})
+    return out

@@ -1,0 +1,82 @@
+"""Figures: units and colour scales chosen by the data, and the thrust line's points."""
+
+import matplotlib
+import numpy as np
+import pytest
+
+from masonry.export.csv import tension_top
+from masonry.plots import COLOUR_PERCENTILE, colour_scale, force_unit
+from masonry.tolerances import TENSION_REPORTED_REL
+
+
+@pytest.mark.parametrize("magnitude, unit", [(12.0, "N"), (999.0, "N"), (1e3, "kN"),
+                                             (4.39e4, "kN"), (2.5e6, "MN")])
+def test_force_unit_by_magnitude(magnitude, unit):
+    factor, got = force_unit(magnitude)
+    assert got == unit and 1 <= magnitude * factor < 1000
+
+
+def test_sequential_scale_ends_at_the_percentile_and_counts_the_rest():
+    rng = np.random.default_rng(0)
+    values = np.concatenate([rng.uniform(0, 2e3, 990), np.full(10, 4e4)])  # 10 supports
+    scale = colour_scale(values, signed=False)
+    assert scale["unit"] == "kN" and scale["factor"] == 1e-3
+    top = np.percentile(values, COLOUR_PERCENTILE)
+    assert scale["norm"].vmin == 0 and scale["norm"].vmax == pytest.approx(top * 1e-3)
+    assert scale["clipped"] == (values > top).sum() and scale["extend"] == "max"
+    assert scale["largest"] == pytest.approx(40.0)
+    assert scale["cmap"].name == "viridis"
+
+
+def test_signed_scale_is_symmetric_about_zero_on_a_diverging_map():
+    values = np.array([-5e3, -1e3, 0.0, 2e2, 3e3])
+    scale = colour_scale(values, signed=True)
+    assert scale["norm"].vmin == -scale["norm"].vmax
+    assert scale["norm"](0.0) == pytest.approx(0.5)
+    assert scale["cmap"].name == "RdBu_r"
+    # zero is the map's middle, white
+    assert np.allclose(scale["cmap"](0.5)[:3], matplotlib.colormaps["RdBu_r"](0.5)[:3])
+
+
+def test_all_zero_values_still_have_a_scale():
+    scale = colour_scale(np.zeros(5), signed=False)
+    assert scale["norm"].vmax > scale["norm"].vmin and scale["clipped"] == 0
+
+
+def test_tension_top_orders_by_tension_and_drops_solver_noise():
+    weight = 1e5
+    tension = np.array([0.0, 30.0, 1e-3, 500.0, 30.0, 2 * TENSION_REPORTED_REL * weight])
+    top = tension_top({"tension": tension}, weight, count=4)
+    assert top.tolist() == [3, 1, 4, 5]
+    assert tension_top({"tension": np.full(3, 1e-3)}, weight).tolist() == []
+
+
+def test_mid_plane_cuts_a_joint_where_its_edges_cross_it():
+    from test_rbe import make_interfaces
+
+    from masonry.plots import _cut_at_y
+
+    # a joint tilted about y: (0, -1, 0) .. (1, 1, 0.5), cut at y = 0.25
+    square = np.array([[0, -1, 0], [1, -1, 0.5], [1, 1, 0.5], [0, 1, 0]], float)
+    normal = np.cross(square[1] - square[0], square[2] - square[1])
+    joint = make_interfaces([(0, 1)], [square], [normal / np.linalg.norm(normal)], 0)
+    segment = _cut_at_y(joint, [0], 0.25)[0]
+    np.testing.assert_allclose(sorted(segment.tolist()), [[0, 0.25, 0], [1, 0.25, 0.5]],
+                               atol=1e-15)
+
+
+def test_cyclic_runs_get_whole_dome_views():
+    from conftest import scene_of
+
+    from masonry.interfaces import detect
+    from masonry.plots import force_pngs, structure_pngs
+
+    scene = scene_of("3", boundary="cyclic", p=4)
+    interfaces = detect(scene.blocks, up=scene.block_up)
+    forces = {key: np.ones(len(interfaces)) for key in
+              ("compression", "tension", "normal", "t1", "t2", "friction")}
+    assert {"05_dome/normal.png", "05_dome/tension.png"} <= set(
+        force_pngs(scene, scene.blocks, interfaces, forces, fast=True))
+    assert "05_dome/3_structure.png" in structure_pngs(scene, fast=True)
+    free = scene_of("3", p=4)
+    assert not any(k.startswith("05_dome") for k in structure_pngs(free, fast=True))

@@ -1,0 +1,320 @@
+"""Construction stages (SPEC 4.7): stage models filtered from the whole structure's, and
+their verdicts against book stacking, an arch laid without centering and the full dome."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+from test_interfaces import box_corners
+
+from masonry.blocks import BLOCK_CLASSES, Blocks
+from masonry.export.obj import blocks_obj
+from masonry.interfaces import detect
+from masonry.params import ParameterError, Params, from_preset, validate
+from masonry.rbe.boundary import Model, analysis_model, restrict
+from masonry.rbe.solve import RBEProblem
+from masonry.scenes import build
+from masonry.studies.stages import (NOT_LAID, analyse_stage, analyse_stages, block_plan,
+                                    brick_plan, course_plan, make_plan)
+from masonry_cli.main import main
+
+PATTERN = BLOCK_CLASSES.index("pattern")
+SMALL_DOME = dict(n=4, p=3, r=1)  # test_dome's smallest 4-sided dome (unit 0.1)
+
+
+# ---------------------------------------------------------------------- book stacking
+def stack(offsets, width=1.0, height=0.2):
+    """Blocks of ``width`` stacked on a wide ground slab, block ``i`` shifted by
+    ``offsets[i]`` along x from the one below (block 0 centred on the slab)."""
+    centre = np.cumsum(np.concatenate([[0.0], offsets]))
+    corners = [box_corners([-3, -0.5, -height], [3, 0.5, 0])]
+    corners += [box_corners([c - width / 2, -0.5, i * height], [c + width / 2, 0.5,
+                                                                 (i + 1) * height])
+                for i, c in enumerate(centre)]
+    blocks = Blocks.from_hexahedra(np.array(corners), ["ground"] + ["block"] *
+                                   len(centre))
+    return blocks, centre
+
+
+def stands_by_statics(centre, width=1.0):
+    """Per stage k (the lowest k blocks): whether every top part's centroid lies over
+    the block below it (book stacking; the slab is wider than any block)."""
+    verdicts = []
+    for k in range(1, len(centre) + 1):
+        top = [centre[j:k].mean() for j in range(1, k)]  # parts on blocks j-1, j >= 1
+        verdicts.append(all(abs(c - centre[j - 1]) <= width / 2
+                            for j, c in zip(range(1, k), top)))
+    return verdicts
+
+
+def stage_verdicts(blocks, order="z", mu=0.7):
+    params = validate(Params(mu=mu))
+    model = Model(blocks, detect(blocks))
+    plan = block_plan(blocks, order)
+    return plan, analyse_stages(model, params, plan)
+
+
+def test_harmonic_stack_stands_at_every_stage():
+    # 95 % of the harmonic overhangs: b/2 over the block below at the top, then b/4,
+    # b/6, ... (laid bottom up, so the smallest first); the whole stack overhangs
+    # 0.95 (1/2 + 1/4 + ... + 1/12) b = 1.16 b, beyond the slab's block
+    n = 6
+    offsets = 0.95 / (2 * np.arange(n - 1, 0, -1))
+    blocks, centre = stack(offsets)
+    assert centre[-1] + 0.5 > 1.1  # the top block lies wholly beyond the bottom one
+    assert all(stands_by_statics(centre))
+    plan, rows = stage_verdicts(blocks)
+    assert plan.n_stages == n
+    assert [r["feasible"] for r in rows] == [True] * n
+    assert all(r["moi_factor"] == pytest.approx(0, abs=1e-6) for r in rows)
+
+
+@pytest.mark.parametrize("offsets, first_failing", [
+    (np.full(5, 0.3), 4),   # blocks 2-4 together tip over block 1: (0.3+0.6+0.9)/3 > 0.5
+    (np.full(5, 0.55), 2),  # the second block alone tips
+    (1.05 / (2 * np.arange(5, 0, -1)), 6),  # 5 % beyond harmonic: the top block tips
+])
+def test_overhanging_stack_fails_at_the_stage_statics_says(offsets, first_failing):
+    n = len(offsets) + 1
+    blocks, centre = stack(offsets)
+    expected = stands_by_statics(centre)
+    assert expected.index(False) + 1 == first_failing
+    plan, rows = stage_verdicts(blocks, order="names")
+    assert [r["feasible"] for r in rows] == expected
+    assert [r["bricks"] for r in rows] == list(range(1, n + 1))
+    failing = rows[first_failing - 1]
+    assert failing["moi"] > 1e-3 * 9.81 * 2000 * 0.2  # tension of a real mechanism, N
+    assert failing["tension"]  # somebody must hold a block
+
+
+# ---------------------------------------------------------------------- arch
+def half_arch_stands(radius, thickness, count, mu):
+    """Per stage k = 1..count/2 - 1 (k voussoirs on each springing, not yet closed):
+    whether a half arch stands. Each part above a joint carries only its own weight, so
+    the vertical through its centroid must cross the joint, and the joint's slope must
+    not exceed the friction angle."""
+    inner, outer = radius - thickness / 2, radius + thickness / 2
+    step = np.pi / count
+    area, cx = [], []
+    for i in range(count // 2):
+        a, b = i * step, (i + 1) * step
+        poly = np.array([[inner * np.cos(a), inner * np.sin(a)],
+                         [outer * np.cos(a), outer * np.sin(a)],
+                         [outer * np.cos(b), outer * np.sin(b)],
+                         [inner * np.cos(b), inner * np.sin(b)]])
+        x, y = poly.T
+        x1, y1 = np.roll(x, -1), np.roll(y, -1)
+        cross = x * y1 - x1 * y
+        area.append(cross.sum() / 2)
+        cx.append(((x + x1) * cross).sum() / (3 * cross.sum()))
+    area, cx = np.array(area), np.array(cx)
+    verdicts = []
+    for k in range(1, count // 2):
+        ok = True
+        for j in range(k):  # joint j at angle j step above the springing
+            x = (area[j:k] * cx[j:k]).sum() / area[j:k].sum()
+            phi = j * step
+            ok &= inner * np.cos(phi) <= x <= outer * np.cos(phi) and np.tan(phi) <= mu
+        verdicts.append(bool(ok))
+    return verdicts
+
+
+def test_arch_laid_without_centering_fails_before_closure_and_stands_closed():
+    # the default arch: semicircular, 16 voussoirs, span 10 m, t = 0.6 m: t/R = 0.12,
+    # above Milankovitch's 0.1075, so the closed arch stands
+    params = validate(Params(scene="arch"))
+    scene = build(params)
+    plan = make_plan(scene, "block", "z")
+    assert plan.n_stages == 8  # one voussoir on each side per stage
+    rows = analyse_stages(analysis_model(scene), params, plan)
+    expected = half_arch_stands(5.0, 0.6, 16, params.mu)
+    assert expected[:2] == [True, True] and not expected[2]  # statics: third pair tips
+    assert [r["feasible"] for r in rows[:-1]] == expected
+    assert rows[-1]["feasible"] and rows[-1]["bricks"] == 16
+
+
+# ---------------------------------------------------------------------- domes
+def dome_stage(scene_kind, plan_of, stage):
+    params = from_preset("1", **SMALL_DOME, **scene_kind)
+    scene = build(params)
+    plan = plan_of(scene)
+    model = analysis_model(scene)
+    part = restrict(model, plan.is_present(stage))
+    return scene, plan, part, analyse_stage(model, params, plan, stage)
+
+
+@pytest.mark.parametrize("plan_of, stage", [
+    (lambda scene: course_plan(scene.blocks), 5),
+    (lambda scene: brick_plan(scene, 4, "pattern-first"), 2),
+])
+def test_cyclic_section_stage_equals_full_dome_stage(plan_of, stage):
+    n = SMALL_DOME["n"]
+    section, plan, part, ours = dome_stage(dict(boundary="cyclic"), plan_of, stage)
+    dome, whole_plan, whole_part, whole = dome_stage(dict(scene="dome"), plan_of, stage)
+    assert whole_plan.n_stages == plan.n_stages
+    assert whole["bricks"] == n * ours["bricks"]
+    assert whole_part.interfaces.counts()["horizontal"] == \
+        n * part.interfaces.counts()["horizontal"]
+    assert whole["feasible"] == ours["feasible"]
+    # one web's share of the whole dome's solution: the objective is strictly convex, the
+    # stage symmetric, so the unique solution is symmetric (SPEC 6.4)
+    params = from_preset("1", **SMALL_DOME)
+    results = []
+    for model in (part, whole_part):
+        problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
+                             side_rotation=model.side_rotation)
+        results.append(problem.solve(mu=params.mu, lp_check=False))
+    assert results[1].weight_N == pytest.approx(n * results[0].weight_N, rel=1e-12)
+    assert results[1].objective == pytest.approx(n * results[0].objective, rel=1e-5)
+
+
+def test_stage_model_keeps_only_interfaces_of_laid_blocks():
+    scene = build(from_preset("1", **SMALL_DOME, boundary="cyclic"))
+    model = analysis_model(scene)
+    plan = course_plan(scene.blocks)
+    source = model.block_source
+    for stage in (1, 3, plan.n_stages):
+        present = plan.is_present(stage)
+        part = restrict(model, present)
+        # every interface of the whole model between two present blocks (a support or
+        # an image of a laid brick), and no other
+        is_kept = present[source] | (scene.blocks.block_is_support[source]
+                                     & (source == np.arange(len(source))))
+        expected = is_kept[model.interfaces.pair].all(axis=1).sum()
+        assert len(part.interfaces) == expected
+        assert (present[part.block_source]).all()
+        centres = np.sort(part.interfaces.centre, axis=0)
+        whole = model.interfaces.centre[is_kept[model.interfaces.pair].all(axis=1)]
+        np.testing.assert_allclose(centres, np.sort(whole, axis=0), atol=0)
+    assert len(restrict(model, plan.is_present(plan.n_stages)).interfaces) == \
+        len(model.interfaces)
+
+
+def test_course_plan_lays_every_brick_once_in_course_order():
+    scene = build(from_preset("1", **SMALL_DOME, boundary="cyclic"))
+    plan = course_plan(scene.blocks)
+    free = ~scene.blocks.block_is_support
+    assert (plan.block_stage[free] == scene.blocks.block_course[free]).all()
+    bricks = [int((plan.is_present(k) & free).sum()) for k in range(1, plan.n_stages + 1)]
+    assert np.all(np.diff(bricks) > 0) and bricks[-1] == free.sum()
+
+
+@pytest.mark.parametrize("order", ["pattern-first", "along"])
+def test_brick_orders(order):
+    scene = build(from_preset("1", **SMALL_DOME, boundary="cyclic"))
+    layout = scene.layout
+    courses = [k for k in range(2, layout.course.max())
+               if ((layout.course == k) & (layout.klass == PATTERN)).any()]
+    course = courses[0]
+    plan = brick_plan(scene, course, order)
+    stage = plan.block_stage[1:]  # the section's layout bricks (block 0: the slab)
+    on = layout.course == course
+    assert (stage[layout.course < course] == 0).all()
+    assert (stage[layout.course > course] == NOT_LAID).all()
+    assert sorted(stage[on]) == list(range(1, on.sum() + 1))
+    sequence = np.flatnonzero(on)[np.argsort(stage[on])]
+    if order == "along":
+        assert np.all(np.diff(layout.s0[sequence]) > 0)
+        return
+    # the pattern bricks of the course first, then every brick beside one already there
+    patterns = int((layout.klass[on] == PATTERN).sum())
+    assert (layout.klass[sequence[:patterns]] == PATTERN).all()
+    there = (layout.course == course - 1) & (layout.klass == PATTERN)
+    occupants = np.flatnonzero(on | there)
+    occupants = occupants[np.argsort(layout.s0[occupants])]
+    is_there = there.copy()
+    for brick in sequence:
+        if layout.klass[brick] != PATTERN:
+            i = int(np.flatnonzero(occupants == brick)[0])
+            beside = occupants[max(i - 1, 0): i + 2]
+            assert is_there[beside].any(), f"brick {brick} laid beside nothing"
+        is_there[brick] = True
+
+
+def test_course_stages_need_courses():
+    with pytest.raises(ParameterError, match="parameter by="):
+        course_plan(build(validate(Params(scene="arch"))).blocks)
+
+
+# ---------------------------------------------------------------------- command line
+def test_stages_command_writes_its_own_folder_reproducibly(tmp_path, capsys):
+    args = ["stages", "--preset", "1", *[f"--{k}={v}" for k, v in SMALL_DOME.items()],
+            "--fast", "--no-plots", "--out", str(tmp_path), "-q"]
+    assert main(["run", *args[1:]]) == 0  # a run of the same dome, beside the stages
+    assert main(args) == 0
+    folders = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
+    assert len(folders) == 2 and folders[1] == folders[0].replace(
+        "dome0", "dome1") + "_stages_course"  # stages default to the cyclic section
+    folder = tmp_path / folders[1]
+    with open(folder / "stages.csv") as f:
+        rows = list(csv.DictReader(f))
+    record = json.loads((folder / "run.json").read_text())
+    assert record["complete"] and record["stages"]["count"] == len(rows)
+    assert [int(r["stage"]) for r in rows] == list(range(1, len(rows) + 1))
+    bricks = [int(r["bricks"]) for r in rows]
+    assert np.all(np.diff(bricks) > 0) and bricks[-1] == record["counts"]["bricks"]
+    assert all(r["load_factor"] == "" for r in rows)  # no lateral load
+    assert main([*args, "--force"]) == 0
+    with open(folder / "stages.csv") as f:
+        again = list(csv.DictReader(f))
+    keep = ("stage", "course", "bricks", "feasible", "moi", "moi_factor")
+    assert [{k: r[k] for k in keep} for r in again] == [{k: r[k] for k in keep}
+                                                        for r in rows]
+
+
+@pytest.mark.parametrize("args, option", [
+    (["--by", "brick", "--course", "99"], "--course"),
+    (["--by", "brick"], "--course"),
+    (["--by", "course", "--order", "along"], "--order"),
+    (["--scene", "arch", "--by", "course"], "--by"),
+])
+def test_bad_stage_options_get_one_line_and_write_nothing(tmp_path, capsys, args, option):
+    out = tmp_path / "out"
+    assert main(["stages", "--preset", "1", *args, "--out", str(out), "-q"]) == 2
+    error = capsys.readouterr().err.strip()
+    assert len(error.splitlines()) == 1 and option in error
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("order", ["names", "z"])
+def test_imported_stack_laid_by_names_or_height(tmp_path, capsys, order):
+    # the stack of 0.3 b overhangs, as an OBJ file: block names b0001 ... b0006 bottom
+    # up, so both orders lay it bottom up and stage 4 is the first to need support
+    blocks, centre = stack(np.full(5, 0.3))
+    path = tmp_path / "stack.obj"
+    path.write_bytes(blocks_obj(blocks))
+    assert main(["stages", str(path), "--support", "*ground*", "--order", order,
+                 "--no-plots", "--out", str(tmp_path / "out"), "-q"]) == 0
+    (folder,) = (tmp_path / "out").glob(f"*_stages_{order}")
+    with open(folder / "stages.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["feasible"] == "True" for r in rows] == stands_by_statics(centre)
+    record = json.loads((folder / "run.json").read_text())
+    first = record["stages"]["first_unsupported"]
+    assert first["stage"] == 4 and len(first["laid"]) == 1
+    assert first["laid"][0] == str(blocks.block_name[4])  # the fourth above the slab
+    assert "first stage that needs support: 4" in capsys.readouterr().out
+
+
+def test_first_unsupported_stage_is_drawn_with_its_new_block_outlined(tmp_path):
+    # the 0.3 b stack again, with plots: stage 4's views must show the magenta outline
+    # of the block laid at that stage in every view (2D elevations and the 3D angle)
+    import matplotlib.image
+
+    from masonry.plots import OUTLINE_COLOUR
+
+    blocks, _ = stack(np.full(5, 0.3))
+    path = tmp_path / "stack.obj"
+    path.write_bytes(blocks_obj(blocks))
+    assert main(["stages", str(path), "--support", "*ground*", "--out",
+                 str(tmp_path / "out"), "-q"]) == 0
+    (folder,) = (tmp_path / "out").glob("*_stages_z")
+    magenta = np.array(matplotlib.colors.to_rgb(OUTLINE_COLOUR))
+    views = sorted((folder / "first_unsupported").glob("*.png"))
+    assert [v.name for v in views] == ["01_angle.png", "02_front.png", "03_top.png",
+                                       "04_side.png"]
+    for view in views:
+        pixels = matplotlib.image.imread(view)[..., :3]
+        assert (np.abs(pixels - magenta).max(axis=-1) < 0.05).sum() > 50, view.name
+    assert (folder / "stages.png").stat().st_size > 10_000
