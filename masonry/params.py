@@ -292,8 +292,15 @@ def _live_loads(p: Params) -> Params:
             raise ParameterError("lateral", p.lateral,
                                  "an azimuth in degrees or 'all'") from None
     if lateral is not None and lateral != "all":
+        _check("lateral", p.lateral, isinstance(lateral, (int, float))
+               and not isinstance(lateral, bool), "an azimuth in degrees or 'all'")
         lateral = float(_number("lateral", lateral)) % 360.0
-    specs = (p.point_loads,) if isinstance(p.point_loads, str) else tuple(p.point_loads)
+    specs = p.point_loads
+    specs = (specs,) if isinstance(specs, str) else specs
+    _check("point_loads", p.point_loads, isinstance(specs, (tuple, list))
+           and all(isinstance(spec, str) for spec in specs),
+           "NAME_OR_PATTERN:FX,FY,FZ strings")
+    specs = tuple(specs)
     for spec in specs:
         parse_point_load(spec)
     if p.crown_load is not None:
@@ -301,9 +308,13 @@ def _live_loads(p: Params) -> Params:
                "> 0 (newtons, downward)")
         _check("crown_load", p.crown_load, p.scene in ("section", "dome"),
                "a dome: --scene section or dome")
-    kinds = sum((lateral is not None, bool(specs), p.crown_load is not None))
-    _check("lateral", p.lateral, kinds <= 1,
-           "one live load per run: --lateral, --point-load or --crown-load")
+    given = [(name, value) for name, value, present in (
+        ("lateral", p.lateral, lateral is not None), ("point_loads", specs and specs[0],
+                                                      bool(specs)),
+        ("crown_load", p.crown_load, p.crown_load is not None)) if present]
+    if len(given) > 1:
+        raise ParameterError(*given[1], "one live load per run: --lateral, --point-load "
+                                        "or --crown-load", related=(given[0][0],))
     if p.scene == "section" and p.boundary == "cyclic" and (lateral is not None or specs):
         # one web with the load repeated in every web is not the asked load case
         raise ParameterError("lateral" if lateral is not None else "point_loads",

@@ -698,12 +698,15 @@ def mechanism_pngs(scene, blocks, interfaces, mechanism, hinge, slides, title,
                 _add_polygons(ax, view, _polygons(interfaces, index), face,
                               edgecolors=edge, linewidths=width)
         _colour_bar(fig, ax, scale, "virtual displacement (largest = 1)")
-        ax.legend(handles=[Patch(facecolor="none", edgecolor="0.6", label="undeformed"),
-                           Patch(facecolor="red", edgecolor="red",
-                                 label=f"hinge ({int(hinge.sum())})"),
-                           Patch(facecolor="none", edgecolor="blue",
-                                 label=f"sliding ({int((slides & ~hinge).sum())} more)")],
-                  loc="upper left", fontsize=7)
+        handles = [Patch(facecolor="none", edgecolor="0.6", label="undeformed"),
+                   Patch(facecolor="red", edgecolor="red", label=f"hinge ({int(hinge.sum())})"),
+                   Patch(facecolor="none", edgecolor="blue",
+                         label=f"sliding ({int(slides.sum())})")]
+        if view in ELEVATIONS:  # below the plot: an elevation fills its axes
+            ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.2),
+                      ncol=3, fontsize=7, frameon=False)
+        else:
+            ax.legend(handles=handles, loc="upper left", fontsize=7)
         ax.set_title(f"{title}; displacement drawn at {MECHANISM_SCALE:g} x size\n"
                      f"{scene_title(scene)}", fontsize=9)
         out[f"collapse/{view}_mechanism.png"] = _png(fig, 60 if fast else 110)

@@ -97,6 +97,12 @@ LISTED = [
     ["--max-bricks", "x"], ["--max-bricks", "10"],
     ["--print-size", "-5"], ["--print-size", "0"], ["--print-size", "nan"],
     ["--print-size", "1e308"], ["--print-size", "150", "--no-printable"],
+    ["--lateral", "east"], ["--lateral", "nan"], ["--lateral", "1e400"],
+    ["--dome", "--lateral", "30"], ["--dome", "--point-load", "w0_*:1000,0,0"],
+    ["--point-load", "w0_*:1,2"], ["--point-load", "w0_*:0,0,0"], ["--point-load", ":1,2,3"],
+    ["--point-load", "w0_*:1,2,nan"], ["--crown-load", "0"], ["--crown-load", "-5"],
+    ["--crown-load", "nan"], ["--scene", "wall", "--crown-load", "500"],
+    ["--lateral", "0", "--crown-load", "500"], ["--point-load", "a*:0,0,-1", "--lateral", "0"],
 ]
 RUN_ONLY = [["--scene", "arch", "--boundary", "cyclic"], ["--scene", "wall", "--dome"],
             ["--friction", "none"], ["--solver", "gurobi"]]
@@ -338,6 +344,9 @@ PLAUSIBLE = {
     "--friction": ["net", "plus", "auto", "none"],
     "--accuracy": ["fast", "balanced", "accurate", "best"],
     "--print-size": ["100", "150", "200"],
+    "--lateral": ["0", "30", "-90", "all", "east"],
+    "--point-load": ["w0_*:1000,0,0", "*:0,0,-500", "w0_b0001*:0,0,-1e4", "w0:1,2", "x"],
+    "--crown-load": ["500", "20000", "0", "-100"],
 }
 INTEGER_OPTIONS = {"--n", "--r", "--p", "--wall-courses", "--blocks"}
 SCENE_OPTIONS = {
@@ -346,7 +355,8 @@ SCENE_OPTIONS = {
     "wall": ["--wall-length", "--wall-courses", "--unit"],
     "arch": ["--span", "--thickness", "--rise", "--depth", "--blocks", "--shape"],
 }
-EVERY_SCENE = ["--mu", "--density", "--friction", "--accuracy", "--print-size"]
+EVERY_SCENE = ["--mu", "--density", "--friction", "--accuracy", "--print-size", "--lateral",
+               "--point-load", "--crown-load"]
 
 
 def test_the_tables_cover_every_option_of_run():
@@ -360,7 +370,7 @@ def test_the_tables_cover_every_option_of_run():
 
 def value_of(option):
     plausible = st.sampled_from(PLAUSIBLE[option])
-    if option in ("--shape", "--boundary", "--friction", "--accuracy"):
+    if option in ("--shape", "--boundary", "--friction", "--accuracy", "--point-load"):
         return plausible
     wild = WILD_INTEGERS if option in INTEGER_OPTIONS else WILD_FLOATS
     return st.one_of(plausible, plausible, plausible, wild)
