@@ -6,7 +6,7 @@ from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS, run_stages
 
 from .options import add_analysis_options, add_model_options, add_verbosity, params_from_args
 
-ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast")
+ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast", "lateral")
 
 
 def register(subparsers):
@@ -36,6 +36,12 @@ def register(subparsers):
                    help="add a ground slab (a support) under the lowest blocks")
     add_model_options(parser)
     add_analysis_options(parser)
+    g = parser.add_argument_group("live load")
+    g.add_argument("--lateral", metavar="AZIMUTH",
+                   help="also the collapse load factor lambda of every stage that stands, "
+                        "under a horizontal body force lambda x each block's weight at "
+                        "AZIMUTH degrees from +x toward +y (one azimuth; not on a cyclic "
+                        "section: use --scene dome)")
     g = parser.add_argument_group("output")
     g.add_argument("--out", default="exports", metavar="DIR",
                    help="output root; the run folder is DIR/<structure id>_stages_<plan>")
@@ -71,6 +77,12 @@ def handle(args, report):
     report(f"{stages['standing']} of {stages['count']} stages stand without support "
            f"(mu {params.mu:g}, friction {params.friction}); stage solves "
            f"{stages['solve_s']:.3g} s")
+    factors = [(r["load_factor"], r["stage"]) for r in record["rows"]
+               if r.get("load_factor") is not None] if "rows" in record else []
+    if factors:
+        low, at = min(factors)
+        report(f"lateral load factor at {params.lateral:g} deg: smallest {low:.4g} (stage "
+               f"{at}), {factors[-1][0]:.4g} at stage {factors[-1][1]} (stages.csv)")
     first = stages["first_unsupported"]
     if first is not None:
         largest = ", ".join(f"{h['name']} ({h['tension_N']:.3g} N)" for h in first["held"][:3])

@@ -318,3 +318,29 @@ def test_first_unsupported_stage_is_drawn_with_its_new_block_outlined(tmp_path):
         pixels = matplotlib.image.imread(view)[..., :3]
         assert (np.abs(pixels - magenta).max(axis=-1) < 0.05).sum() > 50, view.name
     assert (folder / "stages.png").stat().st_size > 10_000
+
+
+# ---------------------------------------------------------------- stage load factors
+def test_lateral_load_factor_of_each_stage_matches_statics():
+    # a block b wide and h high on the slab tips about its edge at lambda = b / h (mu
+    # 0.7 > b/h: no sliding first). Stage 2, a second identical block centred on it: the
+    # two tip together about the bottom block's edge when lambda 2W h (their loads at
+    # h/2 and 3h/2) reaches 2W b/2, lambda = b / (2 h), before the top block tips alone
+    # (b / h) or either joint slides (mu)
+    b, h = 0.2, 0.4
+    blocks, _ = stack([0.0], width=b, height=h)
+    params = validate(Params(mu=0.7, lateral=0.0))
+    model = Model(blocks, detect(blocks))
+    plan = block_plan(blocks, "z")
+    rows = analyse_stages(model, params, plan)
+    assert [r["feasible"] for r in rows] == [True, True]
+    assert rows[0]["load_factor"] == pytest.approx(b / h, abs=1e-6)
+    assert rows[1]["load_factor"] == pytest.approx(b / (2 * h), abs=1e-6)
+
+
+def test_lateral_load_factor_of_a_stage_that_slides():
+    # mu 0.3 < b/h = 0.5: the single block slides at lambda = mu
+    blocks, _ = stack([], width=0.2, height=0.4)
+    params = validate(Params(mu=0.3, lateral=180.0))
+    rows = analyse_stages(Model(blocks, detect(blocks)), params, block_plan(blocks, "z"))
+    assert rows[0]["load_factor"] == pytest.approx(0.3, abs=1e-6)

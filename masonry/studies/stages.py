@@ -45,6 +45,8 @@ from masonry.export.summaries import parameters_text
 from masonry.params import ParameterError, structure_id, validate
 from masonry.pipeline import Timer, cached_model, model_record, versions, write_cache
 from masonry.rbe.boundary import Model, analysis_model, restrict
+from masonry.rbe.collapse import collapse_load
+from masonry.rbe.loads import lateral
 from masonry.rbe.solve import ACCURACY, RBEProblem
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.scenes import check_size
@@ -69,9 +71,9 @@ BLOCK_ORDERS = {
 
 STAGE_COLUMNS = ("stage", "course", "bricks", "feasible", "moi", "moi_factor",
                  "load_factor", "solve_s")
-"""Columns of ``stages.csv``, one row per stage. ``load_factor`` (the collapse load
-factor of the stage under a lateral load) is empty: the collapse analysis is not part of
-this package yet, and :func:`analyse_stage` is the one place that will fill it."""
+"""Columns of ``stages.csv``, one row per stage. ``load_factor``: the collapse load factor
+of the stage under the lateral load of ``params.lateral`` (:func:`stage_load_factor`);
+empty without one, or where the stage does not stand under its own weight."""
 
 NOT_LAID = -1
 """``StagePlan.block_stage`` of a block the plan never lays."""
@@ -250,13 +252,12 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
     -------
     dict
         :data:`STAGE_COLUMNS` (``moi`` in newtons; ``solve_s`` the stage's wall time:
-        model, assembly and solve; ``load_factor`` None: no live load), and ``tension``:
+        model, assembly and solves; ``load_factor`` None: no lateral load, or the stage
+        does not stand), and ``tension``:
         scene block -> newtons of tension it carries (see :func:`tension_by_block`).
     """
     start = time.perf_counter()
     part = restrict(model, plan.is_present(stage))
-    # load_factor: the collapse load factor of ``part`` under a lateral load goes here
-    # once the collapse analysis exists; until then it is not computed (empty)
     row = {"stage": stage, "course": int(plan.stage_course[stage - 1]) or None,
            "bricks": int((~part.blocks.block_is_support).sum()), "load_factor": None}
     if len(part.interfaces) == 0:
@@ -272,8 +273,31 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
         row.update(feasible=result.feasible, moi=_number(result.moi),
                    moi_factor=_number(result.moi_factor),
                    tension=tension_by_block(part, result, plan, floor))
+        if result.feasible:
+            row["load_factor"] = stage_load_factor(part, params)
     row["solve_s"] = round(time.perf_counter() - start, 4)
     return row
+
+
+def stage_load_factor(part: Model, params) -> float | None:
+    """The collapse load factor of a stage (SPEC 6.8) under the lateral load at
+    ``params.lateral`` degrees, built on the stage's own blocks; None without a lateral
+    load or without a factor (unbounded: the stage carries any lateral load).
+
+    Parameters
+    ----------
+    part : Model
+        A stage's model (:func:`masonry.rbe.boundary.restrict`) that stands under its own
+        weight.
+    params : masonry.params.Params
+        ``lateral`` (degrees, not ``'all'``), ``mu`` and ``density``.
+    """
+    if params.lateral is None:
+        return None
+    live = lateral(part, params.lateral, params.density)
+    result = collapse_load(part, live, mu=params.mu, density=params.density,
+                           dead_load_feasible=True)
+    return result.load_factor
 
 
 def tension_by_block(part: Model, result, plan: StagePlan, floor: float) -> dict:
@@ -396,6 +420,20 @@ def stages_folder_name(params, plan: StagePlan) -> str:
     return f"{structure_id(params)}_stages_{plan.tag}"
 
 
+def check_live_load(params) -> None:
+    """Refuse the live loads a stage study does not take (:class:`ParameterError`): point
+    and crown loads (they name blocks a stage may not hold yet) and ``--lateral all``
+    (an azimuth search at every stage: one azimuth per study)."""
+    if params.lateral == "all":
+        raise ParameterError("lateral", "all", "an azimuth in degrees for stages (a "
+                                               "search over azimuths at every stage is "
+                                               "not offered: run one azimuth per study)")
+    for name in ("point_loads", "crown_load"):
+        if getattr(params, name):
+            raise ParameterError(name, getattr(params, name), "none for stages (only "
+                                                              "--lateral AZIMUTH)")
+
+
 def run_stages(params, out_root="exports", *, by="course", order=None, course=None,
                plots_wanted=True, force=False, scene=None, source=None,
                max_bricks=MAX_BRICKS) -> dict:
@@ -429,6 +467,7 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
         stage, :data:`STAGE_COLUMNS` and ``tension``).
     """
     params = validate(params)
+    check_live_load(params)
     check_output_root(out_root)
     if scene is None:
         check_size(params, max_bricks)
