@@ -363,9 +363,14 @@ def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="",
         right.plot(stage, np.asarray(load_factor, float), color="#1f77b4", marker=".",
                    label="load factor")
         right.set_ylabel("collapse load factor")
+        right.set_ylim(0, 1.1 * np.nanmax(np.asarray(load_factor, float)))
         extra = right.get_legend_handles_labels()
         handles, labels = handles + extra[0], labels + extra[1]
-    ax.legend(handles, labels, loc="best", fontsize=8)
+        # below the plot: two axes' curves leave no free corner
+        ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=4,
+                  fontsize=8, frameon=False)
+    else:
+        ax.legend(handles, labels, loc="best", fontsize=8)
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
@@ -703,7 +708,7 @@ def mechanism_pngs(scene, blocks, interfaces, mechanism, hinge, slides, title,
                    Patch(facecolor="none", edgecolor="blue",
                          label=f"sliding ({int(slides.sum())})")]
         if view in ELEVATIONS:  # below the plot: an elevation fills its axes
-            ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.2),
+            ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.3),
                       ncol=3, fontsize=7, frameon=False)
         else:
             ax.legend(handles=handles, loc="upper left", fontsize=7)
