@@ -230,3 +230,11 @@ THRUST_ACTIVE_REL = 1e-7
 """A joint's intrados or extrados bound is active at the best thrust line when the line
 passes within this fraction of (total weight x R) of it
 (:func:`masonry.studies.thrust_line.thrust_line_margin`)."""
+
+MOTION_TOL = 1e-3
+"""Relative motion at a vertex, per largest block displacement (1 after normalising),
+above which an interface counts as opening or sliding in a collapse mechanism
+(:mod:`masonry.rbe.collapse`). Not a rounding tolerance: an interior point's dual is the
+centre of all optimal mechanisms and carries motions of order its tolerance elsewhere (at
+1e-6, preset 2's dome had every web hinging); 0.1 % of the largest displacement keeps
+the mechanism that matters."""

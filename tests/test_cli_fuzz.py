@@ -124,6 +124,8 @@ OTHER_COMMANDS = [
     ["analyze", "missing.obj", "--ground"], ["--bogus"], [],
     ["stages", "--by", "brick"], ["stages", "--by", "brick", "--course", "0"],
     ["stages", "--n", "1000000"], ["stages", "--scene", "arch", "--by", "course"],
+    ["stages", "--scene", "dome", "--lateral", "all"], ["stages", "--lateral", "30"],
+    ["stages", "--scene", "dome", "--lateral", "north"],
 ]
 
 

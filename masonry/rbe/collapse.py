@@ -38,15 +38,9 @@ import scipy.sparse as sp
 from masonry.rbe.equilibrium import assemble, friction_pyramid_edges
 from masonry.rbe.loads import LiveLoad, lateral
 from masonry.rbe.solve import interface_forces
+from masonry.tolerances import MOTION_TOL
 
 log = logging.getLogger(__name__)
-
-MOTION_TOL = 1e-3
-"""Relative motion at a vertex, per largest block displacement (1 after normalising),
-above which an interface counts as opening or sliding in the mechanism. Not a rounding
-tolerance: an interior point's dual is the centre of all optimal mechanisms and carries
-motions of order its tolerance elsewhere (at 1e-6, preset 2's dome had every web
-hinging); 0.1 % of the largest displacement keeps the mechanism that matters."""
 
 FEASIBILITY_TOL = 1e-7
 """HiGHS's primal and dual feasibility tolerance (scaled rows: of order one)."""
@@ -122,7 +116,7 @@ class CollapseResult:
         (radians per unit), normalised so the largest displacement of any block vertex is
         1; zero on supports.
     opens, slides, hinge : (K,) bool or None
-        Per interface: some vertex separates (relative normal motion > :data:`MOTION_TOL`);
+        Per interface: some vertex separates (relative normal motion > :data:`~masonry.tolerances.MOTION_TOL`);
         some vertex slips; opens with some vertex still closed (a hinge, not a separation).
     azimuths : tuple of (float, float or None)
         After :func:`worst_lateral`: every azimuth searched and its factor.
