@@ -1,8 +1,10 @@
 """Collapse load factors and mechanisms (SPEC 6.8-6.9) against analytic limit states and
 an independent 2D linear program on the arch's voussoirs."""
 
+import csv
 import json
 
+import meshio
 import numpy as np
 import pytest
 from scipy.optimize import linprog
@@ -281,6 +283,17 @@ def test_run_writes_the_collapse_record_and_files(tmp_path, capsys):
         assert (folder / "collapse" / name).stat().st_size > 0
     rows = (folder / "collapse" / "mechanism.csv").read_text().splitlines()
     assert rows[0] == "block,name,ux,uy,uz,rx,ry,rz" and len(rows) == 1 + 86
+    # the forces at collapse in RBE's table: same columns; the supports carry the lateral
+    # load, lambda times the weight, against it (forces act on block_b, the brick)
+    with open(folder / "collapse" / "forces.csv") as f:
+        table = list(csv.DictReader(f))
+    with open(folder / "RBE" / "forces.csv") as f:
+        assert list(table[0]) == next(csv.reader(f))
+    weight = json.loads((folder / "run.json").read_text())["rbe"]["weight_N"]
+    support = sum(float(r["shear_x_N"]) for r in table if r["kind"] == "support")
+    assert support == pytest.approx(-0.2 * weight, rel=1e-6)
+    mesh = meshio.read(folder / "collapse" / "interfaces.vtu")
+    assert {"compression_N", "shear_N", "hinge", "slides", "opens"} <= set(mesh.cell_data)
 
 
 def test_sweep_records_the_load_factor(tmp_path):
