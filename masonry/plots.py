@@ -21,6 +21,7 @@ import numpy as np  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
+from matplotlib.transforms import ScaledTranslation  # noqa: E402
 from mpl_toolkits.axes_grid1 import make_axes_locatable  # noqa: E402
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 
@@ -708,8 +709,10 @@ def mechanism_pngs(scene, blocks, interfaces, mechanism, hinge, slides, title,
                    Patch(facecolor="none", edgecolor="blue",
                          label=f"sliding ({int(slides.sum())})")]
         if view in ELEVATIONS:  # below the plot: an elevation fills its axes
-            ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.3),
-                      ncol=3, fontsize=7, frameon=False)
+            # 0.45 inch below the axes, clear of the tick labels at any aspect
+            below = ax.transAxes + ScaledTranslation(0, -0.45, fig.dpi_scale_trans)
+            ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0),
+                      bbox_transform=below, ncol=3, fontsize=7, frameon=False)
         else:
             ax.legend(handles=handles, loc="upper left", fontsize=7)
         ax.set_title(f"{title}; displacement drawn at {MECHANISM_SCALE:g} x size\n"
