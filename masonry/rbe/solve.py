@@ -100,10 +100,10 @@ ACCURACY = {
                  "osqp": {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iter": 100_000,
                           "polishing": True}}),
     # the reference: Clarabel (an independent implementation) with tight gaps for both
-    # models, polished, and the LP's second opinion on an infeasible verdict (on
-    # feasible ones it took 19 s for the cyclic section of preset 1 and ran out of its
-    # minute on every full dome). Clarabel's default gaps (1e-8) leave 2.6e-6 of the
-    # weight as interior-point tension on the straight wall; 1e-10 leaves 2.4e-7.
+    # models, polished, and the LP's second opinion on an infeasible verdict only (on
+    # feasible ones it is slow and adds nothing: docs/bench.md). Clarabel's default gaps
+    # (1e-8) leave 2.6e-6 of the weight as interior-point tension on the straight wall;
+    # 1e-10 leaves 2.4e-7.
     "accurate": AccuracyPreset(
         "accurate", "clarabel", "clarabel", residual=1e-6, lp_check="infeasible",
         polish=True,
