@@ -147,7 +147,8 @@ def test_run_arch_stands_above_and_falls_below_its_minimum(tmp_path):
         assert (outside <= 1 + 1e-6) is feasible
 
 
-def test_arch_thickness_command(capsys):
-    assert main(["arch-thickness", "--blocks", "16", "--mu", "10", "--rtol", "1e-3"]) == 0
+def test_arch_thickness_command(capsys, tmp_path):
+    assert main(["arch-thickness", "--blocks", "16", "--mu", "10", "--rtol", "1e-3",
+                 "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "t/R = 0.107" in out and "thrust line" in out

