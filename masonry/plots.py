@@ -479,14 +479,14 @@ def interface_pngs(scene, blocks, interfaces, fast=False) -> dict:
 
 
 FORCE_PLOTS = (
-    # (file, result key, interface selection, title, signed): thesis figures 4.1-4.8
+    # (file, result key, interface selection, title, signed): thesis figures 4.1-4.8; the
+    # friction components t1, t2 are in forces.csv, not drawn: a bed joint's in-plane
+    # axes follow its longest edge, so their signs have no common meaning across joints
     ("compression_horizontal", "compression", "horizontal",
      "bed joints and supports: compression", False),
     ("compression_vertical", "compression", "vertical", "head joints: compression", False),
     ("tension", "tension", "all", "all interfaces: tension", False),
     ("normal", "normal", "all", "all interfaces: normal force (tension +)", True),
-    ("t1", "t1", "all", "all interfaces: friction along t1", True),
-    ("t2", "t2", "all", "all interfaces: friction along t2", True),
     ("friction", "friction", "all", "all interfaces: friction", False),
 )
 FORCE_LABELS = {"compression": "compression", "tension": "tension",
