@@ -175,7 +175,23 @@ def _geometry_key(params: Params) -> str:
     return hashlib.sha1(key.encode()).hexdigest()[:16]
 
 
-def cached_model(params: Params, out_root, timer: Timer, check=None):
+def run_model(params: Params, out_root, timer: Timer, scene=None, check=None):
+    """Scene and analysis model of a run: ``(scene, model, 'reused' | 'computed' |
+    'given')``. Built from ``params`` through the geometry cache (:func:`_cached_model`),
+    or, when ``scene`` is given (blocks read from files), that scene with ``params``,
+    analysed as is and never cached. ``check(scene)`` runs before the interfaces are
+    detected, as in :func:`_cached_model`."""
+    if scene is None:
+        return _cached_model(params, out_root, timer, check=check)
+    scene = dataclasses.replace(scene, params=params)
+    if check is not None:
+        check(scene)
+    with timer.stage("interfaces"):
+        model = analysis_model(scene)
+    return scene, model, "given"
+
+
+def _cached_model(params: Params, out_root, timer: Timer, check=None):
     """Scene and analysis model (interfaces, boundary routing), from the geometry cache
     when it holds them: ``(scene, model, 'reused' | 'computed')``. ``check(scene)``, when
     given, runs on the scene before the interfaces are detected (it raises on bad input).
@@ -222,7 +238,7 @@ def _read_cache(path: Path):
 
 
 def write_cache(params: Params, out_root, scene: Scene, model: Model):
-    """Cache a model computed by :func:`cached_model` for ``params`` under ``out_root``;
+    """Cache a model computed by :func:`_cached_model` for ``params`` under ``out_root``;
     called once the run's folder is published, so a failed run caches nothing. A cache
     that cannot be written only costs the next run the rebuild (warned), never this
     run's results."""
@@ -350,12 +366,7 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
             params = params.replace(print_size=_print_size(previous))
 
     timer = Timer()
-    if scene is None:
-        scene, model, cached = cached_model(params, out_root, timer)
-    else:
-        scene, cached = dataclasses.replace(scene, params=params), "given"
-        with timer.stage("interfaces"):
-            model = analysis_model(scene)
+    scene, model, cached = run_model(params, out_root, timer, scene)
     record = run_record(scene, model, outputs, cached, source)
     result = _solve(model, params, timer) if outputs["analyse"] else None
     if result is not None:

@@ -2,14 +2,12 @@
 
 3MF states its unit in the file (``unit="millimeter"``), holds one object, and slicers
 (PrusaSlicer, Cura, Bambu Studio) place it on the bed at that size, so no scale is
-entered by hand. Written by trimesh (which needs lxml).
+entered by hand. Written by trimesh (which needs lxml and networkx).
 """
 
 import io
 
 import numpy as np
-
-MM_PER_M = 1000.0
 
 
 def print_scale(mesh, size_mm: float) -> float:

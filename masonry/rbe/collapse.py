@@ -38,6 +38,7 @@ import scipy.sparse as sp
 from masonry.rbe.equilibrium import assemble, friction_pyramid_edges
 from masonry.rbe.loads import LiveLoad, lateral
 from masonry.rbe.solve import interface_forces
+from masonry.rbe.solvers.highs import highs_lp
 from masonry.tolerances import MOTION_TOL
 
 log = logging.getLogger(__name__)
@@ -52,8 +53,8 @@ dual simplex warm-starts across azimuths, but gave no verdict on preset 1's sect
 dome within minutes (docs/collapse.md); Clarabel is the default."""
 
 CLARABEL_SETTINGS = {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8}
-"""Clarabel's tolerances for the collapse LP (its defaults; scaled rows of order one). At
-1e-9 preset 1's full dome ended "almost solved" after 600 s."""
+"""Clarabel's tolerances for the collapse LP (its defaults; scaled rows of order one);
+tighter gaps end "almost solved" on the full domes (docs/collapse.md)."""
 
 ALMOST_RESIDUAL = 1e-6
 """An interior point Clarabel calls "almost solved" is kept when its recomputed relative
@@ -308,27 +309,16 @@ class CollapseLP:
             A = sp.vstack([A, sp.csc_array((np.asarray(tie), ([0, 0], heads)),
                                            shape=(1, A.shape[1]))], format="csc")
             lower = np.append(lower, 0.0)
-        lp = highspy.HighsLp()
-        lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
         col_cost = np.zeros(A.shape[1])
         col_cost[heads] = cost
         free = np.full(A.shape[1] - n, highspy.kHighsInf)
-        lp.col_cost_ = col_cost
-        lp.col_lower_ = np.concatenate([self.lower, -free])
-        lp.col_upper_ = np.concatenate([np.minimum(self.upper, highspy.kHighsInf), free])
-        lp.row_lower_, lp.row_upper_ = lower, lower
-        lp.sense_ = highspy.ObjSense.kMaximize
-        lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-        lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
-            A.indptr, A.indices, A.data)
-        highs = highspy.Highs()
-        for name, value in (("output_flag", False), *HIGHS_METHODS[self.method].items(),
-                            ("time_limit", float(self.time_limit)),
-                            ("primal_feasibility_tolerance", FEASIBILITY_TOL),
-                            ("dual_feasibility_tolerance", FEASIBILITY_TOL)):
-            if highs.setOptionValue(name, value) != highspy.HighsStatus.kOk:
-                raise ValueError(f"HiGHS refused option {name}={value!r}")
-        highs.passModel(lp)
+        highs = highs_lp(A, col_cost, np.concatenate([self.lower, -free]),
+                         np.concatenate([np.minimum(self.upper, highspy.kHighsInf), free]),
+                         lower, lower,
+                         (*HIGHS_METHODS[self.method].items(),
+                          ("time_limit", float(self.time_limit)),
+                          ("primal_feasibility_tolerance", FEASIBILITY_TOL),
+                          ("dual_feasibility_tolerance", FEASIBILITY_TOL)), maximize=True)
         return highs, heads, tie_row
 
     def _result(self, lp, live, azimuth, start, dead_load_feasible) -> CollapseResult:

@@ -36,13 +36,10 @@ class LiveLoad:
     description : dict
         What was applied, for run.json: ``kind`` and the load's inputs, and
         ``total_force_N`` (the resultant force, (3,) list).
-    symmetric : bool
-        The load is the same in every web of a dome (a cyclic section may carry it).
     """
 
     wrench: np.ndarray
     description: dict = field(default_factory=dict)
-    symmetric: bool = False
 
     @property
     def total_force(self) -> np.ndarray:
@@ -168,5 +165,4 @@ def crown_load(blocks, newtons: float, copies: int = 1) -> LiveLoad:
     force[:, 2] = -newtons / copies * share
     wrench = _at_points(blocks, chosen, blocks.face_centre[face], force)
     return LiveLoad(wrench, _describe("crown", wrench, newtons=float(newtons),
-                                      copies=int(copies), blocks=len(chosen)),
-                    symmetric=True)
+                                      copies=int(copies), blocks=len(chosen)))

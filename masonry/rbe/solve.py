@@ -26,6 +26,7 @@ from masonry.rbe.equilibrium import (FRICTION_METHODS, EquilibriumSystem, Variab
                                      assemble, friction_pyramid_edges)
 from masonry.rbe.solvers import BACKENDS, FAMILY
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL
+from masonry.rbe.solvers.highs import highs_lp
 from masonry.tolerances import Tolerances
 
 log = logging.getLogger(__name__)
@@ -118,9 +119,6 @@ ACCURACY = {
 
 SOLVERS = tuple(BACKENDS)
 """Every solver name :func:`solve_rbe` accepts."""
-
-VERDICTS = ("feasible", "infeasible", "not solved")
-"""Values of :attr:`RBEResult.verdict`."""
 
 RESULT_KEYS = ("verdict", "feasible", "friction", "mu", "objective", "moi", "moi_factor",
                "weight_N",
@@ -487,7 +485,7 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
         Run the independent friction-net feasibility LP (HiGHS, zero objective): always,
         never, or only when the verdict is infeasible. Default: the preset's
         (``accurate``: when infeasible). Proving feasibility takes it far longer than
-        proving infeasibility (preset 1's cyclic section: 19 s; its free section: 0.25 s).
+        proving infeasibility (docs/bench.md).
     lp_time_limit : float, s
         HiGHS's time limit; when reached, ``lp_feasible`` is None and a warning is logged.
     side_block, side_rotation : optional
@@ -557,31 +555,18 @@ def _lp_feasible(system: EquilibriumSystem, time_limit: float):
     nothing: a friction-net point with ``0 < t <= c`` stays one with ``(c - t, 0)``.
     The edge form is also a second, independent way to state the constraints. HiGHS's
     interior point method decides it, without crossover (a vertex solution is not
-    needed, only the verdict): on the section of preset 1 it proved infeasibility in
-    0.25 s (6 s with crossover, through scipy's linprog; the dual simplex had no verdict
-    after 120 s). Proving feasibility takes longer (19 s on the cyclic section of
-    preset 1, against 31 s with crossover) and grows faster than linearly, hence
-    ``time_limit``.
+    needed, only the verdict; crossover and the dual simplex were measured slower,
+    docs/bench.md). Proving feasibility takes far longer than proving infeasibility and
+    grows faster than linearly, hence ``time_limit``.
 
     Returns True, False, or None when HiGHS ends without a verdict (time limit).
     """
     generators = friction_pyramid_edges(system.layout.n_vertices, system.mu)
     A = sp.csc_array(system.A_eq @ generators)
-    lp = highspy.HighsLp()
-    lp.num_col_, lp.num_row_ = A.shape[1], A.shape[0]
-    lp.col_cost_ = np.zeros(A.shape[1])
-    lp.col_lower_ = np.zeros(A.shape[1])
-    lp.col_upper_ = np.full(A.shape[1], highspy.kHighsInf)
-    lp.row_lower_ = lp.row_upper_ = -system.f_ext
-    lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
-    lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
-        A.indptr, A.indices, A.data)
-    solver = highspy.Highs()
-    for name, value in (("output_flag", False), ("solver", "ipm"), ("run_crossover", "off"),
-                        ("time_limit", float(time_limit))):
-        if solver.setOptionValue(name, value) != highspy.HighsStatus.kOk:
-            raise ValueError(f"HiGHS refused option {name}={value!r}")
-    solver.passModel(lp)
+    solver = highs_lp(A, np.zeros(A.shape[1]), np.zeros(A.shape[1]),
+                      np.full(A.shape[1], highspy.kHighsInf), -system.f_ext, -system.f_ext,
+                      (("solver", "ipm"), ("run_crossover", "off"),
+                       ("time_limit", float(time_limit))))
     solver.run()
     status = solver.getModelStatus()
     if status == highspy.HighsModelStatus.kOptimal:

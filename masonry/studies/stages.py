@@ -43,8 +43,8 @@ from masonry import plots
 from masonry.blocks import BLOCK_CLASSES
 from masonry.export.summaries import parameters_text
 from masonry.params import ParameterError, structure_id, validate
-from masonry.pipeline import Timer, cached_model, model_record, versions, write_cache
-from masonry.rbe.boundary import Model, analysis_model, restrict
+from masonry.pipeline import Timer, model_record, run_model, versions, write_cache
+from masonry.rbe.boundary import Model, restrict
 from masonry.rbe.collapse import collapse_load
 from masonry.rbe.loads import lateral
 from masonry.rbe.solve import ACCURACY, RBEProblem
@@ -478,13 +478,7 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
         nonlocal plan
         plan = make_plan(built, by, order, course)
 
-    if scene is None:
-        scene, model, cached = cached_model(params, out_root, timer, check=check)
-    else:
-        scene, cached = dataclasses.replace(scene, params=params), "given"
-        check(scene)
-        with timer.stage("interfaces"):
-            model = analysis_model(scene)
+    scene, model, cached = run_model(params, out_root, timer, scene, check=check)
     target = Path(out_root) / stages_folder_name(params, plan)
     previous = _previous(target, params, plan)
     if previous is not None:

@@ -193,8 +193,7 @@ class NewtonSystem:
         if np.ptp(self.h[:, self.pyramid]) != 0:
             raise ValueError("the pyramid projection needs equal weights on c, f1, f2")
         keep = (layout.WIDTH * np.arange(layout.n_vertices)[:, None] + columns).ravel()
-        # columns are the major index of CSC: a fast subset (a CSR column subset took
-        # 0.1 s on preset 1's full dome)
+        # columns are the major index of CSC: a fast subset (a CSR one is slow)
         self.AT = sp.csr_array(sp.csc_array(system.A_eq)[:, keep].T)
         self.A = sp.csr_array(self.AT.T)
         self.b = -system.f_ext

@@ -2,8 +2,7 @@
 
 The problem is written as the thesis states it (every sign bound, both pyramids as
 cvxpy constraints) and cvxpy canonicalizes it for OSQP or Clarabel. The direct paths
-(:mod:`.direct_osqp`, :mod:`.direct_clarabel`) must agree with it (tests/test_solvers.py);
-on preset 1's section cvxpy's compile took 0.4 s of Clarabel's 5 s.
+(:mod:`.direct_osqp`, :mod:`.direct_clarabel`) must agree with it (tests/test_solvers.py).
 """
 
 import logging
