@@ -247,6 +247,11 @@ def test_worst_lateral_searches_the_symmetry_directions_with_one_model(method):
     by_angle = dict(worst.azimuths)
     for a in azimuths:
         assert by_angle[a] == pytest.approx(by_angle[(a + 60.0) % 360.0], rel=1e-6)
+    # so the search may solve each azimuth modulo 60 degrees once
+    reduced = worst_lateral(dome, azimuths, n_webs=6, period_deg=60.0, method=method)
+    np.testing.assert_allclose([f for _, f in reduced.azimuths], factors, rtol=1e-6)
+    assert reduced.azimuth_deg < 60.0 and reduced.load_factor == pytest.approx(
+        worst.load_factor, rel=1e-6)
     # the same factor as an independent solve at that azimuth
     alone = collapse_load(dome, lateral(dome, worst.azimuth_deg))
     assert alone.load_factor == pytest.approx(worst.load_factor, rel=1e-7)

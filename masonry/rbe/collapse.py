@@ -662,26 +662,33 @@ def lateral_azimuths(n_webs=None, count=24) -> np.ndarray:
 
 
 def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
-                  dead_load_feasible=None, time_limit=600.0, method=None) -> CollapseResult:
+                  period_deg=None, dead_load_feasible=None, time_limit=600.0,
+                  method=None) -> CollapseResult:
     """The smallest lateral load factor over ``azimuths`` (``--lateral all``).
 
-    One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: two coefficients and
-    two costs change; HiGHS's simplex restarts from the last basis, Clarabel keeps its
-    symbolic factorization), ``method`` one of :data:`METHODS`, and the dead load is
-    checked once (unless ``dead_load_feasible`` is given). Returns the worst azimuth's
-    result with every azimuth's factor in ``azimuths`` ((azimuth, factor or None) pairs).
+    One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: the interior point
+    method and Clarabel keep their symbolic factorization, HiGHS's simplex restarts from
+    the last basis), ``method`` one of :data:`METHODS`, and the dead load is checked once
+    (unless ``dead_load_feasible`` is given). ``period_deg``: the model repeats under a
+    rotation by this angle about the z axis (a full dome of ``n`` webs: ``360 / n``), so
+    azimuths that differ by it have the same factor and each is solved once. Returns the
+    worst azimuth's result with every azimuth's factor in ``azimuths`` ((azimuth, factor
+    or None) pairs).
     """
     azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
     problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit,
                          method=method)
     start = time.perf_counter()
-    results, known = [], dead_load_feasible
+    results, solved, known = [], {}, dead_load_feasible
     for azimuth in azimuths:
-        result = problem.solve_lateral(float(azimuth), dead_load_feasible=known)
-        known = result.dead_load_feasible
-        results.append(result)
+        key = round(float(azimuth) % period_deg, 9) if period_deg else float(azimuth)
+        if key not in solved:
+            solved[key] = problem.solve_lateral(float(azimuth), dead_load_feasible=known)
+            known = solved[key].dead_load_feasible
+        results.append(solved[key])
         if known is False:
             break
+    log.info("lateral search: %d azimuths, %d solved", len(results), len(solved))
     factors = [(float(a), r.load_factor) for a, r in zip(azimuths, results)]
     found = [r for r in results if r.load_factor is not None]
     worst = min(found, key=lambda r: r.load_factor) if found else results[-1]

@@ -81,6 +81,9 @@ class LoadFactorOptions:
     min_step: float = 1e-6
 
 
+PRIMAL_PASSES = 2
+"""Passes that solve for what the direction leaves of the primal rows."""
+
 REGULARIZATION_RAISE = 1e3
 REGULARIZATION_RAISES = 3
 """A normal matrix that fails to factor is shifted up to this many times more, by this
@@ -117,6 +120,8 @@ class _Normal:
             except np.linalg.LinAlgError:
                 if attempt == REGULARIZATION_RAISES:
                     raise
+                log.debug("collapse LP: normal matrix shifted by %.1e of its diagonal",
+                          regularization * REGULARIZATION_RAISE**(attempt + 1))
         self.v = self.solve(load)
         self.lv = float(load @ self.v)
 
@@ -142,14 +147,25 @@ class _Normal:
     def direction(self, r_primal, r_dual, r_factor, r_comp, g, s, refine=True):
         """Newton direction for the residuals ``M g + lambda l - b``, ``M^T y + s``,
         ``l^T y + 1`` and the complementarity target ``g s - r_comp`` (elementwise):
-        ``(dg, dlambda, dy, ds)``."""
+        ``(dg, dlambda, dy, ds)``. With ``refine``, further passes solve for what the
+        first left of the primal rows (``D`` amplifies the errors of ``dy`` in ``dg``);
+        its correction ``D M^T dy'`` keeps the other rows exact, as ``S D = G``."""
         rhs = -r_primal + self.times_m(r_comp / s - self.d * r_dual)
+        dy, d_factor = self._bordered(rhs, float(r_factor), refine)
+        dg = -r_comp / s + self.d * (r_dual + self.times_mt(dy))
+        for _ in range(PRIMAL_PASSES if refine else 0):
+            left = self.times_m(dg) + d_factor * self.load + r_primal
+            correction, d_extra = self._bordered(-left, 0.0, refine)
+            dy, d_factor = dy + correction, d_factor + d_extra
+            dg = dg + self.d * self.times_mt(correction)
+        ds = -r_dual - self.times_mt(dy)
+        return dg, d_factor, dy, ds
+
+    def _bordered(self, rhs, r_factor, refine):
+        """``(dy, dlambda)`` with ``K dy + l dlambda = rhs`` and ``l^T dy = -r_factor``."""
         u = self.solve(rhs, refine)
         d_factor = (float(self.load @ u) + r_factor) / self.lv
-        dy = u - d_factor * self.v
-        ds = -r_dual - self.times_mt(dy)
-        dg = (-r_comp - g * ds) / s
-        return dg, d_factor, dy, ds
+        return u - d_factor * self.v, d_factor
 
 
 def _start(ns, rays, load, regularization):
