@@ -103,14 +103,14 @@ class _Normal:
 
     def __init__(self, ns: NewtonSystem, rays, d, regularization, load):
         self.ns, self.rays, self.d, self.load = ns, rays, d, load
-        self.blocks = np.einsum("ik,vk,jk->vij", rays, d, rays)
-        matrix = ns.newton_blocks(self.blocks, 0.0, incremental=False)
+        blocks = np.einsum("ik,vk,jk->vij", rays, d, rays)
+        matrix = ns.newton_blocks(blocks, 0.0, incremental=False)
         diagonal = matrix[ns.diagonal_blocks]
         scale = float(np.mean(np.trace(diagonal, axis1=1, axis2=2))) / 6.0
         # near the optimum D spans many decades and K is singular to working precision
         # where no edge ray of a block carries force: a shift relative to K's diagonal,
-        # raised until the factorization succeeds (the refinement in solve() recovers
-        # the digits it costs)
+        # raised until the factorization succeeds (the primal passes of direction()
+        # recover the digits it costs)
         for attempt in range(REGULARIZATION_RAISES + 1):
             shift = regularization * REGULARIZATION_RAISE**attempt * scale
             matrix[ns.diagonal_blocks] = diagonal + shift * np.eye(6)
@@ -122,7 +122,7 @@ class _Normal:
                     raise
                 log.debug("collapse LP: normal matrix shifted by %.1e of its diagonal",
                           regularization * REGULARIZATION_RAISE**(attempt + 1))
-        self.v = self.solve(load)
+        self.v = self.factor.solve(load)
         self.lv = float(load @ self.v)
 
     def times_m(self, g):
@@ -133,17 +133,6 @@ class _Normal:
         """``M^T y`` ((V, 4))."""
         return (self.ns.AT @ y).reshape(-1, 3) @ self.rays
 
-    def solve(self, rhs, refine=True):
-        """``K^-1 rhs``, with one step of iterative refinement unless ``refine`` is False
-        (the shift and the spread of ``D`` over many decades near the optimum cost
-        digits)."""
-        dy = self.factor.solve(rhs)
-        if not refine:
-            return dy
-        product = self.ns.A @ np.einsum("vij,vj->vi", self.blocks,
-                                        (self.ns.AT @ dy).reshape(-1, 3)).ravel()
-        return dy + self.factor.solve(rhs - product)
-
     def direction(self, r_primal, r_dual, r_factor, r_comp, g, s, refine=True):
         """Newton direction for the residuals ``M g + lambda l - b``, ``M^T y + s``,
         ``l^T y + 1`` and the complementarity target ``g s - r_comp`` (elementwise):
@@ -151,19 +140,19 @@ class _Normal:
         first left of the primal rows (``D`` amplifies the errors of ``dy`` in ``dg``);
         its correction ``D M^T dy'`` keeps the other rows exact, as ``S D = G``."""
         rhs = -r_primal + self.times_m(r_comp / s - self.d * r_dual)
-        dy, d_factor = self._bordered(rhs, float(r_factor), refine)
+        dy, d_factor = self._bordered(rhs, float(r_factor))
         dg = -r_comp / s + self.d * (r_dual + self.times_mt(dy))
         for _ in range(PRIMAL_PASSES if refine else 0):
             left = self.times_m(dg) + d_factor * self.load + r_primal
-            correction, d_extra = self._bordered(-left, 0.0, refine)
+            correction, d_extra = self._bordered(-left, 0.0)
             dy, d_factor = dy + correction, d_factor + d_extra
             dg = dg + self.d * self.times_mt(correction)
         ds = -r_dual - self.times_mt(dy)
         return dg, d_factor, dy, ds
 
-    def _bordered(self, rhs, r_factor, refine):
+    def _bordered(self, rhs, r_factor):
         """``(dy, dlambda)`` with ``K dy + l dlambda = rhs`` and ``l^T dy = -r_factor``."""
-        u = self.solve(rhs, refine)
+        u = self.factor.solve(rhs)
         d_factor = (float(self.load @ u) + r_factor) / self.lv
         return u - d_factor * self.v, d_factor
 
@@ -173,7 +162,7 @@ def _start(ns, rays, load, regularization):
     the least-norm dual slacks ``s = -M^T y`` with ``l^T y = -1``, both shifted inside
     the orthant and balanced (:func:`~masonry.rbe.solvers.interior.centred_start`)."""
     unit = _Normal(ns, rays, np.ones((len(ns.h), 4)), regularization, load)
-    g = unit.times_mt(unit.solve(ns.b))
+    g = unit.times_mt(unit.factor.solve(ns.b))
     y = -unit.v / unit.lv
     g, s = centred_start(g, -unit.times_mt(y))
     return g, y, s
