@@ -471,7 +471,10 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     options = dict(mu=params.mu, density=params.density)
     if params.lateral == "all":
         webs = params.n if params.scene in ("section", "dome") else None
-        return worst_lateral(model, n_webs=webs, dead_load_feasible=known, **options)
+        # the full dome repeats every 360/n degrees (tests/test_collapse.py checks it)
+        period = 360.0 / params.n if params.scene == "dome" else None
+        return worst_lateral(model, n_webs=webs, period_deg=period,
+                             dead_load_feasible=known, **options)
     if params.lateral is not None:
         live = lateral(model, params.lateral, params.density)
     elif params.point_loads:

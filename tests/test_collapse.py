@@ -183,8 +183,9 @@ def arch_model(thickness, blocks=12):
     return params, analysis_model(build(params))
 
 
-@pytest.mark.parametrize("thickness, mu, method", [(1.0, 0.9, "clarabel"),
-                                                   (1.6, 0.5, "clarabel"),
+@pytest.mark.parametrize("thickness, mu, method", [(1.0, 0.9, "interior"),
+                                                   (1.6, 0.5, "interior"),
+                                                   (1.0, 0.9, "clarabel"),
                                                    (1.0, 0.9, "ipm-crossover")])
 def test_arch_under_horizontal_load_matches_an_independent_2d_lp(thickness, mu, method):
     params, model = arch_model(thickness)
@@ -234,7 +235,7 @@ def test_crown_load_on_the_cyclic_section_equals_the_full_dome():
     np.testing.assert_allclose(total, [0, 0, -2000.0], atol=1e-9 * 2000.0)
 
 
-@pytest.mark.parametrize("method", ["clarabel", "simplex"])
+@pytest.mark.parametrize("method", ["interior", "clarabel", "simplex"])
 def test_worst_lateral_searches_the_symmetry_directions_with_one_model(method):
     dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
     azimuths = lateral_azimuths(6)
@@ -246,10 +247,29 @@ def test_worst_lateral_searches_the_symmetry_directions_with_one_model(method):
     by_angle = dict(worst.azimuths)
     for a in azimuths:
         assert by_angle[a] == pytest.approx(by_angle[(a + 60.0) % 360.0], rel=1e-6)
+    # so the search may solve each azimuth modulo 60 degrees once
+    reduced = worst_lateral(dome, azimuths, n_webs=6, period_deg=60.0, method=method)
+    np.testing.assert_allclose([f for _, f in reduced.azimuths], factors, rtol=1e-6)
+    assert reduced.azimuth_deg < 60.0 and reduced.load_factor == pytest.approx(
+        worst.load_factor, rel=1e-6)
     # the same factor as an independent solve at that azimuth
     alone = collapse_load(dome, lateral(dome, worst.azimuth_deg))
     assert alone.load_factor == pytest.approx(worst.load_factor, rel=1e-7)
     check_mechanism(dome, lateral(dome, worst.azimuth_deg), worst)
+
+
+@pytest.mark.parametrize("azimuth", [0.0, 45.0])
+def test_interior_point_lp_finds_the_simplex_optimum_on_a_dome(azimuth):
+    """The own interior point method against HiGHS's dual simplex (an exact vertex
+    solution) on the 78-brick dome, without falling back to Clarabel."""
+    dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
+    live = lateral(dome, azimuth, DENSITY)
+    ours = CollapseLP(dome, method="interior").solve(live, dead_load_feasible=True)
+    simplex = CollapseLP(dome, method="simplex").solve(live, dead_load_feasible=True)
+    assert ours.solver == "interior"
+    assert ours.load_factor == pytest.approx(simplex.load_factor, rel=1e-7)
+    assert ours.residual <= 1e-6
+    check_mechanism(dome, live, ours)
 
 
 # ---------------------------------------------------------------------- inputs, CLI

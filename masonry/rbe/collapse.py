@@ -38,7 +38,10 @@ import scipy.sparse as sp
 from masonry.rbe.equilibrium import assemble, friction_pyramid_edges
 from masonry.rbe.loads import LiveLoad, lateral
 from masonry.rbe.solve import interface_forces
+from masonry.rbe.solvers.base import OPTIMAL
 from masonry.rbe.solvers.highs import highs_lp
+from masonry.rbe.solvers.interior_lp import LoadFactorOptions, load_factor
+from masonry.rbe.solvers.newton import NewtonSystem
 from masonry.tolerances import MOTION_TOL
 
 log = logging.getLogger(__name__)
@@ -46,11 +49,15 @@ log = logging.getLogger(__name__)
 FEASIBILITY_TOL = 1e-7
 """HiGHS's primal and dual feasibility tolerance (scaled rows: of order one)."""
 
-METHODS = ("clarabel", "ipm", "ipm-crossover", "simplex")
-"""Solvers of the collapse LP: Clarabel's interior point (direct LDL factorization), or
-HiGHS (``HIGHS_METHODS``). HiGHS decides the small scenes of the tests at once, and its
-dual simplex warm-starts across azimuths, but gave no verdict on preset 1's sections and
-dome within minutes (docs/collapse.md); Clarabel is the default."""
+METHODS = ("interior", "clarabel", "ipm", "ipm-crossover", "simplex")
+"""Solvers of the collapse LP: the project's interior point method on the Newton method's
+matrix (:mod:`masonry.rbe.solvers.interior_lp`; Clarabel decides when it finds no
+optimum: a dead load that cannot stand, a live load carried at every factor), Clarabel's
+interior point (direct LDL factorization of the whole KKT system), or HiGHS
+(``HIGHS_METHODS``). HiGHS decides the small scenes of the tests at once, and its dual
+simplex warm-starts across azimuths, but gave no verdict on preset 1's sections and dome
+within minutes; Clarabel stopped 0.3 % short of the optimum on preset 1's cyclic
+section (docs/collapse.md). ``interior`` is the default."""
 
 CLARABEL_SETTINGS = {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8}
 """Clarabel's tolerances for the collapse LP (its defaults; scaled rows of order one);
@@ -67,7 +74,7 @@ HIGHS_METHODS = {
 }
 """HiGHS settings by name."""
 
-METHOD = "clarabel"
+METHOD = "interior"
 """The default of :data:`METHODS`."""
 
 ASSOCIATED_NOTE = (
@@ -207,6 +214,7 @@ class CollapseLP:
         self.matrix = sp.csc_array(self.system.A_eq @ self.edges)
         self.mu, self.density, self.time_limit = float(mu), float(density), time_limit
         self._lateral = None
+        self._newton_system = None  # the interior point method's, made on first use
         self.method = METHOD if method is None else method
         # bounds of the columns: edge rays are >= 0
         self.lower = np.zeros(self.matrix.shape[1])
@@ -227,7 +235,9 @@ class CollapseLP:
         lower = np.column_stack([np.zeros_like(capacity), -capacity, -capacity])
         upper = np.column_stack([np.full_like(capacity, np.inf), capacity, capacity])
         out = CollapseLP.__new__(CollapseLP)
-        out.__dict__.update(self.__dict__, edges=edges, _lateral=None,
+        # the own interior point method knows the pyramid only: Clarabel takes the bounds
+        method = "clarabel" if self.method == "interior" else self.method
+        out.__dict__.update(self.__dict__, edges=edges, _lateral=None, method=method,
                             matrix=sp.csc_array(self.system.A_eq @ edges),
                             lower=lower.ravel(), upper=upper.ravel())
         return out
@@ -246,8 +256,8 @@ class CollapseLP:
 
     def solve_lateral(self, azimuth_deg: float, *, dead_load_feasible=None) -> CollapseResult:
         """The factor of :func:`masonry.rbe.loads.lateral` at ``azimuth_deg``, reusing the
-        previous azimuth's model (HiGHS: its basis; Clarabel: its symbolic
-        factorization)."""
+        previous azimuth's model (HiGHS: its basis; Clarabel and the interior point
+        method: their symbolic factorization)."""
         start = time.perf_counter()
         angle = np.radians(azimuth_deg)
         cos, sin = np.cos(angle), np.sin(angle)
@@ -262,9 +272,14 @@ class CollapseLP:
                             dead_load_feasible)
 
     def _backend(self, loads, cost, tie=None):
-        if self.method == "clarabel":
-            return _ClarabelLP(self.matrix, loads, -self.system.f_ext, cost, tie,
-                               self.time_limit, self.lower, self.upper)
+        if self.method in ("clarabel", "interior"):
+            clarabel_lp = _ClarabelLP(self.matrix, loads, -self.system.f_ext, cost, tie,
+                                      self.time_limit, self.lower, self.upper)
+            if self.method == "clarabel":
+                return clarabel_lp
+            if self._newton_system is None:
+                self._newton_system = NewtonSystem(self.system, "net")
+            return _InteriorLP(self._newton_system, loads, cost, clarabel_lp)
         return _HighsLP(*self._highs(loads, cost, tie), self)
 
     def _load_columns(self, loads):
@@ -323,7 +338,7 @@ class CollapseLP:
 
     def _result(self, lp, live, azimuth, start, dead_load_feasible) -> CollapseResult:
         status, factor, values, dual, iterations = lp.run()
-        common = dict(solver=self.method, mu=self.mu, live=live, azimuth_deg=azimuth,
+        common = dict(solver=lp.name, mu=self.mu, live=live, azimuth_deg=azimuth,
                       iterations=iterations)
         if status != "optimal":
             feasible = False if status == "dead load infeasible" else dead_load_feasible
@@ -400,6 +415,7 @@ class _HighsLP:
 
     def __init__(self, highs, heads, tie_row, parent):
         self.highs, self.heads, self.tie_row = highs, heads, tie_row
+        self.name = parent.method
         self.columns, self.time_limit = parent.matrix.shape[1], parent.time_limit
 
     def _status(self) -> str:
@@ -443,6 +459,43 @@ class _HighsLP:
         self.highs.changeColsCost(2, self.heads, np.array([cos, sin]))
 
 
+class _InteriorLP:
+    """A collapse LP solved by :func:`masonry.rbe.solvers.interior_lp.load_factor`: the
+    load columns ``loads`` combined by ``cost`` (a lateral direction: ``cos, sin``) into
+    one live load. Without an optimum it hands the LP to ``fallback`` (a
+    :class:`_ClarabelLP` of the same LP), which tells infeasible from unbounded."""
+
+    def __init__(self, newton_system, loads, cost, fallback):
+        self.ns, self.loads, self.fallback = newton_system, loads, fallback
+        self.cost = np.asarray(cost, dtype=float)
+        self.name = "interior"
+
+    def run(self):
+        """``(status, factor, edge ray weights, equilibrium-row duals, iterations)``."""
+        outcome = load_factor(self.ns, self.loads @ self.cost, LoadFactorOptions())
+        self.name = "interior"
+        if outcome.status != OPTIMAL:
+            log.info("collapse LP: the interior point method found no optimum (%s); "
+                     "Clarabel decides", outcome.status)
+            self.name = "interior+clarabel"
+            if len(self.cost) == 2:
+                self.fallback.direct(*self.cost)
+            return self.fallback.run()
+        return ("optimal", outcome.info["load_factor"], outcome.x.ravel(), outcome.y,
+                outcome.iterations)
+
+    def stands_unloaded(self) -> bool | None:
+        """The feasible factors are an interval: ``lambda = 0`` lies in it when the
+        largest factor of the reversed load is also at least 0."""
+        reversed_load = load_factor(self.ns, -(self.loads @ self.cost), LoadFactorOptions())
+        if reversed_load.status == OPTIMAL:
+            return reversed_load.info["load_factor"] >= 0
+        return self.fallback.stands_unloaded()
+
+    def direct(self, cos, sin):
+        self.cost = np.array([cos, sin])
+
+
 class _ClarabelLP:
     """A collapse LP held by Clarabel (interior point, direct LDL): ``minimize -cost .
     lambda`` over ``[g, lambda]`` with the equilibrium (and tie) rows in the zero cone and
@@ -473,6 +526,7 @@ class _ClarabelLP:
                 self.A.indices[self.A.indptr[c]:self.A.indptr[c + 1]] == self.n_eq - 1)[0]
                 for c in (n, n + 1)]
         self.solver = None
+        self.name = "clarabel"
 
     def _settings(self):
         settings = clarabel.DefaultSettings()
@@ -521,7 +575,8 @@ class _ClarabelLP:
     def direct(self, cos, sin):
         self.A.data[self.tie_at[0]], self.A.data[self.tie_at[1]] = -sin, cos
         self.q[self.n:] = (-cos, -sin)
-        self.solver.update(q=self.q, A=self.A)
+        if self.solver is not None:
+            self.solver.update(q=self.q, A=self.A)
 
 
 def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=None,
@@ -607,26 +662,33 @@ def lateral_azimuths(n_webs=None, count=24) -> np.ndarray:
 
 
 def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
-                  dead_load_feasible=None, time_limit=600.0, method=None) -> CollapseResult:
+                  period_deg=None, dead_load_feasible=None, time_limit=600.0,
+                  method=None) -> CollapseResult:
     """The smallest lateral load factor over ``azimuths`` (``--lateral all``).
 
-    One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: two coefficients and
-    two costs change; HiGHS's simplex restarts from the last basis, Clarabel keeps its
-    symbolic factorization), ``method`` one of :data:`METHODS`, and the dead load is
-    checked once (unless ``dead_load_feasible`` is given). Returns the worst azimuth's
-    result with every azimuth's factor in ``azimuths`` ((azimuth, factor or None) pairs).
+    One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: the interior point
+    method and Clarabel keep their symbolic factorization, HiGHS's simplex restarts from
+    the last basis), ``method`` one of :data:`METHODS`, and the dead load is checked once
+    (unless ``dead_load_feasible`` is given). ``period_deg``: the model repeats under a
+    rotation by this angle about the z axis (a full dome of ``n`` webs: ``360 / n``), so
+    azimuths that differ by it have the same factor and each is solved once. Returns the
+    worst azimuth's result with every azimuth's factor in ``azimuths`` ((azimuth, factor
+    or None) pairs).
     """
     azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
     problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit,
                          method=method)
     start = time.perf_counter()
-    results, known = [], dead_load_feasible
+    results, solved, known = [], {}, dead_load_feasible
     for azimuth in azimuths:
-        result = problem.solve_lateral(float(azimuth), dead_load_feasible=known)
-        known = result.dead_load_feasible
-        results.append(result)
+        key = round(float(azimuth) % period_deg, 9) if period_deg else float(azimuth)
+        if key not in solved:
+            solved[key] = problem.solve_lateral(float(azimuth), dead_load_feasible=known)
+            known = solved[key].dead_load_feasible
+        results.append(solved[key])
         if known is False:
             break
+    log.info("lateral search: %d azimuths, %d solved", len(results), len(solved))
     factors = [(float(a), r.load_factor) for a, r in zip(azimuths, results)]
     found = [r for r in results if r.load_factor is not None]
     worst = min(found, key=lambda r: r.load_factor) if found else results[-1]

@@ -323,7 +323,8 @@ def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None
         Of the one-azimuth rows.
     search : bool
         Also a row for ``--lateral all`` (:func:`~masonry.rbe.collapse.worst_lateral`,
-        one LP reused) against independent one-azimuth LPs at the same azimuths.
+        one LP reused, a full dome's azimuths solved once per rotational period, as
+        ``masonry run`` does) against independent one-azimuth LPs at the same azimuths.
     """
     rows = []
     for name, params in structures.items():
@@ -353,8 +354,9 @@ def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None
             continue
         angles = lateral_azimuths(params.n if params.scene in ("section", "dome") else None)
         start = time.perf_counter()
+        period = 360.0 / params.n if params.scene == "dome" else None
         worst = worst_lateral(model, angles, mu=params.mu, density=params.density,
-                              dead_load_feasible=True, method=method)
+                              period_deg=period, dead_load_feasible=True, method=method)
         together = time.perf_counter() - start
         start = time.perf_counter()
         for angle in angles:

@@ -133,7 +133,7 @@ def vertex_inverse(h, w, mu, components) -> np.ndarray:
     return D
 
 
-def _max_step(value, change) -> float:
+def max_step(value, change) -> float:
     """Largest ``a <= 1`` with ``value + a change >= 0`` (``value > 0``)."""
     shrinking = change < 0
     if not shrinking.any():
@@ -180,7 +180,7 @@ class _Iterate:
         return dx, dy, ds, dz
 
 
-def _centred_start(s, z):
+def centred_start(s, z):
     """Mehrotra's starting slacks and multipliers from least-squares ones: shift both
     into the positive orthant, then by half of their mean complementarity."""
     s = s + max(0.0, -1.5 * float(s.min()))
@@ -219,7 +219,7 @@ def solve(ns: NewtonSystem, options: InteriorOptions) -> QPOutcome:
                      np.ones((n_vertices, len(G))), shift)
     zero = np.zeros((n_vertices, len(G)))
     x, y, s, z = first.direction(np.zeros_like(h), -b, zero, zero)
-    s, z = _centred_start(s, z)
+    s, z = centred_start(s, z)
     status, iterations = USER_LIMIT, 0
     for iterations in range(options.max_iter + 1):
         r_dual = h * x - (ns.AT @ y).reshape(x.shape) + z @ G
@@ -245,13 +245,13 @@ def solve(ns: NewtonSystem, options: InteriorOptions) -> QPOutcome:
             break
         # predictor (affine scaling), then Mehrotra's corrector with the same factor
         dx, dy, ds, dz = point.direction(r_dual, r_primal, r_cone, s * z, refine=False)
-        step = min(_max_step(s.ravel(), ds.ravel()), _max_step(z.ravel(), dz.ravel()))
+        step = min(max_step(s.ravel(), ds.ravel()), max_step(z.ravel(), dz.ravel()))
         predicted = float((s + step * ds).ravel() @ (z + step * dz).ravel()) / m
         sigma = (predicted / gap) ** 3
         dx, dy, ds, dz = point.direction(r_dual, r_primal, r_cone,
                                          s * z + ds * dz - sigma * gap)
-        step = options.step_fraction * min(_max_step(s.ravel(), ds.ravel()),
-                                           _max_step(z.ravel(), dz.ravel()))
+        step = options.step_fraction * min(max_step(s.ravel(), ds.ravel()),
+                                           max_step(z.ravel(), dz.ravel()))
         if step < options.min_step:
             log.info("interior point stalled at iteration %d (step %.1e)", iterations, step)
             break
@@ -275,3 +275,4 @@ def backend(system, method, options, workspace) -> QPOutcome:
     outcome = solve(ns, InteriorOptions(**options))
     return dataclasses.replace(outcome, x=ns.full_vector(outcome.x, system.layout),
                                setup_time=preparation)
+

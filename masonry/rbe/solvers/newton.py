@@ -238,7 +238,8 @@ class NewtonSystem:
         target, source = np.concatenate(targets), np.concatenate(sources)
         self._scatter = sp.csr_array((np.ones(len(target)), (target, source)),
                                      shape=(len(sym.lower_rows), 4 * len(rows)))
-        self._diagonal = sym.block_index(np.arange(sym.n_nodes), np.arange(sym.n_nodes))
+        self.diagonal_blocks = sym.block_index(np.arange(sym.n_nodes), np.arange(sym.n_nodes))
+        """Indices of the diagonal blocks among the stored blocks."""
 
     # ------------------------------------------------------------------ kernels
     def project(self, w):
@@ -287,7 +288,7 @@ class NewtonSystem:
         # (K, a, r, b, c) -> (K, a, b, r, c): rows of 36 entries per interface block
         quarters = sums.reshape(-1, 2, 6, 2, 6).transpose(0, 1, 3, 2, 4).reshape(-1, 36)
         blocks = (self._scatter @ quarters).reshape(-1, 6, 6)
-        blocks[self._diagonal] += shift * np.eye(6)
+        blocks[self.diagonal_blocks] += shift * np.eye(6)
         return blocks
 
     def diagonal_scale(self) -> float:
@@ -296,7 +297,7 @@ class NewtonSystem:
         base = np.zeros((len(self.h), self.width, self.width))
         base[:, np.arange(self.width), np.arange(self.width)] = 1.0 / self.h
         blocks = self.newton_blocks(base, 0.0, incremental=False)
-        return float(np.mean(np.trace(blocks[self._diagonal], axis1=1, axis2=2)) / 6.0)
+        return float(np.mean(np.trace(blocks[self.diagonal_blocks], axis1=1, axis2=2)) / 6.0)
 
     def full_vector(self, x, layout):
         """(IV, width) forces in this system's columns -> the (4 IV,) vector of

@@ -1,0 +1,254 @@
+"""Primal-dual interior point method for the collapse LP, on the Newton method's matrix.
+
+The collapse LP of :mod:`masonry.rbe.collapse`, in the scaled rows of
+:mod:`masonry.rbe.equilibrium`::
+
+    maximize lambda   subject to   M g + lambda l = b,   g >= 0
+
+``b = -f_dead``, ``l`` the live load, ``M = A E``: ``A`` the equilibrium matrix over the
+vertex forces ``(c, f1, f2)`` (the friction-net columns of
+:class:`~masonry.rbe.solvers.newton.NewtonSystem`) and ``E`` the four edge rays
+``(1, +-mu, +-mu)`` of every vertex's friction pyramid. Its dual::
+
+    minimize -b^T y   subject to   s = -M^T y >= 0,   l^T y = -1
+
+``y`` is the collapse mechanism (a virtual motion of every block) and ``s`` the work of
+every edge ray on it: ``s >= 0`` is the associated flow rule, no interface penetrates.
+
+Mehrotra's predictor-corrector (S. Mehrotra, SIAM J. Optim. 2, 1992; S. Wright,
+*Primal-Dual Interior-Point Methods*, SIAM 1997, ch. 10) with separate primal and dual
+step lengths. Every iteration solves the normal equations ::
+
+    M D M^T dy = r,   D = diag(g / s)
+
+``M D M^T = A (E D E^T) A^T`` has one 3 x 3 block ``E D E^T`` per vertex, so it is the
+Newton method's matrix ``A J A^T`` (six rows per free block) with ``J = E D E^T``: the
+same :class:`~masonry.rbe.solvers.cholesky.BlockCholesky` symbolic analysis factors it.
+The live load's column touches every loaded block; it stays out of the factor
+(``lambda`` is eliminated by a second solve with ``l``, a bordered system). A general
+interior point solver (Clarabel) factors the whole KKT system instead, one row per
+variable and constraint.
+
+It assumes the LP has an optimum: when the dead load cannot stand at any factor, or the
+live load is carried at every factor, it ends without one (status ``user_limit``) and
+:mod:`masonry.rbe.collapse` asks Clarabel, which detects both.
+"""
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from masonry.rbe.equilibrium import friction_pyramid_edges
+from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
+from masonry.rbe.solvers.interior import centred_start, max_step
+from masonry.rbe.solvers.newton import NewtonSystem, one_blas_thread
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class LoadFactorOptions:
+    """Settings of :func:`load_factor`.
+
+    Parameters
+    ----------
+    tol : float
+        Stop when the residual of the dual rows (``M^T y + s = 0``, relative to the
+        largest ``|M^T y|``), ``|l^T y + 1|`` and the duality gap ``g^T s`` relative to
+        ``1 + |lambda|`` are at most ``tol`` ...
+    primal_tol : float
+        ... and the residual of the primal rows (``M g + lambda l = b``, relative to the
+        largest load entry) at most ``primal_tol``. Near the optimum ``D`` spans
+        20 decades and the primal residual rises again to 1e-7 to 4e-6 on the full
+        domes (the factor has settled to 1e-7 by then), while the dual rows stay exact:
+        ``-b^T y`` is then an upper bound of the factor (:func:`load_factor` reports
+        it) within ``tol`` of the primal one. The residual is recomputed and reported
+        with every collapse result.
+    max_iter : int
+    step_fraction : float
+        Fraction of the largest step to the boundary of ``g, s >= 0`` that is taken.
+    regularization : float
+        Shift of the normal matrix relative to its mean diagonal.
+    min_step : float
+        Give up (status ``user_limit``) when a step falls below this.
+    """
+
+    tol: float = 1e-8
+    primal_tol: float = 1e-5
+    max_iter: int = 100
+    step_fraction: float = 0.99
+    regularization: float = 1e-12
+    min_step: float = 1e-6
+
+
+PRIMAL_PASSES = 2
+"""Passes that solve for what the direction leaves of the primal rows."""
+
+REGULARIZATION_RAISE = 1e3
+REGULARIZATION_RAISES = 3
+"""A normal matrix that fails to factor is shifted up to this many times more, by this
+factor each time."""
+
+
+def pyramid_rays(mu) -> np.ndarray:
+    """``E_v`` ((3, 4) float): the edge rays of a vertex's friction pyramid as columns, in
+    ``(c, f1, f2)`` and in the order of
+    :func:`~masonry.rbe.equilibrium.friction_pyramid_edges`."""
+    return friction_pyramid_edges(1, mu).toarray()[[0, 2, 3]]
+
+
+class _Normal:
+    """The normal equations at one interior point: ``K = M D M^T`` factored once, the
+    live load's solve ``K^-1 l`` kept for both directions of the iteration."""
+
+    def __init__(self, ns: NewtonSystem, rays, d, regularization, load):
+        self.ns, self.rays, self.d, self.load = ns, rays, d, load
+        blocks = np.einsum("ik,vk,jk->vij", rays, d, rays)
+        matrix = ns.newton_blocks(blocks, 0.0, incremental=False)
+        diagonal = matrix[ns.diagonal_blocks]
+        scale = float(np.mean(np.trace(diagonal, axis1=1, axis2=2))) / 6.0
+        # near the optimum D spans many decades and K is singular to working precision
+        # where no edge ray of a block carries force: a shift relative to K's diagonal,
+        # raised until the factorization succeeds (the primal passes of direction()
+        # recover the digits it costs)
+        for attempt in range(REGULARIZATION_RAISES + 1):
+            shift = regularization * REGULARIZATION_RAISE**attempt * scale
+            matrix[ns.diagonal_blocks] = diagonal + shift * np.eye(6)
+            try:
+                self.factor = ns.symbolic.factor(matrix)
+                break
+            except np.linalg.LinAlgError:
+                if attempt == REGULARIZATION_RAISES:
+                    raise
+                log.debug("collapse LP: normal matrix shifted by %.1e of its diagonal",
+                          regularization * REGULARIZATION_RAISE**(attempt + 1))
+        self.v = self.factor.solve(load)
+        self.lv = float(load @ self.v)
+
+    def times_m(self, g):
+        """``M g`` for ``g`` ((V, 4))."""
+        return self.ns.A @ (g @ self.rays.T).ravel()
+
+    def times_mt(self, y):
+        """``M^T y`` ((V, 4))."""
+        return (self.ns.AT @ y).reshape(-1, 3) @ self.rays
+
+    def direction(self, r_primal, r_dual, r_factor, r_comp, g, s, refine=True):
+        """Newton direction for the residuals ``M g + lambda l - b``, ``M^T y + s``,
+        ``l^T y + 1`` and the complementarity target ``g s - r_comp`` (elementwise):
+        ``(dg, dlambda, dy, ds)``. With ``refine``, further passes solve for what the
+        first left of the primal rows (``D`` amplifies the errors of ``dy`` in ``dg``);
+        its correction ``D M^T dy'`` keeps the other rows exact, as ``S D = G``."""
+        rhs = -r_primal + self.times_m(r_comp / s - self.d * r_dual)
+        dy, d_factor = self._bordered(rhs, float(r_factor))
+        dg = -r_comp / s + self.d * (r_dual + self.times_mt(dy))
+        for _ in range(PRIMAL_PASSES if refine else 0):
+            left = self.times_m(dg) + d_factor * self.load + r_primal
+            correction, d_extra = self._bordered(-left, 0.0)
+            dy, d_factor = dy + correction, d_factor + d_extra
+            dg = dg + self.d * self.times_mt(correction)
+        ds = -r_dual - self.times_mt(dy)
+        return dg, d_factor, dy, ds
+
+    def _bordered(self, rhs, r_factor):
+        """``(dy, dlambda)`` with ``K dy + l dlambda = rhs`` and ``l^T dy = -r_factor``."""
+        u = self.factor.solve(rhs)
+        d_factor = (float(self.load @ u) + r_factor) / self.lv
+        return u - d_factor * self.v, d_factor
+
+
+def _start(ns, rays, load, regularization):
+    """Mehrotra's starting point: the least-norm ``g`` with ``M g = b`` (``lambda = 0``),
+    the least-norm dual slacks ``s = -M^T y`` with ``l^T y = -1``, both shifted inside
+    the orthant and balanced (:func:`~masonry.rbe.solvers.interior.centred_start`)."""
+    unit = _Normal(ns, rays, np.ones((len(ns.h), 4)), regularization, load)
+    g = unit.times_mt(unit.factor.solve(ns.b))
+    y = -unit.v / unit.lv
+    g, s = centred_start(g, -unit.times_mt(y))
+    return g, y, s
+
+
+@one_blas_thread
+def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions) -> QPOutcome:
+    """The largest ``lambda`` of the collapse LP (module docstring) on the friction-net
+    system ``ns``, for the live load ``load`` ((6 F,) float, scaled rows).
+
+    Returns
+    -------
+    QPOutcome
+        ``x`` the edge rays' weights ``g`` ((IV, 4), scaled), ``y`` the mechanism (the
+        equilibrium rows' multipliers), ``info["load_factor"]`` and
+        ``info["dual_bound"]`` (``-b^T y``: with exact dual rows, an upper bound of the factor);
+        status ``optimal``, ``user_limit`` (no optimum found: see the module docstring)
+        or ``solver_error``.
+    """
+    start = time.perf_counter()
+    load = np.asarray(load, dtype=float)
+    rays = pyramid_rays(ns.mu)
+    scale = max(np.abs(ns.b).max(), np.abs(load).max())
+    g, y, s = _start(ns, rays, load, options.regularization)
+    factor, status, iterations = 0.0, USER_LIMIT, 0
+    for iterations in range(options.max_iter + 1):
+        residuals = _residuals(ns, rays, load, g, y, s, factor)
+        if _converged(residuals, g, s, factor, scale, options):
+            status = OPTIMAL
+            break
+        if iterations == options.max_iter:
+            break
+        try:
+            normal = _Normal(ns, rays, g / s, options.regularization, load)
+        except np.linalg.LinAlgError as error:
+            log.warning("collapse LP: normal equations not positive definite: %s", error)
+            status = SOLVER_ERROR
+            break
+        (primal, dual), (dg, d_factor, dy, ds) = _mehrotra(normal, residuals[:3], g, s,
+                                                           options.step_fraction)
+        if min(primal, dual) < options.min_step:
+            log.info("collapse LP: stalled at iteration %d (steps %.1e, %.1e)",
+                     iterations, primal, dual)
+            break
+        g, factor = g + primal * dg, factor + primal * d_factor
+        y, s = y + dual * dy, s + dual * ds
+        log.debug("collapse LP %d: lambda %.10g, residuals %.1e %.1e %.1e, gap %.2e, "
+                  "steps %.3f %.3f", iterations, factor,
+                  np.abs(residuals[0]).max() / scale,
+                  np.abs(residuals[1]).max() / max(residuals[3], 1.0), abs(residuals[2]),
+                  float(g.ravel() @ s.ravel()), primal, dual)
+    return QPOutcome(status=status, x=g, iterations=iterations, y=y,
+                     solve_time=time.perf_counter() - start,
+                     info={"factorizations": iterations + 1, "load_factor": factor,
+                           "dual_bound": -float(ns.b @ y)})
+
+
+def _residuals(ns, rays, load, g, y, s, factor):
+    """``(M g + lambda l - b, M^T y + s, l^T y + 1, |M^T y|_inf)``."""
+    mg = ns.A @ (g @ rays.T).ravel()
+    mty = (ns.AT @ y).reshape(-1, 3) @ rays
+    return (mg + factor * load - ns.b, mty + s, float(load @ y) + 1.0,
+            float(np.abs(mty).max()))
+
+
+def _converged(residuals, g, s, factor, scale, options) -> bool:
+    r_primal, r_dual, r_factor, dual_scale = residuals
+    tol = options.tol
+    return (np.abs(r_primal).max() <= options.primal_tol * scale
+            and np.abs(r_dual).max() <= tol * max(dual_scale, 1.0)
+            and abs(r_factor) <= tol
+            and float(g.ravel() @ s.ravel()) <= tol * (1.0 + abs(factor)))
+
+
+def _mehrotra(normal, residuals, g, s, step_fraction):
+    """Predictor (affine scaling), then Mehrotra's corrector with the same factor:
+    ``((primal step, dual step), (dg, dlambda, dy, ds))``."""
+    gap = float(g.ravel() @ s.ravel()) / g.size
+    dg, _, _, ds = normal.direction(*residuals, g * s, g, s, refine=False)
+    primal, dual = max_step(g.ravel(), dg.ravel()), max_step(s.ravel(), ds.ravel())
+    predicted = float((g + primal * dg).ravel() @ (s + dual * ds).ravel()) / g.size
+    sigma = (predicted / gap) ** 3
+    direction = normal.direction(*residuals, g * s + dg * ds - sigma * gap, g, s)
+    dg, _, _, ds = direction
+    steps = (step_fraction * max_step(g.ravel(), dg.ravel()),
+             step_fraction * max_step(s.ravel(), ds.ravel()))
+    return steps, direction
