@@ -31,6 +31,7 @@ Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1
    pivot block, form the update for the parent.
 """
 
+import ctypes
 import logging
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -38,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.linalg import blas, lapack
+from scipy.linalg import blas, cython_blas, cython_lapack
 
 log = logging.getLogger(__name__)
 
@@ -63,6 +64,35 @@ FACTOR_THREADS = 2
 PARALLEL_FLOPS = 5e7
 """Factorizations of fewer flops run on one thread (thread start and the GIL-bound
 Python steps of small fronts outweigh the gain)."""
+
+
+def _cython_function(module, name, *argtypes):
+    """The routine ``name`` of scipy's Cython BLAS or LAPACK (``module``:
+    ``scipy.linalg.cython_blas`` or ``cython_lapack``, the Fortran routines with every
+    argument by pointer) as a ctypes function of ``argtypes``.
+
+    ctypes releases the GIL during the call, so threads factoring different fronts run
+    their dense kernels at the same time; scipy's f2py wrappers (``scipy.linalg.blas``,
+    ``lapack``) hold the GIL, and threads calling them run one at a time.
+    """
+    capsule = module.__pyx_capi__[name]  # how Cython exports the functions to cimport
+    ctypes.pythonapi.PyCapsule_GetName.restype = ctypes.c_char_p
+    ctypes.pythonapi.PyCapsule_GetName.argtypes = [ctypes.py_object]
+    ctypes.pythonapi.PyCapsule_GetPointer.restype = ctypes.c_void_p
+    ctypes.pythonapi.PyCapsule_GetPointer.argtypes = [ctypes.py_object, ctypes.c_char_p]
+    address = ctypes.pythonapi.PyCapsule_GetPointer(
+        capsule, ctypes.pythonapi.PyCapsule_GetName(capsule))
+    return ctypes.CFUNCTYPE(None, *argtypes)(address)
+
+
+# argument types: a flag character, an integer, a double, an array (its address)
+_CHAR, _INT = ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)
+_DOUBLE, _ARRAY = ctypes.POINTER(ctypes.c_double), ctypes.c_void_p
+_DPOTRF = _cython_function(cython_lapack, "dpotrf", _CHAR, _INT, _ARRAY, _INT, _INT)
+_DTRSM = _cython_function(cython_blas, "dtrsm", _CHAR, _CHAR, _CHAR, _CHAR, _INT, _INT,
+                          _DOUBLE, _ARRAY, _INT, _ARRAY, _INT)
+_DSYRK = _cython_function(cython_blas, "dsyrk", _CHAR, _CHAR, _INT, _INT, _DOUBLE, _ARRAY,
+                          _INT, _DOUBLE, _ARRAY, _INT)
 
 
 def _amd_order(graph: sp.csr_array) -> np.ndarray:
@@ -311,7 +341,7 @@ class BlockCholesky:
         """Everything :meth:`factor` needs per supernode, precomputed as one tuple:
         (front size, pivot columns, slice of its stored blocks in :attr:`_entry_order`,
         flat positions of their entries in the front, children, extend-add into the
-        parent). The extend-add of a small update is one add at flat positions of the
+        parent, the sizes as LAPACK's integers). The extend-add of a small update is one add at flat positions of the
         parent's front; a large one goes by the slices of its runs of consecutive rows
         (fewer bytes of indices to read)."""
         bs = self.block_size
@@ -334,8 +364,10 @@ class BlockCholesky:
                     start, value, length = _runs(sn.position)
                     extend = tuple(zip((bs * start).tolist(), (bs * value).tolist(),
                                        (bs * length).tolist()))
-            steps.append((size, bs * (sn.last - sn.first + 1), entries,
-                          (row * size + col).ravel(), self._children[s], extend))
+            k = bs * (sn.last - sn.first + 1)
+            # the front is column-major: entry (row, col) at col * size + row
+            steps.append((size, k, entries, (col * size + row).ravel(), self._children[s],
+                          extend, tuple(ctypes.c_int(n) for n in (k, size, size - k))))
         return steps
 
     def block_index(self, i, j) -> np.ndarray:
@@ -363,7 +395,7 @@ class BlockCholesky:
 
         Independent subtrees of the supernodal elimination tree are factored on
         :data:`FACTOR_THREADS` threads when the factorization is large enough
-        (:data:`PARALLEL_FLOPS`): LAPACK and BLAS release the GIL, and each thread
+        (:data:`PARALLEL_FLOPS`): LAPACK and BLAS run without the GIL, and each thread
         works on its own fronts; the supernodes above the subtrees follow on one thread.
 
         Parameters
@@ -442,41 +474,51 @@ class BlockCholesky:
 
     def _factor_steps(self, supernodes, values, state, worker):
         """Factor ``supernodes`` (postorder; their children already done or among
-        them) with front buffer ``worker``."""
+        them) with front buffer ``worker``.
+
+        A front is a column-major matrix in the buffer, valid in its lower triangle;
+        LAPACK and BLAS work on it in place through ctypes (:func:`_cython_function`:
+        the GIL is free while they run), and the pivot columns, the panel below them
+        and the update for the parent are copied out of it."""
         updates, pivots, below = state
         steps = self._steps
-        # one buffer per thread for every front (LAPACK and BLAS return new arrays,
-        # nothing keeps a view of it): fresh fronts cost 10% of a factorization in page
-        # faults
+        # one buffer per thread for every front: fresh fronts cost 10% of a
+        # factorization in page faults
         while len(self._front_buffers) <= worker:
             self._front_buffers.append(np.empty(max(step[0] for step in steps) ** 2))
         buffer = self._front_buffers[worker]
+        address, itemsize = buffer.ctypes.data, buffer.itemsize
+        one, minus_one, info = ctypes.c_double(1.0), ctypes.c_double(-1.0), ctypes.c_int()
         entry = self.block_size ** 2
         for s in supernodes:
-            size, k, entries, positions, children, _ = steps[s]
+            size, k, entries, positions, children, _, (k_, size_, rest_) = steps[s]
             flat = buffer[:size * size]
             flat.fill(0.0)
             flat[positions] = values[entry * entries.start:entry * entries.stop]
-            front = flat.reshape(size, size)
+            front = flat.reshape(size, size, order="F")
             for child in children:
                 update, extend = updates[child], steps[child][5]
                 updates[child] = None
-                if isinstance(extend, np.ndarray):
-                    flat[extend] += update.reshape(-1)
+                if isinstance(extend, np.ndarray):  # symmetric positions: either order
+                    flat[extend] += update.reshape(-1, order="F")
                     continue
                 # lower triangle only: the update is valid there (dsyrk)
                 for a, (ca, pa, la) in enumerate(extend):
                     for cb, pb, lb in extend[:a + 1]:
                         front[pa:pa + la, pb:pb + lb] += update[ca:ca + la, cb:cb + lb]
-            l11, info = lapack.dpotrf(front[:k, :k], lower=1, clean=1)
-            if info != 0:
+            _DPOTRF(b"L", k_, address, size_, info)  # L11 L11^T = F11
+            if info.value != 0:
                 raise np.linalg.LinAlgError(
-                    f"matrix not positive definite (supernode {s}, pivot {info})")
-            pivots[s] = l11
+                    f"matrix not positive definite (supernode {s}, pivot {info.value})")
+            pivots[s] = front[:k, :k].copy(order="F")
             if size > k:
-                l21 = blas.dtrsm(1.0, l11, front[k:, :k], side=1, lower=1, trans_a=1)
-                below[s] = l21
-                updates[s] = blas.dsyrk(-1.0, l21, beta=1.0, c=front[k:, k:], lower=1)
+                panel = address + itemsize * k  # F21, then L21 = F21 L11^-T
+                _DTRSM(b"R", b"L", b"T", b"N", rest_, k_, one, address, size_, panel, size_)
+                below[s] = front[k:, :k].copy(order="F")
+                # F22 - L21 L21^T, the update for the parent
+                _DSYRK(b"L", b"N", rest_, k_, minus_one, panel, size_, one,
+                       address + itemsize * (k * size + k), size_)
+                updates[s] = front[k:, k:].copy(order="F")
 
 
 class BlockFactor:
