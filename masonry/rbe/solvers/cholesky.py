@@ -19,8 +19,9 @@ library or a 200 MB binary that would become the default install of every user. 
 Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1992):
 
 1. Order the block graph by approximate minimum degree (AMD, from ``qdldl``'s
-   factorization of the graph's diagonally dominant Laplacian-like matrix), then by a
-   postorder of its elimination tree.
+   factorization of the graph's diagonally dominant Laplacian-like matrix) or, for
+   large graphs, by METIS nested dissection (``pymetis``), then by a postorder of its
+   elimination tree.
 2. Symbolic factorization on the block graph: the row structure of every column of L,
    fundamental supernodes, then relaxed amalgamation (merge a supernode into its parent
    when that adds few explicit zeros), which trades a little arithmetic for far fewer
@@ -41,6 +42,11 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import blas, cython_blas, cython_lapack
 
+try:  # wheels for Linux and macOS only (pyproject.toml); elsewhere AMD orders every graph
+    import pymetis
+except ImportError:
+    pymetis = None
+
 log = logging.getLogger(__name__)
 
 RELAX_ZEROS = 0.2
@@ -50,6 +56,14 @@ the merged supernode's stored entries are explicit zeros ..."""
 RELAX_COLUMNS = 8
 """... or if the merged supernode has at most this many block columns (fewer, larger
 fronts: more flops, far fewer Python-level steps; measured in ``docs/bench.md``)."""
+
+
+METIS_NODES = 8000
+"""Block graphs of at least this many nodes are ordered by METIS nested dissection,
+smaller ones by AMD: on the Newton matrices of the domes nested dissection needs up to
+half the flops of AMD at 20,000 blocks, a third less at 6,000, and its factorizations
+run faster from about 10,000 blocks on; below that the Python-level steps per front
+dominate and AMD is as fast or faster (``docs/bench.md``, "Ordering")."""
 
 
 SMALL_UPDATE = 120
@@ -103,6 +117,16 @@ def _amd_order(graph: sp.csr_array) -> np.ndarray:
     # diagonally dominant, hence positive definite: the LDL^T exists in any order
     spd = sp.csc_array(graph + sp.diags_array(degree + 1.0))
     return np.asarray(qdldl.Solver(spd).factors()[2], dtype=np.int64)
+
+
+def _metis_order(graph: sp.csr_array) -> np.ndarray:
+    """Nested dissection ordering of a symmetric block graph, from METIS (pymetis)."""
+    if pymetis is None:
+        raise ModuleNotFoundError("the METIS ordering needs pymetis (pip install pymetis)")
+    graph = sp.csr_array(graph - sp.diags_array(graph.diagonal()))
+    graph.eliminate_zeros()
+    adjacency = pymetis.CSRAdjacency(graph.indptr, graph.indices)
+    return np.asarray(pymetis.nested_dissection(adjacency)[0], dtype=np.int64)
 
 
 def _etree(indptr, indices) -> np.ndarray:
@@ -174,9 +198,15 @@ class BlockCholesky:
         allowed). Diagonal blocks are always present.
     block_size : int
         Size of the dense blocks (6: the equilibrium rows of one rigid block).
+    ordering : {'auto', 'amd', 'metis'}
+        Fill-reducing ordering of the block graph: approximate minimum degree, METIS
+        nested dissection (needs ``pymetis``), or 'auto': METIS from :data:`METIS_NODES`
+        nodes on when ``pymetis`` is installed, else AMD.
 
     Attributes
     ----------
+    ordering : str
+        The ordering used ('amd' or 'metis').
     lower_rows, lower_cols : (NB,) int
         The stored blocks ``(i, j)``, ``i >= j``, in the caller's numbering; values are
         passed to :meth:`factor` in this order (block ``(i, j)`` of the lower triangle).
@@ -186,7 +216,7 @@ class BlockCholesky:
         Entries stored in the factor (explicit zeros of relaxed supernodes included).
     """
 
-    def __init__(self, n_nodes: int, edges, block_size: int = 6):
+    def __init__(self, n_nodes: int, edges, block_size: int = 6, ordering: str = "auto"):
         self.n_nodes = int(n_nodes)
         self.block_size = bs = int(block_size)
         edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
@@ -199,7 +229,12 @@ class BlockCholesky:
         graph.sum_duplicates()
         graph.data[:] = 1.0
 
-        order = _amd_order(graph) if self.n_nodes > 1 else np.arange(self.n_nodes)
+        if ordering == "auto":
+            large = self.n_nodes >= METIS_NODES and pymetis is not None
+            ordering = "metis" if large else "amd"
+        self.ordering = ordering
+        orderings = {"amd": _amd_order, "metis": _metis_order}
+        order = orderings[ordering](graph) if self.n_nodes > 1 else np.arange(self.n_nodes)
         permuted = sp.csr_array(graph[order][:, order])
         parent = _etree(permuted.indptr, permuted.indices)
         # a postorder is an equivalent order: same fill, the tree relabelled
