@@ -68,8 +68,8 @@ dominate and AMD is as fast or faster (``docs/bench.md``, "Ordering")."""
 
 SMALL_UPDATE = 120
 """Update matrices up to this size are added to their parent's front by one add at
-precomputed flat positions, larger ones run by run (the fastest of 60, 120, 240 and
-480 on preset 1's full dome; ``docs/bench.md``)."""
+precomputed flat positions, larger ones by runs of consecutive columns (the fastest
+of 60, 120, 240 and 480 on preset 1's full dome; ``docs/bench.md``)."""
 
 
 FACTOR_THREADS = 2
@@ -376,9 +376,10 @@ class BlockCholesky:
         """Everything :meth:`factor` needs per supernode, precomputed as one tuple:
         (front size, pivot columns, slice of its stored blocks in :attr:`_entry_order`,
         flat positions of their entries in the front, children, extend-add into the
-        parent, the sizes as LAPACK's integers). The extend-add of a small update is one add at flat positions of the
-        parent's front; a large one goes by the slices of its runs of consecutive rows
-        (fewer bytes of indices to read)."""
+        parent, the sizes as LAPACK's integers). The extend-add of a small update is
+        one add at flat positions of the parent's front; a large one goes by its runs of
+        consecutive columns in the parent, each added at the parent's rows (fewer bytes
+        of indices to read)."""
         bs = self.block_size
         inner = np.arange(bs)
         steps = []
@@ -397,8 +398,9 @@ class BlockCholesky:
                     extend = (rows[:, None] * parent_size + rows[None, :]).ravel()
                 else:
                     start, value, length = _runs(sn.position)
-                    extend = tuple(zip((bs * start).tolist(), (bs * value).tolist(),
-                                       (bs * length).tolist()))
+                    rows = (bs * sn.position[:, None] + inner).ravel()
+                    extend = (rows, tuple(zip((bs * start).tolist(), (bs * value).tolist(),
+                                              (bs * length).tolist())))
             k = bs * (sn.last - sn.first + 1)
             # the front is column-major: entry (row, col) at col * size + row
             steps.append((size, k, entries, (col * size + row).ravel(), self._children[s],
@@ -537,10 +539,11 @@ class BlockCholesky:
                 if isinstance(extend, np.ndarray):  # symmetric positions: either order
                     flat[extend] += update.reshape(-1, order="F")
                     continue
-                # lower triangle only: the update is valid there (dsyrk)
-                for a, (ca, pa, la) in enumerate(extend):
-                    for cb, pb, lb in extend[:a + 1]:
-                        front[pa:pa + la, pb:pb + lb] += update[ca:ca + la, cb:cb + lb]
+                # by runs of consecutive columns, in the lower triangle only (the update
+                # is valid there: dsyrk): columns c:c + n go to the parent's p:p + n
+                rows, runs = extend
+                for c, p, n in runs:
+                    front[rows[c:], p:p + n] += update[c:, c:c + n]
             _DPOTRF(b"L", k_, address, size_, info)  # L11 L11^T = F11
             if info.value != 0:
                 raise np.linalg.LinAlgError(
