@@ -89,12 +89,21 @@ def test_pyramid_projection_is_the_nearest_point_and_its_jacobian_is_exact():
         assert np.abs(moved - x - linear).max() < 1e-12
 
 
-def test_block_cholesky_solves_and_refuses_indefinite_matrices():
+@pytest.mark.parametrize("ordering", ["amd", "metis"])
+@pytest.mark.parametrize("parallel", [False, True])
+def test_block_cholesky_solves_and_refuses_indefinite_matrices(monkeypatch, ordering, parallel):
+    # parallel: subtrees on two threads whatever the size (the GIL-free kernels run at
+    # the same time on different fronts of one buffer each)
+    monkeypatch.setattr(cholesky, "PARALLEL_FLOPS", 0.0 if parallel else np.inf)
     rng = np.random.default_rng(0)
     n = 60
     edges = np.unique(np.sort(rng.integers(0, n, size=(150, 2)), axis=1), axis=0)
     edges = edges[edges[:, 0] != edges[:, 1]]
-    sym = BlockCholesky(n, edges, block_size=6)
+    sym = BlockCholesky(n, edges, block_size=6, ordering=ordering)
+    assert sym.ordering == ordering
+    if parallel:
+        threads, top = sym._parallel_schedule()
+        assert len(threads) == 2 and all(threads)
     dense = np.zeros((6 * n, 6 * n))
     values = np.empty((len(sym.lower_rows), 6, 6))
     for k, (i, j) in enumerate(zip(sym.lower_rows, sym.lower_cols)):
@@ -110,7 +119,9 @@ def test_block_cholesky_solves_and_refuses_indefinite_matrices():
     dense += np.diag(strength)
     rhs = rng.normal(size=(6 * n, 2))
     x = sym.factor(values).solve(rhs)
-    np.testing.assert_allclose(dense @ x, rhs, atol=1e-10 * np.abs(rhs).max())
+    np.testing.assert_allclose(dense @ x, rhs, rtol=0, atol=1e-10 * np.abs(rhs).max())
+    expected = scipy.linalg.solve(dense, rhs, assume_a="pos")
+    np.testing.assert_allclose(x, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
     values[diagonal[0]] = -np.eye(6)
     with pytest.raises(np.linalg.LinAlgError):
         sym.factor(values)
@@ -127,13 +138,16 @@ def _dense_factor(factor, n_scalar):
     return low
 
 
-@pytest.mark.parametrize("small_update, parallel", [(0, False), (10**9, False), (0, True)])
-def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_update, parallel):
+@pytest.mark.parametrize("small_update, parallel, ordering",
+                         [(0, False, "amd"), (10**9, False, "amd"), (0, True, "amd"),
+                          (10**9, False, "metis"), (0, True, "metis")])
+def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_update, parallel,
+                                                         ordering):
     # the Cholesky factor of an SPD matrix is unique: every entry of the multifrontal
     # factor (assembly, extend-add of the children's updates, relaxed supernodes) must
     # equal LAPACK's dense factor of the same permuted matrix; small_update forces every
     # extend-add through the run-by-run path (0) or the flat-position path (huge);
-    # parallel: subtrees on two threads whatever the size
+    # parallel: subtrees on two threads whatever the size; both orderings
     monkeypatch.setattr(cholesky, "SMALL_UPDATE", small_update)
     monkeypatch.setattr(cholesky, "PARALLEL_FLOPS", 0.0 if parallel else np.inf)
     rng = np.random.default_rng(7)
@@ -141,7 +155,7 @@ def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_upda
     # a 2D grid graph with a few long-range edges: fronts with several children
     grid = [(i, i + 1) for i in range(n - 1) if (i + 1) % 8] + [(i, i + 8) for i in range(n - 8)]
     edges = np.array(grid + [(0, 37), (5, 30), (12, 39)])
-    sym = BlockCholesky(n, edges, block_size=bs)
+    sym = BlockCholesky(n, edges, block_size=bs, ordering=ordering)
     assert any(len(children) > 1 for children in sym._children)
     if parallel:
         threads, top = sym._parallel_schedule()

@@ -19,8 +19,9 @@ library or a 200 MB binary that would become the default install of every user. 
 Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1992):
 
 1. Order the block graph by approximate minimum degree (AMD, from ``qdldl``'s
-   factorization of the graph's diagonally dominant Laplacian-like matrix), then by a
-   postorder of its elimination tree.
+   factorization of the graph's diagonally dominant Laplacian-like matrix) or, for
+   large graphs, by METIS nested dissection (``pymetis``), then by a postorder of its
+   elimination tree.
 2. Symbolic factorization on the block graph: the row structure of every column of L,
    fundamental supernodes, then relaxed amalgamation (merge a supernode into its parent
    when that adds few explicit zeros), which trades a little arithmetic for far fewer
@@ -31,6 +32,7 @@ Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1
    pivot block, form the update for the parent.
 """
 
+import ctypes
 import logging
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -38,7 +40,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.linalg import blas, lapack
+from scipy.linalg import blas, cython_blas, cython_lapack
+
+try:  # wheels for Linux and macOS only (pyproject.toml); elsewhere AMD orders every graph
+    import pymetis
+except ImportError:
+    pymetis = None
 
 log = logging.getLogger(__name__)
 
@@ -51,10 +58,18 @@ RELAX_COLUMNS = 8
 fronts: more flops, far fewer Python-level steps; measured in ``docs/bench.md``)."""
 
 
+METIS_NODES = 8000
+"""Block graphs of at least this many nodes are ordered by METIS nested dissection,
+smaller ones by AMD: on the Newton matrices of the domes nested dissection needs up to
+half the flops of AMD at 20,000 blocks, a third less at 6,000, and its factorizations
+run faster from about 10,000 blocks on; below that the Python-level steps per front
+dominate and AMD is as fast or faster (``docs/bench.md``, "Ordering")."""
+
+
 SMALL_UPDATE = 120
 """Update matrices up to this size are added to their parent's front by one add at
-precomputed flat positions, larger ones run by run (the fastest of 60, 120, 240 and
-480 on preset 1's full dome; ``docs/bench.md``)."""
+precomputed flat positions, larger ones by runs of consecutive columns (the fastest
+of 60, 120, 240 and 480 on preset 1's full dome; ``docs/bench.md``)."""
 
 
 FACTOR_THREADS = 2
@@ -65,6 +80,35 @@ PARALLEL_FLOPS = 5e7
 Python steps of small fronts outweigh the gain)."""
 
 
+def _cython_function(module, name, *argtypes):
+    """The routine ``name`` of scipy's Cython BLAS or LAPACK (``module``:
+    ``scipy.linalg.cython_blas`` or ``cython_lapack``, the Fortran routines with every
+    argument by pointer) as a ctypes function of ``argtypes``.
+
+    ctypes releases the GIL during the call, so threads factoring different fronts run
+    their dense kernels at the same time; scipy's f2py wrappers (``scipy.linalg.blas``,
+    ``lapack``) hold the GIL, and threads calling them run one at a time.
+    """
+    capsule = module.__pyx_capi__[name]  # how Cython exports the functions to cimport
+    ctypes.pythonapi.PyCapsule_GetName.restype = ctypes.c_char_p
+    ctypes.pythonapi.PyCapsule_GetName.argtypes = [ctypes.py_object]
+    ctypes.pythonapi.PyCapsule_GetPointer.restype = ctypes.c_void_p
+    ctypes.pythonapi.PyCapsule_GetPointer.argtypes = [ctypes.py_object, ctypes.c_char_p]
+    address = ctypes.pythonapi.PyCapsule_GetPointer(
+        capsule, ctypes.pythonapi.PyCapsule_GetName(capsule))
+    return ctypes.CFUNCTYPE(None, *argtypes)(address)
+
+
+# argument types: a flag character, an integer, a double, an array (its address)
+_CHAR, _INT = ctypes.c_char_p, ctypes.POINTER(ctypes.c_int)
+_DOUBLE, _ARRAY = ctypes.POINTER(ctypes.c_double), ctypes.c_void_p
+_DPOTRF = _cython_function(cython_lapack, "dpotrf", _CHAR, _INT, _ARRAY, _INT, _INT)
+_DTRSM = _cython_function(cython_blas, "dtrsm", _CHAR, _CHAR, _CHAR, _CHAR, _INT, _INT,
+                          _DOUBLE, _ARRAY, _INT, _ARRAY, _INT)
+_DSYRK = _cython_function(cython_blas, "dsyrk", _CHAR, _CHAR, _INT, _INT, _DOUBLE, _ARRAY,
+                          _INT, _DOUBLE, _ARRAY, _INT)
+
+
 def _amd_order(graph: sp.csr_array) -> np.ndarray:
     """AMD ordering of a symmetric block graph, from qdldl (SuiteSparse AMD)."""
     import qdldl
@@ -73,6 +117,16 @@ def _amd_order(graph: sp.csr_array) -> np.ndarray:
     # diagonally dominant, hence positive definite: the LDL^T exists in any order
     spd = sp.csc_array(graph + sp.diags_array(degree + 1.0))
     return np.asarray(qdldl.Solver(spd).factors()[2], dtype=np.int64)
+
+
+def _metis_order(graph: sp.csr_array) -> np.ndarray:
+    """Nested dissection ordering of a symmetric block graph, from METIS (pymetis)."""
+    if pymetis is None:
+        raise ModuleNotFoundError("the METIS ordering needs pymetis (pip install pymetis)")
+    graph = sp.csr_array(graph - sp.diags_array(graph.diagonal()))
+    graph.eliminate_zeros()
+    adjacency = pymetis.CSRAdjacency(graph.indptr, graph.indices)
+    return np.asarray(pymetis.nested_dissection(adjacency)[0], dtype=np.int64)
 
 
 def _etree(indptr, indices) -> np.ndarray:
@@ -144,9 +198,15 @@ class BlockCholesky:
         allowed). Diagonal blocks are always present.
     block_size : int
         Size of the dense blocks (6: the equilibrium rows of one rigid block).
+    ordering : {'auto', 'amd', 'metis'}
+        Fill-reducing ordering of the block graph: approximate minimum degree, METIS
+        nested dissection (needs ``pymetis``), or 'auto': METIS from :data:`METIS_NODES`
+        nodes on when ``pymetis`` is installed, else AMD.
 
     Attributes
     ----------
+    ordering : str
+        The ordering used ('amd' or 'metis').
     lower_rows, lower_cols : (NB,) int
         The stored blocks ``(i, j)``, ``i >= j``, in the caller's numbering; values are
         passed to :meth:`factor` in this order (block ``(i, j)`` of the lower triangle).
@@ -156,7 +216,7 @@ class BlockCholesky:
         Entries stored in the factor (explicit zeros of relaxed supernodes included).
     """
 
-    def __init__(self, n_nodes: int, edges, block_size: int = 6):
+    def __init__(self, n_nodes: int, edges, block_size: int = 6, ordering: str = "auto"):
         self.n_nodes = int(n_nodes)
         self.block_size = bs = int(block_size)
         edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
@@ -169,7 +229,12 @@ class BlockCholesky:
         graph.sum_duplicates()
         graph.data[:] = 1.0
 
-        order = _amd_order(graph) if self.n_nodes > 1 else np.arange(self.n_nodes)
+        if ordering == "auto":
+            large = self.n_nodes >= METIS_NODES and pymetis is not None
+            ordering = "metis" if large else "amd"
+        self.ordering = ordering
+        orderings = {"amd": _amd_order, "metis": _metis_order}
+        order = orderings[ordering](graph) if self.n_nodes > 1 else np.arange(self.n_nodes)
         permuted = sp.csr_array(graph[order][:, order])
         parent = _etree(permuted.indptr, permuted.indices)
         # a postorder is an equivalent order: same fill, the tree relabelled
@@ -311,9 +376,10 @@ class BlockCholesky:
         """Everything :meth:`factor` needs per supernode, precomputed as one tuple:
         (front size, pivot columns, slice of its stored blocks in :attr:`_entry_order`,
         flat positions of their entries in the front, children, extend-add into the
-        parent). The extend-add of a small update is one add at flat positions of the
-        parent's front; a large one goes by the slices of its runs of consecutive rows
-        (fewer bytes of indices to read)."""
+        parent, the sizes as LAPACK's integers). The extend-add of a small update is
+        one add at flat positions of the parent's front; a large one goes by its runs of
+        consecutive columns in the parent, each added at the parent's rows (fewer bytes
+        of indices to read)."""
         bs = self.block_size
         inner = np.arange(bs)
         steps = []
@@ -332,10 +398,13 @@ class BlockCholesky:
                     extend = (rows[:, None] * parent_size + rows[None, :]).ravel()
                 else:
                     start, value, length = _runs(sn.position)
-                    extend = tuple(zip((bs * start).tolist(), (bs * value).tolist(),
-                                       (bs * length).tolist()))
-            steps.append((size, bs * (sn.last - sn.first + 1), entries,
-                          (row * size + col).ravel(), self._children[s], extend))
+                    rows = (bs * sn.position[:, None] + inner).ravel()
+                    extend = (rows, tuple(zip((bs * start).tolist(), (bs * value).tolist(),
+                                              (bs * length).tolist())))
+            k = bs * (sn.last - sn.first + 1)
+            # the front is column-major: entry (row, col) at col * size + row
+            steps.append((size, k, entries, (col * size + row).ravel(), self._children[s],
+                          extend, tuple(ctypes.c_int(n) for n in (k, size, size - k))))
         return steps
 
     def block_index(self, i, j) -> np.ndarray:
@@ -363,7 +432,7 @@ class BlockCholesky:
 
         Independent subtrees of the supernodal elimination tree are factored on
         :data:`FACTOR_THREADS` threads when the factorization is large enough
-        (:data:`PARALLEL_FLOPS`): LAPACK and BLAS release the GIL, and each thread
+        (:data:`PARALLEL_FLOPS`): LAPACK and BLAS run without the GIL, and each thread
         works on its own fronts; the supernodes above the subtrees follow on one thread.
 
         Parameters
@@ -442,41 +511,52 @@ class BlockCholesky:
 
     def _factor_steps(self, supernodes, values, state, worker):
         """Factor ``supernodes`` (postorder; their children already done or among
-        them) with front buffer ``worker``."""
+        them) with front buffer ``worker``.
+
+        A front is a column-major matrix in the buffer, valid in its lower triangle;
+        LAPACK and BLAS work on it in place through ctypes (:func:`_cython_function`:
+        the GIL is free while they run), and the pivot columns, the panel below them
+        and the update for the parent are copied out of it."""
         updates, pivots, below = state
         steps = self._steps
-        # one buffer per thread for every front (LAPACK and BLAS return new arrays,
-        # nothing keeps a view of it): fresh fronts cost 10% of a factorization in page
-        # faults
+        # one buffer per thread for every front: fresh fronts cost 10% of a
+        # factorization in page faults
         while len(self._front_buffers) <= worker:
             self._front_buffers.append(np.empty(max(step[0] for step in steps) ** 2))
         buffer = self._front_buffers[worker]
+        address, itemsize = buffer.ctypes.data, buffer.itemsize
+        one, minus_one, info = ctypes.c_double(1.0), ctypes.c_double(-1.0), ctypes.c_int()
         entry = self.block_size ** 2
         for s in supernodes:
-            size, k, entries, positions, children, _ = steps[s]
+            size, k, entries, positions, children, _, (k_, size_, rest_) = steps[s]
             flat = buffer[:size * size]
             flat.fill(0.0)
             flat[positions] = values[entry * entries.start:entry * entries.stop]
-            front = flat.reshape(size, size)
+            front = flat.reshape(size, size, order="F")
             for child in children:
                 update, extend = updates[child], steps[child][5]
                 updates[child] = None
-                if isinstance(extend, np.ndarray):
-                    flat[extend] += update.reshape(-1)
+                if isinstance(extend, np.ndarray):  # symmetric positions: either order
+                    flat[extend] += update.reshape(-1, order="F")
                     continue
-                # lower triangle only: the update is valid there (dsyrk)
-                for a, (ca, pa, la) in enumerate(extend):
-                    for cb, pb, lb in extend[:a + 1]:
-                        front[pa:pa + la, pb:pb + lb] += update[ca:ca + la, cb:cb + lb]
-            l11, info = lapack.dpotrf(front[:k, :k], lower=1, clean=1)
-            if info != 0:
+                # by runs of consecutive columns, in the lower triangle only (the update
+                # is valid there: dsyrk): columns c:c + n go to the parent's p:p + n
+                rows, runs = extend
+                for c, p, n in runs:
+                    front[rows[c:], p:p + n] += update[c:, c:c + n]
+            _DPOTRF(b"L", k_, address, size_, info)  # L11 L11^T = F11
+            if info.value != 0:
                 raise np.linalg.LinAlgError(
-                    f"matrix not positive definite (supernode {s}, pivot {info})")
-            pivots[s] = l11
+                    f"matrix not positive definite (supernode {s}, pivot {info.value})")
+            pivots[s] = front[:k, :k].copy(order="F")
             if size > k:
-                l21 = blas.dtrsm(1.0, l11, front[k:, :k], side=1, lower=1, trans_a=1)
-                below[s] = l21
-                updates[s] = blas.dsyrk(-1.0, l21, beta=1.0, c=front[k:, k:], lower=1)
+                panel = address + itemsize * k  # F21, then L21 = F21 L11^-T
+                _DTRSM(b"R", b"L", b"T", b"N", rest_, k_, one, address, size_, panel, size_)
+                below[s] = front[k:, :k].copy(order="F")
+                # F22 - L21 L21^T, the update for the parent
+                _DSYRK(b"L", b"N", rest_, k_, minus_one, panel, size_, one,
+                       address + itemsize * (k * size + k), size_)
+                updates[s] = front[k:, k:].copy(order="F")
 
 
 class BlockFactor:
