@@ -28,8 +28,10 @@ Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1
    Python-level steps.
 3. Numeric factorization, one dense frontal matrix per supernode: assemble the original
    blocks and the children's update matrices (extend-add: a small update by one add at
-   precomputed flat positions, a large one by contiguous runs of rows), factor the
-   pivot block, form the update for the parent.
+   precomputed flat positions, a large one by runs of consecutive columns), factor the
+   pivot block, form the update for the parent. LAPACK and BLAS are called through
+   ctypes, which frees the GIL while they run, so that independent subtrees of the
+   elimination tree are factored on two threads at the same time.
 """
 
 import ctypes
