@@ -539,7 +539,7 @@ class BlockCholesky:
             for child in children:
                 update, extend = updates[child], steps[child][5]
                 updates[child] = None
-                if isinstance(extend, np.ndarray):  # symmetric positions: either order
+                if isinstance(extend, np.ndarray):  # positions column-major, as the front
                     flat[extend] += update.reshape(-1, order="F")
                     continue
                 # by runs of consecutive columns, in the lower triangle only (the update
