@@ -275,6 +275,9 @@ class BlockCholesky:
             r = bs * len(s.rows)
             self.flops += k**3 / 3 + k * k * r + k * r * r
             self.nnz += k * (k + 1) // 2 + k * r
+        log.debug("block Cholesky: %d blocks, %s ordering, %d supernodes, factor %.3g "
+                  "entries, %.3g flops", self.n_nodes, self.ordering, len(self.supernodes),
+                  self.nnz, self.flops)
 
     # ------------------------------------------------------------------ symbolic
     @staticmethod
