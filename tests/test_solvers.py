@@ -127,6 +127,23 @@ def test_block_cholesky_solves_and_refuses_indefinite_matrices(monkeypatch, orde
         sym.factor(values)
 
 
+def test_block_cholesky_orders_large_graphs_by_metis_when_it_is_installed(monkeypatch):
+    # a 12 x 12 grid of blocks: 'auto' takes METIS from METIS_NODES nodes on, and AMD
+    # without pymetis (Windows: no wheels); the two orderings differ on a grid
+    edges = [(i, i + 1) for i in range(143) if (i + 1) % 12] + [(i, i + 12) for i in range(132)]
+    orders = {}
+    for nodes, metis, expected in ((144, True, "metis"), (145, True, "amd"), (144, False, "amd")):
+        monkeypatch.setattr(cholesky, "METIS_NODES", nodes)
+        if not metis:
+            monkeypatch.setattr(cholesky, "pymetis", None)
+        sym = BlockCholesky(144, edges, block_size=1)
+        assert sym.ordering == expected
+        orders[expected] = sym.order
+    assert not np.array_equal(orders["metis"], orders["amd"])
+    with pytest.raises(ModuleNotFoundError, match="pymetis"):
+        BlockCholesky(144, edges, block_size=1, ordering="metis")
+
+
 def _dense_factor(factor, n_scalar):
     """The factor ``L`` of a :class:`BlockFactor` as a dense matrix (factor order)."""
     low = np.zeros((n_scalar, n_scalar))

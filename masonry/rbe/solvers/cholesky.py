@@ -60,12 +60,12 @@ RELAX_COLUMNS = 8
 fronts: more flops, far fewer Python-level steps; measured in ``docs/bench.md``)."""
 
 
-METIS_NODES = 8000
+METIS_NODES = 2000
 """Block graphs of at least this many nodes are ordered by METIS nested dissection,
-smaller ones by AMD: on the Newton matrices of the domes nested dissection needs up to
-half the flops of AMD at 20,000 blocks, a third less at 6,000, and its factorizations
-run faster from about 10,000 blocks on; below that the Python-level steps per front
-dominate and AMD is as fast or faster (``docs/bench.md``, "Ordering")."""
+smaller ones by AMD: on the Newton matrices of the full domes (2,264 to 21,648 blocks)
+nested dissection needs 12 to 46% fewer flops than AMD and factors faster; on a
+section of 790 blocks it needs more flops and is slower (``docs/bench.md``,
+"Ordering and two threads")."""
 
 
 SMALL_UPDATE = 120
@@ -77,9 +77,10 @@ of 60, 120, 240 and 480 on preset 1's full dome; ``docs/bench.md``)."""
 FACTOR_THREADS = 2
 """Threads of a numeric factorization (at most the cores this process may use)."""
 
-PARALLEL_FLOPS = 5e7
-"""Factorizations of fewer flops run on one thread (thread start and the GIL-bound
-Python steps of small fronts outweigh the gain)."""
+PARALLEL_FLOPS = 1e9
+"""Factorizations of fewer flops run on one thread: below it the Python-level steps of
+small fronts, which hold the GIL, outweigh the gain (``docs/bench.md``, "Ordering and
+two threads")."""
 
 
 def _cython_function(module, name, *argtypes):
@@ -274,6 +275,9 @@ class BlockCholesky:
             r = bs * len(s.rows)
             self.flops += k**3 / 3 + k * k * r + k * r * r
             self.nnz += k * (k + 1) // 2 + k * r
+        log.debug("block Cholesky: %d blocks, %s ordering, %d supernodes, factor %.3g "
+                  "entries, %.3g flops", self.n_nodes, self.ordering, len(self.supernodes),
+                  self.nnz, self.flops)
 
     # ------------------------------------------------------------------ symbolic
     @staticmethod
@@ -538,7 +542,7 @@ class BlockCholesky:
             for child in children:
                 update, extend = updates[child], steps[child][5]
                 updates[child] = None
-                if isinstance(extend, np.ndarray):  # symmetric positions: either order
+                if isinstance(extend, np.ndarray):  # positions column-major, as the front
                     flat[extend] += update.reshape(-1, order="F")
                     continue
                 # by runs of consecutive columns, in the lower triangle only (the update
