@@ -10,9 +10,12 @@ import dataclasses
 import hashlib
 import json
 import logging
+import multiprocessing
 import pickle
+import sys
 import threading
 import time
+import traceback
 from functools import cache
 from contextlib import contextmanager
 from importlib import metadata
@@ -21,7 +24,7 @@ from pathlib import Path
 import masonry
 from masonry import __version__
 from masonry.blocks import BLOCK_CLASSES
-from masonry.export import EXPORTERS, RunOutputs
+from masonry.export import EXPORTERS, Export, RunOutputs
 from masonry.params import Params, structure_id, validate
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.collapse import CollapseResult, collapse_load, worst_lateral
@@ -492,6 +495,11 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
     """Every wanted exporter of :data:`masonry.export.EXPORTERS` into ``folder``; their
     records go into ``record`` under their names.
 
+    Where processes fork (Linux), the exporters marked ``aside`` (the 3DM file, the
+    plots) are made in a second process, on the second core, while this one makes and
+    writes the others; this process writes every file. Their stage then counts the time
+    this process waited for them.
+
     Parameters
     ----------
     folder : RunFolder
@@ -503,12 +511,74 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
     timer : Timer
         Each exporter's time counts towards its stage.
     """
-    for exporter in EXPORTERS:
-        if not exporter.wanted(made):
-            continue
-        with timer.stage(exporter.stage):
-            export = exporter.make(made)
-            for relative, data in export.files.items():
-                folder.write(relative, data)
-        if export.record is not None:
-            record[exporter.name] = export.record
+    wanted = [exporter for exporter in EXPORTERS if exporter.wanted(made)]
+    aside = [exporter for exporter in wanted if exporter.aside] if _can_fork() else []
+    with _Aside(aside, made) as second:
+        for exporter in [e for e in wanted if e not in aside] + aside:
+            with timer.stage(exporter.stage):
+                export = second.result() if exporter in aside else exporter.make(made)
+                for relative, data in export.files.items():
+                    folder.write(relative, data)
+            if export.record is not None:
+                record[exporter.name] = export.record
+
+
+def _can_fork() -> bool:
+    """Whether a second process can start as a copy of this one: fork exists and is safe
+    (not on macOS, whose system libraries do not survive it) and this process may have
+    children (a daemonic worker of a process pool may not)."""
+    return ("fork" in multiprocessing.get_all_start_methods() and sys.platform != "darwin"
+            and not multiprocessing.current_process().daemon)
+
+
+class _Aside:
+    """A forked process that makes ``exporters`` (in order) from ``made`` and sends each
+    :class:`~masonry.export.Export` back; :meth:`result` receives the next one. Forked, the
+    process shares ``made`` without copying or pickling it; it is ended on leaving the
+    ``with`` block (an error or an interrupt included)."""
+
+    def __init__(self, exporters, made):
+        self.exporters, self.made, self.process = exporters, made, None
+
+    def __enter__(self):
+        if self.exporters:
+            context = multiprocessing.get_context("fork")
+            self.receiver, sender = context.Pipe(duplex=False)
+            self.process = context.Process(target=_make_aside, daemon=True,
+                                           args=(self.exporters, self.made, sender))
+            self.process.start()
+            sender.close()
+        return self
+
+    def result(self) -> Export:
+        """The next exporter's files; its error, raised here, if it failed."""
+        try:
+            ok, value = self.receiver.recv()
+        except EOFError:
+            raise RuntimeError(f"the export process ended without its files (exit code "
+                               f"{self.process.exitcode})") from None
+        if not ok:
+            raise value
+        return value
+
+    def __exit__(self, *exc):
+        if self.process is not None:
+            if self.process.is_alive():
+                self.process.terminate()
+            self.process.join()
+            self.receiver.close()
+        return False
+
+
+def _make_aside(exporters, made, sender):
+    """In the forked process: make each exporter's files and send them, or the error."""
+    for exporter in exporters:
+        try:
+            sender.send((True, exporter.make(made)))
+        except Exception as error:
+            try:
+                sender.send((False, error))
+            except Exception:  # an error that does not pickle: its text
+                sender.send((False, RuntimeError(traceback.format_exc())))
+            return
+    sender.close()

@@ -95,6 +95,38 @@ def test_the_run_writes_what_the_registry_makes(wall_run):
             assert (folder / name).read_bytes() == data, name
 
 
+@pytest.mark.parametrize("fork", [True, False])
+def test_plots_made_aside_equal_the_ones_made_here(monkeypatch, fork):
+    """The plots and the 3DM file are made in a forked process where the platform forks
+    (and here, in this process, where it does not): the PNGs are the same bytes."""
+    monkeypatch.setattr("masonry.pipeline._can_fork", lambda: fork)
+    made = wall_outputs(plots=True, printable=False)
+    plots = next(e for e in EXPORTERS if e.name == "plots")
+    assert plots.aside
+    expected = plots.make(made).files
+    recorder = RecordingFolder()
+    write_exports(recorder, made, {}, Timer())
+    assert expected and all(recorder.files[name] == data for name, data in expected.items())
+    assert "bricks.3dm" in recorder.files
+
+
+def test_an_exporter_failing_aside_fails_the_run_and_keeps_the_earlier_folder(
+        wall_run, monkeypatch, capsys):
+    out, folder = wall_run
+    before = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+
+    def broken(*args, **kwargs):
+        raise OSError("no space left on device")  # raised in the forked process
+
+    monkeypatch.setattr("masonry.export.rhino.blocks_3dm", broken)
+    assert main(["run", "--preset", "wall", "--fast", "--force", "--no-plots",
+                 "--out", str(out), "-q"]) == 1
+    assert "no space left on device" in capsys.readouterr().err
+    after = {p: p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+    assert after == before
+    assert not [p for p in out.iterdir() if p.name.startswith(".wall")]
+
+
 def _forces_table(folder):
     with open(folder / "RBE/forces.csv") as f:
         rows = list(csv.DictReader(f))

@@ -14,7 +14,6 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from masonry import plots
 from masonry.export import csv, obj, rhino, stl, summaries, threemf, vtu
 from masonry.printable import printable_blocks, printable_body
 from masonry.rbe.equilibrium import VariableLayout
@@ -73,12 +72,17 @@ class Exporter:
     make : callable RunOutputs -> Export
     wanted : callable RunOutputs -> bool
         Whether this run writes it.
+    aside : bool
+        Made in a second process while the others are made and written (a long
+        exporter that neither needs nor changes what the others make): see
+        :func:`masonry.pipeline.write_exports`.
     """
 
     name: str
     stage: str
     make: Callable
     wanted: Callable = field(default=lambda made: True)
+    aside: bool = False
 
 
 def _model_files(made: RunOutputs) -> Export:
@@ -192,6 +196,8 @@ def _printable_files(made: RunOutputs) -> Export:
 
 
 def _mechanism_plots(made: RunOutputs) -> dict:
+    from masonry import plots  # matplotlib: imported by the runs that draw (see _plot_files)
+
     collapse, model = made.collapse, made.model
     if collapse is None or collapse.mechanism is None or not collapse.load_factor:
         return {}
@@ -204,6 +210,9 @@ def _mechanism_plots(made: RunOutputs) -> dict:
 
 
 def _plot_files(made: RunOutputs) -> Export:
+    # matplotlib takes most of a second to import: a run without plots never does
+    from masonry import plots
+
     scene, model, fast = made.scene, made.model, made.scene.params.fast
     files = {}
     if scene.layout is not None:
@@ -228,12 +237,12 @@ def _plot_files(made: RunOutputs) -> Export:
 
 EXPORTERS = (
     Exporter("model", "exports", _model_files),
-    Exporter("rhino", "exports", _rhino_files),
+    Exporter("rhino", "exports", _rhino_files, aside=True),
     Exporter("rbe", "exports", _rbe_files, wanted=lambda made: made.result is not None),
     Exporter("collapse", "exports", _collapse_files,
              wanted=lambda made: made.collapse is not None),
     Exporter("printable", "printable", _printable_files,
              wanted=lambda made: made.printable),
-    Exporter("plots", "plots", _plot_files, wanted=lambda made: made.plots),
+    Exporter("plots", "plots", _plot_files, wanted=lambda made: made.plots, aside=True),
 )
 """Every exporter, in the order a run writes them."""

@@ -39,7 +39,6 @@ from pathlib import Path
 
 import numpy as np
 
-from masonry import plots
 from masonry.blocks import BLOCK_CLASSES
 from masonry.export.summaries import parameters_text
 from masonry.params import ParameterError, structure_id, validate
@@ -572,6 +571,8 @@ def _previous(target: Path, params, plan):
 def stage_pngs(scene, plan: StagePlan, rows) -> dict:
     """``stages.png`` (MoI factor of every stage, which stand) and, when a stage needs
     support, ``first_unsupported/<view>.png``: that stage with its held bricks marked."""
+    from masonry import plots  # matplotlib, imported only by the runs that draw
+
     params = scene.params
     what = {"course": "course stages", "brick": f"course {plan.course} brick by brick "
             f"({plan.order})", "block": f"block by block ({plan.order})"}[plan.by]

@@ -24,7 +24,6 @@ import numpy as np
 
 from masonry.params import Params, ParameterError, validate
 from masonry.pipeline import run
-from masonry.plots import _png, plt
 from masonry.rbe.solvers.newton import use_one_blas_thread
 
 log = logging.getLogger(__name__)
@@ -351,6 +350,8 @@ def summary_pngs(study: Study, rows) -> dict:
         ``moi_factor_<input>.png`` -> PNG bytes, one per name of ``study.swept``; failed
         variants are left out of the points and counted in the title.
     """
+    from masonry.plots import _png, plt  # matplotlib, imported only by the runs that draw
+
     out = {}
     done = [r for r in rows if r["status"] != "failed"]
     for name in study.swept:
