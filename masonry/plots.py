@@ -50,6 +50,9 @@ COLOUR_PERCENTILE = 99.0
 would otherwise set the scale and leave every other interface in one colour."""
 
 SEQUENTIAL, DIVERGING = "viridis", "RdBu_r"
+ONE_SIDED = 1e-6
+"""A signed quantity whose values of one sign all stay within this fraction of the colour
+range (solver rounding) is drawn on the other sign's half of the diverging map."""
 
 HORIZONTAL_KINDS = (INTERFACE_KINDS.index("horizontal"), INTERFACE_KINDS.index("support"))
 
@@ -77,6 +80,11 @@ def _png(fig, dpi) -> bytes:
     fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
     plt.close(fig)
     return buf.getvalue()
+
+
+def _count(n, noun) -> str:
+    """``'1 hinge'``, ``'3 hinges'``."""
+    return f"{int(n)} {noun}{'' if n == 1 else 's'}"
 
 
 def pattern_png(scene, fast=False) -> bytes:
@@ -396,7 +404,8 @@ def colour_scale(values, signed: bool, is_force: bool = True) -> dict:
     values : (n,) float
         In newtons when ``is_force``.
     signed : bool
-        A diverging map symmetric about 0; else sequential from 0 (or the minimum).
+        A diverging map symmetric about 0 (the half of one sign when every value has it,
+        within :data:`ONE_SIDED` of the range); else sequential from 0 (or the minimum).
 
     Returns
     -------
@@ -414,7 +423,16 @@ def colour_scale(values, signed: bool, is_force: bool = True) -> dict:
     # the unit of the bar's range, not of a few clipped supports
     factor, unit = force_unit(top) if is_force else (1.0, "")
     if signed:
-        norm = matplotlib.colors.Normalize(-top * factor, top * factor)
+        # one sign only (no tension anywhere): the bar keeps the map's half of that sign,
+        # zero still white at its end
+        low = -top if (values < -ONE_SIDED * top).any() else 0.0
+        high = top if (values > ONE_SIDED * top).any() or low == 0 else 0.0
+        norm = matplotlib.colors.Normalize(low * factor, high * factor)
+        part = (0.5 + 0.5 * low / top, 0.5 + 0.5 * high / top)
+        cmap = matplotlib.colormaps[DIVERGING]
+        if part != (0.0, 1.0):
+            cmap = matplotlib.colors.ListedColormap(cmap(np.linspace(*part, 128)),
+                                                    name=f"{DIVERGING}_part")
         clipped = magnitude > top
         extend = "both" if (values < -top).any() and (values > top).any() else (
             "min" if (values < -top).any() else "max" if (values > top).any() else "neither")
@@ -423,9 +441,9 @@ def colour_scale(values, signed: bool, is_force: bool = True) -> dict:
         norm = matplotlib.colors.Normalize(low * factor, top * factor)
         clipped = values > top
         extend = "max" if clipped.any() else "neither"
-    return {"factor": factor, "unit": unit, "norm": norm,
-            "cmap": matplotlib.colormaps[DIVERGING if signed else SEQUENTIAL],
-            "extend": extend, "clipped": int(clipped.sum()), "largest": largest * factor}
+        cmap = matplotlib.colormaps[SEQUENTIAL]
+    return {"factor": factor, "unit": unit, "norm": norm, "cmap": cmap, "extend": extend,
+            "clipped": int(clipped.sum()), "largest": largest * factor}
 
 
 def _colour_bar(fig, ax, scale, quantity):
@@ -592,7 +610,10 @@ def thrust_line_png(scene, interfaces, resultants, fast=False):
     outer_first = (np.linalg.norm(segments[:, 0] - centre, axis=1)
                    > np.linalg.norm(segments[:, 1] - centre, axis=1))
     segments[outer_first] = segments[outer_first, ::-1]
-    fig, ax = plt.subplots(figsize=(7, 6))
+    width, height = np.ptp(segments.reshape(-1, 2), axis=0)
+    # a figure of the structure's proportions (equal scales), the legend below the axes
+    fig, ax = plt.subplots(figsize=(7, min(6.0 * height / width, 8.0) + 1.8),
+                           layout="constrained")
     for seg in segments:
         ax.plot(seg[:, 0], seg[:, 1], color="0.55", linewidth=1)
     for end in (0, 1):
@@ -613,10 +634,10 @@ def thrust_line_png(scene, interfaces, resultants, fast=False):
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("z [m]")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), fontsize=7, frameon=False)
+    fig.legend(loc="outside lower center", fontsize=7, frameon=False)
     where = "the arch" if scene.params.scene == "arch" else f"y = {y:g} m"
     ax.set_title(f"thrust line through {len(index)} bed joints at {where}: "
-                 f"{int(hinge.sum())} hinges, {int(outside.sum())} outside\n"
+                 f"{_count(hinge.sum(), 'hinge')}, {int(outside.sum())} outside\n"
                  f"{scene_title(scene)}", fontsize=9)
     return _png(fig, 80 if fast else 150)
 

@@ -38,6 +38,21 @@ def test_signed_scale_is_symmetric_about_zero_on_a_diverging_map():
     assert np.allclose(scale["cmap"](0.5)[:3], matplotlib.colormaps["RdBu_r"](0.5)[:3])
 
 
+def test_signed_scale_of_one_sign_keeps_that_half_of_the_map():
+    """No tension anywhere (rounding aside): the bar runs from the largest compression to
+    zero, in the blue half of the map, zero white at its end."""
+    values = np.array([-5e3, -1e3, -2e2, 1e-9, 0.0])
+    scale = colour_scale(values, signed=True)
+    full = matplotlib.colormaps["RdBu_r"]
+    assert scale["norm"].vmax == 0 and scale["norm"].vmin == pytest.approx(
+        -np.percentile(np.abs(values), COLOUR_PERCENTILE) * 1e-3)
+    assert np.allclose(scale["cmap"](1.0), full(0.5), atol=0.01)
+    assert np.allclose(scale["cmap"](0.0), full(0.0), atol=0.01)
+    tension = colour_scale(-values, signed=True)
+    assert tension["norm"].vmin == 0 and np.allclose(tension["cmap"](0.0), full(0.5),
+                                                     atol=0.01)
+
+
 def test_all_zero_values_still_have_a_scale():
     scale = colour_scale(np.zeros(5), signed=False)
     assert scale["norm"].vmax > scale["norm"].vmin and scale["clipped"] == 0
