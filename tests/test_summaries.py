@@ -15,8 +15,9 @@ def test_parameters_list_the_scene_that_ran_and_the_values_it_used():
     arch = names(parameters_text(validate(Params(scene="arch"))))
     assert {"arch_blocks", "arch_thickness", "mu", "accuracy", "solver"} <= arch
     assert not arch & {"stretch", "n", "wall_length", "boundary"}
+    assert "cad_offset" not in arch  # voussoirs are not moved inward
     section = parameters_text(from_preset("1"))
-    assert {"stretch", "n", "boundary"} <= names(section)
+    assert {"stretch", "n", "boundary", "cad_offset"} <= names(section)
     assert not names(section) & {"arch_blocks", "wall_courses"}
     # the preset the run used, not the unset option (None)
     assert "accuracy = balanced" in " ".join(section.split())

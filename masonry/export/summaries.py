@@ -25,6 +25,9 @@ _ANALYSIS = (("mu", "friction coefficient"), ("density", "kg/m^3"),
 _OUTPUT = (("fast", "one view, lower resolution"),
            ("cad_offset", "units the CAD files move each brick inward"),
            ("print_size", "mm, largest dimension of dome.3mf (None: no 3MF)"))
+_BRICK_SCENES = ("section", "dome", "wall")
+"""The scenes of bricks with an inward face, which the CAD offset moves (an arch's
+voussoirs and an imported assembly's blocks stay where they are)."""
 
 
 def _line(name, value, note) -> str:
@@ -45,7 +48,8 @@ def parameters_text(params) -> str:
               _line("accuracy", preset.name, f"solver preset; residual <= {preset.residual:g}"),
               _line("solver", solvers, "" if params.solver is None else "set by --solver"),
               ""]
-    lines += [_line(name, getattr(params, name), note) for name, note in _OUTPUT]
+    lines += [_line(name, getattr(params, name), note) for name, note in _OUTPUT
+              if name != "cad_offset" or params.scene in _BRICK_SCENES]
     return "\n".join(lines) + "\n"
 
 
