@@ -1,9 +1,7 @@
 """``masonry arch-thickness``: the minimum thickness t/R of an arch, by bisection on RBE
 feasibility, beside the thrust line's value."""
 
-import dataclasses
-
-from masonry.params import SOLVERS, Params, validate
+from masonry.params import SOLVERS, Params, arch_radius, validate
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.thickness import folder_name, minimum_thickness, steps_csv
 from masonry.studies.thrust_line import thrust_line_minimum_thickness
@@ -40,7 +38,11 @@ def handle(args, report):
     result = minimum_thickness(params, rtol=args.rtol)
     line = thrust_line_minimum_thickness(params.arch_shape, params.arch_blocks,
                                          params.arch_span, params.arch_rise, mu=params.mu)
-    record = {"params": dataclasses.asdict(params), "rtol": args.rtol,
+    inputs = {name: getattr(params, name) for name in ANALYSIS}
+    inputs["arch_rise"] = arch_radius(params.arch_shape, params.arch_span,
+                                      params.arch_rise)[1]  # the default resolved
+    inputs["accuracy"] = params.solver_accuracy
+    record = {"params": inputs, "rtol": args.rtol,
               "rbe": {"t_over_r": result.t_over_r, "lower": result.lower,
                       "thickness_m": result.thickness, "radius_m": result.radius,
                       "solves": len(result.steps), "time_s": result.time_s},

@@ -152,3 +152,9 @@ def test_arch_thickness_command(capsys, tmp_path):
                  "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "t/R = 0.107" in out and "thrust line" in out
+    record = json.loads(next(tmp_path.glob("arch-thickness_*/result.json")).read_text())
+    # the arch's inputs as the study used them, not the dome's or the searched thickness
+    assert record["params"] == {"arch_blocks": 16, "arch_span": 10.0,
+                                "arch_shape": "semicircular", "arch_rise": 5.0,
+                                "arch_depth": 1.0, "mu": 10.0, "density": 2000.0,
+                                "solver": None, "accuracy": "balanced"}
