@@ -642,10 +642,30 @@ def thrust_line_png(scene, interfaces, resultants, fast=False):
     return _png(fig, 80 if fast else 150)
 
 
+RANKED = 10
+"""The interfaces of largest tension numbered in ``where_it_fails.png``."""
+
+
+def _rank_labels(centres, bounds, near=0.03):
+    """``(text, position)`` labels for the ranks 1, 2, ... of points ``centres``; points
+    within ``near`` of the bounding box's diagonal of an earlier label share it
+    (``'1, 4'``) instead of printing over it."""
+    size = float(np.linalg.norm(bounds[1] - bounds[0]))
+    labels = []
+    for rank, centre in enumerate(centres, start=1):
+        for label in labels:
+            if np.linalg.norm(label[1] - centre) <= near * size:
+                label[0].append(str(rank))
+                break
+        else:
+            labels.append(([str(rank)], centre))
+    return [(", ".join(ranks), at) for ranks, at in labels]
+
+
 def failure_png(scene, blocks, interfaces, top, forces, fast=False) -> bytes:
     """Where it fails: every interface in light grey and the interfaces ``top`` (the
     rows of ``RBE/tension_top.csv``, largest tension first) coloured by tension, the
-    first ten numbered by their rank."""
+    first :data:`RANKED` numbered by their rank (neighbours share a label)."""
     fig, ax = _axes3d(blocks.bounds)
     _add_polygons(ax, "01_angle", _polygons(interfaces, range(len(interfaces))),
                   (0.6, 0.6, 0.6, 0.2), edgecolors="none")
@@ -655,8 +675,11 @@ def failure_png(scene, blocks, interfaces, top, forces, fast=False) -> bytes:
     cmap = matplotlib.colormaps["inferno_r"]
     colours = cmap(norm(tension * factor))
     _add_polygons(ax, "01_angle", _polygons(interfaces, top), colours, linewidths=1.0)
-    for rank, k in enumerate(top[:10], start=1):
-        ax.text(*interfaces.centre[k], str(rank), fontsize=7, color="k")
+    for ranks, at in _rank_labels(interfaces.centre[top[:RANKED]], blocks.bounds):
+        # above the polygons (mplot3d orders collections by depth after the texts)
+        ax.text(*at, ranks, fontsize=7, color="k", zorder=1e3,
+                bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "alpha": 0.8,
+                      "linewidth": 0})
     bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
                        shrink=0.6, pad=0.1)
     bar.set_label(f"tension [{unit}]", fontsize=8)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from masonry.export.csv import tension_top
-from masonry.plots import COLOUR_PERCENTILE, colour_scale, force_unit
+from masonry.plots import COLOUR_PERCENTILE, _rank_labels, colour_scale, force_unit
 from masonry.tolerances import TENSION_REPORTED_REL
 
 
@@ -95,3 +95,11 @@ def test_cyclic_runs_get_whole_dome_views():
     assert "05_dome/3_structure.png" in structure_pngs(scene, fast=True)
     free = scene_of("3", p=4)
     assert not any(k.startswith("05_dome") for k in structure_pngs(free, fast=True))
+
+
+def test_rank_labels_of_neighbouring_interfaces_share_one_label():
+    bounds = np.array([[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]])  # 3 % of the diagonal: 0.3
+    centres = np.array([[0.0, 0, 0], [5.0, 0, 0], [0.2, 0, 0], [9.0, 0, 0], [5.29, 0, 0]])
+    labels = _rank_labels(centres, bounds)
+    assert [text for text, _ in labels] == ["1, 3", "2, 5", "4"]
+    assert np.allclose(labels[1][1], [5.0, 0, 0])
