@@ -12,6 +12,7 @@ import json
 import logging
 import multiprocessing
 import pickle
+import signal
 import sys
 import threading
 import time
@@ -561,9 +562,9 @@ class _Aside:
             raise value
         return value
 
-    def __exit__(self, *exc):
+    def __exit__(self, kind, error, trace):
         if self.process is not None:
-            if self.process.is_alive():
+            if kind is not None:  # this process failed or was interrupted: end it
                 self.process.terminate()
             self.process.join()
             self.receiver.close()
@@ -571,7 +572,11 @@ class _Aside:
 
 
 def _make_aside(exporters, made, sender):
-    """In the forked process: make each exporter's files and send them, or the error."""
+    """In the forked process: make each exporter's files and send them, or the error.
+    An interrupt or a terminate ends it without a word (the run's own handlers, copied
+    by the fork, are for the process that reports)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
     for exporter in exporters:
         try:
             sender.send((True, exporter.make(made)))
