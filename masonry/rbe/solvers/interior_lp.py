@@ -62,17 +62,18 @@ class LoadFactorOptions:
         ``1 + |lambda|`` are at most ``tol`` ...
     primal_tol : float
         ... and the residual of the primal rows (``M g + lambda l = b``, relative to the
-        largest load entry) at most ``primal_tol``. Near the optimum ``D`` spans
-        20 decades and the primal residual rises again to 1e-7 to 4e-6 on the full
-        domes (the factor has settled to 1e-7 by then), while the dual rows stay exact:
-        ``-b^T y`` is then an upper bound of the factor (:func:`load_factor` reports
-        it) within ``tol`` of the primal one. The residual is recomputed and reported
-        with every collapse result.
+        largest load entry) at most ``primal_tol``. The dual rows stay exact, so
+        ``-b^T y`` is an upper bound of the factor (:func:`load_factor` reports it),
+        within the gap of the primal one while the primal rows hold. The residual is
+        recomputed and reported with every collapse result.
     max_iter : int
     step_fraction : float
         Fraction of the largest step to the boundary of ``g, s >= 0`` that is taken.
     regularization : float
-        Shift of the normal matrix relative to its mean diagonal.
+        Shift of the normal matrix relative to its mean diagonal. Near the optimum
+        ``D`` spans 20 decades and the mean is set by its largest entries: a shift of
+        1e-12 left the primal rows at 4e-7 (preset 1's full dome) to 4e-6 (its p = 5
+        variant), and the factor up to 1e-6 off the dual bound; 1e-16 keeps them at 1e-13.
     min_step : float
         Give up (status ``user_limit``) when a step falls below this.
     correctors : int
@@ -84,7 +85,7 @@ class LoadFactorOptions:
     primal_tol: float = 1e-5
     max_iter: int = 100
     step_fraction: float = 0.99
-    regularization: float = 1e-12
+    regularization: float = 1e-16
     min_step: float = 1e-6
     correctors: int = 3
 
@@ -129,7 +130,7 @@ class _Normal:
         scale = float(np.mean(np.trace(diagonal, axis1=1, axis2=2))) / 6.0
         # near the optimum D spans many decades and K is singular to working precision
         # where no edge ray of a block carries force: a shift relative to K's diagonal,
-        # raised until the factorization succeeds (the primal passes of direction()
+        # raised until the factorization succeeds (the primal passes of refine()
         # recover the digits it costs)
         for attempt in range(REGULARIZATION_RAISES + 1):
             shift = regularization * REGULARIZATION_RAISE**attempt * scale
