@@ -17,7 +17,9 @@ every edge ray on it: ``s >= 0`` is the associated flow rule, no interface penet
 
 Mehrotra's predictor-corrector (S. Mehrotra, SIAM J. Optim. 2, 1992; S. Wright,
 *Primal-Dual Interior-Point Methods*, SIAM 1997, ch. 10) with separate primal and dual
-step lengths. Every iteration solves the normal equations ::
+step lengths, and Gondzio's multiple centrality correctors (J. Gondzio, Comput. Optim.
+Appl. 6, 1996): a few products ``g s`` far from the target stop the corrector's steps
+short, and further solves with the same factor move them back. Every iteration solves the normal equations ::
 
     M D M^T dy = r,   D = diag(g / s)
 
@@ -60,31 +62,45 @@ class LoadFactorOptions:
         ``1 + |lambda|`` are at most ``tol`` ...
     primal_tol : float
         ... and the residual of the primal rows (``M g + lambda l = b``, relative to the
-        largest load entry) at most ``primal_tol``. Near the optimum ``D`` spans
-        20 decades and the primal residual rises again to 1e-7 to 4e-6 on the full
-        domes (the factor has settled to 1e-7 by then), while the dual rows stay exact:
-        ``-b^T y`` is then an upper bound of the factor (:func:`load_factor` reports
-        it) within ``tol`` of the primal one. The residual is recomputed and reported
-        with every collapse result.
+        largest load entry) at most ``primal_tol``. The dual rows stay exact, so
+        ``-b^T y`` is an upper bound of the factor (:func:`load_factor` reports it),
+        within the gap of the primal one while the primal rows hold. The residual is
+        recomputed and reported with every collapse result.
     max_iter : int
     step_fraction : float
         Fraction of the largest step to the boundary of ``g, s >= 0`` that is taken.
     regularization : float
-        Shift of the normal matrix relative to its mean diagonal.
+        Shift of the normal matrix relative to its mean diagonal. Near the optimum
+        ``D`` spans 20 decades and the mean is set by its largest entries: a shift of
+        1e-12 left the primal rows at 4e-7 (preset 1's full dome) to 4e-6 (its p = 5
+        variant), and the factor up to 1e-6 off the dual bound; 1e-16 keeps them at 1e-13.
     min_step : float
         Give up (status ``user_limit``) when a step falls below this.
+    correctors : int
+        Most centrality correctors per iteration (one solve each, on the iteration's
+        factor).
     """
 
     tol: float = 1e-8
     primal_tol: float = 1e-5
     max_iter: int = 100
     step_fraction: float = 0.99
-    regularization: float = 1e-12
+    regularization: float = 1e-16
     min_step: float = 1e-6
+    correctors: int = 3
 
 
 PRIMAL_PASSES = 2
-"""Passes that solve for what the direction leaves of the primal rows."""
+"""Passes that solve for what the direction leaves of the primal rows ..."""
+PASS_RATIO = 1e-2
+"""... while that is above this fraction of their residual."""
+
+ASPIRATION = 0.3
+"""A centrality corrector aims at steps this much longer than the last direction's ..."""
+ACCEPT = 0.1
+"""... and is kept when its shorter step grows by at least this fraction of that."""
+BOX = (0.1, 10.0)
+"""The products ``g s`` a centrality corrector aims at, relative to the target."""
 
 REGULARIZATION_RAISE = 1e3
 REGULARIZATION_RAISES = 3
@@ -101,17 +117,20 @@ def pyramid_rays(mu) -> np.ndarray:
 
 class _Normal:
     """The normal equations at one interior point: ``K = M D M^T`` factored once, the
-    live load's solve ``K^-1 l`` kept for both directions of the iteration."""
+    live load's solve ``K^-1 l`` made with the first direction's and kept for the
+    others of the iteration."""
 
     def __init__(self, ns: NewtonSystem, rays, d, regularization, load):
         self.ns, self.rays, self.d, self.load = ns, rays, d, load
-        blocks = np.einsum("ik,vk,jk->vij", rays, d, rays)
+        # E_v D_v E_v^T of every vertex: D's rows times the rays' outer products
+        outer = np.einsum("ik,jk->kij", rays, rays).reshape(len(d[0]), 9)
+        blocks = (d @ outer).reshape(-1, 3, 3)
         matrix = ns.newton_blocks(blocks, 0.0, incremental=False)
         diagonal = matrix[ns.diagonal_blocks]
         scale = float(np.mean(np.trace(diagonal, axis1=1, axis2=2))) / 6.0
         # near the optimum D spans many decades and K is singular to working precision
         # where no edge ray of a block carries force: a shift relative to K's diagonal,
-        # raised until the factorization succeeds (the primal passes of direction()
+        # raised until the factorization succeeds (the primal passes of refine()
         # recover the digits it costs)
         for attempt in range(REGULARIZATION_RAISES + 1):
             shift = regularization * REGULARIZATION_RAISE**attempt * scale
@@ -124,8 +143,16 @@ class _Normal:
                     raise
                 log.debug("collapse LP: normal matrix shifted by %.1e of its diagonal",
                           regularization * REGULARIZATION_RAISE**(attempt + 1))
-        self.v = self.factor.solve(load)
-        self.lv = float(load @ self.v)
+        self.v = self.lv = None
+
+    def solve(self, rhs):
+        """``K^-1 rhs``; the first call solves for the live load too (one pass over the
+        factor for both columns costs little more than for one)."""
+        if self.v is not None:
+            return self.factor.solve(rhs)
+        both = self.factor.solve(np.column_stack([rhs, self.load]))
+        self.v, self.lv = both[:, 1], float(self.load @ both[:, 1])
+        return both[:, 0]
 
     def times_m(self, g):
         """``M g`` for ``g`` ((V, 4))."""
@@ -135,26 +162,35 @@ class _Normal:
         """``M^T y`` ((V, 4))."""
         return (self.ns.AT @ y).reshape(-1, 3) @ self.rays
 
-    def direction(self, r_primal, r_dual, r_factor, r_comp, g, s, refine=True):
+    def direction(self, r_primal, r_dual, r_factor, r_comp, g, s):
         """Newton direction for the residuals ``M g + lambda l - b``, ``M^T y + s``,
         ``l^T y + 1`` and the complementarity target ``g s - r_comp`` (elementwise):
-        ``(dg, dlambda, dy, ds)``. With ``refine``, further passes solve for what the
-        first left of the primal rows (``D`` amplifies the errors of ``dy`` in ``dg``);
-        its correction ``D M^T dy'`` keeps the other rows exact, as ``S D = G``."""
+        ``(dg, dlambda, dy, ds)``."""
         rhs = -r_primal + self.times_m(r_comp / s - self.d * r_dual)
         dy, d_factor = self._bordered(rhs, float(r_factor))
         dg = -r_comp / s + self.d * (r_dual + self.times_mt(dy))
-        for _ in range(PRIMAL_PASSES if refine else 0):
+        return dg, d_factor, dy, -r_dual - self.times_mt(dy)
+
+    def refine(self, direction, r_primal):
+        """``direction`` after up to :data:`PRIMAL_PASSES` passes that solve for what it
+        leaves of the primal rows (``D`` amplifies the errors of ``dy`` in ``dg``), while
+        that is above :data:`PASS_RATIO` of their residual; the correction
+        ``D M^T dy'`` keeps the other rows exact, as ``S D = G``."""
+        dg, d_factor, dy, ds = direction
+        bound = PASS_RATIO * np.abs(r_primal).max()
+        for _ in range(PRIMAL_PASSES):
             left = self.times_m(dg) + d_factor * self.load + r_primal
+            if np.abs(left).max() <= bound:
+                break
             correction, d_extra = self._bordered(-left, 0.0)
             dy, d_factor = dy + correction, d_factor + d_extra
-            dg = dg + self.d * self.times_mt(correction)
-        ds = -r_dual - self.times_mt(dy)
+            correction = self.times_mt(correction)
+            dg, ds = dg + self.d * correction, ds - correction
         return dg, d_factor, dy, ds
 
     def _bordered(self, rhs, r_factor):
         """``(dy, dlambda)`` with ``K dy + l dlambda = rhs`` and ``l^T dy = -r_factor``."""
-        u = self.factor.solve(rhs)
+        u = self.solve(rhs)
         d_factor = (float(self.load @ u) + r_factor) / self.lv
         return u - d_factor * self.v, d_factor
 
@@ -164,7 +200,7 @@ def _start(ns, rays, load, regularization):
     the least-norm dual slacks ``s = -M^T y`` with ``l^T y = -1``, both shifted inside
     the orthant and balanced (:func:`~masonry.rbe.solvers.interior.centred_start`)."""
     unit = _Normal(ns, rays, np.ones((len(ns.h), 4)), regularization, load)
-    g = unit.times_mt(unit.factor.solve(ns.b))
+    g = unit.times_mt(unit.solve(ns.b))
     y = -unit.v / unit.lv
     g, s = centred_start(g, -unit.times_mt(y))
     return g, y, s
@@ -204,7 +240,7 @@ def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions) -> QPOutcome
             status = SOLVER_ERROR
             break
         (primal, dual), (dg, d_factor, dy, ds) = _mehrotra(normal, residuals[:3], g, s,
-                                                           options.step_fraction)
+                                                           options)
         if min(primal, dual) < options.min_step:
             log.info("collapse LP: stalled at iteration %d (steps %.1e, %.1e)",
                      iterations, primal, dual)
@@ -239,16 +275,41 @@ def _converged(residuals, g, s, factor, scale, options) -> bool:
             and float(g.ravel() @ s.ravel()) <= tol * (1.0 + abs(factor)))
 
 
-def _mehrotra(normal, residuals, g, s, step_fraction):
-    """Predictor (affine scaling), then Mehrotra's corrector with the same factor:
-    ``((primal step, dual step), (dg, dlambda, dy, ds))``."""
+def _mehrotra(normal, residuals, g, s, options):
+    """Predictor (affine scaling), Mehrotra's corrector and Gondzio's centrality
+    correctors, all with the same factor: ``((primal step, dual step), (dg, dlambda,
+    dy, ds))``."""
     gap = float(g.ravel() @ s.ravel()) / g.size
-    dg, _, _, ds = normal.direction(*residuals, g * s, g, s, refine=False)
-    primal, dual = max_step(g.ravel(), dg.ravel()), max_step(s.ravel(), ds.ravel())
+    dg, _, _, ds = normal.direction(*residuals, g * s, g, s)
+    primal, dual = _steps(g, s, dg, ds)
     predicted = float((g + primal * dg).ravel() @ (s + dual * ds).ravel()) / g.size
-    sigma = (predicted / gap) ** 3
-    direction = normal.direction(*residuals, g * s + dg * ds - sigma * gap, g, s)
-    dg, _, _, ds = direction
-    steps = (step_fraction * max_step(g.ravel(), dg.ravel()),
-             step_fraction * max_step(s.ravel(), ds.ravel()))
-    return steps, direction
+    target = (predicted / gap) ** 3 * gap
+    r_comp = g * s + dg * ds - target
+    direction = normal.direction(*residuals, r_comp, g, s)
+    steps = _steps(g, s, direction[0], direction[3])
+    log.debug("  affine %.3f %.3f sigma %.2e, corrector %.3f %.3f", primal, dual,
+              target / gap, *steps)
+    for _ in range(options.correctors):
+        # Gondzio: move the products of the point that a longer step would reach
+        # into [BOX[0], BOX[1]] x target
+        aspired = [min(1.0, step + ASPIRATION) for step in steps]
+        products = ((g + aspired[0] * direction[0]) * (s + aspired[1] * direction[3]))
+        push = np.clip(products, BOX[0] * target, BOX[1] * target) - products
+        push = np.maximum(push, -BOX[1] * target)
+        trial = normal.direction(*residuals, r_comp - push, g, s)
+        trial_steps = _steps(g, s, trial[0], trial[3])
+        log.debug("  centrality corrector %.3f %.3f", *trial_steps)
+        if min(trial_steps) < min(steps) + ACCEPT * ASPIRATION:
+            if min(trial_steps) > min(steps):
+                direction, steps = trial, trial_steps
+            break
+        direction, steps = trial, trial_steps
+        r_comp = r_comp - push
+    direction = normal.refine(direction, residuals[0])
+    steps = _steps(g, s, direction[0], direction[3])
+    return tuple(options.step_fraction * step for step in steps), direction
+
+
+def _steps(g, s, dg, ds):
+    """The largest steps ``<= 1`` that keep ``g`` and ``s`` nonnegative."""
+    return max_step(g.ravel(), dg.ravel()), max_step(s.ravel(), ds.ravel())
