@@ -98,7 +98,10 @@ ACCURACY = {
     # of a 38,000-row system where Clarabel factors a 790,000-row one 16 times);
     # friction+ by the interior point method on the same system, polished by Newton
     # (Newton alone on friction+ is slowed by the 1,000:1 tension weight: more than 100
-    # steps on preset 1's free section). Clarabel takes over when either fails.
+    # steps on preset 1's free section). When Newton neither solves nor certifies
+    # friction-net (low-friction domes), the load-path LP on the same matrix decides
+    # (preset 1's full dome at mu 0.05: 6 iterations where Clarabel took 22 on its
+    # KKT system); Clarabel takes over when either method fails.
     "balanced": AccuracyPreset(
         "balanced", "newton", "interior", residual=1e-5, lp_check=False, load_path=True,
         polish=True,
@@ -193,8 +196,9 @@ class RBEResult:
     lp_time_s : float, s
         Time of the LP check (0 when not run).
     attempts : tuple of dict
-        Every QP solved, in order: friction model, solver, status, iterations, setup and
-        solve seconds (a fallback shows as a second attempt of the same model).
+        Every QP solved (and the load-path LP, :data:`LOAD_PATH`), in order: friction
+        model, solver, status, iterations, setup and solve seconds (a fallback shows as
+        a second attempt of the same model).
     verdict : {'feasible', 'infeasible', 'not solved'}
         ``'feasible'``: ``feasible`` is True. ``'infeasible'``: friction-net has no
         accepted point, and either a solver certified that (a Farkas certificate, an
@@ -459,7 +463,8 @@ def _settings(friction, solver, tol, accuracy, lp_check):
 def _candidates(method, solver, preset) -> list:
     """Solvers to try for ``method``, in order: the explicit ``solver`` alone, else the
     preset's, followed by Clarabel when the preset's is one of the fast methods on the
-    Newton system (they neither converge nor certify on every structure)."""
+    Newton system (they neither converge nor certify on every structure), and by the
+    load-path LP before Clarabel for Newton on friction-net if the preset says so."""
     if solver is not None:
         return [solver]
     chosen = preset.net_solver if method == "net" else preset.plus_solver
