@@ -16,15 +16,17 @@ import scipy.linalg
 from masonry.studies.bench import (COLUMNS, bench, frontier_png, ratios, ratios_markdown,
                                    table_csv, table_markdown)
 from masonry.rbe.boundary import analysis_model
-from masonry.rbe.equilibrium import assemble
+from masonry.rbe.equilibrium import assemble, friction_pyramid_edges
 from masonry.params import ACCURACIES, SOLVERS, ParameterError, Params, from_preset, structure_id
 from masonry.scenes import build
-from masonry.rbe.solve import ACCURACY, RBEProblem, solve_rbe
+from masonry.rbe import solve as solve_module
+from masonry.rbe.solve import ACCURACY, LOAD_PATH, RBEProblem, _lp_feasible, solve_rbe
 from masonry.rbe.solvers import BACKENDS
 from masonry.rbe.solvers import cholesky
 from masonry.rbe.solvers.cholesky import BlockCholesky
 from masonry.rbe.solvers.interior import vertex_constraints, vertex_inverse
-from masonry.rbe.solvers.newton import COMPONENTS, NewtonSystem, project_pyramid
+from masonry.rbe.solvers.net_feasibility import decide
+from masonry.rbe.solvers.newton import COMPONENTS, NewtonOptions, NewtonSystem, project_pyramid
 from masonry.rbe.solvers.standard_form import standard_form
 from masonry.tolerances import Tolerances
 from masonry_cli.main import main
@@ -352,6 +354,62 @@ def test_polish_finds_the_exact_optimum():
     assert raw.moi > 0 and polished.moi == 0.0
     assert polished.attempts[-1]["solver"] == "newton-polish"
     assert polished.residual_eq < 1e-12
+
+
+# ---------------------------------------------------------------------- load-path LP
+@pytest.mark.parametrize("preset, boundary, mu", [
+    ("3", "free", 0.05), ("3", "free", 0.3), ("3", "free", 0.7), ("3", "free", 1.5),
+    ("3", "cyclic", 0.05), ("3", "cyclic", 0.7), ("1", "free", 0.7)])
+def test_the_load_path_lp_agrees_with_highs_and_clarabel(preset, boundary, mu):
+    m = small(boundary) if preset == "3" else model(preset, boundary=boundary)
+    system = problem(m).system.with_material(mu=mu, density=2000.0)
+    tol = NewtonOptions().infeasibility_tol
+    outcome = decide(NewtonSystem(system, "net"), tol, Tolerances().residual)
+    feasible = _lp_feasible(system, 60.0)
+    clarabel = BACKENDS["clarabel"](system, "net", {}, {})
+    assert clarabel.status == ("optimal" if feasible else "infeasible")
+    assert outcome.info["verdict"] == ("feasible" if feasible else "infeasible")
+    # the verdict's evidence, recomputed from the layout's matrices: the edge rays of
+    # every vertex's pyramid as columns
+    edges = system.A_eq @ friction_pyramid_edges(system.layout.n_vertices, mu)
+    b = -system.f_ext
+    if feasible:
+        weights = outcome.info["weights"].ravel()
+        assert weights.min() >= 0
+        assert np.abs(edges @ weights - b).max() <= 1e-5 * np.abs(b).max()
+    else:
+        gain = float(b @ outcome.y)
+        assert gain > 0 and outcome.status == "infeasible"
+        assert (edges.T @ outcome.y).max() <= tol * gain / np.abs(b).sum()
+
+
+def test_the_balanced_preset_certifies_by_the_load_path_lp():
+    # Newton stalls on this section at mu 0.05: the LP certifies, not Clarabel; friction+
+    # as before, against Clarabel
+    prepared = problem(small("free"))
+    reference = prepared.solve(mu=0.05, solver="clarabel", accuracy="accurate",
+                               lp_check=False)
+    result = prepared.solve(mu=0.05, accuracy="balanced")
+    assert [(a["solver"], a["status"]) for a in result.attempts] == [
+        ("newton", "user_limit"), (LOAD_PATH, "infeasible"), ("interior", "optimal"),
+        ("newton-polish", "optimal")]
+    assert result.verdict == reference.verdict == "infeasible"
+    assert result.moi_factor == pytest.approx(reference.moi_factor, rel=1e-8)
+    np.testing.assert_allclose(result.x, reference.x, rtol=0, atol=1e-8 * scale(reference))
+
+
+def test_a_feasible_load_path_verdict_resumes_newton(monkeypatch):
+    # Newton made to stall after one step without halving: the LP finds friction-net
+    # feasible, Newton resumes and finds Clarabel's optimum
+    monkeypatch.setattr(solve_module, "LOAD_PATH_STALL", 1)
+    # separate problems: Clarabel's Newton polish would warm-start the balanced solve
+    reference = problem(small("cyclic")).solve(mu=0.5, solver="clarabel",
+                                               accuracy="accurate")
+    result = problem(small("cyclic")).solve(mu=0.5, accuracy="balanced")
+    assert [(a["solver"], a["status"]) for a in result.attempts] == [
+        ("newton", "user_limit"), (LOAD_PATH, "user_limit"), ("newton", "optimal")]
+    assert result.verdict == reference.verdict == "feasible"
+    np.testing.assert_allclose(result.x, reference.x, rtol=0, atol=1e-6 * scale(reference))
 
 
 # ---------------------------------------------------------------------- reuse

@@ -24,9 +24,10 @@ import scipy.sparse as sp
 
 from masonry.rbe.equilibrium import (FRICTION_METHODS, EquilibriumSystem, VariableLayout,
                                      assemble, friction_pyramid_edges)
-from masonry.rbe.solvers import BACKENDS, FAMILY
+from masonry.rbe.solvers import BACKENDS, FAMILY, net_feasibility
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL
 from masonry.rbe.solvers.highs import highs_lp
+from masonry.rbe.solvers.newton import NewtonOptions, prepared_system
 from masonry.tolerances import Tolerances
 
 log = logging.getLogger(__name__)
@@ -49,6 +50,11 @@ class AccuracyPreset:
         Run the independent friction-net LP (HiGHS): always, never, or only to confirm
         an infeasible verdict. A feasible verdict needs no second opinion: it rests on
         a point whose equilibrium and friction residuals were recomputed here.
+    load_path : bool
+        When Newton neither solves nor certifies friction-net, decide feasibility by
+        the load-path LP on Newton's matrix (:mod:`masonry.rbe.solvers.net_feasibility`)
+        before Clarabel: its certificate ends friction-net; a feasible verdict resumes
+        Newton from where it stopped, then Clarabel.
     polish : bool
         Refine an accepted interior-point or ADMM point with Newton steps started from
         its multipliers (:mod:`masonry.rbe.solvers.newton`): one or two steps find the exact
@@ -64,6 +70,7 @@ class AccuracyPreset:
     plus_solver: str
     residual: float
     lp_check: bool | str
+    load_path: bool = False
     polish: bool = False
     options: dict = field(default_factory=dict)
 
@@ -80,7 +87,8 @@ ACCURACY = {
     # the active pyramid faces are found, so a looser stop saves little; the savings are
     # the interior point's last iterations and the acceptance of OSQP's ADMM points.
     "fast": AccuracyPreset(
-        "fast", "newton", "interior", residual=1e-4, lp_check=False, polish=False,
+        "fast", "newton", "interior", residual=1e-4, lp_check=False, load_path=True,
+        polish=False,
         options={"newton": {"tol": 1e-6},
                  "interior": {"tol": 1e-6},
                  "clarabel": {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-6},
@@ -90,9 +98,13 @@ ACCURACY = {
     # of a 38,000-row system where Clarabel factors a 790,000-row one 16 times);
     # friction+ by the interior point method on the same system, polished by Newton
     # (Newton alone on friction+ is slowed by the 1,000:1 tension weight: more than 100
-    # steps on preset 1's free section). Clarabel takes over when either fails.
+    # steps on preset 1's free section). When Newton neither solves nor certifies
+    # friction-net (low-friction domes), the load-path LP on the same matrix decides
+    # (preset 1's full dome at mu 0.05: 6 iterations where Clarabel took 22 on its
+    # KKT system); Clarabel takes over when either method fails.
     "balanced": AccuracyPreset(
-        "balanced", "newton", "interior", residual=1e-5, lp_check=False, polish=True,
+        "balanced", "newton", "interior", residual=1e-5, lp_check=False, load_path=True,
+        polish=True,
         options={"newton": {"tol": 1e-9},
                  "interior": {"tol": 1e-10},
                  "clarabel": {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8},
@@ -116,6 +128,13 @@ ACCURACY = {
                           "polishing": True}}),
 }
 """Accuracy preset name -> :class:`AccuracyPreset`."""
+
+LOAD_PATH = "load-path-lp"
+"""The load-path LP's name among the candidates and in :attr:`RBEResult.attempts`."""
+
+LOAD_PATH_STALL = 10
+"""Newton's ``stall`` on friction-net when the load-path LP follows it (Newton's own,
+25, otherwise): steps without halving the residual before the LP decides."""
 
 SOLVERS = tuple(BACKENDS)
 """Every solver name :func:`solve_rbe` accepts."""
@@ -177,8 +196,9 @@ class RBEResult:
     lp_time_s : float, s
         Time of the LP check (0 when not run).
     attempts : tuple of dict
-        Every QP solved, in order: friction model, solver, status, iterations, setup and
-        solve seconds (a fallback shows as a second attempt of the same model).
+        Every QP solved (and the load-path LP, :data:`LOAD_PATH`), in order: friction
+        model, solver, status, iterations, setup and solve seconds (a fallback shows as
+        a second attempt of the same model).
     verdict : {'feasible', 'infeasible', 'not solved'}
         ``'feasible'``: ``feasible`` is True. ``'infeasible'``: friction-net has no
         accepted point, and either a solver certified that (a Farkas certificate, an
@@ -297,8 +317,14 @@ class RBEProblem:
         """One friction model: the candidate solvers in turn until one returns an
         accepted point (polished if the preset says so) or certifies infeasibility.
         Every QP solved is appended to ``attempts``."""
+        outcome = None
         for index, name in enumerate(names):
-            outcome = self._run(system, method, name, preset)
+            if name == LOAD_PATH:
+                name, outcome = self._load_path(system, preset, tol, outcome, attempts)
+            else:
+                # Newton hands over sooner when the load-path LP follows it
+                stall = {"stall": LOAD_PATH_STALL} if LOAD_PATH in names[index:] else {}
+                outcome = self._run(system, method, name, preset, **stall)
             checks = _check(system, outcome.x, method)
             accepted = _accepted(checks, tol)
             attempts.append(_record(method, name, outcome))
@@ -321,6 +347,26 @@ class RBEProblem:
                 log.info("%s found no %s solution (%s); trying %s", name, method,
                             outcome.status, names[index + 1])
         return _Solved(method, name, outcome, checks, False)
+
+    def _load_path(self, system, preset, tol, stalled, attempts):
+        """After Newton (``stalled``, its outcome) neither solved nor certified
+        friction-net: the load-path LP's verdict (:mod:`~masonry.rbe.solvers.net_feasibility`).
+        Its certificate, or its undecided outcome, is returned as is; when it finds
+        friction-net feasible, Newton resumes from its last dual point with its own
+        stall count (the LP's point is feasible but not the QP's optimum). Returns
+        ``(solver name, outcome)``; the LP's record joins ``attempts`` when Newton
+        resumes."""
+        workspace = self._workspace("newton")
+        options = preset.options.get("newton", {})
+        decided = net_feasibility.decide(prepared_system(system, "net", workspace),
+                                         NewtonOptions(**options).infeasibility_tol,
+                                         tol.residual)
+        if decided.info["verdict"] != net_feasibility.FEASIBLE or stalled.y is None:
+            return LOAD_PATH, decided
+        attempts.append(_record("net", LOAD_PATH, decided))
+        log.info("the load-path LP found friction-net feasible: Newton resumes")
+        return "newton", BACKENDS["newton"](system, "net", dict(options), workspace,
+                                            y0=stalled.y)
 
     def _polish(self, system, method, outcome, tol, attempts):
         """Newton steps from ``outcome``'s multipliers: the polished outcome, or None when
@@ -377,9 +423,9 @@ class RBEProblem:
         interior point) share one: the symbolic factorization and prepared matrices."""
         return self._workspaces.setdefault(WORKSPACE.get(name, name), {})
 
-    def _run(self, system, method, name, preset):
-        options = preset.options.get(FAMILY[name], {})
-        return BACKENDS[name](system, method, dict(options), self._workspace(name))
+    def _run(self, system, method, name, preset, **overrides):
+        options = {**preset.options.get(FAMILY[name], {}), **overrides}
+        return BACKENDS[name](system, method, options, self._workspace(name))
 
 
 @dataclass(frozen=True)
@@ -417,11 +463,16 @@ def _settings(friction, solver, tol, accuracy, lp_check):
 def _candidates(method, solver, preset) -> list:
     """Solvers to try for ``method``, in order: the explicit ``solver`` alone, else the
     preset's, followed by Clarabel when the preset's is one of the fast methods on the
-    Newton system (they neither converge nor certify on every structure)."""
+    Newton system (they neither converge nor certify on every structure), and by the
+    load-path LP before Clarabel for Newton on friction-net if the preset says so."""
     if solver is not None:
         return [solver]
     chosen = preset.net_solver if method == "net" else preset.plus_solver
-    return [chosen, "clarabel"] if chosen in ("newton", "interior") else [chosen]
+    if chosen not in ("newton", "interior"):
+        return [chosen]
+    if chosen == "newton" and method == "net" and preset.load_path:
+        return [chosen, LOAD_PATH, "clarabel"]
+    return [chosen, "clarabel"]
 
 
 def _accepted(checks, tol) -> bool:

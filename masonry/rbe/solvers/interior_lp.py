@@ -207,9 +207,19 @@ def _start(ns, rays, load, regularization):
 
 
 @one_blas_thread
-def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions) -> QPOutcome:
+def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
+                stop=None) -> QPOutcome:
     """The largest ``lambda`` of the collapse LP (module docstring) on the friction-net
     system ``ns``, for the live load ``load`` ((6 F,) float, scaled rows).
+
+    Parameters
+    ----------
+    rhs : (6 F,) float, optional
+        The right-hand side in place of ``b = ns.b`` (the dead load).
+    stop : callable, optional
+        ``stop(lambda, g, y) -> bool``, asked at every iterate before the convergence
+        test: True ends the iterations there (status ``user_limit``,
+        ``info["stopped"]`` True) with that iterate.
 
     Returns
     -------
@@ -221,13 +231,18 @@ def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions) -> QPOutcome
         or ``solver_error``.
     """
     start = time.perf_counter()
+    if rhs is not None:
+        ns = ns.with_rhs(rhs)
     load = np.asarray(load, dtype=float)
     rays = pyramid_rays(ns.mu)
     scale = max(np.abs(ns.b).max(), np.abs(load).max())
     g, y, s = _start(ns, rays, load, options.regularization)
-    factor, status, iterations = 0.0, USER_LIMIT, 0
+    factor, status, iterations, stopped = 0.0, USER_LIMIT, 0, False
     for iterations in range(options.max_iter + 1):
         residuals = _residuals(ns, rays, load, g, y, s, factor)
+        if stop is not None and stop(factor, g, y):
+            stopped = True
+            break
         if _converged(residuals, g, s, factor, scale, options):
             status = OPTIMAL
             break
@@ -255,7 +270,7 @@ def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions) -> QPOutcome
     return QPOutcome(status=status, x=g, iterations=iterations, y=y,
                      solve_time=time.perf_counter() - start,
                      info={"factorizations": iterations + 1, "load_factor": factor,
-                           "dual_bound": -float(ns.b @ y)})
+                           "dual_bound": -float(ns.b @ y), "stopped": stopped})
 
 
 def _residuals(ns, rays, load, g, y, s, factor):

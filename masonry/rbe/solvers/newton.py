@@ -36,6 +36,7 @@ method stops when the current step is such a certificate within tolerance, or wh
 stalls, and reports it; :mod:`masonry.rbe.solve` then decides what to do.
 """
 
+import copy
 import dataclasses
 import functools
 import logging
@@ -240,6 +241,13 @@ class NewtonSystem:
                                      shape=(len(sym.lower_rows), 4 * len(rows)))
         self.diagonal_blocks = sym.block_index(np.arange(sym.n_nodes), np.arange(sym.n_nodes))
         """Indices of the diagonal blocks among the stored blocks."""
+
+    def with_rhs(self, b):
+        """The same system with the right-hand side ``b`` ((6 F,) float) in place of the
+        dead load: it shares the matrices and the symbolic factorization."""
+        other = copy.copy(self)
+        other.b = np.asarray(b, dtype=float)
+        return other
 
     # ------------------------------------------------------------------ kernels
     def project(self, w):

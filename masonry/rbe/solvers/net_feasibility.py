@@ -1,0 +1,135 @@
+"""Friction-net feasibility decided by a load-path LP on the Newton method's matrix.
+
+Friction-net is feasible when the dead load is carried by edge rays of the friction
+pyramids alone: ``M g = b`` for some ``g >= 0`` (``M = A E`` and ``b`` as in
+:mod:`masonry.rbe.solvers.interior_lp`). A reference load that is surely carried,
+``r = M g0`` with ``g0 = 1`` (every edge ray at unit weight), is moved towards ``b``::
+
+    maximize lambda   subject to   M g = r + lambda (b - r),   g >= 0
+
+which is the collapse LP of :func:`~masonry.rbe.solvers.interior_lp.load_factor` with
+right-hand side ``r`` and live load ``l = r - b``. ``lambda = 0`` is feasible (``g0``),
+so the LP is never infeasible:
+
+- ``lambda >= 1``: ``g' = g / lambda + (1 - 1 / lambda) g0 >= 0`` has ``M g' = b``, a
+  friction-net point (its residual is recomputed here).
+- an optimum below 1: the dual point has ``M^T y <= 0`` and ``b^T y = r^T y + 1 > 0``
+  (``l^T y = -1``, and ``-r^T y`` bounds ``lambda``), a Farkas certificate: no ``g >=
+  0`` has ``M g = b``.
+
+The interior point method stops at the first iterate that decides either way (it need
+not converge). The certificate is checked on ``M^T y`` and ``b^T y`` recomputed from the
+matrices, with the margins the QP's acceptance allows: for ``M g = b + e``, ``g >= 0``,
+``b^T y <= ||g||_1 max(M^T y)_+ + ||e||_inf ||y||_1``. So when
+
+    max(M^T y)_+ ||b||_1 / infeasibility_tol + residual ||b||_inf ||y||_1 < b^T y
+
+no edge weights with ``||g||_1`` (the sum of the normal forces, in reference weights) up
+to ``||b||_1 / infeasibility_tol`` balance the loads within the relative residual
+``residual``: the Newton method's certificate
+(:func:`~masonry.rbe.solvers.newton.certifies_infeasibility`), plus the residual margin
+of an accepted point. Without either verdict the outcome is ``user_limit`` and the
+caller asks another solver.
+
+Why: when the dual of the friction-net QP is unbounded the Newton method may stall
+instead of certifying (low friction), and Clarabel's certificate costs a factorization
+of the whole KKT system per iteration; this LP factors the Newton method's six rows
+per block.
+"""
+
+import logging
+import time
+
+import numpy as np
+
+from masonry.rbe.solvers.base import INFEASIBLE, USER_LIMIT, QPOutcome
+from masonry.rbe.solvers.interior_lp import LoadFactorOptions, load_factor, pyramid_rays
+from masonry.rbe.solvers.newton import NewtonSystem
+
+log = logging.getLogger(__name__)
+
+FEASIBLE, UNDECIDED = "feasible", "undecided"
+"""``info["verdict"]`` of :func:`decide`, besides :data:`~masonry.rbe.solvers.base.INFEASIBLE`."""
+
+
+class _LoadPath:
+    """The stop test of :func:`decide`: the verdict at an iterate of the LP."""
+
+    def __init__(self, ns: NewtonSystem, infeasibility_tol, residual):
+        self.ns, self.infeasibility_tol, self.residual = ns, infeasibility_tol, residual
+        self.rays = pyramid_rays(ns.mu)
+        self.start = np.ones((len(ns.h), len(self.rays.T)))
+        self.reference = self.times_m(self.start)
+        self.b_inf, self.b_one = np.abs(ns.b).max(), np.abs(ns.b).sum()
+        self.verdict, self.point, self.quality = UNDECIDED, None, np.inf
+
+    def times_m(self, g):
+        return self.ns.A @ (g @ self.rays.T).ravel()
+
+    def __call__(self, factor, g, y) -> bool:
+        if factor >= 1.0:
+            point = g / factor + (1.0 - 1.0 / factor) * self.start
+            if self.point_residual(point) <= self.residual:
+                self.verdict, self.point = FEASIBLE, point
+                return True
+        self.quality = self.certificate_quality(y)
+        if self.quality < 1.0:
+            self.verdict = INFEASIBLE
+            return True
+        return False
+
+    def point_residual(self, g) -> float:
+        """``||M g - b||_inf / ||b||_inf``."""
+        return float(np.abs(self.times_m(g) - self.ns.b).max() / self.b_inf)
+
+    def certificate_quality(self, y) -> float:
+        """The left side of the certificate's test (module docstring) over ``b^T y``:
+        ``y`` certifies infeasibility when it is below 1 (inf when ``b^T y <= 0``)."""
+        gain = float(self.ns.b @ y)
+        if gain <= 0:
+            return np.inf
+        ray_work = (self.ns.AT @ y).reshape(-1, 3) @ self.rays
+        excess = max(float(ray_work.max()), 0.0)
+        bound = (excess * self.b_one / self.infeasibility_tol
+                 + self.residual * self.b_inf * float(np.abs(y).sum()))
+        return bound / gain
+
+
+def decide(ns: NewtonSystem, infeasibility_tol, residual,
+           options=LoadFactorOptions()) -> QPOutcome:
+    """Decide friction-net feasibility of ``ns`` (the friction-net
+    :class:`~masonry.rbe.solvers.newton.NewtonSystem`) by the load-path LP.
+
+    Parameters
+    ----------
+    infeasibility_tol : float
+        See the module docstring (the Newton method's ``infeasibility_tol``).
+    residual : float
+        Relative equilibrium residual of an accepted point (``Tolerances.residual``).
+    options : LoadFactorOptions
+
+    Returns
+    -------
+    QPOutcome
+        ``x`` None (the LP's point is not the QP's optimum). Status ``infeasible`` with
+        ``y`` the certificate, else ``user_limit``. ``info``: ``verdict`` (``feasible``,
+        ``infeasible`` or ``undecided``), ``weights`` (the edge weights ``g'`` ((IV, 4),
+        scaled) of a feasible verdict, else None), ``certificate_quality`` (the last
+        iterate's, see :meth:`_LoadPath.certificate_quality`), ``load_factor``.
+    """
+    start = time.perf_counter()
+    path = _LoadPath(ns, infeasibility_tol, residual)
+    outcome = load_factor(ns, path.reference - ns.b, options, rhs=path.reference,
+                          stop=path)
+    log.info("load-path LP: friction-net %s after %d iterations (lambda %.6g, "
+             "certificate quality %.2e)", path.verdict, outcome.iterations,
+             outcome.info["load_factor"], path.quality)
+    return QPOutcome(
+        status=INFEASIBLE if path.verdict == INFEASIBLE else USER_LIMIT, x=None,
+        iterations=outcome.iterations,
+        y=outcome.y if path.verdict == INFEASIBLE else None,
+        solve_time=time.perf_counter() - start,
+        info={"verdict": path.verdict, "weights": path.point,
+              "certificate_quality": path.quality,
+              "load_factor": outcome.info["load_factor"],
+              "factorizations": outcome.info["factorizations"]})
