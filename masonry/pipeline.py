@@ -532,6 +532,10 @@ def _can_fork() -> bool:
             and not multiprocessing.current_process().daemon)
 
 
+HELD_SIGNALS = {signal.SIGINT, signal.SIGTERM}
+"""The signals that end a run (Ctrl-C, ``kill``): held while the export process forks."""
+
+
 class _Aside:
     """A forked process that makes ``exporters`` (in order) from ``made`` and sends each
     :class:`~masonry.export.Export` back; :meth:`result` receives the next one. Forked, the
@@ -542,13 +546,25 @@ class _Aside:
         self.exporters, self.made, self.process = exporters, made, None
 
     def __enter__(self):
-        if self.exporters:
-            context = multiprocessing.get_context("fork")
-            self.receiver, sender = context.Pipe(duplex=False)
-            self.process = context.Process(target=_make_aside, daemon=True,
-                                           args=(self.exporters, self.made, sender))
-            self.process.start()
+        if not self.exporters:
+            return self
+        context = multiprocessing.get_context("fork")
+        self.receiver, sender = context.Pipe(duplex=False)
+        self.process = context.Process(target=_make_aside, daemon=True,
+                                       args=(self.exporters, self.made, self.receiver,
+                                             sender))
+        try:
+            # a signal during the fork would reach its handler inside the fork's own
+            # callbacks, which swallow the handler's exception: it waits for the fork
+            signal.pthread_sigmask(signal.SIG_BLOCK, HELD_SIGNALS)
+            try:
+                self.process.start()
+            finally:
+                signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD_SIGNALS)
             sender.close()
+        except BaseException:  # interrupted as it started: no __exit__ follows
+            self.__exit__(*sys.exc_info())
+            raise
         return self
 
     def result(self) -> Export:
@@ -564,26 +580,34 @@ class _Aside:
 
     def __exit__(self, kind, error, trace):
         if self.process is not None:
-            if kind is not None:  # this process failed or was interrupted: end it
-                self.process.terminate()
-            self.process.join()
+            if kind is not None and self.process.pid is not None:
+                self.process.terminate()  # this process failed or was interrupted
+            if self.process.pid is not None:
+                self.process.join()
             self.receiver.close()
         return False
 
 
-def _make_aside(exporters, made, sender):
+def _make_aside(exporters, made, receiver, sender):
     """In the forked process: make each exporter's files and send them, or the error.
     An interrupt or a terminate ends it without a word (the run's own handlers, copied
-    by the fork, are for the process that reports)."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    by the fork, are for the process that reports), and so does the end of the run that
+    forked it (its pipe breaks: this process holds no reading end of its own)."""
+    receiver.close()
+    for held in HELD_SIGNALS:
+        signal.signal(held, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD_SIGNALS)
     for exporter in exporters:
         try:
-            sender.send((True, exporter.make(made)))
+            outcome = (True, exporter.make(made))
         except Exception as error:
-            try:
-                sender.send((False, error))
-            except Exception:  # an error that does not pickle: its text
-                sender.send((False, RuntimeError(traceback.format_exc())))
+            outcome = (False, error)
+        try:
+            sender.send(outcome)
+        except OSError:  # the run ended without waiting for these files
+            return
+        except Exception:  # an error that does not pickle: its text
+            sender.send((False, RuntimeError(traceback.format_exc())))
+        if not outcome[0]:
             return
     sender.close()

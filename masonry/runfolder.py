@@ -239,7 +239,11 @@ class RunFolder:
     def __enter__(self):
         self.root.mkdir(parents=True, exist_ok=True)
         remove_leftovers(self.root)
-        self.tmp.mkdir()
+        try:
+            self.tmp.mkdir()
+        except BaseException:  # an interrupt right after the mkdir: no __exit__ follows
+            shutil.rmtree(self.tmp, ignore_errors=True)
+            raise
         return self
 
     def __exit__(self, kind, value, traceback):
