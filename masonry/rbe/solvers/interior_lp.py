@@ -87,7 +87,7 @@ class LoadFactorOptions:
     step_fraction: float = 0.99
     regularization: float = 1e-16
     min_step: float = 1e-6
-    correctors: int = 3
+    correctors: int = 2
 
 
 PRIMAL_PASSES = 2
