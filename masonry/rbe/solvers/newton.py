@@ -204,9 +204,11 @@ class NewtonSystem:
             system.vertex_coefficients[:, :, :, columns].reshape(layout.n_vertices, 12, width))
         # contiguous transposes make the stacked matmuls 3x faster
         self._coefficients_t = np.ascontiguousarray(self.coefficients.transpose(0, 2, 1))
+        self.vertex_interface = np.asarray(layout.vertex_interface)
+        """(IV,) int: the interface of every vertex."""
         # sums vertices into interfaces: a sparse product is 14x faster than reduceat
         self._vertex_sum = sp.csc_array(
-            (np.ones(layout.n_vertices), (layout.vertex_interface, np.arange(layout.n_vertices))),
+            (np.ones(layout.n_vertices), (self.vertex_interface, np.arange(layout.n_vertices))),
             shape=(layout.n_interfaces, layout.n_vertices))
         # the last Jacobian and its per-interface sums: the Jacobian is piecewise constant,
         # so the next Newton matrix only adds the vertices whose Jacobian changed
@@ -293,6 +295,11 @@ class NewtonSystem:
                                    self._coefficients_t[chosen])
             sums = sums + self._vertex_sum[:, chosen] @ per_vertex.reshape(-1, 144)
         self._last = (jacobian.copy(), sums)
+        return self.scatter_sums(sums, shift)
+
+    def scatter_sums(self, sums, shift):
+        """Stored blocks of the Newton matrix with the interfaces' 12 x 12 blocks
+        ``sums`` ((K, 144), side 0's rows then side 1's), plus ``shift I``."""
         # (K, a, r, b, c) -> (K, a, b, r, c): rows of 36 entries per interface block
         quarters = sums.reshape(-1, 2, 6, 2, 6).transpose(0, 1, 3, 2, 4).reshape(-1, 36)
         blocks = (self._scatter @ quarters).reshape(-1, 6, 6)
