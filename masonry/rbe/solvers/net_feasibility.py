@@ -121,8 +121,9 @@ def decide(ns: NewtonSystem, infeasibility_tol, residual,
         ``y`` the certificate, else ``user_limit``. ``info``: ``verdict`` (``feasible``,
         ``likely feasible``, ``infeasible`` or ``undecided``), ``weights`` (the edge
         weights ``g'`` ((IV, 4), scaled) of a (likely) feasible verdict, else None),
-        ``residual`` (their ``||M g' - b||_inf / ||b||_inf``, else NaN), ``certificate_quality`` (the last
-        iterate's, see :meth:`_LoadPath.certificate_quality`), ``load_factor``.
+        ``residual`` (their ``||M g' - b||_inf / ||b||_inf``, else NaN),
+        ``certificate_quality`` (the last iterate's, see
+        :meth:`_LoadPath.certificate_quality`), ``load_factor``.
     """
     start = time.perf_counter()
     path = _LoadPath(ns, infeasibility_tol, residual)
