@@ -368,16 +368,21 @@ def test_the_load_path_lp_agrees_with_highs_and_clarabel(preset, boundary, mu):
     feasible = _lp_feasible(system, 60.0)
     clarabel = BACKENDS["clarabel"](system, "net", {}, {})
     assert clarabel.status == ("optimal" if feasible else "infeasible")
-    assert outcome.info["verdict"] == ("feasible" if feasible else "infeasible")
     # the verdict's evidence, recomputed from the layout's matrices: the edge rays of
     # every vertex's pyramid as columns
     edges = system.A_eq @ friction_pyramid_edges(system.layout.n_vertices, mu)
     b = -system.f_ext
     if feasible:
+        # the LP stops where the load path reaches the dead load: a nonnegative point,
+        # 'feasible' when it meets the equilibrium rows within the acceptance residual
+        assert outcome.info["verdict"] in ("feasible", "likely feasible")
         weights = outcome.info["weights"].ravel()
+        residual = np.abs(edges @ weights - b).max() / np.abs(b).max()
         assert weights.min() >= 0
-        assert np.abs(edges @ weights - b).max() <= 1e-5 * np.abs(b).max()
+        assert residual == pytest.approx(outcome.info["residual"], rel=1e-6)
+        assert (residual <= Tolerances().residual) == (outcome.info["verdict"] == "feasible")
     else:
+        assert outcome.info["verdict"] == "infeasible"
         gain = float(b @ outcome.y)
         assert gain > 0 and outcome.status == "infeasible"
         assert (edges.T @ outcome.y).max() <= tol * gain / np.abs(b).sum()

@@ -12,7 +12,10 @@ right-hand side ``r`` and live load ``l = r - b``. ``lambda = 0`` is feasible (`
 so the LP is never infeasible:
 
 - ``lambda >= 1``: ``g' = g / lambda + (1 - 1 / lambda) g0 >= 0`` has ``M g' = b``, a
-  friction-net point (its residual is recomputed here).
+  friction-net point. Its residual is recomputed here: within the QP's acceptance
+  residual the verdict is ``feasible``, else (the iterate's primal rows not yet met)
+  ``likely feasible``, which proves nothing but tells the caller that a certificate is
+  not coming soon (near the threshold it would take as many iterations again).
 - an optimum below 1: the dual point has ``M^T y <= 0`` and ``b^T y = r^T y + 1 > 0``
   (``l^T y = -1``, and ``-r^T y`` bounds ``lambda``), a Farkas certificate: no ``g >=
   0`` has ``M g = b``.
@@ -48,8 +51,9 @@ from masonry.rbe.solvers.newton import NewtonSystem
 
 log = logging.getLogger(__name__)
 
-FEASIBLE, UNDECIDED = "feasible", "undecided"
-"""``info["verdict"]`` of :func:`decide`, besides :data:`~masonry.rbe.solvers.base.INFEASIBLE`."""
+FEASIBLE, LIKELY_FEASIBLE, UNDECIDED = "feasible", "likely feasible", "undecided"
+"""``info["verdict"]`` of :func:`decide`, besides :data:`~masonry.rbe.solvers.base.INFEASIBLE`
+(module docstring)."""
 
 
 class _LoadPath:
@@ -61,17 +65,19 @@ class _LoadPath:
         self.start = np.ones((len(ns.h), len(self.rays.T)))
         self.reference = self.times_m(self.start)
         self.b_inf, self.b_one = np.abs(ns.b).max(), np.abs(ns.b).sum()
-        self.verdict, self.point, self.quality = UNDECIDED, None, np.inf
+        self.verdict, self.quality = UNDECIDED, np.inf
+        self.point, self.point_error = None, np.nan
 
     def times_m(self, g):
         return self.ns.A @ (g @ self.rays.T).ravel()
 
     def __call__(self, factor, g, y) -> bool:
         if factor >= 1.0:
-            point = g / factor + (1.0 - 1.0 / factor) * self.start
-            if self.point_residual(point) <= self.residual:
-                self.verdict, self.point = FEASIBLE, point
-                return True
+            self.point = g / factor + (1.0 - 1.0 / factor) * self.start
+            self.point_error = self.point_residual(self.point)
+            close = self.point_error <= self.residual
+            self.verdict = FEASIBLE if close else LIKELY_FEASIBLE
+            return True
         self.quality = self.certificate_quality(y)
         if self.quality < 1.0:
             self.verdict = INFEASIBLE
@@ -113,9 +119,11 @@ def decide(ns: NewtonSystem, infeasibility_tol, residual,
     QPOutcome
         ``x`` None (the LP's point is not the QP's optimum). Status ``infeasible`` with
         ``y`` the certificate, else ``user_limit``. ``info``: ``verdict`` (``feasible``,
-        ``infeasible`` or ``undecided``), ``weights`` (the edge weights ``g'`` ((IV, 4),
-        scaled) of a feasible verdict, else None), ``certificate_quality`` (the last
-        iterate's, see :meth:`_LoadPath.certificate_quality`), ``load_factor``.
+        ``likely feasible``, ``infeasible`` or ``undecided``), ``weights`` (the edge
+        weights ``g'`` ((IV, 4), scaled) of a (likely) feasible verdict, else None),
+        ``residual`` (their ``||M g' - b||_inf / ||b||_inf``, else NaN),
+        ``certificate_quality`` (the last iterate's, see
+        :meth:`_LoadPath.certificate_quality`), ``load_factor``.
     """
     start = time.perf_counter()
     path = _LoadPath(ns, infeasibility_tol, residual)
@@ -129,7 +137,7 @@ def decide(ns: NewtonSystem, infeasibility_tol, residual,
         iterations=outcome.iterations,
         y=outcome.y if path.verdict == INFEASIBLE else None,
         solve_time=time.perf_counter() - start,
-        info={"verdict": path.verdict, "weights": path.point,
+        info={"verdict": path.verdict, "weights": path.point, "residual": path.point_error,
               "certificate_quality": path.quality,
               "load_factor": outcome.info["load_factor"],
               "factorizations": outcome.info["factorizations"]})
