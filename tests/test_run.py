@@ -101,9 +101,10 @@ def test_plots_made_aside_equal_the_ones_made_here(monkeypatch, fork):
     (and here, in this process, where it does not): the PNGs are the same bytes."""
     monkeypatch.setattr("masonry.pipeline._can_fork", lambda: fork)
     made = wall_outputs(plots=True, printable=False)
-    plots = next(e for e in EXPORTERS if e.name == "plots")
-    assert plots.aside
-    expected = plots.make(made).files
+    plots = [e for e in EXPORTERS if e.stage == "plots"]
+    assert [e.aside for e in plots] == [True, False]  # the model's aside, the forces' here
+    expected = {name: data for e in plots for name, data in e.make(made).files.items()}
+    assert "RBE/01_angle/tension.png" in expected and "01_angle/3_structure.png" in expected
     recorder = RecordingFolder()
     write_exports(recorder, made, {}, Timer())
     assert expected and all(recorder.files[name] == data for name, data in expected.items())

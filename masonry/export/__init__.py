@@ -210,6 +210,7 @@ def _mechanism_plots(made: RunOutputs) -> dict:
 
 
 def _plot_files(made: RunOutputs) -> Export:
+    """The model's plots: pattern, structure, interfaces (and a collapse mechanism)."""
     # matplotlib takes most of a second to import: a run without plots never does
     from masonry import plots
 
@@ -220,10 +221,16 @@ def _plot_files(made: RunOutputs) -> Export:
     files.update(plots.structure_pngs(scene, fast))
     files.update(plots.interface_pngs(scene, model.blocks, model.interfaces, fast))
     files.update(_mechanism_plots(made))
-    if made.forces is None:
-        return Export(files)
+    return Export(files)
+
+
+def _force_plot_files(made: RunOutputs) -> Export:
+    """The forces' plots: per view, the thrust line and where it fails."""
+    from masonry import plots
+
+    scene, model, fast = made.scene, made.model, made.scene.params.fast
     pngs = plots.force_pngs(scene, model.blocks, model.interfaces, made.forces, fast)
-    files.update({f"RBE/{name}": png for name, png in pngs.items()})
+    files = {f"RBE/{name}": png for name, png in pngs.items()}
     if scene.params.scene in ("arch", "section", "dome"):
         png = plots.thrust_line_png(scene, model.interfaces, _resultants(made), fast)
         if png is not None:
@@ -243,6 +250,10 @@ EXPORTERS = (
              wanted=lambda made: made.collapse is not None),
     Exporter("printable", "printable", _printable_files,
              wanted=lambda made: made.printable),
+    # the model's plots beside the 3DM file in the second process, the forces' here: the
+    # two take about as long
     Exporter("plots", "plots", _plot_files, wanted=lambda made: made.plots, aside=True),
+    Exporter("force_plots", "plots", _force_plot_files,
+             wanted=lambda made: made.plots and made.forces is not None),
 )
 """Every exporter, in the order a run writes them."""
