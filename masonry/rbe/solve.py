@@ -365,7 +365,8 @@ class RBEProblem:
         if decided.info["verdict"] not in resume or stalled.y is None:
             return LOAD_PATH, decided
         attempts.append(_record("net", LOAD_PATH, decided))
-        log.info("the load-path LP found friction-net feasible: Newton resumes")
+        log.info("the load-path LP found friction-net %s: Newton resumes",
+                 decided.info["verdict"])
         return "newton", BACKENDS["newton"](system, "net", dict(options), workspace,
                                             y0=stalled.y)
 
