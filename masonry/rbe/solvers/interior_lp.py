@@ -203,8 +203,8 @@ class _Normal:
         ``(dg, dlambda, dy, ds)``."""
         rhs = -r_primal + self.times_m(r_comp / s - self.d * r_dual)
         dy, d_factor = self._bordered(rhs, float(r_factor))
-        dg = -r_comp / s + self.d * (r_dual + self.times_mt(dy))
-        return dg, d_factor, dy, -r_dual - self.times_mt(dy)
+        ds = -r_dual - self.times_mt(dy)
+        return -r_comp / s - self.d * ds, d_factor, dy, ds
 
     def refine(self, direction, r_primal, floor):
         """``direction`` after up to :data:`PRIMAL_PASSES` passes that solve for what it
