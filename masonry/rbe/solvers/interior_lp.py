@@ -19,7 +19,8 @@ Mehrotra's predictor-corrector (S. Mehrotra, SIAM J. Optim. 2, 1992; S. Wright,
 *Primal-Dual Interior-Point Methods*, SIAM 1997, ch. 10) with separate primal and dual
 step lengths, and Gondzio's multiple centrality correctors (J. Gondzio, Comput. Optim.
 Appl. 6, 1996): a few products ``g s`` far from the target stop the corrector's steps
-short, and further solves with the same factor move them back. Every iteration solves the normal equations ::
+short, and further solves with the same factor move them back. Every iteration solves
+the normal equations ::
 
     M D M^T dy = r,   D = diag(g / s)
 
@@ -73,7 +74,8 @@ class LoadFactorOptions:
         Shift of the normal matrix relative to its mean diagonal. Near the optimum
         ``D`` spans 20 decades and the mean is set by its largest entries: a shift of
         1e-12 left the primal rows at 4e-7 (preset 1's full dome) to 4e-6 (its p = 5
-        variant), and the factor up to 1e-6 off the dual bound; 1e-16 keeps them at 1e-13.
+        variant), and the factor up to 1e-6 off the dual bound; with 1e-16 they end at
+        1e-9 (:data:`PASS_FLOOR`) and the factor within the gap of the bound.
     min_step : float
         Give up (status ``user_limit``) when a step falls below this.
     correctors : int
@@ -122,9 +124,8 @@ class _RayProducts:
     """Per interface, ``sum_v C_v E D_v E^T C_v^T`` (12 x 12, ``C_v`` the vertex's
     coefficients in both blocks' rows) for edge ray weights ``D``: one row ``C_v E_k``
     per vertex and ray, the rows of every interface stacked, and the interfaces with the
-    same vertex count in one product (a third of the time of the Newton method's
-    per-vertex products and sparse sum). The buffers are kept: fresh ones of this size
-    cost as much again in page faults."""
+    same vertex count in one product, into buffers kept from call to call (fresh ones
+    fault their pages in every time; docs/bench.md)."""
 
     def __init__(self, ns: NewtonSystem, rays):
         self.rays = rays
@@ -182,7 +183,7 @@ class _Normal:
 
     def solve(self, rhs):
         """``K^-1 rhs``; the first call solves for the live load too (one pass over the
-        factor for both columns costs little more than for one)."""
+        factor for two columns costs less than two passes)."""
         if self.v is not None:
             return self.factor.solve(rhs)
         both = self.factor.solve(np.column_stack([rhs, self.load]))
@@ -325,25 +326,31 @@ def _mehrotra(normal, residuals, g, s, floor, options):
     steps = _steps(g, s, direction[0], direction[3])
     log.debug("  affine %.3f %.3f sigma %.2e, corrector %.3f %.3f", primal, dual,
               target / gap, *steps)
-    for _ in range(options.correctors):
-        # Gondzio: move the products of the point that a longer step would reach
-        # into [BOX[0], BOX[1]] x target
+    direction = _centrality_correctors(normal, residuals, g, s, r_comp, target,
+                                       direction, steps, options.correctors)
+    direction = normal.refine(direction, residuals[0], floor)
+    steps = _steps(g, s, direction[0], direction[3])
+    return tuple(options.step_fraction * step for step in steps), direction
+
+
+def _centrality_correctors(normal, residuals, g, s, r_comp, target, direction, steps,
+                           count):
+    """Gondzio's correctors of ``direction`` (complementarity residual ``r_comp``,
+    ``steps``): each moves the products ``g s`` of the point that a longer step would
+    reach into ``[BOX[0], BOX[1]] x target``, and is kept while it lengthens the
+    shorter step by :data:`ACCEPT` x :data:`ASPIRATION` at least."""
+    for _ in range(count):
         aspired = [min(1.0, step + ASPIRATION) for step in steps]
-        products = ((g + aspired[0] * direction[0]) * (s + aspired[1] * direction[3]))
+        products = (g + aspired[0] * direction[0]) * (s + aspired[1] * direction[3])
         push = np.clip(products, BOX[0] * target, BOX[1] * target) - products
         push = np.maximum(push, -BOX[1] * target)
         trial = normal.direction(*residuals, r_comp - push, g, s)
         trial_steps = _steps(g, s, trial[0], trial[3])
         log.debug("  centrality corrector %.3f %.3f", *trial_steps)
         if min(trial_steps) < min(steps) + ACCEPT * ASPIRATION:
-            if min(trial_steps) > min(steps):
-                direction, steps = trial, trial_steps
-            break
-        direction, steps = trial, trial_steps
-        r_comp = r_comp - push
-    direction = normal.refine(direction, residuals[0], floor)
-    steps = _steps(g, s, direction[0], direction[3])
-    return tuple(options.step_fraction * step for step in steps), direction
+            return trial if min(trial_steps) > min(steps) else direction
+        direction, steps, r_comp = trial, trial_steps, r_comp - push
+    return direction
 
 
 def _steps(g, s, dg, ds):
