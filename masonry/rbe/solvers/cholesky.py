@@ -35,6 +35,7 @@ Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1
 """
 
 import ctypes
+import functools
 import logging
 import os
 from concurrent.futures import ThreadPoolExecutor
@@ -578,14 +579,19 @@ class BlockFactor:
         sym = self.symbolic
         order = sym._scalar_order
         x = np.asarray(rhs, dtype=float)[order]
-        vector = x.ndim == 1
-        if vector:
-            x = x[:, None]
+        # a vector by dtrsv: fewer checks and copies per supernode than a one-column
+        # dtrsm, and most solves are of one vector (docs/bench.md)
+        if x.ndim == 1:
+            forward = functools.partial(blas.dtrsv, lower=1)
+            backward = functools.partial(blas.dtrsv, lower=1, trans=1)
+        else:
+            forward = functools.partial(blas.dtrsm, 1.0, lower=1)
+            backward = functools.partial(blas.dtrsm, 1.0, lower=1, trans_a=1)
         # one tuple per supernode: its columns, the rows below them, L11, L21
         plan = [(c, r, p, b) for (c, r), p, b in zip(sym._solve_slices, self._pivots,
                                                     self._below)]
         for columns, rows, pivot, below in plan:
-            xs = blas.dtrsm(1.0, pivot, x[columns], lower=1)
+            xs = forward(pivot, x[columns])
             x[columns] = xs
             if below is not None:
                 x[rows] -= below @ xs
@@ -593,7 +599,7 @@ class BlockFactor:
             v = x[columns]
             if below is not None:
                 v = v - below.T @ x[rows]
-            x[columns] = blas.dtrsm(1.0, pivot, v, lower=1, trans_a=1)
+            x[columns] = backward(pivot, v)
         out = np.empty_like(x)
         out[order] = x
-        return out[:, 0] if vector else out
+        return out

@@ -19,7 +19,8 @@ Mehrotra's predictor-corrector (S. Mehrotra, SIAM J. Optim. 2, 1992; S. Wright,
 *Primal-Dual Interior-Point Methods*, SIAM 1997, ch. 10) with separate primal and dual
 step lengths, and Gondzio's multiple centrality correctors (J. Gondzio, Comput. Optim.
 Appl. 6, 1996): a few products ``g s`` far from the target stop the corrector's steps
-short, and further solves with the same factor move them back. Every iteration solves the normal equations ::
+short, and further solves with the same factor move them back. Every iteration solves
+the normal equations ::
 
     M D M^T dy = r,   D = diag(g / s)
 
@@ -73,7 +74,8 @@ class LoadFactorOptions:
         Shift of the normal matrix relative to its mean diagonal. Near the optimum
         ``D`` spans 20 decades and the mean is set by its largest entries: a shift of
         1e-12 left the primal rows at 4e-7 (preset 1's full dome) to 4e-6 (its p = 5
-        variant), and the factor up to 1e-6 off the dual bound; 1e-16 keeps them at 1e-13.
+        variant), and the factor up to 1e-6 off the dual bound; with 1e-16 they end at
+        1e-9 (:data:`PASS_FLOOR`) and the factor within the gap of the bound.
     min_step : float
         Give up (status ``user_limit``) when a step falls below this.
     correctors : int
@@ -91,9 +93,12 @@ class LoadFactorOptions:
 
 
 PRIMAL_PASSES = 2
-"""Passes that solve for what the direction leaves of the primal rows ..."""
+"""Passes that solve for what the direction leaves of the primal rows, ..."""
 PASS_RATIO = 1e-2
-"""... while that is above this fraction of their residual."""
+PASS_FLOOR = 1e-8
+"""... while that is above this fraction of their residual and this fraction of the
+largest load entry (without passes the primal residual rises to 3e-7 in the last
+iterations; with them it falls to 1e-13, which the factor does not need)."""
 
 ASPIRATION = 0.3
 """A centrality corrector aims at steps this much longer than the last direction's ..."""
@@ -119,8 +124,8 @@ class _RayProducts:
     """Per interface, ``sum_v C_v E D_v E^T C_v^T`` (12 x 12, ``C_v`` the vertex's
     coefficients in both blocks' rows) for edge ray weights ``D``: one row ``C_v E_k``
     per vertex and ray, the rows of every interface stacked, and the interfaces with the
-    same vertex count in one product (a third of the time of the Newton method's
-    per-vertex products and sparse sum)."""
+    same vertex count in one product, into buffers kept from call to call (fresh ones
+    fault their pages in every time; docs/bench.md)."""
 
     def __init__(self, ns: NewtonSystem, rays):
         self.rays = rays
@@ -128,23 +133,25 @@ class _RayProducts:
         interface = ns.vertex_interface
         order = np.argsort(interface, kind="stable")
         counts = np.bincount(interface)
-        self.n_interfaces = len(counts)
+        self.out = np.zeros((len(counts), 12, 12))
         self.groups = []
         for count in np.unique(counts[counts > 0]):
             faces = np.flatnonzero(counts == count)
             first = np.searchsorted(interface[order], faces)
             vertices = order[first[:, None] + np.arange(count)]
             rows = per_ray[vertices].reshape(len(faces), 4 * count, 12)
-            self.groups.append((faces, vertices, rows,
-                                np.ascontiguousarray(rows.transpose(0, 2, 1))))
+            columns = np.ascontiguousarray(rows.transpose(0, 2, 1))
+            self.groups.append((faces, vertices, rows, columns, np.empty_like(columns),
+                                np.empty((len(faces), 12, 12))))
 
     def sums(self, d) -> np.ndarray:
-        """(K, 144) float: the interfaces' blocks for ``d`` ((IV, 4))."""
-        out = np.zeros((self.n_interfaces, 12, 12))
-        for faces, vertices, rows, columns in self.groups:
+        """(K, 144) float: the interfaces' blocks for ``d`` ((IV, 4)), valid until the
+        next call."""
+        for faces, vertices, rows, columns, scaled, product in self.groups:
             weights = d[vertices].reshape(len(faces), 1, -1)
-            out[faces] = np.matmul(columns * weights, rows)
-        return out.reshape(-1, 144)
+            np.matmul(np.multiply(columns, weights, out=scaled), rows, out=product)
+            self.out[faces] = product
+        return self.out.reshape(-1, 144)
 
 
 class _Normal:
@@ -176,7 +183,7 @@ class _Normal:
 
     def solve(self, rhs):
         """``K^-1 rhs``; the first call solves for the live load too (one pass over the
-        factor for both columns costs little more than for one)."""
+        factor for two columns costs less than two passes)."""
         if self.v is not None:
             return self.factor.solve(rhs)
         both = self.factor.solve(np.column_stack([rhs, self.load]))
@@ -197,16 +204,16 @@ class _Normal:
         ``(dg, dlambda, dy, ds)``."""
         rhs = -r_primal + self.times_m(r_comp / s - self.d * r_dual)
         dy, d_factor = self._bordered(rhs, float(r_factor))
-        dg = -r_comp / s + self.d * (r_dual + self.times_mt(dy))
-        return dg, d_factor, dy, -r_dual - self.times_mt(dy)
+        ds = -r_dual - self.times_mt(dy)
+        return -r_comp / s - self.d * ds, d_factor, dy, ds
 
-    def refine(self, direction, r_primal):
+    def refine(self, direction, r_primal, floor):
         """``direction`` after up to :data:`PRIMAL_PASSES` passes that solve for what it
         leaves of the primal rows (``D`` amplifies the errors of ``dy`` in ``dg``), while
-        that is above :data:`PASS_RATIO` of their residual; the correction
-        ``D M^T dy'`` keeps the other rows exact, as ``S D = G``."""
+        that is above :data:`PASS_RATIO` of their residual and above ``floor``; the
+        correction ``D M^T dy'`` keeps the other rows exact, as ``S D = G``."""
         dg, d_factor, dy, ds = direction
-        bound = PASS_RATIO * np.abs(r_primal).max()
+        bound = max(PASS_RATIO * np.abs(r_primal).max(), floor)
         for _ in range(PRIMAL_PASSES):
             left = self.times_m(dg) + d_factor * self.load + r_primal
             if np.abs(left).max() <= bound:
@@ -285,7 +292,7 @@ def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
             status = SOLVER_ERROR
             break
         (primal, dual), (dg, d_factor, dy, ds) = _mehrotra(normal, residuals[:3], g, s,
-                                                           options)
+                                                           PASS_FLOOR * scale, options)
         if min(primal, dual) < options.min_step:
             log.info("collapse LP: stalled at iteration %d (steps %.1e, %.1e)",
                      iterations, primal, dual)
@@ -320,7 +327,7 @@ def _converged(residuals, g, s, factor, scale, options) -> bool:
             and float(g.ravel() @ s.ravel()) <= tol * (1.0 + abs(factor)))
 
 
-def _mehrotra(normal, residuals, g, s, options):
+def _mehrotra(normal, residuals, g, s, floor, options):
     """Predictor (affine scaling), Mehrotra's corrector and Gondzio's centrality
     correctors, all with the same factor: ``((primal step, dual step), (dg, dlambda,
     dy, ds))``."""
@@ -334,25 +341,31 @@ def _mehrotra(normal, residuals, g, s, options):
     steps = _steps(g, s, direction[0], direction[3])
     log.debug("  affine %.3f %.3f sigma %.2e, corrector %.3f %.3f", primal, dual,
               target / gap, *steps)
-    for _ in range(options.correctors):
-        # Gondzio: move the products of the point that a longer step would reach
-        # into [BOX[0], BOX[1]] x target
+    direction = _centrality_correctors(normal, residuals, g, s, r_comp, target,
+                                       direction, steps, options.correctors)
+    direction = normal.refine(direction, residuals[0], floor)
+    steps = _steps(g, s, direction[0], direction[3])
+    return tuple(options.step_fraction * step for step in steps), direction
+
+
+def _centrality_correctors(normal, residuals, g, s, r_comp, target, direction, steps,
+                           count):
+    """Gondzio's correctors of ``direction`` (complementarity residual ``r_comp``,
+    ``steps``): each moves the products ``g s`` of the point that a longer step would
+    reach into ``[BOX[0], BOX[1]] x target``, and is kept while it lengthens the
+    shorter step by :data:`ACCEPT` x :data:`ASPIRATION` at least."""
+    for _ in range(count):
         aspired = [min(1.0, step + ASPIRATION) for step in steps]
-        products = ((g + aspired[0] * direction[0]) * (s + aspired[1] * direction[3]))
+        products = (g + aspired[0] * direction[0]) * (s + aspired[1] * direction[3])
         push = np.clip(products, BOX[0] * target, BOX[1] * target) - products
         push = np.maximum(push, -BOX[1] * target)
         trial = normal.direction(*residuals, r_comp - push, g, s)
         trial_steps = _steps(g, s, trial[0], trial[3])
         log.debug("  centrality corrector %.3f %.3f", *trial_steps)
         if min(trial_steps) < min(steps) + ACCEPT * ASPIRATION:
-            if min(trial_steps) > min(steps):
-                direction, steps = trial, trial_steps
-            break
-        direction, steps = trial, trial_steps
-        r_comp = r_comp - push
-    direction = normal.refine(direction, residuals[0])
-    steps = _steps(g, s, direction[0], direction[3])
-    return tuple(options.step_fraction * step for step in steps), direction
+            return trial if min(trial_steps) > min(steps) else direction
+        direction, steps, r_comp = trial, trial_steps, r_comp - push
+    return direction
 
 
 def _steps(g, s, dg, ds):
