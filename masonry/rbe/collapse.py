@@ -272,11 +272,13 @@ class CollapseLP:
                             dead_load_feasible)
 
     def _backend(self, loads, cost, tie=None):
-        if self.method in ("clarabel", "interior"):
-            clarabel_lp = _ClarabelLP(self.matrix, loads, -self.system.f_ext, cost, tie,
-                                      self.time_limit, self.lower, self.upper)
-            if self.method == "clarabel":
-                return clarabel_lp
+        def clarabel_lp():
+            return _ClarabelLP(self.matrix, loads, -self.system.f_ext, cost, tie,
+                               self.time_limit, self.lower, self.upper)
+
+        if self.method == "clarabel":
+            return clarabel_lp()
+        if self.method == "interior":
             if self._newton_system is None:
                 self._newton_system = NewtonSystem(self.system, "net")
             return _InteriorLP(self._newton_system, loads, cost, clarabel_lp)
@@ -462,13 +464,22 @@ class _HighsLP:
 class _InteriorLP:
     """A collapse LP solved by :func:`masonry.rbe.solvers.interior_lp.load_factor`: the
     load columns ``loads`` combined by ``cost`` (a lateral direction: ``cos, sin``) into
-    one live load. Without an optimum it hands the LP to ``fallback`` (a
-    :class:`_ClarabelLP` of the same LP), which tells infeasible from unbounded."""
+    one live load. Without an optimum it hands the LP to the :class:`_ClarabelLP` of the
+    same LP, which tells infeasible from unbounded; ``make_fallback`` builds that one
+    when it is first needed (on preset 1's dome its KKT matrix takes half a second)."""
 
-    def __init__(self, newton_system, loads, cost, fallback):
-        self.ns, self.loads, self.fallback = newton_system, loads, fallback
+    def __init__(self, newton_system, loads, cost, make_fallback):
+        self.ns, self.loads, self.make_fallback = newton_system, loads, make_fallback
         self.cost = np.asarray(cost, dtype=float)
-        self.name = "interior"
+        self.name, self._fallback = "interior", None
+
+    def fallback(self):
+        """The Clarabel LP, set to the current direction."""
+        if self._fallback is None:
+            self._fallback = self.make_fallback()
+        if len(self.cost) == 2:
+            self._fallback.direct(*self.cost)
+        return self._fallback
 
     def run(self):
         """``(status, factor, edge ray weights, equilibrium-row duals, iterations)``."""
@@ -478,9 +489,7 @@ class _InteriorLP:
             log.info("collapse LP: the interior point method found no optimum (%s); "
                      "Clarabel decides", outcome.status)
             self.name = "interior+clarabel"
-            if len(self.cost) == 2:
-                self.fallback.direct(*self.cost)
-            return self.fallback.run()
+            return self.fallback().run()
         return ("optimal", outcome.info["load_factor"], outcome.x.ravel(), outcome.y,
                 outcome.iterations)
 
@@ -490,7 +499,7 @@ class _InteriorLP:
         reversed_load = load_factor(self.ns, -(self.loads @ self.cost), LoadFactorOptions())
         if reversed_load.status == OPTIMAL:
             return reversed_load.info["load_factor"] >= 0
-        return self.fallback.stands_unloaded()
+        return self.fallback().stands_unloaded()
 
     def direct(self, cos, sin):
         self.cost = np.array([cos, sin])
