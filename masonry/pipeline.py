@@ -579,12 +579,13 @@ class _Aside:
         return value
 
     def __exit__(self, kind, error, trace):
-        if self.process is not None:
-            if kind is not None and self.process.pid is not None:
-                self.process.terminate()  # this process failed or was interrupted
-            if self.process.pid is not None:
-                self.process.join()
-            self.receiver.close()
+        if self.process is None:
+            return False
+        if self.process.pid is not None:  # started
+            if kind is not None:  # this process failed or was interrupted: end it
+                self.process.terminate()
+            self.process.join()
+        self.receiver.close()
         return False
 
 

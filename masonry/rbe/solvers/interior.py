@@ -275,4 +275,3 @@ def backend(system, method, options, workspace) -> QPOutcome:
     outcome = solve(ns, InteriorOptions(**options))
     return dataclasses.replace(outcome, x=ns.full_vector(outcome.x, system.layout),
                                setup_time=preparation)
-

@@ -120,6 +120,16 @@ def pyramid_rays(mu) -> np.ndarray:
     return friction_pyramid_edges(1, mu).toarray()[[0, 2, 3]]
 
 
+def times_m(ns: NewtonSystem, rays, g) -> np.ndarray:
+    """``M g`` ((6 F,)): the loads the edge ray weights ``g`` ((IV, 4)) balance."""
+    return ns.A @ (g @ rays.T).ravel()
+
+
+def times_mt(ns: NewtonSystem, rays, y) -> np.ndarray:
+    """``M^T y`` ((IV, 4)): the work of every edge ray on the motion ``y`` ((6 F,))."""
+    return (ns.AT @ y).reshape(-1, 3) @ rays
+
+
 class _RayProducts:
     """Per interface, ``sum_v C_v E D_v E^T C_v^T`` (12 x 12, ``C_v`` the vertex's
     coefficients in both blocks' rows) for edge ray weights ``D``: one row ``C_v E_k``
@@ -191,12 +201,10 @@ class _Normal:
         return both[:, 0]
 
     def times_m(self, g):
-        """``M g`` for ``g`` ((V, 4))."""
-        return self.ns.A @ (g @ self.rays.T).ravel()
+        return times_m(self.ns, self.rays, g)
 
     def times_mt(self, y):
-        """``M^T y`` ((V, 4))."""
-        return (self.ns.AT @ y).reshape(-1, 3) @ self.rays
+        return times_mt(self.ns, self.rays, y)
 
     def direction(self, r_primal, r_dual, r_factor, r_comp, g, s):
         """Newton direction for the residuals ``M g + lambda l - b``, ``M^T y + s``,
@@ -312,9 +320,8 @@ def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
 
 def _residuals(ns, rays, load, g, y, s, factor):
     """``(M g + lambda l - b, M^T y + s, l^T y + 1, |M^T y|_inf)``."""
-    mg = ns.A @ (g @ rays.T).ravel()
-    mty = (ns.AT @ y).reshape(-1, 3) @ rays
-    return (mg + factor * load - ns.b, mty + s, float(load @ y) + 1.0,
+    mty = times_mt(ns, rays, y)
+    return (times_m(ns, rays, g) + factor * load - ns.b, mty + s, float(load @ y) + 1.0,
             float(np.abs(mty).max()))
 
 

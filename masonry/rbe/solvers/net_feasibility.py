@@ -47,7 +47,8 @@ import time
 import numpy as np
 
 from masonry.rbe.solvers.base import INFEASIBLE, USER_LIMIT, QPOutcome
-from masonry.rbe.solvers.interior_lp import LoadFactorOptions, load_factor, pyramid_rays
+from masonry.rbe.solvers.interior_lp import (LoadFactorOptions, load_factor, pyramid_rays,
+                                             times_m, times_mt)
 from masonry.rbe.solvers.newton import NewtonSystem
 
 log = logging.getLogger(__name__)
@@ -64,13 +65,10 @@ class _LoadPath:
         self.ns, self.infeasibility_tol, self.residual = ns, infeasibility_tol, residual
         self.rays = pyramid_rays(ns.mu)
         self.start = np.ones((len(ns.h), len(self.rays.T)))
-        self.reference = self.times_m(self.start)
+        self.reference = times_m(ns, self.rays, self.start)
         self.b_inf, self.b_one = np.abs(ns.b).max(), np.abs(ns.b).sum()
         self.verdict, self.quality = UNDECIDED, np.inf
         self.point, self.point_error = None, np.nan
-
-    def times_m(self, g):
-        return self.ns.A @ (g @ self.rays.T).ravel()
 
     def __call__(self, factor, g, y) -> bool:
         if factor >= 1.0:
@@ -87,7 +85,7 @@ class _LoadPath:
 
     def point_residual(self, g) -> float:
         """``||M g - b||_inf / ||b||_inf``."""
-        return float(np.abs(self.times_m(g) - self.ns.b).max() / self.b_inf)
+        return float(np.abs(times_m(self.ns, self.rays, g) - self.ns.b).max() / self.b_inf)
 
     def certificate_quality(self, y) -> float:
         """The left side of the certificate's test (module docstring) over ``b^T y``:
@@ -95,8 +93,7 @@ class _LoadPath:
         gain = float(self.ns.b @ y)
         if gain <= 0:
             return np.inf
-        ray_work = (self.ns.AT @ y).reshape(-1, 3) @ self.rays
-        excess = max(float(ray_work.max()), 0.0)
+        excess = max(float(times_mt(self.ns, self.rays, y).max()), 0.0)
         bound = (excess * self.b_one / self.infeasibility_tol
                  + self.residual * self.b_inf * float(np.abs(y).sum()))
         return bound / gain
