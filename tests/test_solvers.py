@@ -289,10 +289,11 @@ def test_solvers_agree_on_an_infeasible_section(solver):
                                atol=tolerance * scale(reference))
 
 
-@pytest.mark.parametrize("mu", [0.3, 1.5])
+@pytest.mark.parametrize("mu", [0.05, 0.3, 1.5])
 def test_the_fast_path_agrees_with_clarabel_on_infeasible_structures(mu):
     # the presets' friction+ path (interior point on the Newton system, Newton polish)
-    # against Clarabel: MoI and every vertex force
+    # against Clarabel: MoI and every vertex force, over the range of the interior
+    # point's starting scale (interior.START_SCALE)
     prepared = problem(small("free"))
     reference = prepared.solve(mu=mu, solver="clarabel", accuracy="accurate", lp_check=False)
     result = prepared.solve(mu=mu, accuracy="balanced")
@@ -300,6 +301,19 @@ def test_the_fast_path_agrees_with_clarabel_on_infeasible_structures(mu):
     assert result.verdict == reference.verdict == "infeasible"
     assert result.moi_factor == pytest.approx(reference.moi_factor, rel=1e-8)
     np.testing.assert_allclose(result.x, reference.x, rtol=0, atol=1e-8 * scale(reference))
+
+
+@pytest.mark.parametrize("mu", [0.05, 0.7])
+def test_the_unpolished_interior_point_is_near_clarabels_optimum(mu):
+    # the fast preset keeps the interior point's last point (tol 1e-6, no Newton
+    # polish, no iterative refinement of its directions): still in equilibrium and
+    # within 1e-4 of Clarabel's MoI
+    prepared = problem(small("free"))
+    reference = prepared.solve(mu=mu, solver="clarabel", accuracy="accurate", lp_check=False)
+    result = prepared.solve(mu=mu, accuracy="fast")
+    assert [a["solver"] for a in result.attempts][-1] == "interior"
+    assert result.residual_eq <= 1e-6 and result.friction_violation <= 1e-6
+    assert result.moi_factor == pytest.approx(reference.moi_factor, rel=1e-4)
 
 
 def test_verdicts_and_run_json_fields():

@@ -80,6 +80,11 @@ POLISH_STEPS = 10
 sections, friction+ included; preset 2's full dome took 6 from Clarabel at 1e-10, and
 5 left 2.4e-6 of the weight as tension; from 1e-5, 8 did not)."""
 
+POLISH_STALL = 3
+"""... and it ends after this many steps without halving the residual: a polish that
+converges halves it at every step, one that does not creeps at 1e-9 with tiny steps
+(preset 1's free section at mu 1.0: 10 steps, none kept)."""
+
 
 ACCURACY = {
     # Newton for friction-net, the interior point method on the Newton system for
@@ -378,7 +383,8 @@ class RBEProblem:
         they do not converge within :data:`POLISH_STEPS` (its record joins ``attempts``
         either way)."""
         workspace = self._workspace("newton")
-        options = {"tol": min(tol.residual, 1e-9), "max_iter": POLISH_STEPS}
+        options = {"tol": min(tol.residual, 1e-9), "max_iter": POLISH_STEPS,
+                   "stall": POLISH_STALL}
         polished = BACKENDS["newton"](system, method, options, workspace, y0=outcome.y)
         attempts.append(_record(method, "newton-polish", polished))
         if polished.status == OPTIMAL and _accepted(_check(system, polished.x, method), tol):
