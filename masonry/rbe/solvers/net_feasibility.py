@@ -99,8 +99,14 @@ class _LoadPath:
         return bound / gain
 
 
-def decide(ns: NewtonSystem, infeasibility_tol, residual,
-           options=LoadFactorOptions()) -> QPOutcome:
+OPTIONS = LoadFactorOptions(correctors=1)
+"""The LP's settings: one centrality corrector, not the collapse LP's two. The verdict
+comes within 4 to 8 iterations, too few for a second corrector to pay for its solve:
+preset 1's full dome at mu 0.05 certified in 5 iterations, 1.8 s CPU, against 6
+iterations, 2.7 to 3.6 s with two (``docs/bench.md``, issue 15f)."""
+
+
+def decide(ns: NewtonSystem, infeasibility_tol, residual, options=OPTIONS) -> QPOutcome:
     """Decide friction-net feasibility of ``ns`` (the friction-net
     :class:`~masonry.rbe.solvers.newton.NewtonSystem`) by the load-path LP.
 
