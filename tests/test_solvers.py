@@ -235,6 +235,30 @@ def test_newton_matrices_equal_the_sparse_products():
                                        atol=1e-10 * np.abs(full).max())
 
 
+def test_newton_columns_and_vertex_sums_are_the_equilibrium_matrix():
+    """The Newton system's ``A`` and ``AT``, built from the vertex coefficients, are the
+    columns of ``A_eq`` its model solves for, and ``times_A_eq`` sums ``A_eq x`` vertex by
+    vertex; both against the sparse ``A_eq`` (cyclic: image sides routed onto the
+    section's own blocks, two sides on one block included)."""
+    rng = np.random.default_rng(2)
+    for boundary in ("cyclic", "free"):
+        m = small(boundary)
+        system = assemble(m.blocks, m.interfaces, side_block=m.side_block,
+                          side_rotation=m.side_rotation)
+        dense = system.A_eq.toarray()
+        for method in ("net", "plus"):
+            ns = NewtonSystem(system, method)
+            keep = (4 * np.arange(system.layout.n_vertices)[:, None]
+                    + np.asarray(ns.components)).ravel()
+            np.testing.assert_allclose(ns.A.toarray(), dense[:, keep], rtol=0,
+                                       atol=1e-15)
+            np.testing.assert_allclose(ns.AT.toarray(), dense[:, keep].T, rtol=0,
+                                       atol=1e-15)
+        x = rng.normal(size=system.layout.n_columns)
+        np.testing.assert_allclose(system.times_A_eq(x), dense @ x, rtol=0,
+                                   atol=1e-12 * np.abs(dense).sum(axis=1).max())
+
+
 def test_standard_form_is_the_equilibrium_system():
     m = small("free")
     system = assemble(m.blocks, m.interfaces, mu=0.45)

@@ -68,7 +68,8 @@ class Exporter:
     name : str
         Also the run.json key of its record, if it returns one.
     stage : str
-        The timing stage it counts towards (``exports``, ``printable``, ``plots``).
+        The timing stage it counts towards (``forces``, ``exports``, ``printable``,
+        ``plots``).
     make : callable RunOutputs -> Export
     wanted : callable RunOutputs -> bool
         Whether this run writes it.
@@ -243,9 +244,11 @@ def _force_plot_files(made: RunOutputs) -> Export:
 
 
 EXPORTERS = (
+    # the forces first, under a stage of their own: parameters to forces is the time a
+    # user waits for results (the model's files do not need them)
+    Exporter("rbe", "forces", _rbe_files, wanted=lambda made: made.result is not None),
     Exporter("model", "exports", _model_files),
     Exporter("rhino", "exports", _rhino_files, aside=True),
-    Exporter("rbe", "exports", _rbe_files, wanted=lambda made: made.result is not None),
     Exporter("collapse", "exports", _collapse_files,
              wanted=lambda made: made.collapse is not None),
     Exporter("printable", "printable", _printable_files,

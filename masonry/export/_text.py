@@ -31,5 +31,7 @@ def format_floats(values) -> np.ndarray:
     distinct = bits.view(np.float64).tolist()
     # one % over a long format string: twice as fast as a % per value
     text = ((FLOAT_FORMAT + "\n") * len(distinct) % tuple(distinct)).split("\n")[:-1]
-    text = [t if any(c in t for c in ".en") else t + ".0" for t in text]  # e, nan, inf
+    # a whole number has none of ".en" (e: exponent, n: nan, inf); three tests inline
+    # take a third of the time of any() over a generator
+    text = [t if "." in t or "e" in t or "n" in t else t + ".0" for t in text]
     return np.array(text, dtype=object)[inverse].reshape(values.shape)

@@ -1,24 +1,34 @@
 """Interfaces with their forces as VTK XML unstructured grid (SPEC 7: ``RBE/interfaces.vtu``,
-for ParaView), written with meshio.
+for ParaView), written here; the collapse mechanism's blocks with meshio.
 
-Interface polygons have 3 to 8 vertices. meshio stores a cell block as one
-(cells, vertices per cell) array, so every run of consecutive interfaces with the same
-vertex count becomes one block (``triangle``, ``quad`` or ``polygon``): the file's cells
-are the interfaces in id order, the rows of ``interfaces.csv`` and ``RBE/forces.csv``
-(the cell data ``interface`` repeats the id). Array names carry their unit as the CSV
+Interface polygons have 3 to 8 vertices, each a ``triangle``, ``quad`` or ``polygon``
+cell: the file's cells are the interfaces in id order, the rows of ``interfaces.csv`` and
+``RBE/forces.csv`` (the cell data ``interface`` repeats the id). meshio stores a cell
+block as one (cells, vertices per cell) array, so it needs one block per run of
+consecutive interfaces with the same vertex count (3,841 on preset 1's full dome), and
+its per-block work took most of the file's time; VTU itself stores every cell in three
+flat arrays, written here as meshio writes them (binary, base64, a UInt32 byte count
+before each array, not compressed), and read back by meshio and ParaView alike. Array names carry their unit as the CSV
 columns do (``compression_N``), since ParaView titles a colour bar with the array's name.
 The ``kind`` codes are named in the file's field data (``kind_horizontal = 0``, ...),
 which ParaView lists in its Information panel.
 """
 
+import base64
 import os
+import sys
 import tempfile
 
 import numpy as np
 
+from masonry import __version__
 from masonry.interfaces import INTERFACE_KINDS
 
-_CELL_TYPES = {3: "triangle", 4: "quad"}
+VTK_TRIANGLE, VTK_QUAD, VTK_POLYGON = 5, 9, 7
+"""The VTK cell type codes of the interfaces' polygons."""
+
+_VTU_TYPES = {np.dtype(np.float64): "Float64", np.dtype(np.int64): "Int64",
+              np.dtype(np.int8): "Int8"}
 _RESERVED = ("interface", "kind", "area_m2", "frame_normal", "frame_t1", "frame_t2")
 
 
@@ -90,11 +100,9 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
     Raises
     ------
     ValueError
-        No interfaces (meshio cannot write a grid without cells), a force array of the
+        No interfaces (a grid without cells is not written), a force array of the
         wrong shape, or a force named like one of the fixed cell data.
     """
-    import meshio
-
     count = len(interfaces)
     if count == 0:
         raise ValueError("no interfaces to write: a VTU needs at least one cell")
@@ -108,27 +116,41 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
                              f"({count},) or ({count}, 3)")
         values[name] = value
     values.update(interface=np.arange(count, dtype=np.int64),
-                  kind=np.asarray(interfaces.kind, dtype=np.int8), area_m2=interfaces.area,
-                  frame_normal=interfaces.normal, frame_t1=interfaces.t1,
-                  frame_t2=interfaces.t2)
+                  kind=np.asarray(interfaces.kind, dtype=np.int8),
+                  **{name: np.asarray(value, dtype=float) for name, value in (
+                      ("area_m2", interfaces.area), ("frame_normal", interfaces.normal),
+                      ("frame_t1", interfaces.t1), ("frame_t2", interfaces.t2))})
 
-    vertex_count = interfaces.vertex_count
-    # runs of equal vertex count, in id order
-    starts = np.flatnonzero(np.diff(vertex_count, prepend=-1))
-    ends = np.append(starts[1:], count)
-    cells, cell_data = [], {name: [] for name in values}
-    for lo, hi in zip(starts.tolist(), ends.tolist()):
-        size = int(vertex_count[lo])
-        cells.append((_CELL_TYPES.get(size, "polygon"),
-                      interfaces.offsets[lo:hi, None] + np.arange(size)))
-        for name, value in values.items():
-            cell_data[name].append(value[lo:hi])
-    mesh = meshio.Mesh(np.asarray(interfaces.vertices, dtype=float).reshape(-1, 3), cells,
-                       cell_data=cell_data)
+    vertex_count = np.asarray(interfaces.vertex_count)
+    types = np.select([vertex_count == 3, vertex_count == 4], [VTK_TRIANGLE, VTK_QUAD],
+                      VTK_POLYGON).astype(np.int64)
+    points = np.asarray(interfaces.vertices, dtype=float).reshape(-1, 3)
+    offsets = np.asarray(interfaces.offsets, dtype=np.int64)
+    cells = {"connectivity": np.arange(offsets[0], offsets[-1], dtype=np.int64),
+             "offsets": offsets[1:] - offsets[0], "types": types}
+    order = "LittleEndian" if sys.byteorder == "little" else "BigEndian"
+    text = "".join([
+        '<?xml version="1.0"?>\n',
+        f'<VTKFile type="UnstructuredGrid" version="0.1" byte_order="{order}">\n',
+        f"<!--This file was created by masonry v{__version__}-->\n",
+        "<UnstructuredGrid>\n",
+        f'<Piece NumberOfPoints="{len(points)}" NumberOfCells="{count}">\n',
+        "<Points>\n", _data_array("Points", points), "</Points>\n",
+        "<Cells>\n", *(_data_array(name, v) for name, v in cells.items()), "</Cells>\n",
+        "<CellData>\n", *(_data_array(name, v) for name, v in values.items()),
+        "</CellData>\n", "</Piece>\n", "</UnstructuredGrid>\n", "</VTKFile>\n"])
+    return _with_field_data(text.encode(), {f"kind_{name}": code
+                                            for code, name in enumerate(kind_names)})
 
-    return _with_field_data(_vtu_bytes(mesh, "interfaces.vtu"),
-                            {f"kind_{name}": code
-                             for code, name in enumerate(kind_names)})
+
+def _data_array(name, data) -> str:
+    """One binary ``<DataArray>`` element as meshio writes it: base64 of the array's
+    byte count (UInt32) followed by its bytes, in this machine's byte order."""
+    data = np.ascontiguousarray(data)
+    components = f' NumberOfComponents="{data.shape[1]}"' if data.ndim == 2 else ""
+    payload = base64.b64encode(np.uint32(data.nbytes).tobytes() + data.tobytes())
+    return (f'<DataArray type="{_VTU_TYPES[data.dtype]}" Name="{name}"{components} '
+            f'format="binary">\n{payload.decode()}\n</DataArray>\n')
 
 
 def _with_field_data(data: bytes, integers: dict) -> bytes:

@@ -138,9 +138,6 @@ class EquilibriumSystem:
     free_block : (F,) int
         The blocks with equilibrium rows (non-supports), in order; block ``free_block[r]``
         owns rows ``6 r : 6 r + 6``.
-    A_eq : (6 F, n) scipy.sparse.csr_array, dimensionless
-        Force rows in units of ``weight_ref``, moment rows (about each block's centroid)
-        in units of ``weight_ref * length_ref``.
     f_ext : (6 F,) float, dimensionless
         Self weight in the same units (moment rows are zero: the weight acts at the
         centroid).
@@ -168,6 +165,10 @@ class EquilibriumSystem:
 
     Attributes
     ----------
+    A_eq : (6 F, n) scipy.sparse.csr_array, dimensionless
+        Force rows in units of ``weight_ref``, moment rows (about each block's centroid)
+        in units of ``weight_ref * length_ref``; built from ``vertex_coefficients`` on
+        first use (the Newton method and :meth:`times_A_eq` do without it).
     A_fr : dict str -> (4 IV, n) scipy.sparse.csr_array
         ``'net'`` and ``'plus'`` friction pyramids (thesis eq. 3.26, 3.25), for ``mu``.
         Rows of vertex ``i``: ``4 i + (0, 1, 2, 3)`` bound ``+f1, -f1, +f2, -f2``.
@@ -175,7 +176,6 @@ class EquilibriumSystem:
 
     layout: VariableLayout
     free_block: np.ndarray
-    A_eq: sp.csr_array
     f_ext: np.ndarray
     lower: np.ndarray
     h: np.ndarray
@@ -214,7 +214,30 @@ class EquilibriumSystem:
             out = dataclasses.replace(out, block_weight=self.block_weight * ratio,
                                       weight_ref=self.weight_ref * ratio,
                                       density=float(density))
+        if out is not self and "A_eq" in self.__dict__:  # the matrix depends on neither
+            out.__dict__["A_eq"] = self.A_eq
         return out
+
+    @cached_property
+    def A_eq(self) -> sp.csr_array:
+        """The equilibrium matrix, built on first use (see the class's attributes)."""
+        return _equilibrium_matrix(self.vertex_coefficients, self.vertex_side_row,
+                                   6 * len(self.free_block), self.layout)
+
+    @property
+    def vertex_side_row(self) -> np.ndarray:
+        """(IV, 2) int: the free-block index of each side of every vertex's interface,
+        0 for a support (whose coefficients are zero)."""
+        return np.maximum(self.side_row[self.layout.vertex_interface], 0)
+
+    def times_A_eq(self, x) -> np.ndarray:
+        """(6 F,) float: ``A_eq x`` for ``x`` ((n,) float), summed vertex by vertex from
+        ``vertex_coefficients``, without the matrix."""
+        per_side = np.einsum("vsrc,vc->vsr", self.vertex_coefficients,
+                             np.asarray(x, dtype=float).reshape(-1, self.layout.WIDTH))
+        rows = 6 * self.vertex_side_row[:, :, None] + np.arange(6)
+        return np.bincount(rows.ravel(), weights=per_side.ravel(),
+                           minlength=6 * len(self.free_block))
 
     @cached_property
     def A_fr(self) -> dict:
@@ -262,8 +285,8 @@ class EquilibriumSystem:
 
 def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
              side_rotation=None) -> EquilibriumSystem:
-    """Assemble the scaled RBE matrices (vectorized: ``A_eq`` built column by column in
-    CSC form).
+    """Assemble the scaled RBE matrices: the per-vertex coefficients of ``A_eq``
+    (vectorized); the sparse ``A_eq`` is built from them when a solver asks for it.
 
     Parameters
     ----------
@@ -312,15 +335,12 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
                   else np.asarray(side_block, dtype=np.int64))
     coefficients = _vertex_coefficients(blocks, interfaces, layout, side_block[
         layout.vertex_interface], side_rotation, block_row, length_ref)
-    side_rows = np.maximum(block_row[side_block[layout.vertex_interface]], 0)
-    A_eq = _equilibrium_matrix(coefficients, side_rows, 6 * len(free_block), layout)
 
     f_ext = np.zeros((len(free_block), 6))
     f_ext[:, 2] = -block_weight[free_block] / weight_ref
     lower = np.tile([0.0, 0.0, -np.inf, -np.inf], n_vertices)
     h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], n_vertices)
-    return EquilibriumSystem(layout=layout, free_block=free_block, A_eq=A_eq,
-                             f_ext=f_ext.ravel(),
+    return EquilibriumSystem(layout=layout, free_block=free_block, f_ext=f_ext.ravel(),
                              lower=lower, h=h, mu=float(mu), block_weight=block_weight,
                              weight_ref=weight_ref, length_ref=length_ref,
                              side_row=block_row[side_block],

@@ -592,7 +592,7 @@ def _check(system: EquilibriumSystem, x_scaled, method: str):
     """
     if x_scaled is None:
         return None
-    residual_eq = (np.abs(system.A_eq @ x_scaled + system.f_ext).max()
+    residual_eq = (np.abs(system.times_A_eq(x_scaled) + system.f_ext).max()
                    / np.abs(system.f_ext).max())
     bound = max(0.0, float((system.lower - x_scaled).max()))
     # the rows of A_fr, vertex by vertex: max(|f1|, |f2|) - mu (c - t) (friction-net) or

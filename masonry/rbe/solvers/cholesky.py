@@ -40,6 +40,7 @@ import logging
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
@@ -179,6 +180,27 @@ def _runs(positions):
     first = np.concatenate([[0], breaks])
     length = np.diff(np.concatenate([first, [len(positions)]]))
     return first, positions[first], length
+
+
+@functools.cache
+def _lower_triangle(n):
+    """(columns, rows) of the entries ``i >= j`` of an ``n x n`` matrix, column by
+    column (few sizes: multiples of the block size up to :data:`SMALL_UPDATE`)."""
+    return np.triu_indices(n)
+
+
+class _AddAt(NamedTuple):
+    """A small update's extend-add: the flat positions of its lower triangle in its
+    own front (``front``) and in the parent's (``parent``), column-major."""
+    front: np.ndarray
+    parent: np.ndarray
+
+
+class _AddRuns(NamedTuple):
+    """A large update's extend-add: the parent's rows of its rows (``rows``) and its
+    runs of consecutive columns (start in the update, start in the parent, length)."""
+    rows: np.ndarray
+    runs: tuple
 
 
 @dataclass(frozen=True, eq=False)
@@ -383,10 +405,11 @@ class BlockCholesky:
         """Everything :meth:`factor` needs per supernode, precomputed as one tuple:
         (front size, pivot columns, slice of its stored blocks in :attr:`_entry_order`,
         flat positions of their entries in the front, children, extend-add into the
-        parent, the sizes as LAPACK's integers). The extend-add of a small update is
-        one add at flat positions of the parent's front; a large one goes by its runs of
-        consecutive columns in the parent, each added at the parent's rows (fewer bytes
-        of indices to read)."""
+        parent, the sizes as LAPACK's integers). A small update (:class:`_AddAt`) is
+        taken out of the front as its lower triangle only and added to the parent's
+        front by one add at flat positions; a large one (:class:`_AddRuns`) goes by its
+        runs of consecutive columns in the parent, each added at the parent's rows
+        (fewer bytes of indices to read)."""
         bs = self.block_size
         inner = np.arange(bs)
         steps = []
@@ -397,18 +420,22 @@ class BlockCholesky:
             row = self._local_row[chosen][:, None, None] * bs + inner[:, None]
             col = self._local_col[chosen][:, None, None] * bs + inner[None, :]
             extend = None
+            k = bs * (sn.last - sn.first + 1)
             if sn.parent >= 0:
                 parent = self.supernodes[sn.parent]
                 parent_size = bs * (parent.last - parent.first + 1 + len(parent.rows))
-                if bs * len(sn.rows) <= SMALL_UPDATE:
-                    rows = (bs * sn.position[:, None] + inner).ravel()
-                    extend = (rows[:, None] * parent_size + rows[None, :]).ravel()
+                rows = (bs * sn.position[:, None] + inner).ravel()
+                if len(rows) <= SMALL_UPDATE:
+                    # the update's lower triangle, column by column: where it is in this
+                    # front, and where it goes in the parent's (its upper triangle is
+                    # never read)
+                    j, i = _lower_triangle(len(rows))
+                    extend = _AddAt((k + j) * size + k + i, rows[j] * parent_size + rows[i])
                 else:
                     start, value, length = _runs(sn.position)
-                    rows = (bs * sn.position[:, None] + inner).ravel()
-                    extend = (rows, tuple(zip((bs * start).tolist(), (bs * value).tolist(),
-                                              (bs * length).tolist())))
-            k = bs * (sn.last - sn.first + 1)
+                    extend = _AddRuns(rows, tuple(zip((bs * start).tolist(),
+                                                      (bs * value).tolist(),
+                                                      (bs * length).tolist())))
             # the front is column-major: entry (row, col) at col * size + row
             steps.append((size, k, entries, (col * size + row).ravel(), self._children[s],
                           extend, tuple(ctypes.c_int(n) for n in (k, size, size - k))))
@@ -535,22 +562,21 @@ class BlockCholesky:
         one, minus_one, info = ctypes.c_double(1.0), ctypes.c_double(-1.0), ctypes.c_int()
         entry = self.block_size ** 2
         for s in supernodes:
-            size, k, entries, positions, children, _, (k_, size_, rest_) = steps[s]
+            size, k, entries, positions, children, extend, (k_, size_, rest_) = steps[s]
             flat = buffer[:size * size]
             flat.fill(0.0)
             flat[positions] = values[entry * entries.start:entry * entries.stop]
             front = flat.reshape(size, size, order="F")
             for child in children:
-                update, extend = updates[child], steps[child][5]
+                update, added = updates[child], steps[child][5]
                 updates[child] = None
-                if isinstance(extend, np.ndarray):  # positions column-major, as the front
-                    flat[extend] += update.reshape(-1, order="F")
+                if isinstance(added, _AddAt):  # positions column-major, as the front
+                    flat[added.parent] += update
                     continue
                 # by runs of consecutive columns, in the lower triangle only (the update
                 # is valid there: dsyrk): columns c:c + n go to the parent's p:p + n
-                rows, runs = extend
-                for c, p, n in runs:
-                    front[rows[c:], p:p + n] += update[c:, c:c + n]
+                for c, p, n in added.runs:
+                    front[added.rows[c:], p:p + n] += update[c:, c:c + n]
             _DPOTRF(b"L", k_, address, size_, info)  # L11 L11^T = F11
             if info.value != 0:
                 raise np.linalg.LinAlgError(
@@ -563,7 +589,8 @@ class BlockCholesky:
                 # F22 - L21 L21^T, the update for the parent
                 _DSYRK(b"L", b"N", rest_, k_, minus_one, panel, size_, one,
                        address + itemsize * (k * size + k), size_)
-                updates[s] = front[k:, k:].copy(order="F")
+                updates[s] = (flat[extend.front] if isinstance(extend, _AddAt)
+                              else front[k:, k:].copy(order="F"))
 
 
 class BlockFactor:

@@ -176,9 +176,10 @@ def project_pyramid(p, mu):
 
 class NewtonSystem:
     """What the Newton method keeps for one :class:`~masonry.rbe.equilibrium.EquilibriumSystem`
-    and friction model: the column subset of ``A_eq``, the Cholesky symbolic analysis of
-    the contact graph (shared between friction models and friction coefficients), and the
-    maps that scatter per-interface 12 x 12 blocks into the Newton matrix."""
+    and friction model: the column subset of ``A_eq`` (``A``, and ``AT`` its transpose),
+    the Cholesky symbolic analysis of the contact graph (shared between friction models
+    and friction coefficients), and the maps that scatter per-interface 12 x 12 blocks
+    into the Newton matrix."""
 
     def __init__(self, system, method, symbolic=None):
         self.method = method
@@ -193,15 +194,14 @@ class NewtonSystem:
         self.tension = [i for i, c in enumerate(columns) if c == TENSION]
         if np.ptp(self.h[:, self.pyramid]) != 0:
             raise ValueError("the pyramid projection needs equal weights on c, f1, f2")
-        keep = (layout.WIDTH * np.arange(layout.n_vertices)[:, None] + columns).ravel()
-        # columns are the major index of CSC: a fast subset (a CSR one is slow)
-        self.AT = sp.csr_array(sp.csc_array(system.A_eq)[:, keep].T)
-        self.A = sp.csr_array(self.AT.T)
         self.b = -system.f_ext
         self.mu = system.mu
         # (IV, 12, width): rows of side 0's block, then side 1's
         self.coefficients = np.ascontiguousarray(
             system.vertex_coefficients[:, :, :, columns].reshape(layout.n_vertices, 12, width))
+        # CSC, and its transpose CSR: no conversion, and products as fast as CSR's
+        self.A = _columns_matrix(self.coefficients, system.vertex_side_row, len(self.b))
+        self.AT = self.A.T
         # contiguous transposes make the stacked matmuls 3x faster
         self._coefficients_t = np.ascontiguousarray(self.coefficients.transpose(0, 2, 1))
         self.vertex_interface = np.asarray(layout.vertex_interface)
@@ -328,6 +328,26 @@ class NewtonSystem:
         (the projection of ``H^-1 w`` onto K, in the metric of H)."""
         x, _ = self.project(w)
         return np.sqrt(np.sum(self.h * x * x, axis=1))
+
+
+def _columns_matrix(coefficients, side_rows, n_rows) -> sp.csc_array:
+    """The columns of ``A_eq`` that a friction model solves for, as ``A_eq`` would
+    hold them (:func:`masonry.rbe.equilibrium.assemble`: rows in increasing order, no
+    stored zeros), straight from the vertex coefficients ``coefficients`` ((IV, 12,
+    width): side 0's six rows, then side 1's) and the free-block row of each side
+    ``side_rows`` ((IV, 2) int), without converting the whole matrix."""
+    n_vertices, _, width = coefficients.shape
+    swap = side_rows[:, 0] > side_rows[:, 1]
+    rows = 6 * np.sort(side_rows, axis=1)[:, :, None] + np.arange(6)      # (IV, 2, 6)
+    sides = np.where(swap[:, None], np.arange(12).reshape(2, 6)[::-1].ravel(),
+                     np.arange(12))                                      # (IV, 12)
+    data = np.take_along_axis(coefficients, sides[:, :, None], axis=1)  # (IV, 12, width)
+    data = data.transpose(0, 2, 1)                                       # (IV, width, 12)
+    stored = data != 0
+    indices = np.broadcast_to(rows.reshape(n_vertices, 1, 12), data.shape)[stored]
+    indptr = np.concatenate([[0], np.cumsum(stored.sum(axis=2).ravel())])
+    return sp.csc_array((data[stored], indices, indptr),
+                        shape=(n_rows, n_vertices * width))
 
 
 @functools.cache
