@@ -142,9 +142,9 @@ feasible domes wander that long before converging (preset 1 with ``--p 21``: 16 
 LOAD_PATH_DAMPED_OUT = 3
 """Newton's ``damped_out`` on friction-net when the load-path LP follows it (off
 otherwise): steps in a row ending at the damping ceiling before the LP decides. On the
-infeasible low-friction domes measured, Newton sat at the ceiling from about its eighth
-step to its stall; no feasible dome measured ended two steps in a row there
-(docs/bench.md, issue 15d). A wrong hand-over costs one LP, never a wrong verdict: a
+infeasible low-friction domes measured, Newton's steps ended there in long runs until
+its stall (preset 1's dome at mu 0.05: 20 in a row from its eighth step); no feasible
+structure measured ended two steps in a row there (docs/bench.md, issue 15d). A wrong hand-over costs one LP, never a wrong verdict: a
 feasible verdict resumes Newton without this rule."""
 
 SOLVERS = tuple(BACKENDS)

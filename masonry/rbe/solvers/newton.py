@@ -33,7 +33,7 @@ full dome (``docs/bench.md``).
 When friction-net is infeasible the dual is unbounded: the iterates run off along a
 Farkas direction ``d`` with ``b^T d > 0`` and ``A^T d`` in the polar cone of ``K``. The
 method stops when the current step is such a certificate within tolerance, or when it
-stalls, and reports it; :mod:`masonry.rbe.solve` then decides what to do.
+stalls or damps out (``NewtonOptions.damped_out``), and reports it; :mod:`masonry.rbe.solve` then decides what to do.
 """
 
 import copy
