@@ -459,6 +459,42 @@ def test_a_feasible_load_path_verdict_resumes_newton(monkeypatch):
     np.testing.assert_allclose(result.x, reference.x, rtol=0, atol=1e-6 * scale(reference))
 
 
+def test_newton_hands_a_damped_out_dome_to_the_load_path_lp(monkeypatch):
+    # preset 2's dome with p = 3 at mu 0.05: Newton's steps sit at the damping ceiling
+    # and it hands over before its stall, to the same verdict; the LP's certificate,
+    # recomputed from the layout's matrices (the edge rays of every pyramid as
+    # columns), proves that no edge weights with a bounded total balance the dead load
+    m = model("2", scene="dome", p=3)
+    prepared = problem(m)
+    result = prepared.solve(mu=0.05, friction="net", accuracy="balanced")
+    monkeypatch.setattr(solve_module, "LOAD_PATH_DAMPED_OUT", 0)
+    stalled = problem(m).solve(mu=0.05, friction="net", accuracy="balanced")
+    for run in (result, stalled):
+        assert [(a["solver"], a["status"]) for a in run.attempts] == [
+            ("newton", "user_limit"), (LOAD_PATH, "infeasible")]
+        assert run.verdict == "infeasible" and run.x is None
+    assert result.attempts[0]["iterations"] < stalled.attempts[0]["iterations"]
+    system = prepared.system.with_material(mu=0.05, density=2000.0)
+    tol = NewtonOptions().infeasibility_tol
+    certificate = decide(NewtonSystem(system, "net"), tol, Tolerances().residual).y
+    edges = system.A_eq @ friction_pyramid_edges(system.layout.n_vertices, 0.05)
+    b = -system.f_ext
+    gain = float(b @ certificate)
+    assert gain > 0
+    assert (edges.T @ certificate).max() <= tol * gain / np.abs(b).sum()
+
+
+def test_a_feasible_dome_at_the_damping_ceiling_pays_no_load_path_lp():
+    # preset 3's dome at mu 0.2: Newton's damping reaches its ceiling on single steps
+    # while the active set settles; it converges without the LP, to a point in
+    # equilibrium within the pyramids
+    result = problem(model("3", scene="dome")).solve(mu=0.2, friction="net",
+                                                     accuracy="balanced")
+    assert [(a["solver"], a["status"]) for a in result.attempts] == [("newton", "optimal")]
+    assert result.feasible and result.verdict == "feasible"
+    assert result.residual_eq <= 1e-9 and result.friction_violation <= 1e-9
+
+
 # ---------------------------------------------------------------------- reuse
 @pytest.mark.parametrize("solver", ["newton", "osqp", "clarabel"])
 def test_reuse_between_friction_coefficients_changes_nothing(solver):

@@ -144,6 +144,14 @@ feasible domes wander that long before converging (preset 1 with ``--p 21``: 16 
 ``--p 19``: 19); with 10 the 21,648-block dome paid an LP and took twice as long
 (docs/bench.md)."""
 
+LOAD_PATH_DAMPED_OUT = 3
+"""Newton's ``damped_out`` on friction-net when the load-path LP follows it (off
+otherwise): steps in a row ending at the damping ceiling before the LP decides. On the
+infeasible low-friction domes measured, Newton's steps ended there in long runs until
+its stall (preset 1's dome at mu 0.05: 20 in a row from its eighth step); no feasible
+structure measured ended two steps in a row there (docs/bench.md, issue 15d). A wrong hand-over costs one LP, never a wrong verdict: a
+feasible verdict resumes Newton without this rule."""
+
 SOLVERS = tuple(BACKENDS)
 """Every solver name :func:`solve_rbe` accepts."""
 
@@ -331,8 +339,9 @@ class RBEProblem:
                 name, outcome = self._load_path(system, preset, tol, outcome, attempts)
             else:
                 # Newton hands over sooner when the load-path LP follows it
-                stall = {"stall": LOAD_PATH_STALL} if LOAD_PATH in names[index:] else {}
-                outcome = self._run(system, method, name, preset, **stall)
+                hand_over = ({"stall": LOAD_PATH_STALL, "damped_out": LOAD_PATH_DAMPED_OUT}
+                             if LOAD_PATH in names[index:] else {})
+                outcome = self._run(system, method, name, preset, **hand_over)
             checks = _check(system, outcome.x, method)
             accepted = _accepted(checks, tol)
             attempts.append(_record(method, name, outcome))

@@ -33,7 +33,7 @@ full dome (``docs/bench.md``).
 When friction-net is infeasible the dual is unbounded: the iterates run off along a
 Farkas direction ``d`` with ``b^T d > 0`` and ``A^T d`` in the polar cone of ``K``. The
 method stops when the current step is such a certificate within tolerance, or when it
-stalls, and reports it; :mod:`masonry.rbe.solve` then decides what to do.
+stalls or damps out (``NewtonOptions.damped_out``), and reports it; :mod:`masonry.rbe.solve` then decides what to do.
 """
 
 import copy
@@ -110,6 +110,7 @@ class NewtonOptions:
     max_iter: int = 100
     stall: int = 25
     divergence: float = 1e6
+    damped_out: int = 0
     regularization: float = 1e-10
     infeasibility_tol: float = 1e-4
     sufficient_increase: float = 1e-4
@@ -436,6 +437,7 @@ class _Run:
         self.ns, self.options, self.scale = ns, options, scale
         self.b_inf, self.b_one = np.abs(ns.b).max(), np.abs(ns.b).sum()
         self.floor = options.regularization * scale
+        self.ceiling = options.damping_ceiling * scale
         self.shift = self.floor
         self.steps = self.factorizations = 0
         self.y_scale = max(float(np.abs(y).max()), np.finfo(float).tiny)
@@ -455,10 +457,11 @@ class _Run:
 
     def iterate(self, certify) -> str:
         """Newton steps until converged (``optimal``), certified infeasible (``certify``
-        and a step is a Farkas certificate: ``infeasible``), stalled, diverging or out
-        of steps (``user_limit``), or a matrix that is not positive definite."""
+        and a step is a Farkas certificate: ``infeasible``), stalled, diverging, damped out
+        or out of steps (``user_limit``), or a matrix that is not positive definite."""
         options = self.options
         best, best_at, previous = np.inf, 0, np.inf
+        damped = 0  # steps in a row that ended at the damping ceiling
         for step in range(1, options.max_iter + 1):
             residual = self.gradient()
             size = np.abs(residual).max()
@@ -489,6 +492,11 @@ class _Run:
             if not self._line_search(residual, direction, w_step):
                 log.info("Newton line search stalled at step %d", step)
                 return USER_LIMIT
+            damped = damped + 1 if self.shift >= self.ceiling else 0
+            if 0 < options.damped_out <= damped:
+                log.info("Newton damped out: %d steps in a row at the damping ceiling "
+                         "(residual %.2e)", damped, size / self.b_inf)
+                return USER_LIMIT
         return USER_LIMIT
 
     def _direction(self, residual):
@@ -518,8 +526,7 @@ class _Run:
         # curvature but the shift, its step is huge and the line search cuts every
         # other block's step with it; short steps raise the shift, full steps lower it
         if length < options.short_step:
-            self.shift = min(self.shift * options.damping_raise,
-                             options.damping_ceiling * self.scale)
+            self.shift = min(self.shift * options.damping_raise, self.ceiling)
         elif length == 1.0:
             self.shift = max(self.shift / options.damping_lower, self.floor)
         self._move_to(y_new, self.w + length * w_step, projected)
