@@ -151,7 +151,7 @@ class _Iterate:
         self.w = np.clip(z / s, WEIGHT_BOUNDS[0], WEIGHT_BOUNDS[1])
         self.D = vertex_inverse(ns.h, self.w, ns.mu, ns.components)
         self.factor = ns.symbolic.factor(ns.newton_blocks(self.D, shift, incremental=False))
-        self.s, self.z, self.shift = s, z, shift
+        self.s, self.z = s, z
 
     def direction(self, r_dual, r_primal, r_cone_gap, r_comp):
         """Solve for (dx, dy, ds, dz) given the residuals ``H x - A^T y + G^T z``,
