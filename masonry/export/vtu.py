@@ -8,8 +8,9 @@ block as one (cells, vertices per cell) array, so it needs one block per run of
 consecutive interfaces with the same vertex count (3,841 on preset 1's full dome), and
 its per-block work took most of the file's time; VTU itself stores every cell in three
 flat arrays, written here as meshio writes them (binary, base64, a UInt32 byte count
-before each array, not compressed), and read back by meshio and ParaView alike. Array names carry their unit as the CSV
-columns do (``compression_N``), since ParaView titles a colour bar with the array's name.
+before each array, not compressed), and read back by meshio and ParaView alike. Array
+names carry their unit as the CSV columns do (``compression_N``), since ParaView titles
+a colour bar with the array's name.
 The ``kind`` codes are named in the file's field data (``kind_horizontal = 0``, ...),
 which ParaView lists in its Information panel.
 """

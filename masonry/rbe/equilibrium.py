@@ -221,8 +221,9 @@ class EquilibriumSystem:
     @cached_property
     def A_eq(self) -> sp.csr_array:
         """The equilibrium matrix, built on first use (see the class's attributes)."""
-        return _equilibrium_matrix(self.vertex_coefficients, self.vertex_side_row,
-                                   6 * len(self.free_block), self.layout)
+        coefficients = self.vertex_coefficients.reshape(self.layout.n_vertices, 12, -1)
+        return equilibrium_columns(coefficients, self.vertex_side_row,
+                                   6 * len(self.free_block)).tocsr()
 
     @property
     def vertex_side_row(self) -> np.ndarray:
@@ -379,32 +380,31 @@ def _vertex_coefficients(blocks, interfaces, layout: VariableLayout, vertex_side
     return np.stack(out, axis=1)
 
 
-def _equilibrium_matrix(coefficients, side_rows, n_rows: int,
-                        layout: VariableLayout) -> sp.csr_array:
-    """``A_eq`` ((n_rows, n) csr) from the per-vertex ``coefficients`` ((IV, 2, 6, 4))
-    and the free-block row of each side ``side_rows`` ((IV, 2) int).
+def equilibrium_columns(coefficients, side_rows, n_rows: int) -> sp.csc_array:
+    """Columns of ``A_eq`` ((n_rows, IV width) csc) from per-vertex ``coefficients``
+    ((IV, 12, width): side 0's six rows, then side 1's, in the columns wanted) and the
+    free-block row of each side ``side_rows`` ((IV, 2) int): all of ``A_eq`` with the four
+    columns of :class:`VariableLayout`, the Newton method's subset with its own.
 
     Every column (a vertex's c, t, f1 or f2) has six rows on each side's block, so the
-    matrix is built column by column in CSC form, with no triplet sort.
+    matrix is built column by column in CSC form, with no triplet sort; its rows are in
+    increasing order (the side on the lower block first) and it stores no zeros.
     """
-    # rows of a column in increasing order: the side on the lower block first
+    n_vertices, _, width = coefficients.shape
     swap = side_rows[:, 0] > side_rows[:, 1]
-    first = np.where(swap, side_rows[:, 1], side_rows[:, 0])
-    second = np.where(swap, side_rows[:, 0], side_rows[:, 1])
-    offsets = np.arange(6)
-    indices = np.concatenate([6 * first[:, None] + offsets, 6 * second[:, None] + offsets],
-                             axis=1)                                     # (IV, 12)
-    low = np.where(swap[:, None, None], coefficients[:, 1], coefficients[:, 0])
-    high = np.where(swap[:, None, None], coefficients[:, 0], coefficients[:, 1])
-    data = np.concatenate([low, high], axis=1).transpose(0, 2, 1)       # (IV, 4, 12)
+    rows = 6 * np.sort(side_rows, axis=1)[:, :, None] + np.arange(6)      # (IV, 2, 6)
+    sides = np.where(swap[:, None], np.arange(12).reshape(2, 6)[::-1].ravel(),
+                     np.arange(12))                                      # (IV, 12)
+    data = np.take_along_axis(coefficients, sides[:, :, None], axis=1)  # (IV, 12, width)
+    data = data.transpose(0, 2, 1)                                       # (IV, width, 12)
+    matrix = sp.csc_array(
+        (data.ravel(), np.broadcast_to(rows.reshape(n_vertices, 1, 12), data.shape).ravel(),
+         np.arange(0, data.size + 1, 12)), shape=(n_rows, n_vertices * width))
     # both sides on one block (cyclic symmetry routes an image onto the brick it copies)
     # add up; then the dropped coefficients go
-    A_eq = sp.csc_array((data.ravel(), np.repeat(indices[:, None, :], layout.WIDTH, axis=1)
-                         .ravel(), np.arange(0, 12 * layout.n_columns + 1, 12)),
-                        shape=(n_rows, layout.n_columns))
-    A_eq.sum_duplicates()
-    A_eq.eliminate_zeros()
-    return A_eq.tocsr()
+    matrix.sum_duplicates()
+    matrix.eliminate_zeros()
+    return matrix
 
 
 def friction_pyramids(n_vertices: int, mu: float) -> dict:

@@ -149,8 +149,9 @@ LOAD_PATH_DAMPED_OUT = 3
 otherwise): steps in a row ending at the damping ceiling before the LP decides. On the
 infeasible low-friction domes measured, Newton's steps ended there in long runs until
 its stall (preset 1's dome at mu 0.05: 20 in a row from its eighth step); no feasible
-structure measured ended two steps in a row there (docs/bench.md, issue 15d). A wrong hand-over costs one LP, never a wrong verdict: a
-feasible verdict resumes Newton without this rule."""
+structure measured ended two steps in a row there (docs/bench.md, issue 15d). A wrong
+hand-over costs one LP, never a wrong verdict: a feasible verdict resumes Newton without
+this rule."""
 
 SOLVERS = tuple(BACKENDS)
 """Every solver name :func:`solve_rbe` accepts."""

@@ -22,9 +22,10 @@ so the LP is never infeasible:
 
 The interior point method stops at the first iterate that decides either way (it need
 not converge; the LP is unbounded when ``b - r`` itself is carried, and the stop at
-``lambda >= 1`` comes first). The certificate is checked on ``M^T y`` and ``b^T y`` recomputed from the
-matrices, with the margins the QP's acceptance allows: for ``M g = b + e``, ``g >= 0``,
-``b^T y <= ||g||_1 max(M^T y)_+ + ||e||_inf ||y||_1``. So when
+``lambda >= 1`` comes first). The certificate is checked on ``M^T y`` and ``b^T y``
+recomputed from the matrices, with the margins the QP's acceptance allows: for
+``M g = b + e``, ``g >= 0``, ``b^T y <= ||g||_1 max(M^T y)_+ + ||e||_inf ||y||_1``. So
+when
 
     max(M^T y)_+ ||b||_1 / infeasibility_tol + residual ||b||_inf ||y||_1 < b^T y
 

@@ -33,7 +33,8 @@ full dome (``docs/bench.md``).
 When friction-net is infeasible the dual is unbounded: the iterates run off along a
 Farkas direction ``d`` with ``b^T d > 0`` and ``A^T d`` in the polar cone of ``K``. The
 method stops when the current step is such a certificate within tolerance, or when it
-stalls or damps out (``NewtonOptions.damped_out``), and reports it; :mod:`masonry.rbe.solve` then decides what to do.
+stalls or damps out (``NewtonOptions.damped_out``), and reports it;
+:mod:`masonry.rbe.solve` then decides what to do.
 """
 
 import copy
@@ -47,7 +48,7 @@ import numpy as np
 import scipy.sparse as sp
 from threadpoolctl import ThreadpoolController
 
-from masonry.rbe.equilibrium import VariableLayout
+from masonry.rbe.equilibrium import VariableLayout, equilibrium_columns
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
 from masonry.rbe.solvers.cholesky import BlockCholesky
 
@@ -201,7 +202,7 @@ class NewtonSystem:
         self.coefficients = np.ascontiguousarray(
             system.vertex_coefficients[:, :, :, columns].reshape(layout.n_vertices, 12, width))
         # CSC, and its transpose CSR: no conversion, and products as fast as CSR's
-        self.A = _columns_matrix(self.coefficients, system.vertex_side_row, len(self.b))
+        self.A = equilibrium_columns(self.coefficients, system.vertex_side_row, len(self.b))
         self.AT = self.A.T
         # contiguous transposes make the stacked matmuls 3x faster
         self._coefficients_t = np.ascontiguousarray(self.coefficients.transpose(0, 2, 1))
@@ -329,26 +330,6 @@ class NewtonSystem:
         (the projection of ``H^-1 w`` onto K, in the metric of H)."""
         x, _ = self.project(w)
         return np.sqrt(np.sum(self.h * x * x, axis=1))
-
-
-def _columns_matrix(coefficients, side_rows, n_rows) -> sp.csc_array:
-    """The columns of ``A_eq`` that a friction model solves for, as ``A_eq`` would
-    hold them (:func:`masonry.rbe.equilibrium.assemble`: rows in increasing order, no
-    stored zeros), straight from the vertex coefficients ``coefficients`` ((IV, 12,
-    width): side 0's six rows, then side 1's) and the free-block row of each side
-    ``side_rows`` ((IV, 2) int), without converting the whole matrix."""
-    n_vertices, _, width = coefficients.shape
-    swap = side_rows[:, 0] > side_rows[:, 1]
-    rows = 6 * np.sort(side_rows, axis=1)[:, :, None] + np.arange(6)      # (IV, 2, 6)
-    sides = np.where(swap[:, None], np.arange(12).reshape(2, 6)[::-1].ravel(),
-                     np.arange(12))                                      # (IV, 12)
-    data = np.take_along_axis(coefficients, sides[:, :, None], axis=1)  # (IV, 12, width)
-    data = data.transpose(0, 2, 1)                                       # (IV, width, 12)
-    stored = data != 0
-    indices = np.broadcast_to(rows.reshape(n_vertices, 1, 12), data.shape)[stored]
-    indptr = np.concatenate([[0], np.cumsum(stored.sum(axis=2).ravel())])
-    return sp.csc_array((data[stored], indices, indptr),
-                        shape=(n_rows, n_vertices * width))
 
 
 @functools.cache
