@@ -214,25 +214,31 @@ def test_interior_point_vertex_blocks_are_the_inverse(method):
 
 
 def test_newton_matrices_equal_the_sparse_products():
+    """``A J A^T`` by interface (every vertex changed: the first matrix, a new one) and by
+    vertex update (a third changed), against the dense product."""
     m = small("cyclic")
     system = assemble(m.blocks, m.interfaces, side_block=m.side_block,
                       side_rotation=m.side_rotation)
+    assert len(np.unique(np.bincount(system.layout.vertex_interface))) > 1
     rng = np.random.default_rng(1)
     for method in ("net", "plus"):
         ns = NewtonSystem(system, method)
-        jacobian = rng.normal(size=(len(ns.coefficients), ns.width, ns.width))
-        # the second matrix is an update of the first: a third of the vertices changed
-        ns.newton_blocks(np.where(rng.random(len(jacobian))[:, None, None] < 1 / 3,
-                                  rng.normal(size=jacobian.shape), jacobian), 0.0)
-        blocks = ns.newton_blocks(jacobian, 0.0)
-        per_vertex = np.zeros((ns.A.shape[1],) * 2)
-        for v, block in enumerate(jacobian):
-            per_vertex[v * ns.width:(v + 1) * ns.width, v * ns.width:(v + 1) * ns.width] = block
-        full = ns.A.toarray() @ per_vertex @ ns.A.toarray().T
-        sym = ns.symbolic
-        for k, (i, j) in enumerate(zip(sym.lower_rows, sym.lower_cols)):
-            np.testing.assert_allclose(blocks[k], full[6 * i:6 * i + 6, 6 * j:6 * j + 6],
-                                       atol=1e-10 * np.abs(full).max())
+        first = rng.normal(size=(len(ns.coefficients), ns.width, ns.width))
+        update = np.where(rng.random(len(first))[:, None, None] < 1 / 3,
+                          rng.normal(size=first.shape), first)
+        renewed = rng.normal(size=first.shape)
+        for jacobian in (first, update, renewed):
+            blocks = ns.newton_blocks(jacobian, 0.0)
+            per_vertex = np.zeros((ns.A.shape[1],) * 2)
+            for v, block in enumerate(jacobian):
+                per_vertex[v * ns.width:(v + 1) * ns.width,
+                           v * ns.width:(v + 1) * ns.width] = block
+            full = ns.A.toarray() @ per_vertex @ ns.A.toarray().T
+            sym = ns.symbolic
+            for k, (i, j) in enumerate(zip(sym.lower_rows, sym.lower_cols)):
+                np.testing.assert_allclose(blocks[k],
+                                           full[6 * i:6 * i + 6, 6 * j:6 * j + 6],
+                                           atol=1e-10 * np.abs(full).max())
 
 
 def test_newton_columns_and_vertex_sums_are_the_equilibrium_matrix():

@@ -46,7 +46,7 @@ import numpy as np
 from masonry.rbe.equilibrium import friction_pyramid_edges
 from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
 from masonry.rbe.solvers.interior import centred_start, max_step
-from masonry.rbe.solvers.newton import NewtonSystem, one_blas_thread
+from masonry.rbe.solvers.newton import NewtonSystem, one_blas_thread, vertex_groups
 
 log = logging.getLogger(__name__)
 
@@ -140,16 +140,10 @@ class _RayProducts:
     def __init__(self, ns: NewtonSystem, rays):
         self.rays = rays
         per_ray = np.einsum("vij,jk->vki", ns.coefficients, rays)  # (IV, 4, 12)
-        interface = ns.vertex_interface
-        order = np.argsort(interface, kind="stable")
-        counts = np.bincount(interface)
-        self.out = np.zeros((len(counts), 12, 12))
+        self.out = np.zeros((ns.n_interfaces, 12, 12))
         self.groups = []
-        for count in np.unique(counts[counts > 0]):
-            faces = np.flatnonzero(counts == count)
-            first = np.searchsorted(interface[order], faces)
-            vertices = order[first[:, None] + np.arange(count)]
-            rows = per_ray[vertices].reshape(len(faces), 4 * count, 12)
+        for faces, vertices in vertex_groups(ns.vertex_interface):
+            rows = per_ray[vertices].reshape(len(faces), -1, 12)
             columns = np.ascontiguousarray(rows.transpose(0, 2, 1))
             self.groups.append((faces, vertices, rows, columns, np.empty_like(columns),
                                 np.empty((len(faces), 12, 12))))

@@ -65,7 +65,11 @@ COMPONENTS = {method: tuple(VariableLayout.COMPONENTS.index(name) for name in na
 TENSION = VariableLayout.COMPONENTS.index("t")
 
 VERTEX_CHUNK = 32768
-"""Vertices per stacked product when forming Newton matrices (bounds the buffers)."""
+"""Vertices per stacked product when updating Newton matrices (bounds the buffers)."""
+
+INCREMENTAL_SHARE = 0.5
+"""A Newton matrix is updated vertex by vertex when at most this share of the vertices
+changed their Jacobian, else formed anew interface by interface."""
 
 
 @dataclass(frozen=True)
@@ -208,10 +212,11 @@ class NewtonSystem:
         self._coefficients_t = np.ascontiguousarray(self.coefficients.transpose(0, 2, 1))
         self.vertex_interface = np.asarray(layout.vertex_interface)
         """(IV,) int: the interface of every vertex."""
+        self.n_interfaces = layout.n_interfaces
         # sums vertices into interfaces: a sparse product is 14x faster than reduceat
         self._vertex_sum = sp.csc_array(
             (np.ones(layout.n_vertices), (self.vertex_interface, np.arange(layout.n_vertices))),
-            shape=(layout.n_interfaces, layout.n_vertices))
+            shape=(self.n_interfaces, layout.n_vertices))
         # the last Jacobian and its per-interface sums: the Jacobian is piecewise constant,
         # so the next Newton matrix only adds the vertices whose Jacobian changed
         self._last = None
@@ -281,23 +286,57 @@ class NewtonSystem:
         vertices that moved to another face of their cone change it (preset 1's full
         dome: 18,000 of 75,000 vertices at the second step, 500 at the ninth), so the
         per-interface sums of the last call are updated with those vertices alone, unless
-        ``incremental`` is False (the interior point method changes every vertex)."""
+        ``incremental`` is False (the interior point method changes every vertex) or
+        more than :data:`INCREMENTAL_SHARE` of them changed: then every interface's sum
+        is formed anew (:meth:`interface_sums`)."""
         if self._last is None or not incremental:
-            vertices, delta = np.arange(len(jacobian)), jacobian
-            sums = np.zeros((self._vertex_sum.shape[0], 144))
+            sums = self.interface_sums(jacobian)
         else:
             last_jacobian, sums = self._last
             vertices = np.flatnonzero((jacobian != last_jacobian).any(axis=(1, 2)))
-            delta = jacobian[vertices] - last_jacobian[vertices]
-        # stacked 12 x 12 products in chunks: bounded buffers on the largest models
+            if len(vertices) > INCREMENTAL_SHARE * len(jacobian):
+                sums = self.interface_sums(jacobian)
+            else:
+                sums = sums + self._vertex_sums(
+                    vertices, jacobian[vertices] - last_jacobian[vertices])
+        if incremental:
+            self._last = (jacobian.copy(), sums)
+        return self.scatter_sums(sums, shift)
+
+    def _vertex_sums(self, vertices, delta):
+        """(K, 144): the interfaces' sums of ``C_v delta_v C_v^T`` over ``vertices``,
+        by stacked 12 x 12 products in chunks (bounded buffers on the largest models)."""
+        sums = 0.0
         for start in range(0, len(vertices), VERTEX_CHUNK):
             part = slice(start, start + VERTEX_CHUNK)
             chosen = vertices[part]
             per_vertex = np.matmul(np.matmul(self.coefficients[chosen], delta[part]),
                                    self._coefficients_t[chosen])
             sums = sums + self._vertex_sum[:, chosen] @ per_vertex.reshape(-1, 144)
-        self._last = (jacobian.copy(), sums)
-        return self.scatter_sums(sums, shift)
+        return sums
+
+    def interface_sums(self, jacobian) -> np.ndarray:
+        """(K, 144): every interface's ``sum_v C_v J_v C_v^T`` (``C_v`` the vertex's
+        coefficients in both blocks' rows), as the one product ``[C_1 .. C_n] [J_1 C_1^T;
+        ..; J_n C_n^T]`` per interface of ``n`` vertices, stacked over the interfaces
+        with as many vertices (:attr:`groups`): no per-vertex 12 x 12 products to sum."""
+        right = np.matmul(jacobian, self._coefficients_t)  # (IV, width, 12)
+        sums = np.zeros((self.n_interfaces, 12, 12))
+        for faces, vertices, left in self.groups:
+            sums[faces] = np.matmul(left, right[vertices].reshape(len(faces), -1, 12))
+        return sums.reshape(-1, 144)
+
+    @functools.cached_property
+    def groups(self):
+        """Per vertex count ``n``: the interfaces with ``n`` vertices ((F,) int), their
+        vertices ((F, n) int) and the vertices' coefficients side by side ((F, 12,
+        n width) float)."""
+        out = []
+        for faces, vertices in vertex_groups(self.vertex_interface):
+            left = self.coefficients[vertices].transpose(0, 2, 1, 3)
+            out.append((faces, vertices, np.ascontiguousarray(left).reshape(
+                len(faces), 12, -1)))
+        return out
 
     def scatter_sums(self, sums, shift):
         """Stored blocks of the Newton matrix with the interfaces' 12 x 12 blocks
@@ -330,6 +369,19 @@ class NewtonSystem:
         (the projection of ``H^-1 w`` onto K, in the metric of H)."""
         x, _ = self.project(w)
         return np.sqrt(np.sum(self.h * x * x, axis=1))
+
+
+def vertex_groups(vertex_interface):
+    """The interfaces grouped by vertex count ``n``: per count, the interfaces ((F,) int)
+    and their vertices ((F, n) int), for one stacked product per count."""
+    order = np.argsort(vertex_interface, kind="stable")
+    counts = np.bincount(vertex_interface)
+    groups = []
+    for count in np.unique(counts[counts > 0]):
+        faces = np.flatnonzero(counts == count)
+        first = np.searchsorted(vertex_interface[order], faces)
+        groups.append((faces, order[first[:, None] + np.arange(count)]))
+    return groups
 
 
 @functools.cache
