@@ -7,25 +7,21 @@ and the source of the code that builds them, so a run that changes only ``mu``,
 """
 
 import dataclasses
+import functools
 import hashlib
 import json
 import logging
-import multiprocessing
 import pickle
-import signal
-import sys
 import threading
 import time
-import traceback
-from functools import cache
 from contextlib import contextmanager
 from importlib import metadata
 from pathlib import Path
 
 import masonry
-from masonry import __version__
+from masonry import __version__, forking
 from masonry.blocks import BLOCK_CLASSES
-from masonry.export import EXPORTERS, Export, RunOutputs
+from masonry.export import EXPORTERS, RunOutputs
 from masonry.params import Params, structure_id, validate
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.collapse import CollapseResult, collapse_load, worst_lateral
@@ -152,7 +148,7 @@ GEOMETRY_SOURCES = ("params.py", "tolerances.py", "blocks.py", "meshing.py", "in
 """The package's files (or folders) whose code decides a cached scene and model."""
 
 
-@cache
+@functools.cache
 def geometry_code_digest() -> str:
     """SHA-1 of the source of :data:`GEOMETRY_SOURCES`: part of the cache key, so an edited
     geometry stage never reuses a stale cache at the same version number.
@@ -513,8 +509,8 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
         Each exporter's time counts towards its stage.
     """
     wanted = [exporter for exporter in EXPORTERS if exporter.wanted(made)]
-    aside = [exporter for exporter in wanted if exporter.aside] if _can_fork() else []
-    with _Aside(aside, made) as second:
+    aside = [exporter for exporter in wanted if exporter.aside] if forking.can_fork() else []
+    with forking.Forked([functools.partial(e.make, made) for e in aside]) as second:
         for exporter in [e for e in wanted if e not in aside] + aside:
             with timer.stage(exporter.stage):
                 export = second.result() if exporter in aside else exporter.make(made)
@@ -522,93 +518,3 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
                     folder.write(relative, data)
             if export.record is not None:
                 record[exporter.name] = export.record
-
-
-def _can_fork() -> bool:
-    """Whether a second process can start as a copy of this one: fork exists and is safe
-    (not on macOS, whose system libraries do not survive it) and this process may have
-    children (a daemonic worker of a process pool may not)."""
-    return ("fork" in multiprocessing.get_all_start_methods() and sys.platform != "darwin"
-            and not multiprocessing.current_process().daemon)
-
-
-HELD_SIGNALS = {signal.SIGINT, signal.SIGTERM}
-"""The signals that end a run (Ctrl-C, ``kill``): held while the export process forks."""
-
-
-class _Aside:
-    """A forked process that makes ``exporters`` (in order) from ``made`` and sends each
-    :class:`~masonry.export.Export` back; :meth:`result` receives the next one. Forked, the
-    process shares ``made`` without copying or pickling it; it is ended on leaving the
-    ``with`` block (an error or an interrupt included)."""
-
-    def __init__(self, exporters, made):
-        self.exporters, self.made, self.process = exporters, made, None
-
-    def __enter__(self):
-        if not self.exporters:
-            return self
-        context = multiprocessing.get_context("fork")
-        self.receiver, sender = context.Pipe(duplex=False)
-        self.process = context.Process(target=_make_aside, daemon=True,
-                                       args=(self.exporters, self.made, self.receiver,
-                                             sender))
-        try:
-            # a signal during the fork would reach its handler inside the fork's own
-            # callbacks, which swallow the handler's exception: it waits for the fork
-            signal.pthread_sigmask(signal.SIG_BLOCK, HELD_SIGNALS)
-            try:
-                self.process.start()
-            finally:
-                signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD_SIGNALS)
-            sender.close()
-        except BaseException:  # interrupted as it started: no __exit__ follows
-            self.__exit__(*sys.exc_info())
-            raise
-        return self
-
-    def result(self) -> Export:
-        """The next exporter's files; its error, raised here, if it failed."""
-        try:
-            ok, value = self.receiver.recv()
-        except EOFError:
-            raise RuntimeError(f"the export process ended without its files (exit code "
-                               f"{self.process.exitcode})") from None
-        if not ok:
-            raise value
-        return value
-
-    def __exit__(self, kind, error, trace):
-        if self.process is None:
-            return False
-        if self.process.pid is not None:  # started
-            if kind is not None:  # this process failed or was interrupted: end it
-                self.process.terminate()
-            self.process.join()
-        self.receiver.close()
-        return False
-
-
-def _make_aside(exporters, made, receiver, sender):
-    """In the forked process: make each exporter's files and send them, or the error.
-    An interrupt or a terminate ends it without a word (the run's own handlers, copied
-    by the fork, are for the process that reports), and so does the end of the run that
-    forked it (its pipe breaks: this process holds no reading end of its own)."""
-    receiver.close()
-    for held in HELD_SIGNALS:
-        signal.signal(held, signal.SIG_DFL)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD_SIGNALS)
-    for exporter in exporters:
-        try:
-            outcome = (True, exporter.make(made))
-        except Exception as error:
-            outcome = (False, error)
-        try:
-            sender.send(outcome)
-        except OSError:  # the run ended without waiting for these files
-            return
-        except Exception:  # an error that does not pickle: its text
-            sender.send((False, RuntimeError(traceback.format_exc())))
-        if not outcome[0]:
-            return
-    sender.close()

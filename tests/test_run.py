@@ -100,7 +100,7 @@ def test_the_run_writes_what_the_registry_makes(wall_run):
 def test_plots_made_aside_equal_the_ones_made_here(monkeypatch, fork):
     """The plots and the 3DM file are made in a forked process where the platform forks
     (and here, in this process, where it does not): the PNGs are the same bytes."""
-    monkeypatch.setattr("masonry.pipeline._can_fork", lambda: fork)
+    monkeypatch.setattr("masonry.forking.can_fork", lambda: fork)
     made = wall_outputs(plots=True, printable=False)
     plots = [e for e in EXPORTERS if e.stage == "plots"]
     assert [e.aside for e in plots] == [True, False]  # the model's aside, the forces' here

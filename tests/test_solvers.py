@@ -7,12 +7,14 @@ measured by ``masonry bench``, never here.
 """
 
 import functools
+import logging
 
 import numpy as np
 import pytest
 
 import scipy.linalg
 
+from masonry import forking
 from masonry.studies.bench import (COLUMNS, bench, frontier_png, ratios, ratios_markdown,
                                    table_csv, table_markdown)
 from masonry.rbe.boundary import analysis_model
@@ -499,6 +501,64 @@ def test_a_feasible_dome_at_the_damping_ceiling_pays_no_load_path_lp():
     assert [(a["solver"], a["status"]) for a in result.attempts] == [("newton", "optimal")]
     assert result.feasible and result.verdict == "feasible"
     assert result.residual_eq <= 1e-9 and result.friction_violation <= 1e-9
+
+
+def _alongside(monkeypatch, on):
+    """Let friction+ run on the second core (``on``: as on any two-core Linux machine)
+    or never."""
+    monkeypatch.setattr(forking, "cores", lambda: 2)
+    if not on:
+        monkeypatch.setattr(solve_module._Alongside, "wanted", staticmethod(lambda *a: False))
+
+
+@pytest.mark.skipif(not forking.can_fork(), reason="friction+ alongside needs fork")
+def test_friction_plus_alongside_is_the_one_solved_after(monkeypatch, caplog):
+    """preset 2's dome with p = 3 at mu 0.05: Newton hands friction-net over to the
+    load-path LP, friction+ starts on the second core, and its result is the one this
+    process gets by solving friction+ after friction-net: the same attempts, MoI and
+    forces."""
+    m = model("2", scene="dome", p=3)
+    _alongside(monkeypatch, False)
+    after = problem(m).solve(mu=0.05, accuracy="balanced")
+    monkeypatch.undo()
+    _alongside(monkeypatch, True)
+    with caplog.at_level(logging.INFO, logger="masonry.rbe.solve"):
+        alongside = problem(m).solve(mu=0.05, accuracy="balanced")
+    assert "friction+ was solved on the second core" in caplog.text
+    assert alongside.verdict == after.verdict == "infeasible"
+    key = [(a["friction"], a["solver"], a["status"], a["iterations"]) for a in after.attempts]
+    assert [(a["friction"], a["solver"], a["status"], a["iterations"])
+            for a in alongside.attempts] == key
+    assert abs(alongside.moi - after.moi) <= 1e-12 * after.weight_N
+    np.testing.assert_allclose(alongside.x, after.x, rtol=0, atol=1e-12 * scale(after))
+
+
+@pytest.mark.skipif(not forking.can_fork(), reason="friction+ alongside needs fork")
+def test_friction_plus_alongside_failing_is_solved_here(monkeypatch, caplog):
+    m = model("2", scene="dome", p=3)
+    _alongside(monkeypatch, True)
+
+    def broken(self):
+        raise MemoryError("out of memory")  # raised in the forked process
+
+    monkeypatch.setattr(solve_module._Alongside, "_solve", broken)
+    with caplog.at_level(logging.INFO, logger="masonry.rbe.solve"):
+        result = problem(m).solve(mu=0.05, accuracy="balanced")
+    assert "friction+ on the second core failed (out of memory)" in caplog.text
+    assert result.verdict == "infeasible" and result.friction == "plus"
+    assert result.residual_eq <= 1e-9 and result.moi > 0
+
+
+def test_a_feasible_structure_solves_friction_net_alone(monkeypatch):
+    """A feasible section that Newton solves alone never starts friction+."""
+    _alongside(monkeypatch, True)
+
+    def start(self):
+        raise AssertionError("friction+ started beside a feasible structure")
+
+    monkeypatch.setattr(forking.Forked, "start", start)
+    result = problem(small("cyclic")).solve(mu=0.7, accuracy="balanced")
+    assert result.feasible and [a["solver"] for a in result.attempts] == ["newton"]
 
 
 # ---------------------------------------------------------------------- reuse

@@ -10,7 +10,9 @@ friction-net feasibility.
 
 :class:`RBEProblem` keeps one scene's matrices, symbolic factorizations and solver
 objects between solves, so a sweep over ``mu`` or ``density``, or friction+ after
-friction-net, does not start from scratch; :func:`solve_rbe` is one solve.
+friction-net, does not start from scratch; :func:`solve_rbe` is one solve. On a machine
+with a second core, when Newton neither solves nor certifies friction-net, friction+
+is solved there while the load-path LP decides friction-net (:class:`_Alongside`).
 """
 
 import dataclasses
@@ -22,6 +24,7 @@ import highspy
 import numpy as np
 import scipy.sparse as sp
 
+from masonry import forking
 from masonry.rbe.equilibrium import (FRICTION_METHODS, EquilibriumSystem, VariableLayout,
                                      assemble, friction_pyramid_edges)
 from masonry.rbe.solvers import BACKENDS, FAMILY, net_feasibility
@@ -313,16 +316,27 @@ class RBEProblem:
         preset, tol, lp_check = _settings(friction, solver, tol, accuracy, lp_check)
         system = self.system.with_material(mu=mu, density=density)
         attempts = []
-        for method in ("net", "plus") if friction == "auto" else (friction,):
-            log.info("solving friction-%s (mu %.3g, %d unknowns)", method, mu,
-                     system.layout.n_columns)
-            solved = self._solve_model(system, method, _candidates(method, solver, preset),
-                                       preset, tol, attempts)
-            if solved.accepted:
-                break
-            if method == "net" and friction == "auto":
-                log.info("friction-net has no solution (%s from %s): friction+ measures the "
-                         "tension needed", solved.outcome.status, solved.name)
+        alongside = (_Alongside(self, system, _candidates("plus", solver, preset), preset, tol)
+                     if _Alongside.wanted(friction, solver, preset) else None)
+        try:
+            for method in ("net", "plus") if friction == "auto" else (friction,):
+                solved = None
+                if method == "plus" and alongside is not None and alongside.started:
+                    solved = alongside.solved(attempts)
+                if solved is None:
+                    log.info("solving friction-%s (mu %.3g, %d unknowns)", method, mu,
+                             system.layout.n_columns)
+                    solved = self._solve_model(
+                        system, method, _candidates(method, solver, preset), preset, tol,
+                        attempts, before_lp=alongside.start if alongside else None)
+                if solved.accepted:
+                    break
+                if method == "net" and friction == "auto":
+                    log.info("friction-net has no solution (%s from %s): friction+ measures "
+                             "the tension needed", solved.outcome.status, solved.name)
+        finally:
+            if alongside is not None:
+                alongside.close()
         result = self._result(system, solved, tol, lp_check, lp_time_limit, accuracy,
                               attempts, friction)
         log.info("%s: %s, MoI factor %.4g, residual %.1e, %.2f s", result.solver,
@@ -330,13 +344,17 @@ class RBEProblem:
                  time.perf_counter() - start)
         return dataclasses.replace(result, time_s=time.perf_counter() - start)
 
-    def _solve_model(self, system, method, names, preset, tol, attempts) -> "_Solved":
+    def _solve_model(self, system, method, names, preset, tol, attempts,
+                     before_lp=None) -> "_Solved":
         """One friction model: the candidate solvers in turn until one returns an
         accepted point (polished if the preset says so) or certifies infeasibility.
-        Every QP solved is appended to ``attempts``."""
+        Every QP solved is appended to ``attempts``; ``before_lp`` (a callable) is
+        called when Newton hands friction-net over to the load-path LP."""
         outcome = None
         for index, name in enumerate(names):
             if name == LOAD_PATH:
+                if before_lp is not None:
+                    before_lp()
                 name, outcome = self._load_path(system, preset, tol, outcome, attempts)
             else:
                 # Newton hands over sooner when the load-path LP follows it
@@ -459,6 +477,67 @@ class _Solved:
     outcome: object
     checks: tuple | None
     accepted: bool
+
+
+class _Alongside:
+    """friction+ solved in a forked copy of this process, on the second core, while the
+    load-path LP decides friction-net in this one: started when Newton hands friction-net
+    over to the LP (it has neither solved nor certified it: most such structures are
+    infeasible), taken when friction-net has no solution, ended unused when it has one.
+    The two processes factor on one thread each meanwhile. The forked process solves
+    friction+ as this one would after friction-net (the same candidates from the same
+    state), so the result does not depend on where it was solved."""
+
+    def __init__(self, problem, system, names, preset, tol):
+        self.problem, self.system = problem, system
+        self.args = (system, "plus", names, preset, tol)
+        self.forked = forking.Forked([self._solve])
+        self.symbolic = None
+
+    @staticmethod
+    def wanted(friction, solver, preset) -> bool:
+        """Whether a solve may work on the second core: the thesis's flow with friction+
+        on the Newton system (not Clarabel's), a process that may fork, two cores."""
+        return (friction == "auto" and solver is None and preset.plus_solver == "interior"
+                and forking.can_fork() and forking.cores() >= 2)
+
+    @property
+    def started(self) -> bool:
+        return self.forked.started
+
+    def start(self):
+        """Start friction+ on the second core (once)."""
+        if self.started:
+            return
+        log.info("friction+ starts on the second core while the load-path LP decides "
+                 "friction-net")
+        self.symbolic = prepared_system(self.system, "net",
+                                        self.problem._workspace("newton")).symbolic
+        self.symbolic.limit_threads(1)
+        self.forked.start()
+
+    def _solve(self):
+        """In the forked process: friction+ and its attempts."""
+        logging.disable(logging.INFO)  # its progress would mix with this process's
+        attempts = []
+        return self.problem._solve_model(*self.args, attempts), attempts
+
+    def solved(self, attempts):
+        """friction+ from the second core, its attempts appended to ``attempts``; None
+        if it failed (this process then solves it)."""
+        try:
+            solved, theirs = self.forked.result()
+        except Exception as error:
+            log.warning("friction+ on the second core failed (%s); solving it here", error)
+            return None
+        log.info("friction+ was solved on the second core")
+        attempts.extend(theirs)
+        return solved
+
+    def close(self):
+        self.forked.close(cancel=True)
+        if self.symbolic is not None:
+            self.symbolic.limit_threads(None)
 
 
 WORKSPACE = {"interior": "newton"}

@@ -289,6 +289,7 @@ class BlockCholesky:
         self._scalar_order = (bs * order[:, None] + np.arange(bs)).ravel()
         self._front_buffers = []
         self._schedule = None
+        self._threads = None  # FACTOR_THREADS
         self._steps = self._numeric_plan()
 
         self.flops = 0.0
@@ -461,6 +462,12 @@ class BlockCholesky:
         return self.position[np.asarray(i)] < self.position[np.asarray(j)]
 
     # ------------------------------------------------------------------ numeric
+    def limit_threads(self, threads=None):
+        """Factor on at most ``threads`` threads from now on (None: :data:`FACTOR_THREADS`),
+        e.g. one while another process works on the second core."""
+        self._threads = threads
+        self._schedule = None
+
     def factor(self, values) -> "BlockFactor":
         """Numeric Cholesky factorization.
 
@@ -513,7 +520,8 @@ class BlockCholesky:
         for s, sn in enumerate(self.supernodes):  # postorder: children first
             if sn.parent >= 0:
                 subtree[sn.parent] += subtree[s]
-        threads = min(FACTOR_THREADS, len(os.sched_getaffinity(0)))
+        threads = FACTOR_THREADS if self._threads is None else self._threads
+        threads = min(threads, len(os.sched_getaffinity(0)))
         if threads < 2 or work.sum() < PARALLEL_FLOPS:
             return [], range(n)
         share = work.sum() / threads
