@@ -217,10 +217,11 @@ def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_upda
 @pytest.mark.parametrize("parallel", [False, True])
 def test_batched_leaves_factor_and_solve_as_the_dense_cholesky(monkeypatch, parallel):
     # leaves of one shape are factored and solved as one stack: on a 10 x 10 grid with
-    # diagonals (AMD), groups of 1, 2, 3 and 8 block columns; the factor, solves of one
-    # and of several right-hand sides against scipy's dense results, and a leaf that is
-    # not positive definite must stop the factorization
-    monkeypatch.setattr(cholesky, "BATCH_LEAVES", 2)
+    # diagonals (AMD), every leaf batched, stacks of 1 to 3 leaves of 1, 2, 3 and 8
+    # block columns; the factor, solves of one and of several right-hand sides against
+    # scipy's dense results, and a leaf that is not positive definite must stop the
+    # factorization
+    monkeypatch.setattr(cholesky, "BATCH_LEAVES", 0)
     monkeypatch.setattr(cholesky, "PARALLEL_FLOPS", 0.0 if parallel else np.inf)
     n, bs = 100, 3
     grid = ([(i, i + 1) for i in range(n - 1) if (i + 1) % 10]
@@ -228,7 +229,8 @@ def test_batched_leaves_factor_and_solve_as_the_dense_cholesky(monkeypatch, para
             + [(i, i + 11) for i in range(n - 11) if (i + 1) % 10])
     sym = BlockCholesky(n, np.array(grid), block_size=bs, ordering="amd")
     shapes = [(group.k, len(group.supernodes)) for group in sym._leaf_groups]
-    assert {k for k, _ in shapes} >= {3, 6, 9, 24} and min(g for _, g in shapes) >= 2
+    assert {k for k, _ in shapes} >= {3, 6, 9, 24} and max(g for _, g in shapes) >= 3
+    assert sym._batched.sum() == sum(not children for children in sym._children)
     values, dense = _random_spd_blocks(sym, np.random.default_rng(3), shift=0.3)
     order = sym._scalar_order
     expected = scipy.linalg.cholesky(dense[np.ix_(order, order)], lower=True)

@@ -76,10 +76,11 @@ precomputed flat positions, larger ones by runs of consecutive columns (the fast
 of 60, 120, 240 and 480 on preset 1's full dome; ``docs/bench.md``)."""
 
 
-BATCH_LEAVES = 4
+BATCH_LEAVES = 2
 """Leaf supernodes (no children, an update of at most :data:`SMALL_UPDATE` rows) with
 the same pivot columns and front size are factored and solved as one stack when at
-least this many share the shape (``docs/bench.md``, "Batched leaves")."""
+least this many per pivot block column share the shape (a stack steps through its
+pivot columns one by one; ``docs/bench.md``, "Batched leaves of the sparse Cholesky")."""
 
 
 FACTOR_THREADS = 2
@@ -470,8 +471,9 @@ class BlockCholesky:
 
     def _leaf_plan(self):
         """The leaf supernodes batched by shape (:class:`_LeafGroup`, at least
-        :data:`BATCH_LEAVES` of a shape). A leaf's front holds only its own stored
-        blocks, all in its pivot columns (its lower right part is zero: no children)."""
+        :data:`BATCH_LEAVES` of a shape per pivot block column). A leaf's front holds
+        only its own stored blocks, all in its pivot columns (its lower right part is
+        zero: no children)."""
         by_shape = {}
         for s, (size, k, _, _, children, extend, _) in enumerate(self._steps):
             if not children and isinstance(extend, _AddAt):
@@ -479,7 +481,7 @@ class BlockCholesky:
         entry = self.block_size ** 2
         groups = []
         for (k, size), members in sorted(by_shape.items()):
-            if len(members) < BATCH_LEAVES:
+            if len(members) * self.block_size < BATCH_LEAVES * k:
                 continue
             steps = [self._steps[s] for s in members]
             values = np.concatenate([np.arange(entry * step[2].start, entry * step[2].stop)
@@ -613,14 +615,16 @@ class BlockCholesky:
             if j:
                 l21t[:, j] -= (l11[:, j, None, :j] @ l21t[:, :j])[:, 0]
             l21t[:, j] /= l11[:, j, j, None]
-        # the update F22 - L21 L21^T (F22 is zero in a leaf), its lower triangle
-        product = l21t.transpose(0, 2, 1) @ l21t
+        # the update F22 - L21 L21^T (F22 is zero in a leaf), its lower triangle; numpy
+        # multiplies stacks by BLAS when the first factor is contiguous
+        l21 = np.ascontiguousarray(l21t.transpose(0, 2, 1))
+        product = l21 @ l21t
         j, i = _lower_triangle(size - k)
         lower = np.take(product.reshape(len(product), -1), j * (size - k) + i, axis=1)
         np.negative(lower, out=lower)
         for s, update in zip(group.supernodes.tolist(), lower):
             updates[s] = update
-        return l11, l21t.transpose(0, 2, 1)
+        return l11, l21
 
     def _subtree_members(self, roots):
         """Every supernode under ``roots`` (themselves included), in postorder."""
