@@ -32,6 +32,16 @@ Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1
    pivot block, form the update for the parent. LAPACK and BLAS are called through
    ctypes, which frees the GIL while they run, so that independent subtrees of the
    elimination tree are factored on two threads at the same time.
+4. Leaves of the supernodal tree in stacks: most supernodes of a dome's Newton matrix
+   are leaves with small fronts (there the Python-level steps of a front, not its
+   arithmetic, are the cost), and many share a shape (pivot columns, front size). A
+   stack of them is factored at once, before the threads start: one fancy-index
+   assembly of their pivot columns (a leaf has no children, so the rest of its front
+   is zero), numpy's stacked Cholesky of the pivot blocks, the panels by forward
+   substitution one pivot column at a time (a triangular solve, no inverse), and the
+   updates by one stacked product. The triangular solves take a stack's forward
+   substitution first and its backward substitution last, the rows below its leaves
+   summed by ``np.subtract.at`` (leaves share rows, never columns).
 """
 
 import ctypes
