@@ -231,6 +231,9 @@ def test_batched_leaves_factor_and_solve_as_the_dense_cholesky(monkeypatch, para
     shapes = [(group.k, len(group.supernodes)) for group in sym._leaf_groups]
     assert {k for k, _ in shapes} >= {3, 6, 9, 24} and max(g for _, g in shapes) >= 3
     assert sym._batched.sum() == sum(not children for children in sym._children)
+    if parallel:  # the stacks first, then the other supernodes on two threads
+        threads, top = sym._parallel_schedule()
+        assert len(threads) == 2 and not any(sym._batched[s] for s in sum(threads, top))
     values, dense = _random_spd_blocks(sym, np.random.default_rng(3), shift=0.3)
     order = sym._scalar_order
     expected = scipy.linalg.cholesky(dense[np.ix_(order, order)], lower=True)
