@@ -221,12 +221,13 @@ class _AddRuns(NamedTuple):
 
 
 class _LeafGroup(NamedTuple):
-    """Leaf supernodes of one shape, factored and solved as one stack of ``G``: their
-    pivot columns ``k`` (scalar), front size ``size``; where their stored entries are
-    in the values passed to :meth:`BlockCholesky.factor` (``values``) and in the stacked
-    panels, ``(G, k, size)`` C order, i.e. each front's first ``k`` columns column-major
-    (``positions``); their scalar columns ``(G, k)`` and rows below ``(G, size - k)``,
-    in the factor's order."""
+    """``G`` leaf supernodes of one shape (``k`` pivot columns, fronts of ``size``),
+    factored and solved as one stack. ``values``: where their stored entries are in
+    the values :meth:`BlockCholesky.factor` reorders; ``positions``: where they go in
+    the stack of the fronts' first ``k`` columns, flat ``(G, k, size)`` (each front
+    column-major, as in :meth:`BlockCholesky._numeric_plan`); ``columns`` ``(G, k)`` and
+    ``rows`` ``(G, size - k)``: their scalar columns and the rows below them, in the
+    factor's order."""
     supernodes: np.ndarray
     k: int
     size: int
@@ -530,7 +531,8 @@ class BlockCholesky:
     def factor(self, values) -> "BlockFactor":
         """Numeric Cholesky factorization.
 
-        Independent subtrees of the supernodal elimination tree are factored on
+        The stacks of leaves (:data:`BATCH_LEAVES`) come first. Then independent
+        subtrees of the supernodal elimination tree are factored on
         :data:`FACTOR_THREADS` threads when the factorization is large enough
         (:data:`PARALLEL_FLOPS`): LAPACK and BLAS run without the GIL, and each thread
         works on its own fronts; the supernodes above the subtrees follow on one thread.
@@ -717,7 +719,8 @@ class BlockFactor:
         else:
             forward = functools.partial(blas.dtrsm, 1.0, lower=1)
             backward = functools.partial(blas.dtrsm, 1.0, lower=1, trans_a=1)
-        # one tuple per supernode: its columns, the rows below them, L11, L21
+        # one tuple per supernode outside the stacks: (its columns, the rows below
+        # them), L11, L21
         plan = [(sym._solve_slices[s], self._pivots[s], self._below[s])
                 for s in sym._one_by_one]
         stacked = x.reshape(len(x), -1)  # a view: columns of the right-hand sides
