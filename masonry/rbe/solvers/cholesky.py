@@ -32,6 +32,16 @@ Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1
    pivot block, form the update for the parent. LAPACK and BLAS are called through
    ctypes, which frees the GIL while they run, so that independent subtrees of the
    elimination tree are factored on two threads at the same time.
+4. Leaves of the supernodal tree in stacks: most supernodes of a dome's Newton matrix
+   are leaves with small fronts (there the Python-level steps of a front, not its
+   arithmetic, are the cost), and many share a shape (pivot columns, front size). A
+   stack of them is factored at once, before the threads start: one fancy-index
+   assembly of their pivot columns (a leaf has no children, so the rest of its front
+   is zero), numpy's stacked Cholesky of the pivot blocks, the panels by forward
+   substitution one pivot column at a time (a triangular solve, no inverse), and the
+   updates by one stacked product. The triangular solves take a stack's forward
+   substitution first and its backward substitution last, the rows below its leaves
+   summed by ``np.subtract.at`` (leaves share rows, never columns).
 """
 
 import ctypes
@@ -74,6 +84,13 @@ SMALL_UPDATE = 120
 """Update matrices up to this size are added to their parent's front by one add at
 precomputed flat positions, larger ones by runs of consecutive columns (the fastest
 of 60, 120, 240 and 480 on preset 1's full dome; ``docs/bench.md``)."""
+
+
+BATCH_LEAVES = 2
+"""Leaf supernodes (no children, an update of at most :data:`SMALL_UPDATE` rows) with
+the same pivot columns and front size are factored and solved as one stack when at
+least this many per pivot block column share the shape (a stack steps through its
+pivot columns one by one; ``docs/bench.md``, "Batched leaves of the sparse Cholesky")."""
 
 
 FACTOR_THREADS = 2
@@ -203,6 +220,23 @@ class _AddRuns(NamedTuple):
     runs: tuple
 
 
+class _LeafGroup(NamedTuple):
+    """``G`` leaf supernodes of one shape (``k`` pivot columns, fronts of ``size``),
+    factored and solved as one stack. ``values``: where their stored entries are in
+    the values :meth:`BlockCholesky.factor` reorders; ``positions``: where they go in
+    the stack of the fronts' first ``k`` columns, flat ``(G, k, size)`` (each front
+    column-major, as in :meth:`BlockCholesky._numeric_plan`); ``columns`` ``(G, k)`` and
+    ``rows`` ``(G, size - k)``: their scalar columns and the rows below them, in the
+    factor's order."""
+    supernodes: np.ndarray
+    k: int
+    size: int
+    values: np.ndarray
+    positions: np.ndarray
+    columns: np.ndarray
+    rows: np.ndarray
+
+
 @dataclass(frozen=True, eq=False)
 class _Supernode:
     first: int          # first block column (in the factor's order)
@@ -291,6 +325,11 @@ class BlockCholesky:
         self._schedule = None
         self._threads = None  # FACTOR_THREADS
         self._steps = self._numeric_plan()
+        self._leaf_groups = self._leaf_plan()
+        self._batched = np.zeros(len(self.supernodes), dtype=bool)
+        for group in self._leaf_groups:
+            self._batched[group.supernodes] = True
+        self._one_by_one = np.flatnonzero(~self._batched).tolist()  # postorder
 
         self.flops = 0.0
         self.nnz = 0
@@ -442,6 +481,34 @@ class BlockCholesky:
                           extend, tuple(ctypes.c_int(n) for n in (k, size, size - k))))
         return steps
 
+    def _leaf_plan(self):
+        """The leaf supernodes batched by shape (:class:`_LeafGroup`, at least
+        :data:`BATCH_LEAVES` of a shape per pivot block column). A leaf's front holds
+        only its own stored blocks, all in its pivot columns (its lower right part is
+        zero: no children)."""
+        by_shape = {}
+        for s, (size, k, _, _, children, extend, _) in enumerate(self._steps):
+            if not children and isinstance(extend, _AddAt):
+                by_shape.setdefault((k, size), []).append(s)
+        entry = self.block_size ** 2
+        groups = []
+        for (k, size), members in sorted(by_shape.items()):
+            if len(members) * self.block_size < BATCH_LEAVES * k:
+                continue
+            steps = [self._steps[s] for s in members]
+            values = np.concatenate([np.arange(entry * step[2].start, entry * step[2].stop)
+                                     for step in steps])
+            # a leaf's stored entries are in its first k columns: flat positions in
+            # the front (column-major) are positions in its panel of k columns
+            positions = np.concatenate([g * k * size + step[3]
+                                        for g, step in enumerate(steps)])
+            columns = np.array([np.arange(self._solve_slices[s][0].start,
+                                          self._solve_slices[s][0].stop) for s in members])
+            rows = np.array([self._solve_slices[s][1] for s in members])
+            groups.append(_LeafGroup(np.array(members), k, size, values, positions,
+                                     columns, rows))
+        return groups
+
     def block_index(self, i, j) -> np.ndarray:
         """Index into :attr:`lower_rows` of the stored block holding ``(i, j)``.
 
@@ -471,7 +538,8 @@ class BlockCholesky:
     def factor(self, values) -> "BlockFactor":
         """Numeric Cholesky factorization.
 
-        Independent subtrees of the supernodal elimination tree are factored on
+        The stacks of leaves (:data:`BATCH_LEAVES`) come first. Then independent
+        subtrees of the supernodal elimination tree are factored on
         :data:`FACTOR_THREADS` threads when the factorization is large enough
         (:data:`PARALLEL_FLOPS`): LAPACK and BLAS run without the GIL, and each thread
         works on its own fronts; the supernodes above the subtrees follow on one thread.
@@ -493,6 +561,8 @@ class BlockCholesky:
         if self._schedule is None:
             self._schedule = self._parallel_schedule()
         bins, top = self._schedule
+        leaves = [self._factor_leaves(group, values, state[0])
+                  for group in self._leaf_groups]
         if len(bins) > 1:
             with ThreadPoolExecutor(max_workers=len(bins) - 1) as pool:
                 others = [pool.submit(self._factor_steps, part, values, state, k + 1)
@@ -501,9 +571,9 @@ class BlockCholesky:
                 for other in others:
                     other.result()
         else:
-            top = range(n)
+            top = self._one_by_one
         self._factor_steps(top, values, state, 0)
-        return BlockFactor(self, state[1], state[2])
+        return BlockFactor(self, state[1], state[2], leaves)
 
     def _parallel_schedule(self):
         """Subtrees for the threads: (one list of supernodes per thread, in postorder;
@@ -539,8 +609,42 @@ class BlockCholesky:
             k = int(np.argmin(load))
             load[k] += subtree[s]
             bins[k].append(s)
-        members = [self._subtree_members(roots) for roots in bins]
+        # the batched leaves are factored before the threads start
+        members = [[s for s in self._subtree_members(roots) if not self._batched[s]]
+                   for roots in bins]
         return members, sorted(top)
+
+    def _factor_leaves(self, group, values, updates):
+        """Factor the leaves of ``group`` as one stack; their updates into ``updates``
+        (each the lower triangle, column by column, as :class:`_AddAt` adds it).
+
+        Returns (L11, L21): the stacked pivot blocks ``(G, k, k)`` and the panels below
+        them ``(G, size - k, k)``."""
+        k, size = group.k, group.size
+        panel = np.zeros(len(group.supernodes) * k * size)
+        panel[group.positions] = values[group.values]
+        panel = panel.reshape(-1, k, size)  # (G, k, size): the fronts' columns, transposed
+        try:  # reads the lower triangles only
+            l11 = np.linalg.cholesky(panel[:, :, :k].transpose(0, 2, 1))
+        except np.linalg.LinAlgError:
+            raise np.linalg.LinAlgError(
+                f"matrix not positive definite (a leaf among supernodes "
+                f"{group.supernodes.tolist()})") from None
+        l21t = panel[:, :, k:]  # F21^T, then L21^T = L11^-1 F21^T row by row
+        for j in range(k):
+            if j:
+                l21t[:, j] -= (l11[:, j, None, :j] @ l21t[:, :j])[:, 0]
+            l21t[:, j] /= l11[:, j, j, None]
+        # the update F22 - L21 L21^T (F22 is zero in a leaf), its lower triangle; numpy
+        # multiplies stacks by BLAS when the first factor is contiguous
+        l21 = np.ascontiguousarray(l21t.transpose(0, 2, 1))
+        product = l21 @ l21t
+        j, i = _lower_triangle(size - k)
+        lower = np.take(product.reshape(len(product), -1), j * (size - k) + i, axis=1)
+        np.negative(lower, out=lower)
+        for s, update in zip(group.supernodes.tolist(), lower):
+            updates[s] = update
+        return l11, l21
 
     def _subtree_members(self, roots):
         """Every supernode under ``roots`` (themselves included), in postorder."""
@@ -604,10 +708,11 @@ class BlockCholesky:
 class BlockFactor:
     """A numeric factorization ``P M P^T = L L^T``; :meth:`solve` applies ``M^-1``."""
 
-    def __init__(self, symbolic: BlockCholesky, pivots, below):
+    def __init__(self, symbolic: BlockCholesky, pivots, below, leaves):
         self.symbolic = symbolic
-        self._pivots = pivots
-        self._below = below
+        self._pivots = pivots    # per supernode: L11 (Fortran order), None if batched
+        self._below = below      # per supernode: L21, None if batched or a root
+        self._leaves = leaves    # per leaf group: stacked (L11, L21)
 
     def solve(self, rhs) -> np.ndarray:
         """``M^-1 rhs`` for ``rhs`` of shape (n,) or (n, k), n = nodes x block size."""
@@ -622,19 +727,49 @@ class BlockFactor:
         else:
             forward = functools.partial(blas.dtrsm, 1.0, lower=1)
             backward = functools.partial(blas.dtrsm, 1.0, lower=1, trans_a=1)
-        # one tuple per supernode: its columns, the rows below them, L11, L21
-        plan = [(c, r, p, b) for (c, r), p, b in zip(sym._solve_slices, self._pivots,
-                                                    self._below)]
-        for columns, rows, pivot, below in plan:
+        # one tuple per supernode outside the stacks: (its columns, the rows below
+        # them), L11, L21
+        plan = [(sym._solve_slices[s], self._pivots[s], self._below[s])
+                for s in sym._one_by_one]
+        stacked = x.reshape(len(x), -1)  # a view: columns of the right-hand sides
+        for group, (l11, l21) in zip(sym._leaf_groups, self._leaves):
+            _forward_leaves(stacked, group, l11, l21)
+        for (columns, rows), pivot, below in plan:
             xs = forward(pivot, x[columns])
             x[columns] = xs
             if below is not None:
                 x[rows] -= below @ xs
-        for columns, rows, pivot, below in reversed(plan):
+        for (columns, rows), pivot, below in reversed(plan):
             v = x[columns]
             if below is not None:
                 v = v - below.T @ x[rows]
             x[columns] = backward(pivot, v)
+        for group, (l11, l21) in zip(sym._leaf_groups, self._leaves):
+            _backward_leaves(stacked, group, l11, l21)
         out = np.empty_like(x)
         out[order] = x
         return out
+
+
+def _forward_leaves(x, group, l11, l21):
+    """Forward substitution of a group of leaves (:class:`_LeafGroup`) on ``x`` (n, m),
+    in place: their columns by ``L11 xs = x``, then the rows below them less ``L21 xs``
+    (rows of different leaves overlap: summed by ``np.subtract.at``)."""
+    xs = x[group.columns]  # (G, k, m)
+    for j in range(group.k):
+        if j:
+            xs[:, j] -= (l11[:, j, None, :j] @ xs[:, :j])[:, 0]
+        xs[:, j] /= l11[:, j, j, None]
+    x[group.columns] = xs
+    np.subtract.at(x, group.rows, l21 @ xs)
+
+
+def _backward_leaves(x, group, l11, l21):
+    """Backward substitution of a group of leaves on ``x`` (n, m), in place:
+    ``L11^T xs = x - L21^T x_below`` on their columns (the rows below are final)."""
+    xs = x[group.columns] - l21.transpose(0, 2, 1) @ x[group.rows]
+    for j in reversed(range(group.k)):
+        if j < group.k - 1:
+            xs[:, j] -= (l11[:, None, j + 1:, j] @ xs[:, j + 1:])[:, 0]
+        xs[:, j] /= l11[:, j, j, None]
+    x[group.columns] = xs
