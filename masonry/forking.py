@@ -7,6 +7,7 @@ exporters use it (the 3DM file and the plots beside the other files) and so does
 rigid block equilibrium (friction+ beside friction-net, :mod:`masonry.rbe.solve`).
 """
 
+import ctypes
 import multiprocessing
 import os
 import signal
@@ -15,6 +16,9 @@ import traceback
 
 HELD_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 """The signals that end a run (Ctrl-C, ``kill``): held while the process forks."""
+
+PR_SET_PDEATHSIG = 1
+"""Linux ``prctl`` option: the signal a process gets when its parent ends (prctl.h)."""
 
 
 def can_fork() -> bool:
@@ -26,8 +30,11 @@ def can_fork() -> bool:
 
 
 def cores() -> int:
-    """The cores this process may run on."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else 1
+    """The cores this process may run on (all of the machine's where the system does
+    not say: macOS, Windows)."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
 
 
 class Forked:
@@ -37,7 +44,8 @@ class Forked:
     or an interrupt); :meth:`start` and :meth:`close` do the same by hand.
 
     The process stops at the first call that raises: :meth:`result` raises that error
-    (its text, if it does not pickle) here.
+    here (a :class:`RuntimeError` with its traceback when it does not pickle). On Linux
+    the process ends with the one that forked it, even when that one is killed.
     """
 
     def __init__(self, calls):
@@ -45,13 +53,13 @@ class Forked:
 
     @property
     def started(self) -> bool:
-        return self.process is not None
+        return self.process is not None and self.process.pid is not None
 
     def start(self) -> "Forked":
         context = multiprocessing.get_context("fork")
         self.receiver, sender = context.Pipe(duplex=False)
         self.process = context.Process(target=_serve, daemon=True,
-                                       args=(self.calls, self.receiver, sender))
+                                       args=(self.calls, self.receiver, sender, os.getpid()))
         try:
             # a signal during the fork would reach its handler inside the fork's own
             # callbacks, which swallow the handler's exception: it waits for the fork
@@ -71,8 +79,12 @@ class Forked:
         try:
             ok, value = self.receiver.recv()
         except EOFError:
+            self.process.join()
             raise RuntimeError(f"the forked process ended without its result (exit code "
                                f"{self.process.exitcode})") from None
+        except Exception as error:  # pickled there, but does not unpickle here
+            raise RuntimeError(f"the forked process's result does not unpickle: "
+                               f"{type(error).__name__}: {error}") from None
         if not ok:
             raise value
         return value
@@ -95,15 +107,20 @@ class Forked:
         return False
 
 
-def _serve(calls, receiver, sender):
+def _serve(calls, receiver, sender, parent):
     """In the forked process: make each call and send its result, or its error. An
     interrupt or a terminate ends it without a word (the handlers copied by the fork
     are for the process that reports), and so does the end of the process that forked
-    it (its pipe breaks: this process holds no reading end of its own)."""
+    it: on Linux the kernel kills it then (``PR_SET_PDEATHSIG``), elsewhere its next
+    send finds the pipe broken."""
     receiver.close()
     for held in HELD_SIGNALS:
         signal.signal(held, signal.SIG_DFL)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD_SIGNALS)
+    if sys.platform.startswith("linux"):
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL)
+        if os.getppid() != parent:  # it died before the request
+            os._exit(1)
     for call in calls:
         try:
             outcome = (True, call())
@@ -113,8 +130,10 @@ def _serve(calls, receiver, sender):
             sender.send(outcome)
         except OSError:  # the process that forked this one did not wait for it
             return
-        except Exception:  # an error or a result that does not pickle: its text
-            sender.send((False, RuntimeError(traceback.format_exc())))
+        except Exception:  # an error or a result that does not pickle: the text
+            error = outcome[1] if not outcome[0] else sys.exception()
+            text = "".join(traceback.format_exception(error))
+            sender.send((False, RuntimeError(f"in the forked process:\n{text}")))
             return
         if not outcome[0]:
             return

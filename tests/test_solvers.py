@@ -505,14 +505,23 @@ def test_the_balanced_preset_certifies_by_the_load_path_lp():
     np.testing.assert_allclose(result.x, reference.x, rtol=0, atol=1e-8 * scale(reference))
 
 
-def test_a_feasible_load_path_verdict_resumes_newton(monkeypatch):
+def test_a_feasible_load_path_verdict_resumes_newton(monkeypatch, caplog):
     # Newton made to stall after one step without halving: the LP finds friction-net
-    # feasible, Newton resumes and finds Clarabel's optimum
+    # feasible, Newton resumes and finds Clarabel's optimum; friction+, started on the
+    # second core at the hand-over, is ended unused and the factorization gets its
+    # threads back
     monkeypatch.setattr(solve_module, "LOAD_PATH_STALL", 1)
+    monkeypatch.setattr(forking, "cores", lambda: 2)
     # separate problems: Clarabel's Newton polish would warm-start the balanced solve
     reference = problem(small("cyclic")).solve(mu=0.5, solver="clarabel",
                                                accuracy="accurate")
-    result = problem(small("cyclic")).solve(mu=0.5, accuracy="balanced")
+    prepared = problem(small("cyclic"))
+    with caplog.at_level(logging.INFO, logger="masonry.rbe.solve"):
+        result = prepared.solve(mu=0.5, accuracy="balanced")
+    if forking.can_fork():
+        assert "friction+ starts on the second core" in caplog.text
+    assert "friction+ was solved" not in caplog.text
+    assert _factor_threads(prepared) is None
     assert [(a["solver"], a["status"]) for a in result.attempts] == [
         ("newton", "user_limit"), (LOAD_PATH, "user_limit"), ("newton", "optimal")]
     assert result.verdict == reference.verdict == "feasible"
@@ -555,6 +564,11 @@ def test_a_feasible_dome_at_the_damping_ceiling_pays_no_load_path_lp():
     assert result.residual_eq <= 1e-9 and result.friction_violation <= 1e-9
 
 
+def _factor_threads(prepared):
+    """The thread limit of a solved problem's factorization (None: the default)."""
+    return prepared._workspaces["newton"]["systems"]["net"].symbolic._threads
+
+
 def _alongside(monkeypatch, on):
     """Let friction+ run on the second core (``on``: as on any two-core Linux machine)
     or never."""
@@ -574,9 +588,11 @@ def test_friction_plus_alongside_is_the_one_solved_after(monkeypatch, caplog):
     after = problem(m).solve(mu=0.05, accuracy="balanced")
     monkeypatch.undo()
     _alongside(monkeypatch, True)
+    prepared = problem(m)
     with caplog.at_level(logging.INFO, logger="masonry.rbe.solve"):
-        alongside = problem(m).solve(mu=0.05, accuracy="balanced")
+        alongside = prepared.solve(mu=0.05, accuracy="balanced")
     assert "friction+ was solved on the second core" in caplog.text
+    assert _factor_threads(prepared) is None
     assert alongside.verdict == after.verdict == "infeasible"
     key = [(a["friction"], a["solver"], a["status"], a["iterations"]) for a in after.attempts]
     assert [(a["friction"], a["solver"], a["status"], a["iterations"])
@@ -586,19 +602,32 @@ def test_friction_plus_alongside_is_the_one_solved_after(monkeypatch, caplog):
 
 
 @pytest.mark.skipif(not forking.can_fork(), reason="friction+ alongside needs fork")
-def test_friction_plus_alongside_failing_is_solved_here(monkeypatch, caplog):
+@pytest.mark.parametrize("where", ["in the forked process", "at the fork"])
+def test_friction_plus_alongside_failing_is_solved_here(monkeypatch, caplog, where):
     m = model("2", scene="dome", p=3)
+    _alongside(monkeypatch, False)
+    after = problem(m).solve(mu=0.05, accuracy="balanced")
+    monkeypatch.undo()
     _alongside(monkeypatch, True)
 
-    def broken(self):
-        raise MemoryError("out of memory")  # raised in the forked process
+    def broken(*args):
+        raise MemoryError("out of memory")
 
-    monkeypatch.setattr(solve_module._Alongside, "_solve", broken)
+    def no_fork(self):
+        raise OSError(12, "Cannot allocate memory")
+
+    if where == "at the fork":
+        monkeypatch.setattr(forking.Forked, "start", no_fork)
+    else:
+        monkeypatch.setattr(solve_module._Alongside, "_solve", broken)
+    prepared = problem(m)
     with caplog.at_level(logging.INFO, logger="masonry.rbe.solve"):
-        result = problem(m).solve(mu=0.05, accuracy="balanced")
-    assert "friction+ on the second core failed (out of memory)" in caplog.text
+        result = prepared.solve(mu=0.05, accuracy="balanced")
+    assert ("cannot start on the second core" if where == "at the fork"
+            else "friction+ on the second core failed (out of memory)") in caplog.text
     assert result.verdict == "infeasible" and result.friction == "plus"
-    assert result.residual_eq <= 1e-9 and result.moi > 0
+    assert abs(result.moi - after.moi) <= 1e-12 * after.weight_N
+    assert _factor_threads(prepared) is None
 
 
 def test_a_feasible_structure_solves_friction_net_alone(monkeypatch):

@@ -484,9 +484,11 @@ class _Alongside:
     load-path LP decides friction-net in this one: started when Newton hands friction-net
     over to the LP (it has neither solved nor certified it: most such structures are
     infeasible), taken when friction-net has no solution, ended unused when it has one.
-    The two processes factor on one thread each meanwhile. The forked process solves
-    friction+ as this one would after friction-net (the same candidates from the same
-    state), so the result does not depend on where it was solved."""
+    Both factor on one thread from the start, the forked one to its end (two threads
+    gain little at the sizes measured: docs/bench.md, "Batched leaves"). The forked
+    process solves friction+ as this one would after friction-net (the same candidates
+    from the same state), so the result does not depend on where it was solved; if it
+    cannot start or fails, this process solves friction+ (with a warning)."""
 
     def __init__(self, problem, system, names, preset, tol):
         self.problem, self.system = problem, system
@@ -514,7 +516,12 @@ class _Alongside:
         self.symbolic = prepared_system(self.system, "net",
                                         self.problem._workspace("newton")).symbolic
         self.symbolic.limit_threads(1)
-        self.forked.start()
+        try:
+            self.forked.start()
+        except OSError as error:  # no memory or processes left for a fork
+            log.warning("friction+ cannot start on the second core (%s); it is solved "
+                        "here after friction-net", error)
+            self.close()
 
     def _solve(self):
         """In the forked process: friction+ and its attempts."""
@@ -529,15 +536,20 @@ class _Alongside:
             solved, theirs = self.forked.result()
         except Exception as error:
             log.warning("friction+ on the second core failed (%s); solving it here", error)
+            self.close()
             return None
         log.info("friction+ was solved on the second core")
         attempts.extend(theirs)
         return solved
 
     def close(self):
-        self.forked.close(cancel=True)
-        if self.symbolic is not None:
-            self.symbolic.limit_threads(None)
+        """End the forked process (if it still runs) and give the factorization its
+        threads back."""
+        try:
+            self.forked.close(cancel=True)
+        finally:
+            if self.symbolic is not None:
+                self.symbolic.limit_threads(None)
 
 
 WORKSPACE = {"interior": "newton"}

@@ -47,7 +47,6 @@ Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1
 import ctypes
 import functools
 import logging
-import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -55,6 +54,8 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import blas, cython_blas, cython_lapack
+
+from masonry import forking
 
 try:  # wheels for Linux and macOS only (pyproject.toml); elsewhere AMD orders every graph
     import pymetis
@@ -591,7 +592,7 @@ class BlockCholesky:
             if sn.parent >= 0:
                 subtree[sn.parent] += subtree[s]
         threads = FACTOR_THREADS if self._threads is None else self._threads
-        threads = min(threads, len(os.sched_getaffinity(0)))
+        threads = min(threads, forking.cores())
         if threads < 2 or work.sum() < PARALLEL_FLOPS:
             return [], range(n)
         share = work.sum() / threads

@@ -65,7 +65,7 @@ COMPONENTS = {method: tuple(VariableLayout.COMPONENTS.index(name) for name in na
 TENSION = VariableLayout.COMPONENTS.index("t")
 
 VERTEX_CHUNK = 32768
-"""Vertices per stacked product when updating Newton matrices (bounds the buffers)."""
+"""Vertices per stacked product when forming Newton matrices (bounds the buffers)."""
 
 INCREMENTAL_SHARE = 0.5
 """A Newton matrix is updated vertex by vertex when at most this share of the vertices
@@ -319,11 +319,18 @@ class NewtonSystem:
         """(K, 144): every interface's ``sum_v C_v J_v C_v^T`` (``C_v`` the vertex's
         coefficients in both blocks' rows), as the one product ``[C_1 .. C_n] [J_1 C_1^T;
         ..; J_n C_n^T]`` per interface of ``n`` vertices, stacked over the interfaces
-        with as many vertices (:attr:`groups`): no per-vertex 12 x 12 products to sum."""
-        right = np.matmul(jacobian, self._coefficients_t)  # (IV, width, 12)
+        with as many vertices (:attr:`groups`): no per-vertex 12 x 12 products to sum.
+        In chunks of :data:`VERTEX_CHUNK` vertices (bounded buffers on the largest
+        models)."""
         sums = np.zeros((self.n_interfaces, 12, 12))
         for faces, vertices, left in self.groups:
-            sums[faces] = np.matmul(left, right[vertices].reshape(len(faces), -1, 12))
+            step = max(1, VERTEX_CHUNK // vertices.shape[1])
+            for start in range(0, len(faces), step):
+                part = slice(start, start + step)
+                chosen = vertices[part]
+                right = np.matmul(jacobian[chosen], self._coefficients_t[chosen])
+                sums[faces[part]] = np.matmul(left[part],
+                                              right.reshape(len(chosen), -1, 12))
         return sums.reshape(-1, 144)
 
     @functools.cached_property
