@@ -215,7 +215,7 @@ def solve(ns: NewtonSystem, options: InteriorOptions) -> QPOutcome:
     b_inf = np.abs(b).max()
     n_vertices = len(h)
     m = n_vertices * len(G)
-    shift = options.regularization * ns.diagonal_scale()
+    shift = options.regularization * ns.diagonal_scale
 
     # start (Mehrotra's rule): the least-squares point of
     #   min 1/2 x^T H x + 1/2 ||G x||^2,  A x = b,

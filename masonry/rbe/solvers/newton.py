@@ -354,13 +354,20 @@ class NewtonSystem:
         blocks[self.diagonal_blocks] += shift * np.eye(6)
         return blocks
 
+    @functools.cached_property
+    def base_blocks(self) -> np.ndarray:
+        """Stored blocks of ``A H^-1 A^T``, the Newton matrix without the cones (the
+        same for every ``mu``)."""
+        base = np.zeros((len(self.h), self.width, self.width))
+        base[:, np.arange(self.width), np.arange(self.width)] = 1.0 / self.h
+        return self.newton_blocks(base, 0.0, incremental=False)
+
+    @functools.cached_property
     def diagonal_scale(self) -> float:
         """Mean diagonal entry of ``A H^-1 A^T``: the scale of the Newton matrix, which
         the regularization and the damping are relative to."""
-        base = np.zeros((len(self.h), self.width, self.width))
-        base[:, np.arange(self.width), np.arange(self.width)] = 1.0 / self.h
-        blocks = self.newton_blocks(base, 0.0, incremental=False)
-        return float(np.mean(np.trace(blocks[self.diagonal_blocks], axis1=1, axis2=2)) / 6.0)
+        diagonal = self.base_blocks[self.diagonal_blocks]
+        return float(np.mean(np.trace(diagonal, axis1=1, axis2=2)) / 6.0)
 
     def full_vector(self, x, layout):
         """(IV, width) forces in this system's columns -> the (4 IV,) vector of
@@ -448,7 +455,7 @@ def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOut
     start = time.perf_counter()
     ns = NewtonSystem(system, method) if newton_system is None else newton_system
     setup = time.perf_counter() - start
-    scale = ns.diagonal_scale()
+    scale = ns.diagonal_scale
     if y0 is None:
         y = _unconstrained_dual(ns, options.regularization * scale)
     else:
@@ -464,9 +471,9 @@ def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOut
 
 def _unconstrained_dual(ns, shift):
     """The dual point of the QP without cones: ``A H^-1 A^T y = b``."""
-    base = np.zeros((len(ns.h), ns.width, ns.width))
-    base[:, np.arange(ns.width), np.arange(ns.width)] = 1.0 / ns.h
-    return ns.symbolic.factor(ns.newton_blocks(base, shift)).solve(ns.b)
+    blocks = ns.base_blocks.copy()
+    blocks[ns.diagonal_blocks] += shift * np.eye(6)
+    return ns.symbolic.factor(blocks).solve(ns.b)
 
 
 class _Run:
