@@ -631,11 +631,8 @@ class BlockCholesky:
             raise np.linalg.LinAlgError(
                 f"matrix not positive definite (a leaf among supernodes "
                 f"{group.supernodes.tolist()})") from None
-        l21t = panel[:, :, k:]  # F21^T, then L21^T = L11^-1 F21^T row by row
-        for j in range(k):
-            if j:
-                l21t[:, j] -= (l11[:, j, None, :j] @ l21t[:, :j])[:, 0]
-            l21t[:, j] /= l11[:, j, j, None]
+        l21t = panel[:, :, k:]  # F21^T, then L21^T = L11^-1 F21^T
+        _stacked_forward(l11, l21t)
         # the update F22 - L21 L21^T (F22 is zero in a leaf), its lower triangle; numpy
         # multiplies stacks by BLAS when the first factor is contiguous
         l21 = np.ascontiguousarray(l21t.transpose(0, 2, 1))
@@ -757,12 +754,18 @@ def _forward_leaves(x, group, l11, l21):
     in place: their columns by ``L11 xs = x``, then the rows below them less ``L21 xs``
     (rows of different leaves overlap: summed by ``np.subtract.at``)."""
     xs = x[group.columns]  # (G, k, m)
-    for j in range(group.k):
-        if j:
-            xs[:, j] -= (l11[:, j, None, :j] @ xs[:, :j])[:, 0]
-        xs[:, j] /= l11[:, j, j, None]
+    _stacked_forward(l11, xs)
     x[group.columns] = xs
     np.subtract.at(x, group.rows, l21 @ xs)
+
+
+def _stacked_forward(l11, b):
+    """``b <- L11^-1 b`` in place for stacks of lower triangles ``l11`` (G, k, k) and
+    right-hand sides ``b`` (G, k, m): forward substitution, one row at a time."""
+    for j in range(l11.shape[1]):
+        if j:
+            b[:, j] -= (l11[:, j, None, :j] @ b[:, :j])[:, 0]
+        b[:, j] /= l11[:, j, j, None]
 
 
 def _backward_leaves(x, group, l11, l21):

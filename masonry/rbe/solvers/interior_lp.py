@@ -46,7 +46,7 @@ import numpy as np
 from masonry.rbe.equilibrium import friction_pyramid_edges
 from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
 from masonry.rbe.solvers.interior import centred_start, max_step
-from masonry.rbe.solvers.newton import NewtonSystem, one_blas_thread, vertex_groups
+from masonry.rbe.solvers.newton import NewtonSystem, one_blas_thread
 
 log = logging.getLogger(__name__)
 
@@ -132,19 +132,21 @@ def times_mt(ns: NewtonSystem, rays, y) -> np.ndarray:
 
 class _RayProducts:
     """Per interface, ``sum_v C_v E D_v E^T C_v^T`` (12 x 12, ``C_v`` the vertex's
-    coefficients in both blocks' rows) for edge ray weights ``D``: one row ``C_v E_k``
-    per vertex and ray, the rows of every interface stacked, and the interfaces with the
-    same vertex count in one product, into buffers kept from call to call (fresh ones
-    fault their pages in every time; docs/bench.md)."""
+    coefficients in both blocks' rows) for edge ray weights ``D``: one column ``C_v E_k``
+    per vertex and ray, the columns of every interface side by side, and the interfaces
+    with the same vertex count in one product (the Newton system's
+    :attr:`~masonry.rbe.solvers.newton.NewtonSystem.groups`), into buffers kept from call
+    to call (fresh ones fault their pages in every time; docs/bench.md)."""
 
     def __init__(self, ns: NewtonSystem, rays):
         self.rays = rays
-        per_ray = np.einsum("vij,jk->vki", ns.coefficients, rays)  # (IV, 4, 12)
         self.out = np.zeros((ns.n_interfaces, 12, 12))
         self.groups = []
-        for faces, vertices in vertex_groups(ns.vertex_interface):
-            rows = per_ray[vertices].reshape(len(faces), -1, 12)
-            columns = np.ascontiguousarray(rows.transpose(0, 2, 1))
+        for faces, vertices, left in ns.groups:
+            # (F, 12, n, 3) coefficients times the rays: (F, 12, 4 n), vertex by vertex
+            columns = (left.reshape(len(faces), 12, -1, ns.width) @ rays).reshape(
+                len(faces), 12, -1)
+            rows = np.ascontiguousarray(columns.transpose(0, 2, 1))
             self.groups.append((faces, vertices, rows, columns, np.empty_like(columns),
                                 np.empty((len(faces), 12, 12))))
 

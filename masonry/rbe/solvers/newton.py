@@ -339,7 +339,7 @@ class NewtonSystem:
         vertices ((F, n) int) and the vertices' coefficients side by side ((F, 12,
         n width) float)."""
         out = []
-        for faces, vertices in vertex_groups(self.vertex_interface):
+        for faces, vertices in _vertex_groups(self.vertex_interface):
             left = self.coefficients[vertices].transpose(0, 2, 1, 3)
             out.append((faces, vertices, np.ascontiguousarray(left).reshape(
                 len(faces), 12, -1)))
@@ -385,7 +385,7 @@ class NewtonSystem:
         return np.sqrt(np.sum(self.h * x * x, axis=1))
 
 
-def vertex_groups(vertex_interface):
+def _vertex_groups(vertex_interface):
     """The interfaces grouped by vertex count ``n``: per count, the interfaces ((F,) int)
     and their vertices ((F, n) int), for one stacked product per count."""
     order = np.argsort(vertex_interface, kind="stable")
