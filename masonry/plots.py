@@ -159,9 +159,11 @@ def _axes3d(bounds):
     ax.set_zlim(low[2], high[2])
     ax.set_box_aspect(tuple(extent))
     ax.view_init(*ANGLE)
-    for axis in "xyz":
-        getattr(ax, f"set_{axis}label")(f"{axis} [m]")
-        getattr(ax, f"{axis}axis").set_major_locator(matplotlib.ticker.MaxNLocator(5))
+    for axis, length in zip("xyz", extent / extent.max()):
+        getattr(ax, f"set_{axis}label")(f"{axis} [m]", labelpad=10)
+        # fewer ticks on a short side (a wall's thickness): their labels would overlap
+        ticks = matplotlib.ticker.MaxNLocator(max(2, int(np.ceil(5 * length))))
+        getattr(ax, f"{axis}axis").set_major_locator(ticks)
     return fig, ax
 
 
@@ -450,7 +452,7 @@ def _colour_bar(fig, ax, scale, quantity):
     """A colour bar labelled ``quantity [unit]``, saying where the scale is clipped."""
     mappable = matplotlib.cm.ScalarMappable(norm=scale["norm"], cmap=scale["cmap"])
     if hasattr(ax, "get_zlim"):  # a 3D box sits inside its axes: a shorter bar
-        bar = fig.colorbar(mappable, ax=ax, shrink=0.6, pad=0.1, extend=scale["extend"])
+        bar = fig.colorbar(mappable, ax=ax, shrink=0.6, pad=0.16, extend=scale["extend"])
     else:  # as tall as the equal-scale plot
         cax = make_axes_locatable(ax).append_axes("right", size="4%", pad=0.12)
         bar = fig.colorbar(mappable, cax=cax, extend=scale["extend"])
@@ -712,27 +714,56 @@ def _mechanism_faces(blocks, mechanism):
     return undeformed, deformed, per_block[blocks.face_block[faces]], bounds
 
 
-def mechanism_pngs(scene, blocks, interfaces, mechanism, hinge, slides, title,
-                   fast=False) -> dict:
+MECHANISM_DRAWN = 0.05
+"""The mechanism plots mark the hinges that open, and the joints that slip, by at least
+this fraction of the largest opening or slip: an interior point's mechanism moves many
+joints by little (:data:`~masonry.tolerances.MOTION_TOL`), and marking them all hides the
+blocks."""
+
+
+def _carrying(flags, motion):
+    """Of the interfaces flagged, those whose motion is at least :data:`MECHANISM_DRAWN`
+    of the largest among them."""
+    flags = np.asarray(flags, dtype=bool)
+    if not flags.any():
+        return flags
+    return flags & (motion >= MECHANISM_DRAWN * motion[flags].max())
+
+
+def mechanism_pngs(scene, blocks, interfaces, collapse, title, fast=False) -> dict:
     """The collapse mechanism (SPEC 6.9) drawn exaggerated over the undeformed structure,
     in the four views (``collapse/<view>_mechanism.png``; one view when ``fast``):
     displaced blocks coloured by their largest vertex displacement, the undeformed ones as
-    grey outlines, hinges (interfaces that open about a line) filled red and sliding
-    interfaces outlined blue, at their undeformed places (seen through the blocks).
+    grey outlines, the hinges and sliding joints that carry the mechanism
+    (:func:`_carrying`) filled red and outlined blue, at their undeformed places (seen
+    through the blocks).
 
     Parameters
     ----------
     scene : Scene
         For the figure titles.
     blocks, interfaces : the analysed model's
-    mechanism : (B, 6) float
-        Per block ``(u, theta)`` about its centroid, largest vertex displacement 1.
-    hinge, slides : (K,) bool
+    collapse : masonry.rbe.collapse.CollapseResult
+        With a mechanism: ``mechanism`` ((B, 6), per block ``(u, theta)`` about its
+        centroid, largest vertex displacement 1), ``hinge``, ``slides``, ``gap``, ``slip``.
     title : str
     """
-    undeformed, deformed, value, bounds = _mechanism_faces(blocks, np.asarray(mechanism))
+    undeformed, deformed, value, bounds = _mechanism_faces(
+        blocks, np.asarray(collapse.mechanism))
     scale = colour_scale(value, signed=False, is_force=False)
     colours = scale["cmap"](scale["norm"](value))
+    hinge = _carrying(collapse.hinge, collapse.gap)
+    slides = _carrying(collapse.slides & ~collapse.hinge, collapse.slip)
+    share = f"\u2265 {MECHANISM_DRAWN:.0%} of the largest"
+    sliding = int((collapse.slides & ~collapse.hinge).sum())
+    handles = [Patch(facecolor="none", edgecolor="0.6", label="undeformed")]
+    if collapse.hinges:
+        handles.append(Patch(facecolor="red", edgecolor="red",
+                             label=f"hinges opening {share}: {int(hinge.sum())} of "
+                                   f"{collapse.hinges}"))
+    if sliding:
+        handles.append(Patch(facecolor="none", edgecolor="blue",
+                             label=f"sliding {share}: {int(slides.sum())} of {sliding}"))
     out = {}
     for view in ["01_angle"] if fast else list(VIEWS):
         fig, ax = _axes(bounds, view)
@@ -740,18 +771,13 @@ def mechanism_pngs(scene, blocks, interfaces, mechanism, hinge, slides, title,
             ax.computed_zorder = False  # in the order drawn: the joints on top
         _add_polygons(ax, view, undeformed, NO_FILL, edgecolors="0.6", linewidths=0.1)
         _add_polygons(ax, view, deformed, colours, edgecolors="k", linewidths=0.05)
-        # sliding interfaces outlined, hinges filled, both where they are undeformed
-        for mask, face, edge, width in ((slides & ~hinge, NO_FILL, "blue", 0.6),
-                                        (hinge, "red", "red", 1.5)):
+        for mask, face, edge, width in ((slides, NO_FILL, "blue", 0.6),
+                                        (hinge, "red", "red", 0.8)):
             index = np.flatnonzero(mask)
             if len(index):
                 _add_polygons(ax, view, _polygons(interfaces, index), face,
                               edgecolors=edge, linewidths=width)
         _colour_bar(fig, ax, scale, "virtual displacement (largest = 1)")
-        handles = [Patch(facecolor="none", edgecolor="0.6", label="undeformed"),
-                   Patch(facecolor="red", edgecolor="red", label=f"hinge ({int(hinge.sum())})"),
-                   Patch(facecolor="none", edgecolor="blue",
-                         label=f"sliding ({int(slides.sum())})")]
         if view in ELEVATIONS:  # below the plot: an elevation fills its axes
             # 0.45 inch below the axes, clear of the tick labels at any aspect
             below = ax.transAxes + ScaledTranslation(0, -0.45, fig.dpi_scale_trans)

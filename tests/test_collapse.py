@@ -57,8 +57,16 @@ def check_mechanism(model, live, result):
         arm = vertex - blocks.block_centroid[block]
         return motion[block, :3] + np.cross(motion[block, 3:], arm)
 
-    opening = np.einsum("ij,ij->i", moved(other) - moved(main_block), interfaces.normal[k])
+    relative = moved(other) - moved(main_block)
+    opening = np.einsum("ij,ij->i", relative, interfaces.normal[k])
     assert opening.min() >= -1e-7
+    # each joint's largest opening and slip, from the blocks' motions
+    gap, slip = np.zeros(len(interfaces)), np.zeros(len(interfaces))
+    np.maximum.at(gap, k, opening)
+    np.maximum.at(slip, k, np.linalg.norm(
+        relative - opening[:, None] * interfaces.normal[k], axis=1))
+    assert np.abs(result.gap - gap).max() <= 1e-7
+    assert np.abs(result.slip - slip).max() <= 1e-7
     # normalised: the largest vertex displacement of any block is 1
     owner = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
     arm = blocks.vertices - blocks.block_centroid[owner]
@@ -82,6 +90,15 @@ def test_single_block_tips_at_b_over_h_or_slides_at_mu(azimuth, expected, mode):
     assert result.hinge.all() == (mode == "tips")
     assert result.slides.all() == (mode == "slides")
     assert (result.note is not None) == (mode == "slides")
+    # normalised to a largest displacement of 1: tipping about a base edge opens the far
+    # edge by b / sqrt(b^2 + h^2) (its top corner moves 1); sliding with the associated
+    # dilation moves the block by (1, mu) / sqrt(1 + mu^2) along and off the joint
+    if mode == "tips":
+        assert result.gap[0] == pytest.approx(0.2 / np.hypot(0.2, 0.5), rel=1e-6)
+        assert result.slip[0] == pytest.approx(0.0, abs=1e-6)
+    else:
+        assert result.gap[0] == pytest.approx(0.7 / np.hypot(1, 0.7), rel=1e-6)
+        assert result.slip[0] == pytest.approx(1 / np.hypot(1, 0.7), rel=1e-6)
     check_mechanism(model, live, result)
 
 
@@ -96,17 +113,30 @@ def test_column_tips_at_b_over_its_whole_height(count):
     check_mechanism(model, live, result)
 
 
-def test_point_load_at_the_top_face_tips_a_block_at_the_lever_ratio():
+@pytest.mark.parametrize("force", [1e-6, 100.0, 1e15])
+def test_point_load_at_the_top_face_tips_a_block_at_the_lever_ratio(force):
     """A horizontal point force P at the top of a block of weight W tips it when
-    P h = W b / 2, i.e. lambda = W b / (2 P h)."""
+    P h = W b / 2, i.e. lambda = W b / (2 P h), whatever the size of P."""
     model = column(1, (0.2, 0.4, 0.5))
-    live = point_loads(model.blocks, ["b*:100,0,0"])
+    live = point_loads(model.blocks, [f"b*:{force!r},0,0"])
     weight = DENSITY * G * 0.2 * 0.4 * 0.5
     result = collapse_load(model, live, mu=0.9, density=DENSITY)
-    assert result.load_factor == pytest.approx(weight * 0.1 / (100 * 0.5), rel=1e-6)
+    assert result.load_factor == pytest.approx(weight * 0.1 / (force * 0.5), rel=1e-6)
+    assert result.residual < 1e-9
     check_mechanism(model, live, result)
-    with pytest.raises(ParameterError, match="--point-load"):
-        point_loads(model.blocks, ["nothing*:1,0,0"])
+
+
+def test_a_point_load_spec_that_matches_no_block_is_refused():
+    with pytest.raises(ParameterError, match="point_loads"):
+        point_loads(column(1, (0.2, 0.4, 0.5)).blocks, ["nothing*:1,0,0"])
+
+
+def test_a_point_load_on_no_block_is_refused_naming_the_option(tmp_path, capsys):
+    code = main(["run", "--preset", "wall", "--point-load", "zzz:0,0,-1", "--out",
+                 str(tmp_path), "--no-plots", "--no-printable"])
+    error = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(error) == 1 and not any(tmp_path.iterdir())
+    assert error[0].startswith("masonry: error: --point-load zzz:0,0,-1: expected a name")
 
 
 def test_free_wall_overturns_out_of_plane_at_t_over_h():
@@ -313,7 +343,8 @@ def test_run_writes_the_collapse_record_and_files(tmp_path, capsys):
     support = sum(float(r["shear_x_N"]) for r in table if r["kind"] == "support")
     assert support == pytest.approx(-0.2 * weight, rel=1e-6)
     mesh = meshio.read(folder / "collapse" / "interfaces.vtu")
-    assert {"compression_N", "shear_N", "hinge", "slides", "opens"} <= set(mesh.cell_data)
+    assert {"compression_N", "shear_N", "hinge", "slides", "opens", "gap",
+            "slip"} <= set(mesh.cell_data)
 
 
 def test_sweep_records_the_load_factor(tmp_path):

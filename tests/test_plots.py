@@ -1,12 +1,19 @@
 """Figures: units and colour scales chosen by the data, and the thrust line's points."""
 
+from types import SimpleNamespace
+
 import matplotlib
 import numpy as np
 import pytest
 
 from masonry.export.csv import tension_top
-from masonry.plots import COLOUR_PERCENTILE, _rank_labels, colour_scale, force_unit
+from masonry.params import from_preset
+from masonry.plots import (COLOUR_PERCENTILE, MECHANISM_DRAWN, _carrying, _rank_labels,
+                           colour_scale, force_unit, mechanism_pngs)
+from masonry.rbe.collapse import collapse_load
+from masonry.rbe.loads import lateral
 from masonry.tolerances import TENSION_REPORTED_REL
+from test_collapse import DENSITY, column
 
 
 @pytest.mark.parametrize("magnitude, unit", [(12.0, "N"), (999.0, "N"), (1e3, "kN"),
@@ -103,3 +110,19 @@ def test_rank_labels_of_neighbouring_interfaces_share_one_label():
     labels = _rank_labels(centres, bounds)
     assert [text for text, _ in labels] == ["1, 3", "2, 5", "4"]
     assert np.allclose(labels[1][1], [5.0, 0, 0])
+
+
+def test_mechanism_plots_mark_the_joints_that_carry_it():
+    """Joints that open or slip by less than MECHANISM_DRAWN of the largest are left
+    unmarked; the four views are written."""
+    flags = np.array([True, True, True, False])
+    motion = np.array([1.0, 0.9 * MECHANISM_DRAWN, 1.1 * MECHANISM_DRAWN, 2.0])
+    assert _carrying(flags, motion).tolist() == [True, False, True, False]
+    assert not _carrying(np.zeros(3, bool), np.ones(3)).any()
+    model = column(2, (0.1, 0.3, 0.15))
+    result = collapse_load(model, lateral(model, 0.0, DENSITY), mu=0.9, density=DENSITY)
+    scene = SimpleNamespace(params=from_preset("wall"))  # names the figures only
+    pngs = mechanism_pngs(scene, model.blocks, model.interfaces, result, "column")
+    assert sorted(pngs) == [f"collapse/{v}_mechanism.png" for v in
+                            ("01_angle", "02_front", "03_top", "04_side")]
+    assert all(png.startswith(b"\x89PNG") for png in pngs.values())

@@ -134,9 +134,9 @@ def force_tables(blocks, interfaces, result, forces: dict, resultants=None,
         :func:`~masonry.rbe.resultants.interface_resultants`, computed when None.
     folder : str
         The folder of the files in the run folder.
-    flags : dict str -> (K,) bool, optional
+    flags : dict str -> (K,) bool or float, optional
         More cell data for the VTU (the collapse mechanism's ``opens``, ``slides``,
-        ``hinge``; written as 0/1).
+        ``hinge``, written as 0/1, and its ``gap`` and ``slip``).
     weight_N : float, optional, N
         The reference weight of ``tension_top.csv``; None: ``result.weight_N``.
     """
@@ -174,7 +174,8 @@ def _collapse_files(made: RunOutputs) -> Export:
         files["collapse/azimuths.csv"] = csv.azimuths_csv(result.azimuths)
     if result.forces is not None and result.load_factor is not None:
         blocks, interfaces = made.model.blocks, made.model.interfaces
-        flags = {name: getattr(result, name) for name in ("opens", "slides", "hinge")}
+        flags = {name: getattr(result, name)
+                 for name in ("opens", "slides", "hinge", "gap", "slip")}
         files.update(force_tables(blocks, interfaces, result, result.forces,
                                   folder="collapse", flags=flags,
                                   weight_N=made.result.weight_N))
@@ -205,8 +206,7 @@ def _mechanism_plots(made: RunOutputs) -> dict:
     title = (f"collapse mechanism: lambda = {collapse.load_factor:.4g}, "
              f"{collapse.live.description['kind']} load"
              + ("" if collapse.azimuth_deg is None else f" at {collapse.azimuth_deg:g} deg"))
-    return plots.mechanism_pngs(made.scene, model.blocks, model.interfaces,
-                                collapse.mechanism, collapse.hinge, collapse.slides, title,
+    return plots.mechanism_pngs(made.scene, model.blocks, model.interfaces, collapse, title,
                                 made.scene.params.fast)
 
 

@@ -126,6 +126,11 @@ class CollapseResult:
     opens, slides, hinge : (K,) bool or None
         Per interface: some vertex separates (relative normal motion > :data:`~masonry.tolerances.MOTION_TOL`);
         some vertex slips; opens with some vertex still closed (a hinge, not a separation).
+    gap, slip : (K,) float or None
+        Per interface: the largest opening (relative motion along the normal) and slip
+        (along the plane) of its vertices, per largest block displacement (1). An interior
+        point's mechanism moves many joints by little (see ``MOTION_TOL``): these say
+        which joints carry it.
     azimuths : tuple of (float, float or None)
         After :func:`worst_lateral`: every azimuth searched and its factor.
     friction_law : str
@@ -152,6 +157,8 @@ class CollapseResult:
     opens: np.ndarray | None = None
     slides: np.ndarray | None = None
     hinge: np.ndarray | None = None
+    gap: np.ndarray | None = None
+    slip: np.ndarray | None = None
     azimuths: tuple = field(default=())
     friction_law: str = "associated"
     associated_factor: float | None = None
@@ -251,8 +258,12 @@ class CollapseLP:
         """The largest factor of ``live``; ``dead_load_feasible`` (e.g. the RBE's verdict)
         saves the check of ``lambda = 0`` when the optimum is positive."""
         start = time.perf_counter()
-        lp = self._backend(self.scaled(live)[:, None], np.ones(1))
-        return self._result(lp, live, None, start, dead_load_feasible)
+        load = self.scaled(live)
+        # the LP takes the load at the dead load's size (the same optimum, times the
+        # ratio): a point load of 1e12 N would leave the factor at the rows' rounding
+        ratio = float(np.abs(load).max() / np.abs(self.system.f_ext).max())
+        lp = self._backend(load[:, None] / ratio, np.ones(1))
+        return self._result(lp, live, None, start, dead_load_feasible, per_unit=1 / ratio)
 
     def solve_lateral(self, azimuth_deg: float, *, dead_load_feasible=None) -> CollapseResult:
         """The factor of :func:`masonry.rbe.loads.lateral` at ``azimuth_deg``, reusing the
@@ -338,7 +349,9 @@ class CollapseLP:
                           ("dual_feasibility_tolerance", FEASIBILITY_TOL)), maximize=True)
         return highs, heads, tie_row
 
-    def _result(self, lp, live, azimuth, start, dead_load_feasible) -> CollapseResult:
+    def _result(self, lp, live, azimuth, start, dead_load_feasible,
+                per_unit=1.0) -> CollapseResult:
+        """The result of ``lp`` run, whose factor times ``per_unit`` is ``live``'s."""
         status, factor, values, dual, iterations = lp.run()
         common = dict(solver=lp.name, mu=self.mu, live=live, azimuth_deg=azimuth,
                       iterations=iterations)
@@ -350,6 +363,7 @@ class CollapseLP:
                 log.warning("collapse LP without a verdict: %s", status)
             return CollapseResult(None, feasible, status, time_s=time.perf_counter() - start,
                                   residual=np.nan, work_balance=np.nan, **common)
+        factor *= per_unit
         n = self.matrix.shape[1]
         x_scaled = self.edges @ values[:n]
         load = self.scaled(live)
@@ -400,6 +414,9 @@ class CollapseLP:
                              minlength=layout.n_interfaces) > 0
         slides = np.bincount(layout.vertex_interface, slip > MOTION_TOL,
                              minlength=layout.n_interfaces) > 0
+        gap, most_slip = np.zeros(layout.n_interfaces), np.zeros(layout.n_interfaces)
+        np.maximum.at(gap, layout.vertex_interface, opening)
+        np.maximum.at(most_slip, layout.vertex_interface, slip)
         # kinematic theorem on the normalised mechanism, in physical units
         free = system.free_block
         work_live = float(np.sum(load.reshape(-1, 6) * system.row_scale.reshape(-1, 6)
@@ -408,7 +425,7 @@ class CollapseLP:
         work_dead = float(np.sum(dead * mechanism[free]))
         balance = abs(factor * work_live + work_dead) / max(abs(work_dead), abs(work_live))
         return dict(mechanism=mechanism, opens=opens, slides=slides, hinge=opens & closed,
-                    work_balance=balance)
+                    gap=gap, slip=most_slip, work_balance=balance)
 
 
 class _HighsLP:

@@ -109,7 +109,7 @@ def point_loads(blocks, specs) -> LiveLoad:
     Raises
     ------
     ParameterError
-        A spec that is malformed or matches no free block (named ``--point-load``).
+        A spec that is malformed or matches no free block (named ``point_loads``).
     """
     blocks = _blocks(blocks)
     free = ~np.asarray(blocks.block_is_support)
@@ -120,7 +120,7 @@ def point_loads(blocks, specs) -> LiveLoad:
         pattern, force = parse_point_load(spec)
         matched = [i for i in np.flatnonzero(free) if fnmatch.fnmatchcase(names[i], pattern)]
         if not matched:
-            raise ParameterError("--point-load", spec, "a name or pattern that matches a "
+            raise ParameterError("point_loads", spec, "a name or pattern that matches a "
                                  "free block (see bricks.obj or locations.csv)")
         chosen += matched
         forces += [force] * len(matched)
