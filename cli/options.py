@@ -220,7 +220,8 @@ def collapse_summary(record, report):
         report(f"collapse: no load factor ({c['status']}), {what}")
         return
     report(f"collapse: lambda = {c['load_factor']:.4g} for the {what}; mechanism: "
-           f"{c['opening']} interfaces open ({c['hinges']} hinges), {c['sliding']} slide; "
+           f"{c['main_hinges']} hinges, {c['main_sliding']} sliding joints (of "
+           f"{c['hinges']} and {c['sliding']} that move at all); "
            f"{c['solver']} {c['time_s']:.3g} s")
     if c["note"]:
         report(f"note: {c['note']}")

@@ -28,6 +28,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
 from masonry.blocks import BLOCK_CLASSES, PATTERN, concatenate, rotated_web, rotation_z  # noqa: E402
 from masonry.interfaces import INTERFACE_KINDS  # noqa: E402
 from masonry.params import structure_id  # noqa: E402
+from masonry.tolerances import MECHANISM_MAIN  # noqa: E402
 
 CLASS_COLOURS = {
     "ground": "#9e9e9e",
@@ -714,29 +715,13 @@ def _mechanism_faces(blocks, mechanism):
     return undeformed, deformed, per_block[blocks.face_block[faces]], bounds
 
 
-MECHANISM_DRAWN = 0.05
-"""The mechanism plots mark the hinges that open, and the joints that slip, by at least
-this fraction of the largest opening or slip: an interior point's mechanism moves many
-joints by little (:data:`~masonry.tolerances.MOTION_TOL`), and marking them all hides the
-blocks."""
-
-
-def _carrying(flags, motion):
-    """Of the interfaces flagged, those whose motion is at least :data:`MECHANISM_DRAWN`
-    of the largest among them."""
-    flags = np.asarray(flags, dtype=bool)
-    if not flags.any():
-        return flags
-    return flags & (motion >= MECHANISM_DRAWN * motion[flags].max())
-
-
 def mechanism_pngs(scene, blocks, interfaces, collapse, title, fast=False) -> dict:
     """The collapse mechanism (SPEC 6.9) drawn exaggerated over the undeformed structure,
     in the four views (``collapse/<view>_mechanism.png``; one view when ``fast``):
     displaced blocks coloured by their largest vertex displacement, the undeformed ones as
     grey outlines, the hinges and sliding joints that carry the mechanism
-    (:func:`_carrying`) filled red and outlined blue, at their undeformed places (seen
-    through the blocks).
+    (:data:`~masonry.tolerances.MECHANISM_MAIN`) filled red and outlined blue, at their
+    undeformed places (seen through the blocks).
 
     Parameters
     ----------
@@ -745,25 +730,23 @@ def mechanism_pngs(scene, blocks, interfaces, collapse, title, fast=False) -> di
     blocks, interfaces : the analysed model's
     collapse : masonry.rbe.collapse.CollapseResult
         With a mechanism: ``mechanism`` ((B, 6), per block ``(u, theta)`` about its
-        centroid, largest vertex displacement 1), ``hinge``, ``slides``, ``gap``, ``slip``.
+        centroid, largest vertex displacement 1) and the joints that carry it.
     title : str
     """
     undeformed, deformed, value, bounds = _mechanism_faces(
         blocks, np.asarray(collapse.mechanism))
     scale = colour_scale(value, signed=False, is_force=False)
     colours = scale["cmap"](scale["norm"](value))
-    hinge = _carrying(collapse.hinge, collapse.gap)
-    slides = _carrying(collapse.slides & ~collapse.hinge, collapse.slip)
-    share = f"\u2265 {MECHANISM_DRAWN:.0%} of the largest"
-    sliding = int((collapse.slides & ~collapse.hinge).sum())
+    share = f"\u2265 {MECHANISM_MAIN:.0%} of the largest"
     handles = [Patch(facecolor="none", edgecolor="0.6", label="undeformed")]
     if collapse.hinges:
         handles.append(Patch(facecolor="red", edgecolor="red",
-                             label=f"hinges opening {share}: {int(hinge.sum())} of "
+                             label=f"hinges opening {share}: {collapse.main_hinges} of "
                                    f"{collapse.hinges}"))
-    if sliding:
+    if collapse.sliding:
         handles.append(Patch(facecolor="none", edgecolor="blue",
-                             label=f"sliding {share}: {int(slides.sum())} of {sliding}"))
+                             label=f"sliding {share}: {collapse.main_sliding} of "
+                                   f"{collapse.sliding}"))
     out = {}
     for view in ["01_angle"] if fast else list(VIEWS):
         fig, ax = _axes(bounds, view)
@@ -771,8 +754,8 @@ def mechanism_pngs(scene, blocks, interfaces, collapse, title, fast=False) -> di
             ax.computed_zorder = False  # in the order drawn: the joints on top
         _add_polygons(ax, view, undeformed, NO_FILL, edgecolors="0.6", linewidths=0.1)
         _add_polygons(ax, view, deformed, colours, edgecolors="k", linewidths=0.05)
-        for mask, face, edge, width in ((slides, NO_FILL, "blue", 0.6),
-                                        (hinge, "red", "red", 0.8)):
+        for mask, face, edge, width in ((collapse.main_slides, NO_FILL, "blue", 0.6),
+                                        (collapse.main_hinge, "red", "red", 0.8)):
             index = np.flatnonzero(mask)
             if len(index):
                 _add_polygons(ax, view, _polygons(interfaces, index), face,

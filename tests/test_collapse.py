@@ -12,13 +12,14 @@ from scipy.optimize import linprog
 from masonry.blocks import Blocks
 from masonry.params import ParameterError, Params, from_preset, validate
 from masonry.rbe.boundary import Model, analysis_model
-from masonry.rbe.collapse import CollapseLP, collapse_load, lateral_azimuths, worst_lateral
+from masonry.rbe.collapse import (CollapseLP, CollapseResult, collapse_load,
+                                  lateral_azimuths, worst_lateral)
 from masonry.rbe.loads import crown_load, lateral, point_loads
 from masonry.scenes import build
 from masonry.scenes.arch import arch_profile
 from masonry.studies.structures import lateral_record
 from masonry.studies.thrust_line import thrust_line_minimum_thickness
-from masonry.tolerances import G
+from masonry.tolerances import MECHANISM_MAIN, G
 from masonry_cli.main import main
 from test_rbe import HORIZONTAL, SUPPORT, box, make_interfaces
 
@@ -124,6 +125,20 @@ def test_point_load_at_the_top_face_tips_a_block_at_the_lever_ratio(force):
     assert result.load_factor == pytest.approx(weight * 0.1 / (force * 0.5), rel=1e-6)
     assert result.residual < 1e-9
     check_mechanism(model, live, result)
+
+
+def test_the_joints_that_carry_a_mechanism_move_by_a_share_of_the_largest():
+    """Of the joints that move at all, those within MECHANISM_MAIN of the largest opening
+    (hinges) or slip (sliding) carry the mechanism."""
+    flags = np.array([True, True, True, False])
+    gap = np.array([1.0, 0.9 * MECHANISM_MAIN, 1.1 * MECHANISM_MAIN, 2.0])
+    result = CollapseResult(0.5, True, "optimal", solver="", iterations=0, time_s=0.0,
+                            residual=0.0, work_balance=0.0, mu=0.7, live=None,
+                            opens=flags, hinge=flags, gap=gap, slides=~flags,
+                            slip=np.array([0.0, 0.0, 0.0, 0.01]))
+    assert result.main_hinge.tolist() == [True, False, True, False]
+    assert result.main_slides.tolist() == [False, False, False, True]
+    assert (result.main_hinges, result.main_sliding) == (2, 1)
 
 
 def test_a_point_load_spec_that_matches_no_block_is_refused():

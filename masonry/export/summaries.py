@@ -2,6 +2,7 @@
 
 from masonry.params import arch_radius, structure_id
 from masonry.rbe.solve import ACCURACY
+from masonry.tolerances import MECHANISM_MAIN, MOTION_TOL
 
 # the inputs of each scene, with their units, in the order they are printed
 _GEOMETRY = {
@@ -116,11 +117,13 @@ def collapse_text(result) -> str:
         f"load factor:        {factor} ({d['status']})",
         f"dead load stands:   {d['dead_load_feasible']}",
         f"live load:          {live['kind']}, "
-        + ", ".join(f"{k} {v}" for k, v in live.items() if k != "kind"),
+        + ", ".join(f"{k} {_readable(v)}" for k, v in live.items() if k != "kind"),
         f"azimuth:            {d['azimuth_deg']}",
         f"mu:                 {d['mu']:g}",
-        f"mechanism:          {d['opening']} interfaces open ({d['hinges']} hinges), "
-        f"{d['sliding']} slide",
+        f"mechanism:          {d['main_hinges']} hinges, {d['main_sliding']} sliding joints "
+        f"(opening or slipping by {MECHANISM_MAIN:.0%} of the largest or more)",
+        f"joints that move:   {d['opening']} open ({d['hinges']} hinges), {d['sliding']} "
+        f"slide (by {MOTION_TOL:.1%} of the largest displacement or more)",
         f"solver:             {d['solver']} ({d['iterations']} iterations)",
         f"residual (eq):      {d['residual']:.3g}",
         f"work balance:       {d['work_balance']:.3g}",
@@ -129,6 +132,15 @@ def collapse_text(result) -> str:
     if d["note"]:
         lines.append(f"note:               {d['note']}")
     return "\n".join(lines) + "\n"
+
+
+def _readable(value) -> str:
+    """A number or a list of numbers to six significant digits; anything else as is."""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_readable(v) for v in value) + "]"
+    return str(value)
 
 
 def _residual(accuracy) -> str:

@@ -42,7 +42,7 @@ from masonry.rbe.solvers.base import OPTIMAL
 from masonry.rbe.solvers.highs import highs_lp
 from masonry.rbe.solvers.interior_lp import LoadFactorOptions, load_factor
 from masonry.rbe.solvers.newton import NewtonSystem
-from masonry.tolerances import MOTION_TOL
+from masonry.tolerances import MECHANISM_MAIN, MOTION_TOL
 
 log = logging.getLogger(__name__)
 
@@ -84,7 +84,8 @@ ASSOCIATED_NOTE = (
 
 RESULT_KEYS = ("load_factor", "dead_load_feasible", "status", "solver", "iterations",
                "time_s", "residual", "work_balance", "mu", "azimuth_deg", "opening",
-               "sliding", "hinges", "friction_law", "associated_factor", "note")
+               "sliding", "hinges", "main_hinges", "main_sliding", "friction_law",
+               "associated_factor", "note")
 """Scalar fields of :class:`CollapseResult` in run.json, in order (plus ``live_load``)."""
 
 
@@ -176,6 +177,24 @@ class CollapseResult:
         return -1 if self.hinge is None else int(self.hinge.sum())
 
     @property
+    def main_hinge(self) -> np.ndarray | None:
+        """(K,) bool: the hinges that carry the mechanism (:data:`MECHANISM_MAIN`)."""
+        return None if self.hinge is None else _main(self.hinge, self.gap)
+
+    @property
+    def main_slides(self) -> np.ndarray | None:
+        """(K,) bool: the sliding joints that carry the mechanism."""
+        return None if self.slides is None else _main(self.slides, self.slip)
+
+    @property
+    def main_hinges(self) -> int:
+        return -1 if self.hinge is None else int(self.main_hinge.sum())
+
+    @property
+    def main_sliding(self) -> int:
+        return -1 if self.slides is None else int(self.main_slides.sum())
+
+    @property
     def note(self) -> str | None:
         """:data:`ASSOCIATED_NOTE` when sliding takes part in an associated mechanism."""
         return (ASSOCIATED_NOTE if self.sliding > 0 and self.friction_law == "associated"
@@ -192,6 +211,14 @@ class CollapseResult:
         if self.azimuths:
             out["azimuths"] = [{"azimuth_deg": a, "load_factor": f} for a, f in self.azimuths]
         return out
+
+
+def _main(flags, motion) -> np.ndarray:
+    """Of the interfaces flagged, those whose motion is at least :data:`MECHANISM_MAIN`
+    of the largest among them."""
+    if not flags.any():
+        return flags
+    return flags & (motion >= MECHANISM_MAIN * motion[flags].max())
 
 
 class CollapseLP:
