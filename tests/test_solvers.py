@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import scipy.linalg
+import scipy.sparse as sp
 
 from masonry import forking
 from masonry.studies.bench import (COLUMNS, bench, frontier_png, ratios, ratios_markdown,
@@ -26,6 +27,7 @@ from masonry.rbe.solve import ACCURACY, LOAD_PATH, RBEProblem, _lp_feasible, sol
 from masonry.rbe.solvers import BACKENDS
 from masonry.rbe.solvers import cholesky
 from masonry.rbe.solvers.cholesky import BlockCholesky
+from masonry.rbe.solvers.highs import highs_lp
 from masonry.rbe.solvers.interior import vertex_constraints, vertex_inverse
 from masonry.rbe.solvers.net_feasibility import decide
 from masonry.rbe.solvers.newton import COMPONENTS, NewtonOptions, NewtonSystem, project_pyramid
@@ -710,3 +712,12 @@ def test_bench_command_writes_its_files(tmp_path, capsys):
     for name in ("bench.csv", "bench.md", "frontier.png"):
         assert (tmp_path / "bench" / name).is_file()
     assert "| 3 | section |" in capsys.readouterr().out
+
+
+def test_highs_prints_nothing_to_standard_output(capfd):
+    """A run's stdout is its summary (pipes, -q): HiGHS's banner stays out of it."""
+    highs = highs_lp(sp.csc_array(np.ones((1, 2))), np.ones(2), np.zeros(2),
+                     np.full(2, 10.0), np.ones(1), np.ones(1), ())
+    highs.run()
+    assert highs.getInfo().objective_function_value == pytest.approx(1.0)
+    assert capfd.readouterr().out == ""

@@ -2,11 +2,18 @@
 and the collapse LP."""
 
 import highspy
+import highspy.highs
 import numpy as np
+
+_HIGHS = getattr(highspy.highs, "_Highs", highspy.Highs)
+"""The HiGHS class without highspy's Python layer: from highspy 1.16, ``highspy.Highs()``
+prints HiGHS's banner to standard output as it sets up its callbacks, before
+``output_flag`` can be switched off (HiGHS issues 1702, 2749); the class under it prints
+nothing until run, and has every method used here (no callbacks are used)."""
 
 
 def highs_lp(A, cost, col_lower, col_upper, row_lower, row_upper, options,
-             maximize=False) -> highspy.Highs:
+             maximize=False) -> _HIGHS:
     """A HiGHS instance holding ``cost @ x`` (minimised, or maximised when ``maximize``)
     subject to ``row_lower <= A x <= row_upper`` and ``col_lower <= x <= col_upper``.
 
@@ -33,7 +40,7 @@ def highs_lp(A, cost, col_lower, col_upper, row_lower, row_upper, options,
     lp.a_matrix_.format_ = highspy.MatrixFormat.kColwise
     lp.a_matrix_.start_, lp.a_matrix_.index_, lp.a_matrix_.value_ = (
         A.indptr, A.indices, A.data)
-    highs = highspy.Highs()
+    highs = _HIGHS()
     for name, value in (("output_flag", False), *options):
         if highs.setOptionValue(name, value) != highspy.HighsStatus.kOk:
             raise ValueError(f"HiGHS refused option {name}={value!r}")
