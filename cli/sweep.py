@@ -6,7 +6,7 @@ import os
 import sys
 from pathlib import Path
 
-from masonry.params import PRESETS, ParameterError, read_toml
+from masonry.params import PRESETS, ParameterError, Params, read_toml, validate
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.sweep import (Study, execute, summary_csv, summary_parquet, summary_pngs,
                            summary_rows)
@@ -104,12 +104,27 @@ def load_study(path) -> Study:
     if size > MAX_VARIANTS:
         refuse("grid", f"{size} variants", f"at most {MAX_VARIANTS} variants")
     names = run_option_names()
-    return Study(
+    study = Study(
         base={**(PRESETS[str(preset)] if preset is not None else {}),
               **_fields(base, "base", names, where)},
         grid=_fields(grid, "grid", names, where, lists=True),
         sample=_fields(sample, "sample", names, where), count=count, seed=seed,
         plots=outputs.get("plots", False), printable=outputs.get("printable", False))
+    _check_variants(study, where)
+    return study
+
+
+def _check_variants(study: Study, where):
+    """Every variant's inputs checked as ``masonry run`` checks them, before any runs: a
+    value out of range names the table and key it came from."""
+    for inputs in study.variants():
+        try:
+            validate(Params(**inputs))
+        except ParameterError as error:
+            table = ("grid" if error.name in study.grid else
+                     "sample" if error.name in study.sample else "base")
+            raise ParameterError(f"{table}.{error.name}", error.value, error.expected,
+                                 where=where) from None
 
 
 def _fields(table, name, names, where, lists=False) -> dict:
@@ -185,4 +200,4 @@ def handle(args, report):
     report(f"{total} variants: {counts['computed']} computed, {counts['reused']} reused, "
            f"{counts['failed']} failed")
     report(f"summary: {folder.target}")
-    return 0
+    return 3 if counts["failed"] else 0

@@ -50,14 +50,34 @@ def test_local_cluster_gives_the_serial_summary(tmp_path, study):
         assert (tmp_path / "a" / row["structure_id"] / "run.json").is_file()
 
 
-def test_a_failing_variant_is_recorded_and_the_rest_complete(tmp_path):
-    path = tmp_path / "bad.toml"
-    path.write_text(STUDY.replace("mu = [0.3, 0.7]", "mu = [0.7, -1.0]"))
-    assert main(["sweep", str(path), "--workers", "1", "--out", str(tmp_path), "-q"]) == 0
-    rows = _summary(tmp_path, "bad")
+def test_a_failing_variant_is_recorded_the_rest_complete_and_the_exit_says_so(
+        tmp_path, study, monkeypatch):
+    import masonry.studies.sweep as sweep
+
+    def run(params, *args, **kwargs):
+        if params.mu == 0.3:
+            raise MemoryError("no memory for this variant")
+        return real(params, *args, **kwargs)
+
+    real = sweep.run
+    monkeypatch.setattr(sweep, "run", run)
+    assert main(["sweep", str(study), "--workers", "1", "--out", str(tmp_path), "-q"]) == 3
+    rows = _summary(tmp_path)
     failed = [r for r in rows if r["status"] == "failed"]
-    assert len(failed) == 2 and all("mu=-1.0" in r["error"] for r in failed)
+    assert len(failed) == 2 and all("no memory" in r["error"] for r in failed)
     assert sum(r["status"] == "computed" for r in rows) == 2
+
+
+@pytest.mark.parametrize("values, shown", [("[0.7, -1.0]", "grid.mu = -1.0"),
+                                           ('[0.7, "x"]', "grid.mu = 'x'")])
+def test_a_variant_masonry_run_would_refuse_stops_the_study_first(tmp_path, capsys,
+                                                                  values, shown):
+    path = tmp_path / "bad.toml"
+    path.write_text(STUDY.replace("mu = [0.3, 0.7]", f"mu = {values}"))
+    assert main(["sweep", str(path), "--workers", "1", "--out", str(tmp_path / "x")]) == 2
+    error = capsys.readouterr().err.strip().splitlines()
+    assert len(error) == 1 and f"bad.toml: {shown}: expected" in error[0]
+    assert not (tmp_path / "x").exists()
 
 
 def test_interrupted_study_resumes_with_only_the_missing_variants(tmp_path, study,

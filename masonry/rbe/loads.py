@@ -120,8 +120,10 @@ def point_loads(blocks, specs) -> LiveLoad:
         pattern, force = parse_point_load(spec)
         matched = [i for i in np.flatnonzero(free) if fnmatch.fnmatchcase(names[i], pattern)]
         if not matched:
+            example = names[int(np.flatnonzero(free)[0])]
             raise ParameterError("point_loads", spec, "a name or pattern that matches a "
-                                 "free block (see bricks.obj or locations.csv)")
+                                 f"free block (names are like {example!r}; see bricks.obj "
+                                 "or locations.csv)")
         chosen += matched
         forces += [force] * len(matched)
     chosen = np.asarray(chosen, dtype=np.int64)
