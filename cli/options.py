@@ -59,6 +59,8 @@ def describe_error(error, args) -> str:
     typed = getattr(args, "typed", {})
     if value is None and not _given(args, name):  # an option missing beside another
         return f"{option}: expected {expected}"
+    if value is True and option not in typed:  # a flag given where it does not apply
+        return f"{option}: expected {expected}"
     if name not in Params.__dataclass_fields__ or _given(args, name):
         return f"{option} {typed.get(option, _typed(value))}: expected {expected}"
     given = [r for r in error.related if _given(args, r)]
@@ -83,9 +85,9 @@ def typed_values(argv) -> dict:
             continue
         if "=" in token:
             option, value = token.split("=", 1)
-        elif i + 1 < len(argv):
+        elif i + 1 < len(argv) and not _is_option(argv[i + 1]):
             option, value = token, argv[i + 1]
-        else:
+        else:  # a flag
             continue
         typed[option] = shlex.quote(value)
     return typed
@@ -93,6 +95,17 @@ def typed_values(argv) -> dict:
 
 def _given(args, name) -> bool:
     return getattr(args, name, None) is not None
+
+
+def _is_option(token) -> bool:
+    """``--out``, ``-q``; not ``-90`` (a value)."""
+    if not token.startswith("-"):
+        return False
+    try:
+        float(token)
+    except ValueError:
+        return True
+    return False
 
 
 def _typed(value) -> str:
@@ -255,7 +268,8 @@ def add_verbosity(parser):
     when the output is redirected); by default progress shows on a terminal only."""
     group = parser.add_mutually_exclusive_group()
     group.add_argument("-q", "--quiet", action="store_true",
-                       help="no progress messages, only warnings and errors")
+                       help="no progress messages: the results (on stdout), warnings and "
+                            "errors only")
     group.add_argument("-v", "--verbose", action="store_true",
                        help="progress and the solvers' choices (fallbacks), also when "
                             "the output is redirected")

@@ -1,6 +1,7 @@
 """``masonry structures``: the thesis's table 4.1 and friction test, every boundary model
 side by side."""
 
+from masonry.params import ParameterError
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.structures import structures_table, table_csv, table_markdown
 
@@ -26,6 +27,9 @@ def register(subparsers):
 
 
 def handle(args, report):
+    if args.lateral and not args.full_dome:
+        raise ParameterError("lateral", True, "the full domes, whose factor it is: "
+                             "not with --no-full-dome")
     check_output_root(args.out)
     rows = structures_table(full_dome=args.full_dome, lp_check=args.lp_check,
                             lateral=args.lateral)

@@ -149,3 +149,13 @@ def test_analyze_writes_the_3mf_it_is_asked_for(tmp_path):
     assert extents[2] == pytest.approx(50, rel=1e-9)
     # the printable body grows each block by OVERLAP_REL (1e-5) of the scene's size
     assert extents[:2] == pytest.approx([25, 25], rel=1e-4)
+
+
+def test_a_flag_that_does_not_apply_is_refused_by_name(tmp_path, capsys):
+    """``structures --lateral`` is the full domes' factor: refused without them, the flag
+    named alone (not with the next option as its value)."""
+    assert main(["structures", "--no-full-dome", "--lateral", "--out", str(tmp_path)]) == 2
+    error = capsys.readouterr().err.strip().splitlines()
+    assert error == ["masonry: error: --lateral: expected the full domes, whose factor "
+                     "it is: not with --no-full-dome"]
+    assert not any(tmp_path.iterdir())
