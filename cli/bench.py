@@ -75,7 +75,8 @@ def handle(args, report):
 
 def _collapse(args, report):
     overrides = {} if args.p is None else {"p": args.p}
-    domes = {f"preset {k} full dome": from_preset(k, scene="dome", **overrides)
+    named = "" if args.p is None else f" (p {args.p})"
+    domes = {f"preset {k} full dome{named}": from_preset(k, scene="dome", **overrides)
              for k in args.presets}
     small = {"small dome (n 6, p 3)": validate(Params(**SMALL_DOME))}
     progress = None if args.quiet else _progress

@@ -684,10 +684,12 @@ def failure_png(scene, blocks, interfaces, top, forces, fast=False) -> bytes:
                 bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "alpha": 0.8,
                       "linewidth": 0})
     bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
-                       shrink=0.6, pad=0.1)
+                       shrink=0.6, pad=0.16)
     bar.set_label(f"tension [{unit}]", fontsize=8)
-    ax.set_title(f"where it fails: the {len(top)} interfaces with the largest tension "
-                 f"(RBE/tension_top.csv)\n{scene_title(scene)}", fontsize=9)
+    numbered = (f", the first {RANKED} numbered by rank" if len(top) > RANKED
+                else ", numbered by rank")
+    ax.set_title(f"where it fails: the {len(top)} interfaces with the largest tension"
+                 f"{numbered} (RBE/tension_top.csv)\n{scene_title(scene)}", fontsize=9)
     return _png(fig, 60 if fast else 130)
 
 

@@ -314,11 +314,13 @@ def frontier_png(rows) -> bytes:
 
 COLLAPSE_COLUMNS = ("structure", "bricks", "unknowns", "azimuths", "rbe_s", "collapse_s",
                     "ratio", "load_factor", "azimuth_deg", "solver")
-"""Columns of a collapse bench row (medians over the repeats, seconds). One azimuth:
-``rbe_s`` is the balanced RBE solve with its assembly, ``collapse_s`` the collapse LP
-with its assembly, ``ratio`` their quotient (the target: at most 3). The azimuth search
-(``azimuths`` > 1): ``rbe_s`` holds the sum of independent one-azimuth LPs instead, and
-``ratio`` is ``collapse_s`` over that sum."""
+"""Columns of a collapse bench row (:data:`COLLAPSE_NOTE` says what they hold)."""
+
+COLLAPSE_NOTE = """Seconds are medians over the repeats, each with its assembly. One azimuth
+(`azimuths` 1): `rbe_s` is the balanced RBE solve, `collapse_s` the collapse LP at that
+azimuth, `ratio` their quotient (the target: at most 3). The azimuth search
+(`azimuths` > 1, `--lateral all`): `rbe_s` holds the sum of independent one-azimuth LPs
+instead, `collapse_s` the search reusing one LP, `ratio` their quotient."""
 
 
 def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None,
@@ -381,10 +383,10 @@ def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None
 
 
 def collapse_markdown(rows) -> str:
-    """A Markdown table of collapse bench rows."""
+    """A Markdown table of collapse bench rows, and what its columns hold."""
     lines = ["| " + " | ".join(COLLAPSE_COLUMNS) + " |", "|" + "---|" * len(COLLAPSE_COLUMNS)]
     for row in rows:
         cells = [f"{row[c]:.4g}" if isinstance(row[c], float) else str(row[c])
                  for c in COLLAPSE_COLUMNS]
         lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n\n" + COLLAPSE_NOTE + "\n"
