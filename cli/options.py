@@ -231,6 +231,8 @@ def collapse_summary(record, report):
         what += f" (worst of {len(c['azimuths'])} azimuths)"
     if c["load_factor"] is None:
         report(f"collapse: no load factor ({c['status']}), {what}")
+        if c["note"]:
+            report(f"note: {c['note']}")
         return
     report(f"collapse: lambda = {c['load_factor']:.4g} for the {what}; mechanism: "
            f"{c['main_hinges']} hinges, {c['main_sliding']} sliding joints (of "

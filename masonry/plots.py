@@ -250,7 +250,9 @@ def structure_pngs(scene, fast=False) -> dict:
             _draw_blocks(ax, view, blocks, mask)
             count = int((mask & ~blocks.block_is_support).sum())
             what = "blocks" if scene.params.scene in ("arch", "assembly") else "bricks"
-            ax.set_title(f"{stage[2:]}: {count} {what}\n{scene_title(scene)}", fontsize=9)
+            shown = (f"{count} {what}" if mask.any()
+                     else "the web's outline (blue), before any brick is laid")
+            ax.set_title(f"{stage[2:]}: {shown}\n{scene_title(scene)}", fontsize=9)
             out[f"{view}/{stage}.png"] = _png(fig, 60 if fast else 110)
     if is_cyclic(scene):
         n = scene.params.n

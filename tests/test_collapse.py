@@ -12,8 +12,8 @@ from scipy.optimize import linprog
 from masonry.blocks import Blocks
 from masonry.params import ParameterError, Params, from_preset, validate
 from masonry.rbe.boundary import Model, analysis_model
-from masonry.rbe.collapse import (CollapseLP, CollapseResult, collapse_load,
-                                  lateral_azimuths, worst_lateral)
+from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
+                                  collapse_load, lateral_azimuths, worst_lateral)
 from masonry.rbe.loads import crown_load, lateral, point_loads
 from masonry.scenes import build
 from masonry.scenes.arch import arch_profile
@@ -272,6 +272,7 @@ def test_crown_load_on_the_cyclic_section_equals_the_full_dome():
             for model, copies in ((section, 6), (dome, 1))]
     assert [r.status for r in down] == ["unbounded", "unbounded"]
     assert all(r.load_factor is None and r.dead_load_feasible for r in down)
+    assert all(r.note == UNBOUNDED_NOTE for r in down)
     on_section = collapse_load(section, crown_load(section, -2000.0, copies=6))
     on_dome = collapse_load(dome, crown_load(dome, -2000.0))
     assert on_section.load_factor is not None and on_section.load_factor > 0

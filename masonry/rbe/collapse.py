@@ -82,6 +82,11 @@ ASSOCIATED_NOTE = (
     "friction (the pyramid's normal as flow rule, joints that dilate as they slide) and "
     "can overestimate the collapse load of real, non-dilatant joints (SPEC 6.8)")
 
+UNBOUNDED_NOTE = (
+    "the live load stands at any factor: rigid blocks pass it to the supports in "
+    "compression without a joint reaching its limit (a downward load on a dome's top "
+    "ring; a lateral load on a section whose rigid boundary holds it)")
+
 RESULT_KEYS = ("load_factor", "dead_load_feasible", "status", "solver", "iterations",
                "time_s", "residual", "work_balance", "mu", "azimuth_deg", "opening",
                "sliding", "hinges", "main_hinges", "main_sliding", "friction_law",
@@ -196,7 +201,10 @@ class CollapseResult:
 
     @property
     def note(self) -> str | None:
-        """:data:`ASSOCIATED_NOTE` when sliding takes part in an associated mechanism."""
+        """:data:`ASSOCIATED_NOTE` when sliding takes part in an associated mechanism,
+        :data:`UNBOUNDED_NOTE` when no factor bounds the live load."""
+        if self.status == "unbounded":
+            return UNBOUNDED_NOTE
         return (ASSOCIATED_NOTE if self.sliding > 0 and self.friction_law == "associated"
                 else None)
 
