@@ -84,10 +84,18 @@ def handle(args, report):
         report(f"lateral load factor at {params.lateral:g} deg: smallest {low:.4g} (stage "
                f"{at}), {factors[-1][0]:.4g} at stage {factors[-1][1]} (stages.csv)")
     first = stages["first_unsupported"]
-    if first is not None:
+    if first is not None and first.get("loose"):
+        report(f"first stage that needs support: {first['stage']} ({first['bricks']} "
+               f"bricks): {', '.join(first['loose'][:3])} touch nothing that joins them to "
+               f"a support")
+    elif first is not None:
         largest = ", ".join(f"{h['name']} ({h['tension_N']:.3g} N)" for h in first["held"][:3])
         report(f"first stage that needs support: {first['stage']} ({first['bricks']} "
                f"bricks, MoI factor {first['moi_factor']:.3g}); most tension in {largest}; "
                f"{len(first['held'])} bricks carry some (first_unsupported/held.csv)")
+    loose = [str(r["stage"]) for r in record.get("rows", ()) if r.get("loose")]
+    if loose:
+        report(f"stages with blocks joined to no support, so no MoI: {', '.join(loose[:10])}"
+               f"{', ...' if len(loose) > 10 else ''} (stages.csv, column loose)")
     report(f"{state}: {record['path']}")
     return 0

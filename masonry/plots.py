@@ -343,10 +343,10 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
 
 
 def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="",
-                    xlabel="stage") -> bytes:
+                    xlabel="stage", loose=None) -> bytes:
     """MoI factor (and the collapse load factor, where given) against the construction
     stage: stages that stand in green, those that need support in red, the first of
-    them marked by a dashed line.
+    them marked by a dashed line; stages with loose blocks (no MoI) as red crosses at 0.
 
     Parameters
     ----------
@@ -354,16 +354,23 @@ def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="",
     moi_factor : (N,) float (NaN: not solved)
     feasible : (N,) bool
     load_factor : (N,) float or None (NaN: not computed)
+    loose : (N,) int or None
+        Blocks per stage that touch nothing joining them to a support.
     """
     stage = np.asarray(stage)
     moi = np.asarray(moi_factor, dtype=float)
     feasible = np.asarray(feasible, dtype=bool)
+    loose = np.zeros(len(stage), int) if loose is None else np.asarray(loose)
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(stage, moi, color="0.6", linewidth=0.8, zorder=1)
     ax.scatter(stage[feasible], moi[feasible], s=14, color="#2ca02c",
                label=f"stands ({int(feasible.sum())})", zorder=2)
     ax.scatter(stage[~feasible], moi[~feasible], s=14, color="#d62728",
                label=f"needs support ({int((~feasible).sum())})", zorder=2)
+    if loose.any():
+        ax.scatter(stage[loose > 0], np.zeros(int((loose > 0).sum())), marker="x", s=24,
+                   color="#d62728", zorder=2, label=f"a block touches nothing that holds "
+                   f"it, no MoI ({int((loose > 0).sum())})")
     if not feasible.all():
         first = stage[np.argmin(feasible)]
         ax.axvline(first, color="#d62728", linestyle="--", linewidth=0.8,

@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 import pytest
+from test_collapse import column
 from test_interfaces import box_corners
 
 from masonry.blocks import BLOCK_CLASSES, Blocks
@@ -15,8 +16,8 @@ from masonry.params import ParameterError, Params, from_preset, validate
 from masonry.rbe.boundary import Model, analysis_model, restrict
 from masonry.rbe.solve import RBEProblem
 from masonry.scenes import build
-from masonry.studies.stages import (NOT_LAID, analyse_stage, analyse_stages, block_plan,
-                                    brick_plan, course_plan, make_plan)
+from masonry.studies.stages import (NOT_LAID, StagePlan, analyse_stage, analyse_stages,
+                                    block_plan, brick_plan, course_plan, make_plan)
 from masonry_cli.main import main
 
 PATTERN = BLOCK_CLASSES.index("pattern")
@@ -344,3 +345,16 @@ def test_lateral_load_factor_of_a_stage_that_slides():
     params = validate(Params(mu=0.3, lateral=180.0))
     rows = analyse_stages(Model(blocks, detect(blocks)), params, block_plan(blocks, "z"))
     assert rows[0]["load_factor"] == pytest.approx(0.3, abs=1e-6)
+
+
+def test_a_block_laid_before_the_one_under_it_is_loose_and_has_no_moi():
+    """A column laid top block first: at stage 1 the top blocks touch nothing that joins
+    them to the ground (no equilibrium, even with tension: no solve, no MoI); at stage 2
+    the column stands."""
+    model = column(3, (0.2, 0.2, 0.1))
+    plan = StagePlan(np.array([0, 2, 1, 1]), np.array([0, 0]), by="block", order="names")
+    params = validate(Params(scene="wall"))
+    first, second = (analyse_stage(model, params, plan, k) for k in (1, 2))
+    assert first["loose"] == 2 and first["loose_blocks"] == [2, 3]
+    assert not first["feasible"] and first["moi"] is None
+    assert second["loose"] == 0 and second["feasible"]

@@ -38,6 +38,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
 
 from masonry.blocks import BLOCK_CLASSES
 from masonry.export.summaries import parameters_text
@@ -68,11 +70,13 @@ BLOCK_ORDERS = {
 }
 """Laying orders of :func:`block_plan`."""
 
-STAGE_COLUMNS = ("stage", "course", "bricks", "feasible", "moi", "moi_factor",
+STAGE_COLUMNS = ("stage", "course", "bricks", "feasible", "loose", "moi", "moi_factor",
                  "load_factor", "solve_s")
-"""Columns of ``stages.csv``, one row per stage. ``load_factor``: the collapse load factor
-of the stage under the lateral load of ``params.lateral`` (:func:`stage_load_factor`);
-empty without one, or where the stage does not stand under its own weight."""
+"""Columns of ``stages.csv``, one row per stage. ``loose``: the laid blocks that touch
+nothing joining them to a support (:func:`loose_blocks`: the stage has no equilibrium at
+all, and no MoI). ``load_factor``: the collapse load factor of the stage under the
+lateral load of ``params.lateral`` (:func:`stage_load_factor`); empty without one, or
+where the stage does not stand under its own weight."""
 
 NOT_LAID = -1
 """``StagePlan.block_stage`` of a block the plan never lays."""
@@ -257,10 +261,11 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
     """
     start = time.perf_counter()
     part = restrict(model, plan.is_present(stage))
+    loose = loose_blocks(part)
     row = {"stage": stage, "course": int(plan.stage_course[stage - 1]) or None,
-           "bricks": int((~part.blocks.block_is_support).sum()), "load_factor": None}
-    if len(part.interfaces) == 0:
-        log.warning("stage %d: no block touches another or a support", stage)
+           "bricks": int((~part.blocks.block_is_support).sum()), "loose": len(loose),
+           "loose_blocks": loose.tolist(), "load_factor": None}
+    if len(loose):  # no equilibrium holds them, tension or not: nothing to solve
         row.update(feasible=False, moi=None, moi_factor=None, tension={})
     else:
         problem = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
@@ -276,6 +281,19 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
             row["load_factor"] = stage_load_factor(part, params)
     row["solve_s"] = round(time.perf_counter() - start, 4)
     return row
+
+
+def loose_blocks(part: Model) -> np.ndarray:
+    """The scene blocks of a stage that no chain of interfaces joins to a support (a
+    block laid before the ones under it): sorted, (k,) int."""
+    source = part.block_source
+    a, b = source[part.interfaces.pair.T]
+    size = len(source) and int(source.max()) + 1
+    joined = sp.coo_array((np.ones(len(a)), (a, b)), shape=(size, size))
+    _, component = connected_components(joined, directed=False)
+    held = np.isin(component, component[source[part.blocks.block_is_support]])
+    laid = np.unique(source[~part.blocks.block_is_support])
+    return laid[~held[laid]]
 
 
 def stage_load_factor(part: Model, params) -> float | None:
@@ -373,8 +391,11 @@ def analyse_stages(model: Model, params, plan: StagePlan) -> list:
     rows = []
     for stage in range(1, plan.n_stages + 1):
         row = analyse_stage(model, params, plan, stage)
+        verdict = ("stands" if row["feasible"] else
+                   f"needs support ({row['loose']} blocks touch nothing that holds them)"
+                   if row["loose"] else "needs support")
         log.info("stage %d of %d: %d bricks, %s, MoI factor %s, %.2f s", stage,
-                 plan.n_stages, row["bricks"], "stands" if row["feasible"] else "needs support",
+                 plan.n_stages, row["bricks"], verdict,
                  "-" if row["moi_factor"] is None else f"{row['moi_factor']:.3g}",
                  row["solve_s"])
         rows.append(row)
@@ -533,6 +554,7 @@ def _record(scene, model, plan, rows, outputs, cached, source) -> dict:
                 "bricks": first["bricks"], "moi_factor": first["moi_factor"],
                 "laid": [str(name) for name in scene.blocks.block_name[
                     plan.block_stage == first["stage"]]],
+                "loose": [str(scene.blocks.block_name[b]) for b in first["loose_blocks"]],
                 "held": held},
             "solve_s": round(sum(row["solve_s"] for row in rows), 4),
         },
@@ -583,7 +605,7 @@ def stage_pngs(scene, plan: StagePlan, rows) -> dict:
         [np.nan if r["moi_factor"] is None else r["moi_factor"] for r in rows],
         [bool(r["feasible"]) for r in rows],
         [np.nan if r["load_factor"] is None else r["load_factor"] for r in rows],
-        title=title, xlabel={"course": "stage (courses laid)", "brick": f"stage (bricks "
+        loose=[r["loose"] for r in rows], title=title, xlabel={"course": "stage (courses laid)", "brick": f"stage (bricks "
                              f"of course {plan.course} laid, per web)"}.get(plan.by, "stage"))}
     first = first_unsupported(rows)
     if first is None:
