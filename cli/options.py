@@ -5,9 +5,9 @@ import math
 import shlex
 
 from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS
-from masonry.params import (ACCURACIES, ARCH_SHAPES, BOUNDARIES, FRICTIONS, PRESETS,
-                            RANGES, SCENE_FIELDS, SCENES, SOLVERS, ParameterError, Params,
-                            from_preset, load, validate)
+from masonry.params import (ACCURACIES, ARCH_SHAPES, BOUNDARIES, FRICTION_LAWS, FRICTIONS,
+                            PRESETS, RANGES, SCENE_FIELDS, SCENES, SOLVERS, ParameterError,
+                            Params, from_preset, load, validate)
 
 DEFAULTS = Params()
 
@@ -219,6 +219,11 @@ def add_live_load_options(parser):
     g.add_argument("--crown-load", dest="crown_load", type=float, metavar="NEWTONS",
                    help="domes: a downward load on the top course, shared by brick top "
                         "area (a lantern; a section carries its 1/n share)")
+    g.add_argument("--friction-law", dest="friction_law", choices=FRICTION_LAWS,
+                   help="associated (default: the LP; sliding joints dilate, which can "
+                        "overestimate the factor) or non-associative (an estimate with "
+                        "joints that slide without dilating: friction capacities fixed "
+                        "from the last collapse and solved again)")
 
 
 def collapse_summary(record, report):
@@ -234,6 +239,9 @@ def collapse_summary(record, report):
         if c["note"]:
             report(f"note: {c['note']}")
         return
+    if c["friction_law"] != "associated" and c["associated_factor"] is not None:
+        what += (f", {c['friction_law']} friction (associated: "
+                 f"{c['associated_factor']:.4g})")
     report(f"collapse: lambda = {c['load_factor']:.4g} for the {what}; mechanism: "
            f"{c['main_hinges']} hinges, {c['main_sliding']} sliding joints (of "
            f"{c['hinges']} and {c['sliding']} that move at all); "

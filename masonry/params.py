@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 SCENES = ("section", "wall", "dome", "assembly", "arch")
 FRICTIONS = ("net", "plus", "auto")
+FRICTION_LAWS = ("associated", "non-associative")
 BOUNDARIES = ("free", "rigid", "cyclic")
 # QP solvers (masonry.rbe.solvers.BACKENDS) and accuracy presets (masonry.rbe.solve.ACCURACY)
 SOLVERS = ("newton", "interior", "clarabel", "osqp", "clarabel-cvxpy", "osqp-cvxpy")
@@ -85,7 +86,9 @@ class Params:
     force of each block's weight, or ``'all'`` for the worst azimuth; ``point_loads``
     ``'NAME_OR_PATTERN:FX,FY,FZ'`` strings (newtons at the centre of each matched block's
     top face); ``crown_load`` newtons, downward, on the top course by brick top area. At
-    most one kind per run.
+    most one kind per run. ``friction_law`` of the collapse load factor: ``associated``
+    (the LP of SPEC 6.8) or ``non-associative`` (joints that slide without dilating: the
+    estimate of :func:`masonry.rbe.collapse.fixed_capacity_factor`).
     """
 
     stretch: float = 1.0
@@ -117,6 +120,7 @@ class Params:
     lateral: float | str | None = None
     point_loads: tuple = ()
     crown_load: float | None = None
+    friction_law: str = "associated"
 
     def replace(self, **changes) -> "Params":
         return dataclasses.replace(self, **changes)
@@ -315,6 +319,11 @@ def _live_loads(p: Params) -> Params:
     if len(given) > 1:
         raise ParameterError(*given[1], "one live load per run: --lateral, --point-load "
                                         "or --crown-load", related=(given[0][0],))
+    _choice("friction_law", p.friction_law, FRICTION_LAWS)
+    if p.friction_law != "associated" and (not given or lateral == "all"):
+        raise ParameterError("friction_law", p.friction_law, "associated without a live "
+                             "load or with --lateral all (the estimate is of one load "
+                             "case: --lateral AZIMUTH, --point-load or --crown-load)")
     if p.scene == "section" and p.boundary == "cyclic" and (lateral is not None or specs):
         # one web with the load repeated in every web is not the asked load case
         raise ParameterError("lateral" if lateral is not None else "point_loads",
@@ -473,7 +482,7 @@ def structure_id(params: Params) -> str:
             continue  # dome0 / dome1 already say free / cyclic
         if value != getattr(default, name):
             head += f"_{tag}{value:g}" if isinstance(value, float) else f"_{tag}{value}"
-    return head + _live_load_tag(p)
+    return head + _live_load_tag(p) + _friction_law_tag(p)
 
 
 def _live_load_tag(p: Params) -> str:
@@ -487,3 +496,8 @@ def _live_load_tag(p: Params) -> str:
         digest = hashlib.sha1("\n".join(p.point_loads).encode()).hexdigest()[:8]
         return f"_pl{digest}"
     return ""
+
+
+def _friction_law_tag(p: Params) -> str:
+    """Structure id suffix of the collapse's friction law: none for associated."""
+    return "" if p.friction_law == "associated" else "_nonassoc"

@@ -482,7 +482,9 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     else:
         live = crown_load(model.blocks, params.crown_load,
                           copies=params.n if params.scene == "section" else 1)
-    result = collapse_load(model, live, dead_load_feasible=known, **options)
+    friction = None if params.friction_law == "associated" else params.friction_law
+    result = collapse_load(model, live, dead_load_feasible=known, friction=friction,
+                           **options)
     if params.lateral is not None:
         result = dataclasses.replace(result, azimuth_deg=float(params.lateral))
     return result

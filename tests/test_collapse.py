@@ -396,8 +396,35 @@ def test_non_associative_friction_lowers_a_sliding_collapse_and_keeps_a_tipping_
     assert associated.note is not None  # sliding takes part: the outputs say so
     assert estimate.associated_factor == pytest.approx(associated.load_factor, rel=1e-6)
     assert 0 < estimate.load_factor < 0.95 * associated.load_factor
-    assert estimate.x.reshape(-1, 4)[:, 1].max() == 0  # no tension
+    forces = estimate.x.reshape(-1, 4)
+    assert forces[:, 1].max() == 0  # no tension
     assert estimate.residual < 1e-7
+    # settled: Coulomb's law holds at the estimate's forces (the fixed capacities of the
+    # last round are those of its own compression) to within a fraction of a percent
+    excess = np.abs(forces[:, 2:]).max(axis=1) - 0.7 * forces[:, 0]
+    assert excess.max() <= 5e-3 * forces[:, 0].max()
+
+
+def test_run_reports_the_non_associative_estimate_beside_the_associated_factor(tmp_path,
+                                                                              capsys):
+    common = ["run", "--scene", "dome", "--stretch", "1", "--n", "6", "--r", "0", "--p",
+              "3", "--cut", "0.5", "--lateral", "0", "--out", str(tmp_path), "--no-plots",
+              "--no-printable", "-q"]
+    assert main(common + ["--friction-law", "non-associative"]) == 0
+    assert main(common) == 0
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if "lambda" in ln]
+    assert "non-associative friction (associated: 0.8066)" in lines[0]
+    records = {path.name: json.loads((path / "run.json").read_text())["collapse"]
+               for path in tmp_path.glob("fulldome_*")}
+    estimate = records[next(n for n in records if n.endswith("_nonassoc"))]
+    associated = records[next(n for n in records if n.endswith("_lat0"))]
+    assert estimate["friction_law"] == "non-associative"
+    assert estimate["associated_factor"] == pytest.approx(associated["load_factor"])
+    assert estimate["load_factor"] < 0.95 * associated["load_factor"]
+    assert main(["run", "--preset", "wall", "--friction-law", "non-associative", "--out",
+                 str(tmp_path / "x")]) == 2
+    assert "--friction-law non-associative: expected associated without a live load" in \
+        capsys.readouterr().err
 
 
 def test_the_dome_symmetry_leaves_azimuths_from_a_web_to_its_corner():

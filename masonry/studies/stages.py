@@ -312,8 +312,9 @@ def stage_load_factor(part: Model, params) -> float | None:
     if params.lateral is None:
         return None
     live = lateral(part, params.lateral, params.density)
+    friction = None if params.friction_law == "associated" else params.friction_law
     result = collapse_load(part, live, mu=params.mu, density=params.density,
-                           dead_load_feasible=True)
+                           friction=friction, dead_load_feasible=True)
     return result.load_factor
 
 
