@@ -648,7 +648,7 @@ def thrust_line_png(scene, interfaces, resultants, fast=False):
     ax.set_ylabel("z [m]")
     fig.legend(loc="outside lower center", fontsize=7, frameon=False)
     where = "the arch" if scene.params.scene == "arch" else f"y = {y:g} m"
-    ax.set_title(f"thrust line through {len(index)} bed joints at {where}: "
+    ax.set_title(f"thrust line under self-weight through {len(index)} bed joints at {where}: "
                  f"{_count(hinge.sum(), 'hinge')}, {int(outside.sum())} outside\n"
                  f"{scene_title(scene)}", fontsize=9)
     return _png(fig, 80 if fast else 150)

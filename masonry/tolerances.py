@@ -244,3 +244,8 @@ MECHANISM_MAIN = 0.05
 mechanism: hinges that open, and joints that slip, by at least this fraction of the
 largest opening or slip (preset 3's full dome at azimuth 0: 124 of 1,811 hinges). The
 plots mark these, the summaries count both."""
+
+FACTOR_TIE_REL = 1e-6
+"""Load factors of two azimuths this close (relative) are the same worst case: the search
+reports the first azimuth (a symmetric structure's 0 and 180 degrees differ by the LP's
+rounding only)."""

@@ -42,7 +42,7 @@ from masonry.rbe.solvers.base import OPTIMAL
 from masonry.rbe.solvers.highs import highs_lp
 from masonry.rbe.solvers.interior_lp import LoadFactorOptions, load_factor
 from masonry.rbe.solvers.newton import NewtonSystem
-from masonry.tolerances import MECHANISM_MAIN, MOTION_TOL
+from masonry.tolerances import FACTOR_TIE_REL, MECHANISM_MAIN, MOTION_TOL
 
 log = logging.getLogger(__name__)
 
@@ -764,6 +764,10 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
     log.info("lateral search: %d azimuths, %d solved", len(results), len(solved))
     factors = [(float(a), r.load_factor) for a, r in zip(azimuths, results)]
     found = [r for r in results if r.load_factor is not None]
-    worst = min(found, key=lambda r: r.load_factor) if found else results[-1]
+    worst = results[-1]
+    if found:
+        least = min(r.load_factor for r in found)
+        worst = next(r for r in found
+                     if r.load_factor <= least + FACTOR_TIE_REL * abs(least))
     return dataclasses.replace(worst, azimuths=tuple(factors),
                                time_s=time.perf_counter() - start)
