@@ -389,6 +389,11 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
 
     with RunFolder(out_root, sid, keep=keep) as folder:
         write_exports(folder, made, record, timer)
+        # the files this folder holds (no 3DM without rhino3dm, no 3MF without a size)
+        record["coordinates"] = {
+            key: [name for name in value if (folder.tmp / name).exists()]
+            if isinstance(value, list) else value
+            for key, value in record["coordinates"].items()}
         record["timings_s"] = timer.seconds
         record["versions"] = versions()
         record["complete"] = True

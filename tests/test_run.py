@@ -2,6 +2,7 @@
 
 import csv
 import json
+from pathlib import Path
 
 import meshio
 import numpy as np
@@ -9,8 +10,8 @@ import pytest
 import trimesh
 
 from masonry.export import EXPORTERS, RunOutputs
-from masonry.params import from_preset, validate
-from masonry.pipeline import Timer, write_exports
+from masonry.params import Params, from_preset, validate
+from masonry.pipeline import Timer, run, write_exports
 from masonry.rbe.boundary import analysis_model
 from masonry.rbe.solve import RBEProblem
 from masonry.scenes import build
@@ -235,3 +236,15 @@ def test_invalid_mu_writes_nothing(tmp_path, capsys):
     assert main(["run", "--mu", "-1", "--out", str(tmp_path / "x")]) == 2
     assert "--mu -1: expected" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+def test_run_json_names_only_the_files_the_folder_holds(tmp_path):
+    """``coordinates`` lists files by coordinate system: a build without a solve or a
+    printable body has no forces and no STL to list."""
+    record = run(validate(Params(scene="wall", wall_courses=2, wall_length=8)), tmp_path,
+                 analyse=False, plots_wanted=False, printable=False)
+    folder = Path(record["path"])
+    listed = record["coordinates"]["model"] + record["coordinates"]["moved_inward"]
+    assert "bricks.obj" in listed and "RBE/forces.csv" not in listed
+    assert "dome.stl" not in listed and not (folder / "RBE").exists()
+    assert all((folder / name).is_file() for name in listed)
