@@ -103,6 +103,8 @@ LISTED = [
     ["--point-load", "w0_*:1,2,nan"], ["--crown-load", "0"], ["--crown-load", "-5"],
     ["--crown-load", "nan"], ["--scene", "wall", "--crown-load", "500"],
     ["--lateral", "0", "--crown-load", "500"], ["--point-load", "a*:0,0,-1", "--lateral", "0"],
+    ["--friction-law", "non-associative"], ["--friction-law", "coulomb", "--lateral", "0"],
+    ["--scene", "dome", "--lateral", "all", "--friction-law", "non-associative"],
 ]
 RUN_ONLY = [["--scene", "arch", "--boundary", "cyclic"], ["--scene", "wall", "--dome"],
             ["--friction", "none"], ["--solver", "gurobi"]]
@@ -349,6 +351,7 @@ PLAUSIBLE = {
     "--lateral": ["0", "30", "-90", "all", "east"],
     "--point-load": ["w0_*:1000,0,0", "*:0,0,-500", "w0_b0001*:0,0,-1e4", "w0:1,2", "x"],
     "--crown-load": ["500", "20000", "0", "-100"],
+    "--friction-law": ["associated", "non-associative", "coulomb"],
 }
 INTEGER_OPTIONS = {"--n", "--r", "--p", "--wall-courses", "--blocks"}
 SCENE_OPTIONS = {
@@ -358,7 +361,7 @@ SCENE_OPTIONS = {
     "arch": ["--span", "--thickness", "--rise", "--depth", "--blocks", "--shape"],
 }
 EVERY_SCENE = ["--mu", "--density", "--friction", "--accuracy", "--print-size", "--lateral",
-               "--point-load", "--crown-load"]
+               "--point-load", "--crown-load", "--friction-law"]
 
 
 def test_the_tables_cover_every_option_of_run():
@@ -372,7 +375,8 @@ def test_the_tables_cover_every_option_of_run():
 
 def value_of(option):
     plausible = st.sampled_from(PLAUSIBLE[option])
-    if option in ("--shape", "--boundary", "--friction", "--accuracy", "--point-load"):
+    if option in ("--shape", "--boundary", "--friction", "--accuracy", "--point-load",
+                  "--friction-law"):
         return plausible
     wild = WILD_INTEGERS if option in INTEGER_OPTIONS else WILD_FLOATS
     return st.one_of(plausible, plausible, plausible, wild)
