@@ -461,19 +461,19 @@ def structure_id(params: Params) -> str:
     p = params
     default = Params()
     if p.scene == "wall":
-        head = f"wall_fast{int(p.fast)}_fric{p.friction}_L{p.wall_length:g}_k{p.wall_courses}"
+        head = f"wall_fast{int(p.fast)}_fric{p.friction}_L{_n(p.wall_length)}_k{p.wall_courses}"
     elif p.scene == "arch":
         head = (f"arch_fast{int(p.fast)}_fric{p.friction}_{p.arch_shape}_N{p.arch_blocks}"
-                f"_s{p.arch_span:g}_t{p.arch_thickness:g}_d{p.arch_depth:g}"
-                + ("" if p.arch_rise is None else f"_h{p.arch_rise:g}"))
+                f"_s{_n(p.arch_span)}_t{_n(p.arch_thickness)}_d{_n(p.arch_depth)}"
+                + ("" if p.arch_rise is None else f"_h{_n(p.arch_rise)}"))
     elif p.scene == "assembly":
         head = f"assembly_{p.assembly}_fast{int(p.fast)}_fric{p.friction}"
     else:
         mode = "fulldome" if p.scene == "dome" else f"dome{int(p.boundary != 'free')}"
-        head = (f"{mode}_fast{int(p.fast)}_fric{p.friction}_s{p.stretch:g}_n{p.n}_r{p.r}"
-                f"_p{p.p}_c{p.cut:g}")
+        head = (f"{mode}_fast{int(p.fast)}_fric{p.friction}_s{_n(p.stretch)}_n{p.n}_r{p.r}"
+                f"_p{p.p}_c{_n(p.cut)}")
     if p.scene not in ("arch", "assembly"):  # no brick unit in these scenes
-        head += f"_u{p.unit:g}"
+        head += f"_u{_n(p.unit)}"
     extras = [("boundary", "b"), ("mu", "mu"), ("density", "rho"), ("min_fill", "mf"),
               ("accuracy", ""), ("solver", ""), ("cad_offset", "cad")]
     for name, tag in extras:
@@ -481,7 +481,7 @@ def structure_id(params: Params) -> str:
         if name == "boundary" and (p.scene == "wall" or value != "rigid"):
             continue  # dome0 / dome1 already say free / cyclic
         if value != getattr(default, name):
-            head += f"_{tag}{value:g}" if isinstance(value, float) else f"_{tag}{value}"
+            head += f"_{tag}{_n(value)}" if isinstance(value, float) else f"_{tag}{value}"
     return head + _live_load_tag(p) + _friction_law_tag(p)
 
 
@@ -489,13 +489,21 @@ def _live_load_tag(p: Params) -> str:
     """Structure id suffix of the live load: ``_latall``, ``_lat30``, ``_crown500``, or
     ``_pl`` and a digest of the point loads (they can be long)."""
     if p.lateral is not None:
-        return "_latall" if p.lateral == "all" else f"_lat{p.lateral:g}"
+        return "_latall" if p.lateral == "all" else f"_lat{_n(p.lateral)}"
     if p.crown_load is not None:
-        return f"_crown{p.crown_load:g}"
+        return f"_crown{_n(p.crown_load)}"
     if p.point_loads:
         digest = hashlib.sha1("\n".join(p.point_loads).encode()).hexdigest()[:8]
         return f"_pl{digest}"
     return ""
+
+
+def _n(value: float) -> str:
+    """A number in a structure id: ``%g`` (``0.1``, ``1``, ``1e-05``) where that is the
+    value, else every digit it needs (``2011.8216``: ``%g`` would give ``2011.82``, the
+    name of another input)."""
+    short = f"{value:g}"
+    return short if float(short) == value else repr(float(value))
 
 
 def _friction_law_tag(p: Params) -> str:

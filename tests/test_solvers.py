@@ -68,6 +68,10 @@ def test_params_accuracy_validation_and_structure_id():
     assert structure_id(from_preset("1")) == "dome0_fast0_fricauto_s1_n8_r1_p10_c0.1_u0.1"
     assert structure_id(from_preset("1", accuracy="accurate")).endswith("_accurate")
     assert structure_id(from_preset("1", solver="osqp")).endswith("_osqp")
+    # two inputs, two folders: 2011.8216 and 2011.8219 are both 2011.82 to six digits
+    assert structure_id(from_preset("1", density=2011.8216)).endswith("_rho2011.8216")
+    assert structure_id(from_preset("1", density=2011.8219)).endswith("_rho2011.8219")
+    assert structure_id(from_preset("1", density=2500.0, mu=0.3)).endswith("_mu0.3_rho2500")
     with pytest.raises(ParameterError, match="accuracy"):
         from_preset("1", accuracy="exact")
     with pytest.raises(ParameterError, match="solver"):

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from masonry.export._text import format_floats
 from masonry.params import Params, ParameterError, validate
 from masonry.pipeline import run
 from masonry.rbe.solvers.newton import use_one_blas_thread
@@ -308,16 +309,20 @@ def summary_rows(study: Study, results) -> list:
 
 def summary_csv(study: Study, rows) -> bytes:
     """CSV (UTF-8 bytes) of :func:`summary_rows`: swept inputs, then
-    :data:`SUMMARY_COLUMNS`; floats to 6 significant digits, None as an empty cell."""
+    :data:`SUMMARY_COLUMNS`; floats as every CSV of the project prints them
+    (:func:`~masonry.export._text.format_floats`: a sampled input keeps the digits that
+    name its run folder), None as an empty cell."""
     columns = study.swept + list(SUMMARY_COLUMNS)
-    lines = [",".join(columns)]
-    for row in rows:
-        cells = []
-        for c in columns:
-            v = row.get(c)
-            text = "" if v is None else (f"{v:.6g}" if isinstance(v, float) else str(v))
-            cells.append('"' + text.replace('"', "'") + '"' if "," in text else text)
-        lines.append(",".join(cells))
+    texts = []
+    for c in columns:
+        values = [row.get(c) for row in rows]
+        text = ["" if v is None else str(v) for v in values]
+        floats = [i for i, v in enumerate(values) if isinstance(v, float)]
+        if floats:
+            for i, printed in zip(floats, format_floats([values[i] for i in floats])):
+                text[i] = printed
+        texts.append(['"' + t.replace('"', "'") + '"' if "," in t else t for t in text])
+    lines = [",".join(columns), *map(",".join, zip(*texts))]
     return ("\n".join(lines) + "\n").encode()
 
 
