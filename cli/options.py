@@ -351,6 +351,12 @@ def rbe_summary(record, report) -> int:
                f"{rbe['solver']} stopped with status {rbe.get('status')!r}, residual "
                f"{rbe['residual_eq']:.2g}; no verdict")
         return 3
+    if verdict == "infeasible" and rbe["moi"] is not None and not math.isfinite(rbe["moi"]):
+        # friction-net has no equilibrium, and friction+ was not solved: no MoI
+        report(f"RBE: infeasible (friction-net has no equilibrium, mu {rbe['mu']:g}); MoI "
+               f"not computed: {rbe['solver']} stopped with status {rbe.get('status')!r} "
+               f"on friction-{rbe['friction']}, residual {rbe['residual_eq']:.2g}")
+        return 3
     report(f"RBE: {verdict} (friction-{rbe['friction']}, mu {rbe['mu']:g}), "
            f"MoI {rbe['moi']:.4g} N, MoI factor {rbe['moi_factor']:.4g}, "
            f"residual {rbe['residual_eq']:.2g}, {rbe['solver']} {rbe['time_s']:.3g} s")

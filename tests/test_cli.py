@@ -159,3 +159,18 @@ def test_a_flag_that_does_not_apply_is_refused_by_name(tmp_path, capsys):
     assert error == ["masonry: error: --lateral: expected the full domes, whose factor "
                      "it is: not with --no-full-dome"]
     assert not any(tmp_path.iterdir())
+
+
+def test_an_infeasible_verdict_without_its_moi_exits_3():
+    """friction-net certified infeasible, friction+ stopped short: the verdict stands, the
+    MoI the run was for is missing, and the exit code says so."""
+    from masonry_cli.options import rbe_summary
+
+    lines = []
+    record = {"params": {"friction": "auto"},
+              "rbe": {"verdict": "infeasible", "friction": "plus", "mu": 0.01, "moi": np.nan,
+                      "solver": "osqp", "status": "user_limit", "residual_eq": 1.1e-4}}
+    assert rbe_summary(record, lines.append) == 3
+    assert lines == ["RBE: infeasible (friction-net has no equilibrium, mu 0.01); MoI not "
+                     "computed: osqp stopped with status 'user_limit' on friction-plus, "
+                     "residual 0.00011"]
