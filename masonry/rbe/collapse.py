@@ -171,15 +171,15 @@ class CollapseResult:
 
     @property
     def opening(self) -> int:
-        return -1 if self.opens is None else int(self.opens.sum())
+        return _count(self.opens)
 
     @property
     def sliding(self) -> int:
-        return -1 if self.slides is None else int(self.slides.sum())
+        return _count(self.slides)
 
     @property
     def hinges(self) -> int:
-        return -1 if self.hinge is None else int(self.hinge.sum())
+        return _count(self.hinge)
 
     @property
     def main_hinge(self) -> np.ndarray | None:
@@ -193,11 +193,11 @@ class CollapseResult:
 
     @property
     def main_hinges(self) -> int:
-        return -1 if self.hinge is None else int(self.main_hinge.sum())
+        return _count(self.main_hinge)
 
     @property
     def main_sliding(self) -> int:
-        return -1 if self.slides is None else int(self.main_slides.sum())
+        return _count(self.main_slides)
 
     @property
     def note(self) -> str | None:
@@ -219,6 +219,11 @@ class CollapseResult:
         if self.azimuths:
             out["azimuths"] = [{"azimuth_deg": a, "load_factor": f} for a, f in self.azimuths]
         return out
+
+
+def _count(flags) -> int:
+    """How many interfaces ``flags`` marks; -1 without a mechanism (None)."""
+    return -1 if flags is None else int(flags.sum())
 
 
 def _main(flags, motion) -> np.ndarray:
