@@ -351,7 +351,8 @@ def rbe_summary(record, report) -> int:
                f"{rbe['solver']} stopped with status {rbe.get('status')!r}, residual "
                f"{rbe['residual_eq']:.2g}; no verdict")
         return 3
-    if verdict == "infeasible" and rbe["moi"] is not None and not math.isfinite(rbe["moi"]):
+    if (verdict == "infeasible" and rbe["friction"] == "plus" and rbe["moi"] is not None
+            and not math.isfinite(rbe["moi"])):
         # friction-net has no equilibrium, and friction+ was not solved: no MoI
         report(f"RBE: infeasible (friction-net has no equilibrium, mu {rbe['mu']:g}); MoI "
                f"not computed: {rbe['solver']} stopped with status {rbe.get('status')!r} "
