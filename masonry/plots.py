@@ -19,6 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.collections import PolyCollection  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch, Rectangle  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 from matplotlib.transforms import ScaledTranslation  # noqa: E402
@@ -726,6 +727,41 @@ def _mechanism_faces(blocks, mechanism):
     return undeformed, deformed, per_block[blocks.face_block[faces]], bounds
 
 
+def _live_load_marks(ax, view, blocks, live, bounds) -> list:
+    """Where the live load acts: its resultant's direction as an arrow, into the loaded
+    blocks (marked) when not every block is loaded (a point or crown load), else from the
+    plot's edge the load comes from. Returns the legend handles."""
+    handles = []
+    loaded = np.flatnonzero(np.abs(live.wrench[:, :3]).max(axis=1) > 0)
+    total = live.total_force
+    direction = total / max(float(np.linalg.norm(total)), 1e-300)
+    size = float(np.abs(direction) @ (bounds[1] - bounds[0]))  # the box along it
+    if len(loaded) < int((~np.asarray(blocks.block_is_support)).sum()):
+        _points(ax, view, blocks.block_centroid[loaded], marker="v", color="k", s=18)
+        handles.append(Line2D([], [], marker="v", color="k", linestyle="none",
+                              label=f"loaded blocks ({len(loaded)})"))
+        end = blocks.block_centroid[loaded].mean(axis=0)
+        # as long as the box leaves room for behind the loaded blocks
+        room = np.where(direction > 0, end - bounds[0], bounds[1] - end)
+        moving = np.abs(direction) > 1e-9
+        length = min(0.25 * size, 0.9 * float((room[moving] / np.abs(direction[moving])).min()))
+        start = end - length * direction
+    else:
+        start = bounds.mean(axis=0) - 0.45 * size * direction
+        end = start + 0.25 * size * direction
+    if view not in ELEVATIONS:
+        ax.quiver(*start, *(end - start), color="k", linewidth=1.5, arrow_length_ratio=0.3)
+    else:
+        h, v, _, _ = ELEVATIONS[view]
+        if np.hypot(*direction[[h, v]]) < 0.1:  # seen along the load
+            return handles
+        ax.annotate("", xy=end[[h, v]], xytext=start[[h, v]], zorder=11,
+                    arrowprops=dict(arrowstyle="-|>", color="k", linewidth=1.5))
+    handles.append(Line2D([], [], marker=r"$\rightarrow$", color="k", linestyle="none",
+                          markersize=12, label="live load's direction"))
+    return handles
+
+
 def mechanism_pngs(scene, blocks, interfaces, collapse, title, fast=False) -> dict:
     """The collapse mechanism (SPEC 6.9) drawn exaggerated over the undeformed structure,
     in the four views (``collapse/<view>_mechanism.png``; one view when ``fast``):
@@ -771,14 +807,16 @@ def mechanism_pngs(scene, blocks, interfaces, collapse, title, fast=False) -> di
             if len(index):
                 _add_polygons(ax, view, _polygons(interfaces, index), face,
                               edgecolors=edge, linewidths=width)
+        shown = handles + (_live_load_marks(ax, view, blocks, collapse.live, bounds)
+                           if collapse.live is not None else [])
         _colour_bar(fig, ax, scale, "virtual displacement (largest = 1)")
         if view in ELEVATIONS:  # below the plot: an elevation fills its axes
             # 0.45 inch below the axes, clear of the tick labels at any aspect
             below = ax.transAxes + ScaledTranslation(0, -0.45, fig.dpi_scale_trans)
-            ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0),
+            ax.legend(handles=shown, loc="upper center", bbox_to_anchor=(0.5, 0),
                       bbox_transform=below, ncol=3, fontsize=7, frameon=False)
         else:
-            ax.legend(handles=handles, loc="upper left", fontsize=7)
+            ax.legend(handles=shown, loc="upper left", fontsize=7)
         ax.set_title(f"{title}; displacement drawn at {MECHANISM_SCALE:g} x size\n"
                      f"{scene_title(scene)}", fontsize=9)
         out[f"collapse/{view}_mechanism.png"] = _png(fig, 60 if fast else 110)
