@@ -11,7 +11,7 @@ from masonry.params import from_preset
 from masonry.plots import (COLOUR_PERCENTILE, _rank_labels, colour_scale, force_unit,
                            mechanism_pngs)
 from masonry.rbe.collapse import collapse_load
-from masonry.rbe.loads import lateral
+from masonry.rbe.loads import lateral, point_loads
 from masonry.tolerances import TENSION_REPORTED_REL
 from test_collapse import DENSITY, column
 
@@ -112,9 +112,12 @@ def test_rank_labels_of_neighbouring_interfaces_share_one_label():
     assert np.allclose(labels[1][1], [5.0, 0, 0])
 
 
-def test_mechanism_plots_are_written_in_the_four_views():
+@pytest.mark.parametrize("load", ["lateral", "point"])
+def test_mechanism_plots_are_written_in_the_four_views(load):
     model = column(2, (0.1, 0.3, 0.15))
-    result = collapse_load(model, lateral(model, 0.0, DENSITY), mu=0.9, density=DENSITY)
+    live = (lateral(model, 0.0, DENSITY) if load == "lateral"
+            else point_loads(model.blocks, ["b1:100,0,0"]))
+    result = collapse_load(model, live, mu=0.9, density=DENSITY)
     scene = SimpleNamespace(params=from_preset("wall"))  # names the figures only
     pngs = mechanism_pngs(scene, model.blocks, model.interfaces, result, "column")
     assert sorted(pngs) == [f"collapse/{v}_mechanism.png" for v in
