@@ -194,7 +194,7 @@ def handle(args, report):
         parquet = summary_parquet(study, rows)
         if parquet is not None:
             folder.write("summary.parquet", parquet)
-        for png_name, png in summary_pngs(study, rows).items():
+        for png_name, png in summary_pngs(study, rows, Path(args.study).stem).items():
             folder.write(png_name, png)
     counts = {s: sum(r["status"] == s for r in rows) for s in ("computed", "reused", "failed")}
     report(f"{total} variants: {counts['computed']} computed, {counts['reused']} reused, "

@@ -345,9 +345,18 @@ def summary_parquet(study: Study, rows):
     return buf.getvalue()
 
 
-def summary_pngs(study: Study, rows) -> dict:
+def _fixed_inputs(study: Study) -> str:
+    """The study's fixed inputs away from their defaults, for figure titles."""
+    default = Params()
+    text = ", ".join(f"{key} {value}" for key, value in study.base.items()
+                     if key not in study.swept and getattr(default, key, None) != value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def summary_pngs(study: Study, rows, label="") -> dict:
     """MoI factor and feasibility against each swept input (one figure per input); with
     a second swept input, one colour per value of it (the first other swept input).
+    Titled with ``label`` (the study's name), its variants and its fixed inputs.
 
     Returns
     -------
@@ -359,6 +368,9 @@ def summary_pngs(study: Study, rows) -> dict:
 
     out = {}
     done = [r for r in rows if r["status"] != "failed"]
+    fixed = _fixed_inputs(study)
+    title = (f"{label + ': ' if label else ''}{len(done)} variants ({len(rows) - len(done)} "
+             f"failed)" + (f"\nfixed: {fixed}" if fixed else ""))
     for name in study.swept:
         others = [other for other in study.swept if other != name]
         group = others[0] if others else None
@@ -388,7 +400,7 @@ def summary_pngs(study: Study, rows) -> dict:
         bottom.set_xlabel(name)
         if labels is not None:
             bottom.set_xticks(range(len(labels)), labels)
-        top.set_title(f"{len(done)} variants ({len(rows) - len(done)} failed)")
+        top.set_title(title, fontsize=9)
         out[f"moi_factor_{name}.png"] = _png(fig, 100)
         factors = [(v, r["load_factor"]) for v, r in zip(xs, done)
                    if r.get("load_factor") is not None]
@@ -400,5 +412,6 @@ def summary_pngs(study: Study, rows) -> dict:
             if labels is not None:
                 ax.set_xticks(range(len(labels)), labels)
             ax.set_ylim(bottom=0)
+            ax.set_title(title, fontsize=9)
             out[f"load_factor_{name}.png"] = _png(fig, 100)
     return out
