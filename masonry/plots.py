@@ -727,6 +727,27 @@ def _mechanism_faces(blocks, mechanism):
     return undeformed, deformed, per_block[blocks.face_block[faces]], bounds
 
 
+def azimuths_png(scene, collapse) -> bytes:
+    """``collapse/azimuths.png``: the lateral load factor against the load's azimuth
+    (``--lateral all``) on polar axes, the worst marked."""
+    angle, factor = (np.array([a for a, f in collapse.azimuths if f is not None]),
+                     np.array([f for _, f in collapse.azimuths if f is not None]))
+    order = np.argsort(angle)
+    theta = np.radians(np.append(angle[order], angle[order][0]))
+    fig, ax = plt.subplots(figsize=(5.5, 5.5), subplot_kw={"projection": "polar"})
+    ax.plot(theta, np.append(factor[order], factor[order][0]), "-o", color="C0",
+            markersize=3, linewidth=1)
+    worst = np.radians(collapse.azimuth_deg)
+    ax.plot([worst], [collapse.load_factor], "o", color="#d62728", markersize=8,
+            label=f"worst: {collapse.load_factor:.4g} at {collapse.azimuth_deg:g} deg")
+    ax.set_ylim(0, 1.1 * factor.max())
+    ax.set_rlabel_position(100)
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, -0.15), fontsize=8, frameon=False)
+    ax.set_title(f"lateral load factor against the load's azimuth (from +x toward +y)\n"
+                 f"{scene_title(scene)}", fontsize=9, pad=20)
+    return _png(fig, 110)
+
+
 def _live_load_marks(ax, view, blocks, live, bounds) -> list:
     """Where the live load acts: its resultant's direction as an arrow, into the loaded
     blocks (marked) when not every block is loaded (a point or crown load), else from the

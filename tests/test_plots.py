@@ -7,13 +7,15 @@ import numpy as np
 import pytest
 
 from masonry.export.csv import tension_top
-from masonry.params import from_preset
-from masonry.plots import (COLOUR_PERCENTILE, _rank_labels, colour_scale, force_unit,
-                           mechanism_pngs)
-from masonry.rbe.collapse import collapse_load
+from masonry.params import Params, from_preset, validate
+from masonry.plots import (COLOUR_PERCENTILE, _rank_labels, azimuths_png, colour_scale,
+                           force_unit, mechanism_pngs)
+from masonry.rbe.boundary import analysis_model
+from masonry.rbe.collapse import collapse_load, worst_lateral
 from masonry.rbe.loads import lateral, point_loads
+from masonry.scenes import build
 from masonry.tolerances import TENSION_REPORTED_REL
-from test_collapse import DENSITY, column
+from test_collapse import DENSITY, SMALL_DOME, column
 
 
 @pytest.mark.parametrize("magnitude, unit", [(12.0, "N"), (999.0, "N"), (1e3, "kN"),
@@ -123,3 +125,10 @@ def test_mechanism_plots_are_written_in_the_four_views(load):
     assert sorted(pngs) == [f"collapse/{v}_mechanism.png" for v in
                             ("01_angle", "02_front", "03_top", "04_side")]
     assert all(png.startswith(b"\x89PNG") for png in pngs.values())
+
+
+def test_the_azimuth_search_is_drawn_on_polar_axes():
+    params = validate(Params(scene="dome", **SMALL_DOME))
+    worst = worst_lateral(analysis_model(build(params)), n_webs=6, period_deg=60.0)
+    assert len(worst.azimuths) >= 24
+    assert azimuths_png(SimpleNamespace(params=params), worst).startswith(b"\x89PNG")

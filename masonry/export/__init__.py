@@ -206,8 +206,11 @@ def _mechanism_plots(made: RunOutputs) -> dict:
     title = (f"collapse mechanism: lambda = {collapse.load_factor:.4g}, "
              f"{collapse.live.description['kind']} load"
              + ("" if collapse.azimuth_deg is None else f" at {collapse.azimuth_deg:g} deg"))
-    return plots.mechanism_pngs(made.scene, model.blocks, model.interfaces, collapse, title,
-                                made.scene.params.fast)
+    files = plots.mechanism_pngs(made.scene, model.blocks, model.interfaces, collapse, title,
+                                 made.scene.params.fast)
+    if collapse.azimuths:
+        files["collapse/azimuths.png"] = plots.azimuths_png(made.scene, collapse)
+    return files
 
 
 def _plot_files(made: RunOutputs) -> Export:
