@@ -218,12 +218,38 @@ def _cache_path(params: Params, out_root) -> Path:
     return Path(out_root) / ".cache" / f"{_geometry_key(params)}.pickle"
 
 
+NUMPY_REBUILDERS = {("numpy._core.multiarray", "_reconstruct"),
+                    ("numpy._core.multiarray", "scalar"),
+                    ("numpy._core.numeric", "_frombuffer"),
+                    ("numpy.core.multiarray", "_reconstruct"),
+                    ("numpy.core.multiarray", "scalar"),
+                    ("numpy.core.numeric", "_frombuffer")}
+"""The functions a pickled numpy array or scalar is rebuilt by (numpy 2 and 1.26)."""
+
+
+class _CacheUnpickler(pickle.Unpickler):
+    """Loads this package's classes and numpy's arrays only: a cache file put in an output
+    folder by someone else cannot name a function to run (the pickle module's
+    "Restricting Globals"); anything else is refused before its module is imported."""
+
+    def find_class(self, module, name):
+        ours = module.startswith("masonry.") or module in ("numpy", "numpy.dtypes")
+        if (module, name) in NUMPY_REBUILDERS:
+            return super().find_class(module, name)
+        found = super().find_class(module, name) if ours else None
+        if not isinstance(found, type):
+            raise pickle.UnpicklingError(f"{module}.{name} is not allowed in a geometry "
+                                         f"cache")
+        return found
+
+
 def _read_cache(path: Path):
     """``(scene, model)`` from a cache file, or None when there is none or it is unusable
-    (truncated, corrupt, or not a cache of this code): then it is rebuilt, with a warning."""
+    (truncated, corrupt, naming anything but this package's classes and numpy arrays, or
+    not a cache of this code): then it is rebuilt, with a warning."""
     try:
         with open(path, "rb") as f:
-            content = pickle.load(f)
+            content = _CacheUnpickler(f).load()
     except (FileNotFoundError, NotADirectoryError):
         return None
     except Exception as error:  # unpickling garbage can raise anything

@@ -3,6 +3,8 @@ runs leave nothing behind, a corrupt cache is rebuilt, internal failures are one
 
 import json
 import os
+import pathlib
+import pickle
 import re
 import signal
 import socket
@@ -148,6 +150,30 @@ def test_a_corrupt_cache_is_rebuilt_with_a_warning(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "geometry cache" in err and "unreadable" in err and "rebuilding" in err
     assert cache.read_bytes() == good  # rebuilt, the same model
+
+
+class _Planted:
+    """A pickle that calls a function when loaded (here a harmless one that leaves a
+    file: the marker of code run from a cache someone put in the output folder)."""
+
+    def __init__(self, marker):
+        self.marker = marker
+
+    def __reduce__(self):
+        return (pathlib.Path.touch, (pathlib.Path(self.marker),))
+
+
+def test_a_cache_that_would_run_code_is_refused(tmp_path, capsys):
+    assert main(["build", *WALL, "--no-plots", "--out", str(tmp_path), "-q"]) == 0
+    (cache,) = (tmp_path / ".cache").iterdir()
+    marker = tmp_path / "ran"
+    cache.write_bytes(pickle.dumps(_Planted(marker)))
+    capsys.readouterr()
+    assert main(["build", *WALL, "--no-plots", "--force", "--out", str(tmp_path),
+                 "-q"]) == 0
+    err = capsys.readouterr().err
+    assert "pathlib.Path.touch is not allowed in a geometry cache" in err
+    assert not marker.exists()
 
 
 def test_a_file_where_the_cache_folder_goes_costs_only_the_cache(tmp_path, capsys):
