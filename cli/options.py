@@ -295,6 +295,13 @@ def params_from_args(args) -> Params:
     if args.params is not None:
         params = load(args.params, **given)
     elif args.preset:
+        # a preset's inputs are its scene's: another scene would take none of them
+        scenes = ((PRESETS[args.preset]["scene"],) if "scene" in PRESETS[args.preset]
+                  else ("section", "dome"))
+        if given.get("scene", scenes[0]) not in scenes:
+            raise ParameterError("scene", given["scene"], f"{' or '.join(scenes)} with "
+                                 f"--preset {args.preset} (leave --preset out for another "
+                                 f"scene)")
         params = from_preset(args.preset, **given)
     elif given.get("scene") == "wall":
         params = from_preset("wall", **given)

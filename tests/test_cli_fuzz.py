@@ -104,6 +104,7 @@ LISTED = [
     ["--crown-load", "nan"], ["--scene", "wall", "--crown-load", "500"],
     ["--lateral", "0", "--crown-load", "500"], ["--point-load", "a*:0,0,-1", "--lateral", "0"],
     ["--friction-law", "non-associative"], ["--friction-law", "coulomb", "--lateral", "0"],
+    ["--preset", "wall", "--scene", "dome"], ["--preset", "1", "--scene", "arch"],
     ["--scene", "dome", "--lateral", "all", "--friction-law", "non-associative"],
 ]
 RUN_ONLY = [["--scene", "arch", "--boundary", "cyclic"], ["--scene", "wall", "--dome"],

@@ -265,14 +265,15 @@ def test_stages_command_writes_its_own_folder_reproducibly(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("args, option", [
-    (["--by", "brick", "--course", "99"], "--course"),
-    (["--by", "brick"], "--course"),
-    (["--by", "course", "--order", "along"], "--order"),
+    (["--preset", "1", "--by", "brick", "--course", "99"], "--course"),
+    (["--preset", "1", "--by", "brick"], "--course"),
+    (["--preset", "1", "--by", "course", "--order", "along"], "--order"),
     (["--scene", "arch", "--by", "course"], "--by"),
+    (["--preset", "1", "--scene", "arch"], "--scene"),
 ])
 def test_bad_stage_options_get_one_line_and_write_nothing(tmp_path, capsys, args, option):
     out = tmp_path / "out"
-    assert main(["stages", "--preset", "1", *args, "--out", str(out), "-q"]) == 2
+    assert main(["stages", *args, "--out", str(out), "-q"]) == 2
     error = capsys.readouterr().err.strip()
     assert len(error.splitlines()) == 1 and option in error
     assert not out.exists()
