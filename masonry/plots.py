@@ -749,27 +749,23 @@ def azimuths_png(scene, collapse) -> bytes:
 
 
 def _live_load_marks(ax, view, blocks, live, bounds) -> list:
-    """Where the live load acts: its resultant's direction as an arrow, into the loaded
-    blocks (marked) when not every block is loaded (a point or crown load), else from the
-    plot's edge the load comes from. Returns the legend handles."""
+    """Where the live load acts: the loaded blocks marked when not every block is loaded
+    (a point or crown load), and its resultant's direction as an arrow, into them, or
+    from the plot's edge the load comes from (none for forces that cancel). Returns the
+    legend handles."""
     handles = []
     loaded = np.flatnonzero(np.abs(live.wrench[:, :3]).max(axis=1) > 0)
-    total = live.total_force
-    direction = total / max(float(np.linalg.norm(total)), 1e-300)
-    size = float(np.abs(direction) @ (bounds[1] - bounds[0]))  # the box along it
-    if len(loaded) < int((~np.asarray(blocks.block_is_support)).sum()):
+    some = len(loaded) < int((~np.asarray(blocks.block_is_support)).sum())
+    if some:
         _points(ax, view, blocks.block_centroid[loaded], marker="v", color="k", s=18)
         handles.append(Line2D([], [], marker="v", color="k", linestyle="none",
                               label=f"loaded blocks ({len(loaded)})"))
-        end = blocks.block_centroid[loaded].mean(axis=0)
-        # as long as the box leaves room for behind the loaded blocks
-        room = np.where(direction > 0, end - bounds[0], bounds[1] - end)
-        moving = np.abs(direction) > 1e-9
-        length = min(0.25 * size, 0.9 * float((room[moving] / np.abs(direction[moving])).min()))
-        start = end - length * direction
-    else:
-        start = bounds.mean(axis=0) - 0.45 * size * direction
-        end = start + 0.25 * size * direction
+    total = live.total_force
+    if np.linalg.norm(total) <= 1e-9 * np.abs(live.wrench[:, :3]).sum():
+        return handles  # a couple, a push and a pull: no one direction
+    direction = total / float(np.linalg.norm(total))
+    start, end = _arrow(blocks.block_centroid[loaded].mean(axis=0) if some else None,
+                        direction, bounds)
     if view not in ELEVATIONS:
         ax.quiver(*start, *(end - start), color="k", linewidth=1.5, arrow_length_ratio=0.3)
     else:
@@ -781,6 +777,19 @@ def _live_load_marks(ax, view, blocks, live, bounds) -> list:
     handles.append(Line2D([], [], marker=r"$\rightarrow$", color="k", linestyle="none",
                           markersize=12, label="live load's direction"))
     return handles
+
+
+def _arrow(target, direction, bounds):
+    """``(start, end)`` of an arrow along ``direction`` (a unit (3,)): into ``target``, as
+    long as the box ``bounds`` leaves room for behind it, or (None) from the box's edge."""
+    size = float(np.abs(direction) @ (bounds[1] - bounds[0]))  # the box along it
+    if target is None:
+        start = bounds.mean(axis=0) - 0.45 * size * direction
+        return start, start + 0.25 * size * direction
+    room = np.where(direction > 0, target - bounds[0], bounds[1] - target)
+    moving = np.abs(direction) > 1e-9  # not empty: a unit vector
+    length = min(0.25 * size, 0.9 * float((room[moving] / np.abs(direction[moving])).min()))
+    return target - length * direction, target
 
 
 def mechanism_pngs(scene, blocks, interfaces, collapse, title, fast=False) -> dict:

@@ -141,9 +141,12 @@ def test_the_joints_that_carry_a_mechanism_move_by_a_share_of_the_largest():
     assert (result.main_hinges, result.main_sliding) == (2, 1)
 
 
-def test_a_point_load_spec_that_matches_no_block_is_refused():
+def test_a_point_load_spec_that_matches_no_block_or_cancels_is_refused():
+    blocks = column(1, (0.2, 0.4, 0.5)).blocks
     with pytest.raises(ParameterError, match="point_loads"):
-        point_loads(column(1, (0.2, 0.4, 0.5)).blocks, ["nothing*:1,0,0"])
+        point_loads(blocks, ["nothing*:1,0,0"])
+    with pytest.raises(ParameterError, match="do not cancel"):
+        point_loads(blocks, ["b0:100,0,0", "b*:-100,0,0"])
 
 
 def test_a_point_load_on_no_block_is_refused_naming_the_option(tmp_path, capsys):

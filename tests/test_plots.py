@@ -114,11 +114,12 @@ def test_rank_labels_of_neighbouring_interfaces_share_one_label():
     assert np.allclose(labels[1][1], [5.0, 0, 0])
 
 
-@pytest.mark.parametrize("load", ["lateral", "point"])
+@pytest.mark.parametrize("load", ["lateral", "point", "push and pull"])
 def test_mechanism_plots_are_written_in_the_four_views(load):
     model = column(2, (0.1, 0.3, 0.15))
+    specs = {"point": ["b1:100,0,0"], "push and pull": ["b0:100,0,0", "b1:-100,0,0"]}
     live = (lateral(model, 0.0, DENSITY) if load == "lateral"
-            else point_loads(model.blocks, ["b1:100,0,0"]))
+            else point_loads(model.blocks, specs[load]))
     result = collapse_load(model, live, mu=0.9, density=DENSITY)
     scene = SimpleNamespace(params=from_preset("wall"))  # names the figures only
     pngs = mechanism_pngs(scene, model.blocks, model.interfaces, result, "column")

@@ -17,7 +17,8 @@ from masonry.rbe.boundary import Model, analysis_model, restrict
 from masonry.rbe.solve import RBEProblem
 from masonry.scenes import build
 from masonry.studies.stages import (NOT_LAID, StagePlan, analyse_stage, analyse_stages,
-                                    block_plan, brick_plan, course_plan, make_plan)
+                                    block_plan, brick_plan, course_plan, loose_blocks,
+                                    make_plan)
 from masonry_cli.main import main
 
 PATTERN = BLOCK_CLASSES.index("pattern")
@@ -359,3 +360,23 @@ def test_a_block_laid_before_the_one_under_it_is_loose_and_has_no_moi():
     assert first["loose"] == 2 and first["loose_blocks"] == [2, 3]
     assert not first["feasible"] and first["moi"] is None
     assert second["loose"] == 0 and second["feasible"]
+
+
+@pytest.mark.parametrize("boundary", ["cyclic", "rigid"])
+def test_a_sections_end_brick_laid_alone_is_loose_and_course_stages_are_not(boundary):
+    """A cyclic neighbour's images are the section's own bricks: a top end brick laid
+    alone touches nothing that joins it to the ground, its copies in the other webs
+    included (a rigid neighbour's images are supports: they may hold it). Every brick of
+    the first courses is joined to the ground, through the images too."""
+    scene = build(from_preset("3", scene="section", boundary=boundary, p=4))
+    model = analysis_model(scene)
+    count = scene.blocks.n_blocks
+    ends = np.unique(model.block_source[count:])  # the bricks with an image
+    top = ends[np.argmax(scene.blocks.block_course[ends])]
+    alone = np.zeros(count, bool)
+    alone[top] = True
+    if boundary == "cyclic":
+        assert loose_blocks(restrict(model, alone)).tolist() == [top]
+    plan = course_plan(scene.blocks)
+    for stage in (1, 2, 3):
+        assert len(loose_blocks(restrict(model, plan.is_present(stage)))) == 0

@@ -301,6 +301,8 @@ class CollapseLP:
         load = self.scaled(live)
         # the LP takes the load at the dead load's size (the same optimum, times the
         # ratio): a point load of 1e12 N would leave the factor at the rows' rounding
+        if not np.any(load):
+            raise ValueError("the live load is zero on every free block")
         ratio = float(np.abs(load).max() / np.abs(self.system.f_ext).max())
         lp = self._backend(load[:, None] / ratio, np.ones(1))
         return self._result(lp, live, None, start, dead_load_feasible, per_unit=1 / ratio)

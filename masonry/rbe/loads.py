@@ -129,6 +129,9 @@ def point_loads(blocks, specs) -> LiveLoad:
     chosen = np.asarray(chosen, dtype=np.int64)
     wrench = _at_points(blocks, chosen, blocks.face_centre[top[chosen]],
                         np.asarray(forces, dtype=float))
+    if not np.any(wrench[:, :3]):
+        raise ParameterError("point_loads", specs[0], "point loads that do not cancel "
+                             "(these add up to zero on every block they match)")
     return LiveLoad(wrench, _describe("point", wrench, specs=list(specs),
                                       blocks=len(chosen)))
 

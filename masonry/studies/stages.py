@@ -265,7 +265,7 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
     row = {"stage": stage, "course": int(plan.stage_course[stage - 1]) or None,
            "bricks": int((~part.blocks.block_is_support).sum()), "loose": len(loose),
            "loose_blocks": loose.tolist(), "load_factor": None}
-    if len(loose):  # no equilibrium holds them, tension or not: nothing to solve
+    if len(loose) or len(part.interfaces) == 0:  # no equilibrium: nothing to solve
         row.update(feasible=False, moi=None, moi_factor=None, tension={})
     else:
         problem = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
@@ -285,15 +285,20 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
 
 def loose_blocks(part: Model) -> np.ndarray:
     """The scene blocks of a stage that no chain of interfaces joins to a support (a
-    block laid before the ones under it): sorted, (k,) int."""
-    source = part.block_source
-    a, b = source[part.interfaces.pair.T]
-    size = len(source) and int(source.max()) + 1
-    joined = sp.coo_array((np.ones(len(a)), (a, b)), shape=(size, size))
+    block laid before the ones under it): sorted, (k,) int.
+
+    A section's images come after the scene's blocks (:func:`restrict` keeps the model's
+    order): a rigid neighbour's image is a support of its own, a cyclic one acts on the
+    brick it copies (``side_block``), so it joins nothing by itself."""
+    source, support = part.block_source, part.blocks.block_is_support
+    pair = part.interfaces.pair if part.side_block is None else part.side_block
+    size = len(source)
+    joined = sp.coo_array((np.ones(len(pair)), (pair[:, 0], pair[:, 1])), shape=(size, size))
     _, component = connected_components(joined, directed=False)
-    held = np.isin(component, component[source[part.blocks.block_is_support]])
-    laid = np.unique(source[~part.blocks.block_is_support])
-    return laid[~held[laid]]
+    body = np.zeros(size, bool)
+    body[np.unique(source, return_index=True)[1]] = True  # not an image
+    loose = body & ~support & ~np.isin(component, component[support])
+    return np.unique(source[loose])
 
 
 def stage_load_factor(part: Model, params) -> float | None:
