@@ -234,14 +234,14 @@ def collapse_summary(record, report):
             else f"{live['kind']} load")
     if c.get("azimuths"):
         what += f" (worst of {len(c['azimuths'])} azimuths)"
+    if c["friction_law"] != "associated" and c["associated_factor"] is not None:
+        what += (f", {c['friction_law']} friction (associated: "
+                 f"{c['associated_factor']:.4g})")
     if c["load_factor"] is None:
         report(f"collapse: no load factor ({c['status']}), {what}")
         if c["note"]:
             report(f"note: {c['note']}")
         return
-    if c["friction_law"] != "associated" and c["associated_factor"] is not None:
-        what += (f", {c['friction_law']} friction (associated: "
-                 f"{c['associated_factor']:.4g})")
     report(f"collapse: lambda = {c['load_factor']:.4g} for the {what}; mechanism: "
            f"{c['main_hinges']} hinges, {c['main_sliding']} sliding joints (of "
            f"{c['hinges']} and {c['sliding']} that move at all); "

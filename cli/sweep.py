@@ -116,14 +116,18 @@ def load_study(path) -> Study:
 
 def _check_variants(study: Study, where):
     """Every variant's inputs checked as ``masonry run`` checks them, before any runs: a
-    value out of range names the table and key it came from."""
+    value out of range names the table and key it came from (of the inputs the check
+    involves, a swept one first; one the study leaves at its default says so)."""
     for inputs in study.variants():
         try:
             validate(Params(**inputs))
         except ParameterError as error:
-            table = ("grid" if error.name in study.grid else
-                     "sample" if error.name in study.sample else "base")
-            raise ParameterError(f"{table}.{error.name}", error.value, error.expected,
+            names = (error.name, *error.related)
+            table, name = next(((t, n) for t in ("grid", "sample", "base") for n in names
+                                if n in getattr(study, t)), (None, error.name))
+            key = name.replace("_", "-")
+            raise ParameterError(f"{table}.{key}" if table else f"{key} (the default)",
+                                 inputs.get(name, error.value), error.expected,
                                  where=where) from None
 
 

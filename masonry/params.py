@@ -500,10 +500,12 @@ def _live_load_tag(p: Params) -> str:
 
 def _n(value: float) -> str:
     """A number in a structure id: ``%g`` (``0.1``, ``1``, ``1e-05``) where that is the
-    value, else every digit it needs (``2011.8216``: ``%g`` would give ``2011.82``, the
-    name of another input)."""
+    value to 15 significant digits, else those 15 digits, trailing zeros dropped
+    (``2011.8216``: ``%g`` would give ``2011.82``, the name of another input). Fifteen
+    tell any two decimal inputs apart, and name ``0.1 + 0.2`` as ``0.3``."""
+    value = float(f"{value:.15g}")
     short = f"{value:g}"
-    return short if float(short) == value else repr(float(value))
+    return short if float(short) == value else f"{value:.15g}"
 
 
 def _friction_law_tag(p: Params) -> str:

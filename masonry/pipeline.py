@@ -415,11 +415,7 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
 
     with RunFolder(out_root, sid, keep=keep) as folder:
         write_exports(folder, made, record, timer)
-        # the files this folder holds (no 3DM without rhino3dm, no 3MF without a size)
-        record["coordinates"] = {
-            key: [name for name in value if (folder.tmp / name).exists()]
-            if isinstance(value, list) else value
-            for key, value in record["coordinates"].items()}
+        record["coordinates"] = _held(record["coordinates"], folder)
         record["timings_s"] = timer.seconds
         record["versions"] = versions()
         record["complete"] = True
@@ -428,6 +424,13 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
         write_cache(params, out_root, scene, model)
     record["path"] = str(folder.target)
     return record
+
+
+def _held(coordinates: dict, folder: RunFolder) -> dict:
+    """``coordinates`` with the files ``folder`` holds only (no 3DM without rhino3dm, no
+    3MF without a size, no forces in a build)."""
+    return {key: [name for name in value if (folder.tmp / name).exists()]
+            if isinstance(value, list) else value for key, value in coordinates.items()}
 
 
 def run_record(scene: Scene, model: Model, outputs: dict, cached: str, source=None) -> dict:

@@ -2,6 +2,7 @@
 an independent 2D linear program on the arch's voussoirs."""
 
 import csv
+import dataclasses
 import json
 
 import meshio
@@ -13,7 +14,8 @@ from masonry.blocks import Blocks
 from masonry.params import ParameterError, Params, from_preset, validate
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
-                                  collapse_load, lateral_azimuths, worst_lateral)
+                                  collapse_load, fixed_capacity_factor, lateral_azimuths,
+                                  worst_lateral)
 from masonry.rbe.loads import crown_load, lateral, point_loads
 from masonry.scenes import build
 from masonry.scenes.arch import arch_profile
@@ -444,3 +446,31 @@ def test_the_dome_symmetry_leaves_azimuths_from_a_web_to_its_corner():
     circle = worst_lateral(dome, lateral_azimuths(6))  # every 15 degrees
     assert sector["lateral_factor"] == pytest.approx(circle.load_factor, rel=1e-6)
     assert sector["hinge_webs"] and sector["hinge_courses"]
+
+
+def test_a_non_associative_round_without_equilibrium_gives_no_factor(monkeypatch):
+    """Capacities fixed from a collapse may admit no equilibrium at all (preset 3's dome
+    at p = 6, round 2): then there is no estimate, and no mechanism of unsettled
+    capacities; the associated factor stays."""
+    model = column(1, (0.2, 0.4, 0.5))
+    live = lateral(model, 90.0)
+    problem = CollapseLP(model, mu=0.7, density=DENSITY)
+    fixed = problem.with_friction_capacity
+
+    def one_good_round(capacity):
+        out = fixed(capacity)
+        rounds.append(out)
+        if len(rounds) > 1:  # the second re-solve: no equilibrium with these capacities
+            out.solve = lambda *args, **kwargs: dataclasses.replace(
+                problem.solve(live), load_factor=None, status="dead load infeasible")
+        return out
+
+    rounds = []
+    monkeypatch.setattr(problem, "with_friction_capacity", one_good_round)
+    result = fixed_capacity_factor(problem, live)
+    assert result.load_factor is None and result.mechanism is None and result.hinges == -1
+    assert result.status == ("non-associative estimate: round 2 has no equilibrium (dead "
+                             "load infeasible)")
+    assert result.associated_factor == pytest.approx(0.7, rel=1e-6)
+    with pytest.raises(ValueError, match="at least 2"):
+        fixed_capacity_factor(problem, live, rounds=1)

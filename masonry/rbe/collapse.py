@@ -699,17 +699,20 @@ def fixed_capacity_factor(problem: CollapseLP, live: LiveLoad, *, dead_load_feas
     Comput. Struct. 84) for non-associative frictional joints: an estimate, not a bound,
     that removes the dilatancy by which the associated factor overestimates a sliding
     collapse. Between rounds a joint's friction may exceed ``mu`` times its compression,
-    so only a settled factor is reported: after ``rounds`` re-solves without one, or a
-    round whose capacities admit no equilibrium, the factor is None (the status says
-    so). The LP's optimum is degenerate, so the factor wanders by a few 1e-3 as it
+    so only a settled factor is reported: after ``rounds`` (at least 2) re-solves
+    without one, or a round whose capacities admit no equilibrium, the factor and the
+    mechanism are None (the status says which). The LP's optimum is degenerate, so the factor wanders by a few 1e-3 as it
     settles (the small dome of docs/collapse.md: 0.586 to 0.590 from the 14th round).
     ``friction_law`` of the result says ``non-associative``; ``associated_factor`` keeps
     the starting factor.
     """
+    if rounds < 2:
+        raise ValueError(f"rounds must be at least 2 (a factor settles over two), not "
+                         f"{rounds}")
     start = time.perf_counter()
     associated = problem.solve(live, dead_load_feasible=dead_load_feasible)
     result, known = associated, associated.dead_load_feasible
-    settled, following = 0, associated
+    settled, following, done = 0, associated, 0
     for done in range(1, rounds + 1 if result.load_factor is not None else 1):
         compression = problem.system.to_scaled(result.x).reshape(-1, 4)[:, 0]
         following = problem.with_friction_capacity(problem.mu * compression).solve(
@@ -722,10 +725,13 @@ def fixed_capacity_factor(problem: CollapseLP, live: LiveLoad, *, dead_load_feas
         if settled == 2:
             break
     if associated.load_factor is not None and settled < 2:
-        log.warning("non-associative estimate: no settled factor after %d rounds (the "
-                    "last: %s); no factor", done, following.status)
-        result = dataclasses.replace(result, load_factor=None,
-                                     status="non-associative estimate did not settle")
+        why = (f"round {done} has no equilibrium ({following.status})"
+               if following.load_factor is None else f"not settled after {done} rounds")
+        log.warning("non-associative estimate: %s; no factor", why)
+        # no mechanism either: the last round's is of capacities that were not settled
+        result = dataclasses.replace(
+            result, load_factor=None, status=f"non-associative estimate: {why}",
+            **dict.fromkeys(("mechanism", "opens", "slides", "hinge", "gap", "slip")))
     return dataclasses.replace(result, friction_law="non-associative",
                                associated_factor=associated.load_factor,
                                time_s=time.perf_counter() - start)

@@ -106,8 +106,8 @@ class Study:
                     low, high = bounds
                     if isinstance(low, int) and isinstance(high, int):
                         draw[name] = int(rng.integers(low, high + 1))
-                    else:
-                        draw[name] = float(rng.uniform(low, high))
+                    else:  # ten digits: its run folder's name and summary.csv's
+                        draw[name] = float(f"{rng.uniform(low, high):.10g}")
                 draws.append(draw)
         return [{**self.base, **point, **draw} for point in points for draw in draws]
 
@@ -310,8 +310,8 @@ def summary_rows(study: Study, results) -> list:
 def summary_csv(study: Study, rows) -> bytes:
     """CSV (UTF-8 bytes) of :func:`summary_rows`: swept inputs, then
     :data:`SUMMARY_COLUMNS`; floats as every CSV of the project prints them
-    (:func:`~masonry.export._text.format_floats`: a sampled input keeps the digits that
-    name its run folder), None as an empty cell."""
+    (:func:`~masonry.export._text.format_floats`: 12 digits, every digit of a sampled
+    input and of its run folder's name), None as an empty cell."""
     columns = study.swept + list(SUMMARY_COLUMNS)
     texts = []
     for c in columns:
@@ -321,7 +321,8 @@ def summary_csv(study: Study, rows) -> bytes:
         if floats:
             for i, printed in zip(floats, format_floats([values[i] for i in floats])):
                 text[i] = printed
-        texts.append(['"' + t.replace('"', "'") + '"' if "," in t else t for t in text])
+        texts.append(['"' + t.replace('"', '""') + '"' if any(c in t for c in ',"\n')
+                      else t for t in text])
     lines = [",".join(columns), *map(",".join, zip(*texts))]
     return ("\n".join(lines) + "\n").encode()
 
