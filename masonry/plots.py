@@ -408,7 +408,7 @@ def _polygons(interfaces, index):
     return [interfaces.polygon(k) for k in index]
 
 
-def colour_scale(values, signed: bool, is_force: bool = True) -> dict:
+def colour_scale(values, signed: bool, is_force: bool = True, unit: str = "") -> dict:
     """How to colour ``values``: a robust range (:data:`COLOUR_PERCENTILE`), the unit and
     the map.
 
@@ -419,14 +419,16 @@ def colour_scale(values, signed: bool, is_force: bool = True) -> dict:
     signed : bool
         A diverging map symmetric about 0 (the half of one sign when every value has it,
         within :data:`ONE_SIDED` of the range); else sequential from 0 (or the minimum).
+    unit : str
+        Of values that are not forces (``is_force`` False).
 
     Returns
     -------
     dict
         ``factor`` (multiply values for the display unit), ``unit``, ``norm``, ``cmap``,
-        ``extend`` (the colour bar's arrows where values are clipped), ``clipped`` (how
-        many values lie beyond the range), ``largest`` (the largest magnitude, display
-        unit).
+        ``extend`` (the colour bar's arrows where values are clipped), ``above`` and
+        ``below`` (how many values lie beyond the range's ends), ``largest`` (the largest
+        magnitude, display unit).
     """
     values = np.asarray(values, dtype=float)
     magnitude = np.abs(values)
@@ -434,7 +436,7 @@ def colour_scale(values, signed: bool, is_force: bool = True) -> dict:
     top = float(np.percentile(magnitude, COLOUR_PERCENTILE)) if len(values) else 0.0
     top = top if top > 0 else (largest if largest > 0 else 1.0)
     # the unit of the bar's range, not of a few clipped supports
-    factor, unit = force_unit(top) if is_force else (1.0, "")
+    factor, unit = force_unit(top) if is_force else (1.0, unit)
     if signed:
         # one sign only (no tension anywhere): the bar keeps the map's half of that sign,
         # zero still white at its end
@@ -446,17 +448,17 @@ def colour_scale(values, signed: bool, is_force: bool = True) -> dict:
         if part != (0.0, 1.0):
             cmap = matplotlib.colors.ListedColormap(cmap(np.linspace(*part, 128)),
                                                     name=f"{DIVERGING}_part")
-        clipped = magnitude > top
-        extend = "both" if (values < -top).any() and (values > top).any() else (
-            "min" if (values < -top).any() else "max" if (values > top).any() else "neither")
+        below = int((values < -top).sum())
+        extend = "both" if below and (values > top).any() else (
+            "min" if below else "max" if (values > top).any() else "neither")
     else:
         low = min(float(values.min()), 0.0) if len(values) else 0.0
         norm = matplotlib.colors.Normalize(low * factor, top * factor)
-        clipped = values > top
-        extend = "max" if clipped.any() else "neither"
+        below = 0
+        extend = "max" if (values > top).any() else "neither"
         cmap = matplotlib.colormaps[SEQUENTIAL]
     return {"factor": factor, "unit": unit, "norm": norm, "cmap": cmap, "extend": extend,
-            "clipped": int(clipped.sum()), "largest": largest * factor}
+            "above": int((values > top).sum()), "below": below, "largest": largest * factor}
 
 
 def _colour_bar(fig, ax, scale, quantity):
@@ -470,17 +472,20 @@ def _colour_bar(fig, ax, scale, quantity):
     label = f"{quantity} [{scale['unit']}]" if scale["unit"] else quantity
     if scale["largest"] == 0:
         label += "\nall zero"
-    if scale["clipped"]:
+    beyond = [f"{scale[end]} {end}" for end in ("above", "below") if scale[end]]
+    if beyond:
         label += (f"\nscale ends at the {COLOUR_PERCENTILE:g}th percentile; "
-                  f"{scale['clipped']} beyond, up to {scale['largest']:.3g} {scale['unit']}")
+                  f"{', '.join(beyond)}, up to {scale['largest']:.3g} {scale['unit']}"
+                  + (" in size" if scale["below"] else "")).rstrip()
     bar.set_label(label, fontsize=8)
 
 
 def _colour_plot(blocks, interfaces, index, values, title, view, fast, quantity,
-                 signed=False, is_force=True, subtitle=""):
-    """One view of the interfaces ``index`` coloured by ``values`` (SI units)."""
+                 signed=False, is_force=True, subtitle="", unit=""):
+    """One view of the interfaces ``index`` coloured by ``values`` (SI units, or ``unit``
+    for values that are not forces)."""
     fig, ax = _axes(blocks.bounds, view)
-    scale = colour_scale(values, signed, is_force)
+    scale = colour_scale(values, signed, is_force, unit)
     shown = np.asarray(values, dtype=float) * scale["factor"]
     colours = scale["cmap"](scale["norm"](shown))
     # edges in the face colour: interfaces seen edge on stay visible as coloured lines
@@ -504,8 +509,8 @@ def interface_pngs(scene, blocks, interfaces, fast=False) -> dict:
             if len(index):
                 out[f"{view}/{name}.png"] = _colour_plot(
                     blocks, interfaces, index, interfaces.area[index] * 1e4,
-                    name.replace("_", " "), view, fast, "area [cm^2]", is_force=False,
-                    subtitle=scene_title(scene))
+                    name.replace("_", " "), view, fast, "area", is_force=False,
+                    subtitle=scene_title(scene), unit="cm^2")
     return out
 
 

@@ -32,7 +32,8 @@ def test_sequential_scale_ends_at_the_percentile_and_counts_the_rest():
     assert scale["unit"] == "kN" and scale["factor"] == 1e-3
     top = np.percentile(values, COLOUR_PERCENTILE)
     assert scale["norm"].vmin == 0 and scale["norm"].vmax == pytest.approx(top * 1e-3)
-    assert scale["clipped"] == (values > top).sum() and scale["extend"] == "max"
+    assert scale["above"] == (values > top).sum() and scale["below"] == 0
+    assert scale["extend"] == "max"
     assert scale["largest"] == pytest.approx(40.0)
     assert scale["cmap"].name == "viridis"
 
@@ -45,6 +46,12 @@ def test_signed_scale_is_symmetric_about_zero_on_a_diverging_map():
     assert scale["cmap"].name == "RdBu_r"
     # zero is the map's middle, white
     assert np.allclose(scale["cmap"](0.5)[:3], matplotlib.colormaps["RdBu_r"](0.5)[:3])
+    # beyond the range's two ends, counted apart (the bar's two arrows)
+    wide = np.concatenate([np.linspace(-1e3, 1e3, 996), [-9e4, -8e4, 7e4, 6e4]])
+    scale = colour_scale(wide, signed=True)
+    top = np.percentile(np.abs(wide), COLOUR_PERCENTILE)
+    assert (scale["above"], scale["below"]) == ((wide > top).sum(), (wide < -top).sum())
+    assert scale["extend"] == "both"
 
 
 def test_signed_scale_of_one_sign_keeps_that_half_of_the_map():
@@ -64,7 +71,7 @@ def test_signed_scale_of_one_sign_keeps_that_half_of_the_map():
 
 def test_all_zero_values_still_have_a_scale():
     scale = colour_scale(np.zeros(5), signed=False)
-    assert scale["norm"].vmax > scale["norm"].vmin and scale["clipped"] == 0
+    assert scale["norm"].vmax > scale["norm"].vmin and scale["above"] == 0
 
 
 def test_tension_top_orders_by_tension_and_drops_solver_noise():
