@@ -161,10 +161,16 @@ def _axes3d(bounds):
     ax.set_zlim(low[2], high[2])
     ax.set_box_aspect(tuple(extent))
     ax.view_init(*ANGLE)
-    for axis, length in zip("xyz", extent / extent.max()):
+    for k, axis in enumerate("xyz"):
         getattr(ax, f"set_{axis}label")(f"{axis} [m]", labelpad=10)
-        # fewer ticks on a short side (a wall's thickness): their labels would overlap
-        ticks = matplotlib.ticker.MaxNLocator(max(2, int(np.ceil(5 * length))))
+        # fewer ticks on a shorter side, one on a thin one (a wall's or an arch's
+        # thickness): their labels would overlap each other and the next axis's
+        ticks = matplotlib.ticker.MaxNLocator(max(2, int(np.ceil(5 * extent[k]
+                                                                 / extent.max()))))
+        if extent[k] < 0.3 * extent.max():
+            nice = ticks.tick_values(low[k], high[k])
+            ticks = matplotlib.ticker.FixedLocator([nice[np.argmin(np.abs(nice
+                                                                          - centre[k]))]])
         getattr(ax, f"{axis}axis").set_major_locator(ticks)
     return fig, ax
 
@@ -331,14 +337,18 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
             centre = blocks.block_centroid[is_outlined & is_present]
             _points(ax, view, centre, s=160, facecolors="none", edgecolors=OUTLINE_COLOUR,
                     linewidths=1.5)
-            handles.append(Patch(facecolor="none", edgecolor=OUTLINE_COLOUR,
-                                 label=outline_label))
+            handles.append(Line2D([], [], color=OUTLINE_COLOUR, marker="o", markersize=9,
+                                  fillstyle="none", linewidth=2, label=outline_label))
         if is_marked.any():
+            below = bool(((face_value > 0) & ~is_marked).any())
             bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
-                               shrink=0.6, pad=0.1)
+                               shrink=0.6, pad=0.16 if view not in ELEVATIONS else 0.05,
+                               extend="min" if below else "neither")
             bar.set_label(value_label)
+            handles.append(Patch(facecolor=CLASS_COLOURS["regular"], edgecolor="k",
+                                 label=f"laid, below the scale (class colours)"))
         ax.legend(handles=handles, loc="upper left", fontsize=8)
-        ax.set_title(title)
+        ax.set_title(f"{title}\n{scene_title(scene)}", fontsize=9)
         out[f"{view}.png"] = _png(fig, 60 if fast else 110)
     return out
 
