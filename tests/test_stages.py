@@ -380,3 +380,15 @@ def test_a_sections_end_brick_laid_alone_is_loose_and_course_stages_are_not(boun
     plan = course_plan(scene.blocks)
     for stage in (1, 2, 3):
         assert len(loose_blocks(restrict(model, plan.is_present(stage)))) == 0
+
+
+def test_stages_csv_names_what_each_stage_lays(tmp_path):
+    """A block plan's rows say which blocks each stage lays (an arch rises from both
+    springings at once), with floats as every CSV prints them."""
+    assert main(["stages", "--scene", "arch", "--no-plots", "--out", str(tmp_path),
+                 "-q"]) == 0
+    (folder,) = tmp_path.glob("arch_*_stages_z")
+    with open(folder / "stages.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [r["laid"] for r in rows[:2]] == ["v000 v015", "v001 v014"]
+    assert all(r["moi"] == "" or "." in r["moi"] or "e" in r["moi"] for r in rows)

@@ -42,6 +42,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from masonry.blocks import BLOCK_CLASSES
+from masonry.export._text import format_floats
 from masonry.export.summaries import parameters_text
 from masonry.params import ParameterError, structure_id, validate
 from masonry.pipeline import Timer, model_record, run_model, versions, write_cache
@@ -70,9 +71,11 @@ BLOCK_ORDERS = {
 }
 """Laying orders of :func:`block_plan`."""
 
-STAGE_COLUMNS = ("stage", "course", "bricks", "feasible", "loose", "moi", "moi_factor",
-                 "load_factor", "solve_s")
-"""Columns of ``stages.csv``, one row per stage. ``loose``: the laid blocks that touch
+STAGE_COLUMNS = ("stage", "course", "laid", "bricks", "feasible", "loose", "moi",
+                 "moi_factor", "load_factor", "solve_s")
+"""Columns of ``stages.csv``, one row per stage. ``laid``: the names of the blocks the
+stage lays, in a brick or block plan (a course plan's stage is its course). ``loose``: the
+laid blocks that touch
 nothing joining them to a support (:func:`loose_blocks`: the stage has no equilibrium at
 all, and no MoI). ``load_factor``: the collapse load factor of the stage under the
 lateral load of ``params.lateral`` (:func:`stage_load_factor`); empty without one, or
@@ -262,7 +265,10 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
     start = time.perf_counter()
     part = restrict(model, plan.is_present(stage))
     loose = loose_blocks(part)
-    row = {"stage": stage, "course": int(plan.stage_course[stage - 1]) or None,
+    laid = (None if plan.by == "course" else
+            " ".join(map(str, model.blocks.block_name[:len(plan.block_stage)][
+                plan.block_stage == stage])))
+    row = {"stage": stage, "course": int(plan.stage_course[stage - 1]) or None, "laid": laid,
            "bricks": int((~part.blocks.block_is_support).sum()), "loose": len(loose),
            "loose_blocks": loose.tolist(), "load_factor": None}
     if len(loose) or len(part.interfaces) == 0:  # no equilibrium: nothing to solve
@@ -414,28 +420,31 @@ def first_unsupported(rows) -> dict | None:
 
 
 def stages_csv(rows) -> bytes:
-    """``stages.csv``: :data:`STAGE_COLUMNS`, one row per stage; empty cells for None."""
+    """``stages.csv``: :data:`STAGE_COLUMNS`, one row per stage; empty cells for None,
+    floats as every CSV of the project prints them."""
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(STAGE_COLUMNS)
     for row in rows:
         writer.writerow(["" if row[c] is None else
-                         f"{row[c]:.6g}" if isinstance(row[c], float) else row[c]
-                         for c in STAGE_COLUMNS])
+                         format_floats([row[c]])[0] if isinstance(row[c], float)
+                         else row[c] for c in STAGE_COLUMNS])
     return buf.getvalue().encode()
 
 
 def held_csv(scene, row) -> bytes:
     """``first_unsupported/held.csv``: the bricks that carry tension at the first stage
-    that needs support (block, name, class, course, tension in newtons), largest first."""
+    that needs support (block, name, class, course (empty for a block without one: an
+    arch's voussoir, an imported block), tension in newtons), largest first."""
     blocks = scene.blocks
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(("block", "name", "class", "course", "tension_N"))
     for block, newtons in row["tension"].items():
+        course = int(blocks.block_course[block])
         writer.writerow((block, blocks.block_name[block],
                          BLOCK_CLASSES[blocks.block_class[block]],
-                         int(blocks.block_course[block]), f"{newtons:.6g}"))
+                         course or "", format_floats([newtons])[0]))
     return buf.getvalue().encode()
 
 
