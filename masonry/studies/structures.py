@@ -13,6 +13,7 @@ import time
 
 import numpy as np
 
+from masonry.export._text import format_floats
 from masonry.rbe.boundary import analysis_model
 from masonry.rbe.collapse import worst_lateral
 from masonry.rbe.equilibrium import VariableLayout
@@ -157,11 +158,13 @@ def _cell(value):
 
 def table_csv(rows) -> bytes:
     """The rows of :func:`structures_table` as CSV (UTF-8 bytes): a header of
-    :data:`COLUMNS` (and :data:`LATERAL_COLUMNS` when a row has them), floats to 4
-    significant digits, None as an empty cell."""
+    :data:`COLUMNS` (and :data:`LATERAL_COLUMNS` when a row has them), floats as every
+    CSV of the project prints them (the Markdown table rounds to 4 digits), None as an
+    empty cell."""
     columns = COLUMNS + (LATERAL_COLUMNS if any("lateral_factor" in r for r in rows) else ())
     lines = [",".join(columns)]
-    lines += [",".join(_cell(row.get(c)) for c in columns) for row in rows]
+    lines += [",".join(format_floats([v])[0] if isinstance(v, float) else _cell(v)
+                       for v in (row.get(c) for c in columns)) for row in rows]
     return ("\n".join(lines) + "\n").encode()
 
 
