@@ -87,7 +87,8 @@ def check_output_root(root, option="out") -> Path:
     try:
         os.rmdir(tempfile.mkdtemp(prefix=".masonry-probe-", dir=existing))
     except OSError as error:
-        raise ParameterError(option, str(root), f"a folder masonry can write in ({existing}: "
+        raise ParameterError(option, str(root), f"a folder masonry can write in (creating "
+                                                f"an entry in {existing} failed: "
                                                 f"{error.strerror or error})") from None
     return path
 
