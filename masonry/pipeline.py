@@ -516,9 +516,8 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     else:
         live = crown_load(model.blocks, params.crown_load,
                           copies=params.n if params.scene == "section" else 1)
-    friction = None if params.friction_law == "associated" else params.friction_law
-    result = collapse_load(model, live, dead_load_feasible=known, friction=friction,
-                           **options)
+    result = collapse_load(model, live, dead_load_feasible=known,
+                           friction=params.friction_law, **options)
     if params.lateral is not None:
         result = dataclasses.replace(result, azimuth_deg=float(params.lateral))
     return result

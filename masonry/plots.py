@@ -47,6 +47,10 @@ VIEWS = ("01_angle", "02_front", "03_top", "04_side")
 ANGLE = (25, -50)
 ELEVATIONS = {"02_front": (1, 2, 0, 1), "03_top": (0, 1, 2, 1), "04_side": (0, 2, 1, -1)}
 
+BAR_3D = dict(shrink=0.6, pad=0.16)
+"""A colour bar beside a 3D box (which sits inside its axes): shorter, and far enough
+out to clear the z axis's label."""
+
 COLOUR_PERCENTILE = 99.0
 """Colour scales end at this percentile of the plotted magnitudes: a few support values
 would otherwise set the scale and leave every other interface in one colour."""
@@ -342,11 +346,11 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
         if is_marked.any():
             below = bool(((face_value > 0) & ~is_marked).any())
             bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
-                               shrink=0.6, pad=0.16 if view not in ELEVATIONS else 0.05,
-                               extend="min" if below else "neither")
+                               extend="min" if below else "neither",
+                               **(BAR_3D if view not in ELEVATIONS else dict(pad=0.05)))
             bar.set_label(value_label)
             handles.append(Patch(facecolor=CLASS_COLOURS["regular"], edgecolor="k",
-                                 label=f"laid, below the scale (class colours)"))
+                                 label="laid, below the scale (class colours)"))
         ax.legend(handles=handles, loc="upper left", fontsize=8)
         ax.set_title(f"{title}\n{scene_title(scene)}", fontsize=9)
         out[f"{view}.png"] = _png(fig, 60 if fast else 110)
@@ -475,7 +479,7 @@ def _colour_bar(fig, ax, scale, quantity):
     """A colour bar labelled ``quantity [unit]``, saying where the scale is clipped."""
     mappable = matplotlib.cm.ScalarMappable(norm=scale["norm"], cmap=scale["cmap"])
     if hasattr(ax, "get_zlim"):  # a 3D box sits inside its axes: a shorter bar
-        bar = fig.colorbar(mappable, ax=ax, shrink=0.6, pad=0.16, extend=scale["extend"])
+        bar = fig.colorbar(mappable, ax=ax, extend=scale["extend"], **BAR_3D)
     else:  # as tall as the equal-scale plot
         cax = make_axes_locatable(ax).append_axes("right", size="4%", pad=0.12)
         bar = fig.colorbar(mappable, cax=cax, extend=scale["extend"])
@@ -708,8 +712,7 @@ def failure_png(scene, blocks, interfaces, top, forces, fast=False) -> bytes:
         ax.text(*at, ranks, fontsize=7, color="k", zorder=1e3,
                 bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "alpha": 0.8,
                       "linewidth": 0})
-    bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
-                       shrink=0.6, pad=0.16)
+    bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, **BAR_3D)
     bar.set_label(f"tension [{unit}]", fontsize=8)
     numbered = (f", the first {RANKED} numbered by rank" if len(top) > RANKED
                 else ", numbered by rank")
@@ -839,6 +842,10 @@ def mechanism_pngs(scene, blocks, interfaces, collapse, title, fast=False) -> di
         handles.append(Patch(facecolor="none", edgecolor="blue",
                              label=f"sliding {share}: {collapse.main_sliding} of "
                                    f"{collapse.sliding}"))
+    joints = [(_polygons(interfaces, np.flatnonzero(mask)), face, edge, width)
+              for mask, face, edge, width in ((collapse.main_slides, NO_FILL, "blue", 0.6),
+                                              (collapse.main_hinge, "red", "red", 0.8))
+              if mask.any()]
     out = {}
     for view in ["01_angle"] if fast else list(VIEWS):
         fig, ax = _axes(bounds, view)
@@ -846,12 +853,8 @@ def mechanism_pngs(scene, blocks, interfaces, collapse, title, fast=False) -> di
             ax.computed_zorder = False  # in the order drawn: the joints on top
         _add_polygons(ax, view, undeformed, NO_FILL, edgecolors="0.6", linewidths=0.1)
         _add_polygons(ax, view, deformed, colours, edgecolors="k", linewidths=0.05)
-        for mask, face, edge, width in ((collapse.main_slides, NO_FILL, "blue", 0.6),
-                                        (collapse.main_hinge, "red", "red", 0.8)):
-            index = np.flatnonzero(mask)
-            if len(index):
-                _add_polygons(ax, view, _polygons(interfaces, index), face,
-                              edgecolors=edge, linewidths=width)
+        for polygons, face, edge, width in joints:
+            _add_polygons(ax, view, polygons, face, edgecolors=edge, linewidths=width)
         shown = handles + (_live_load_marks(ax, view, blocks, collapse.live, bounds)
                            if collapse.live is not None else [])
         _colour_bar(fig, ax, scale, "virtual displacement (largest = 1)")

@@ -35,3 +35,9 @@ def format_floats(values) -> np.ndarray:
     # take a third of the time of any() over a generator
     text = [t if "." in t or "e" in t or "n" in t else t + ".0" for t in text]
     return np.array(text, dtype=object)[inverse].reshape(values.shape)
+
+
+def format_float(value) -> str:
+    """One value printed as :func:`format_floats` prints it (a cell of a table written
+    row by row)."""
+    return format_floats([value])[0]

@@ -449,16 +449,12 @@ class CollapseLP:
         relative = (system.A_eq.T @ dual).reshape(-1, 4) / largest
         layout = system.layout
         opening, slip = relative[:, 0], np.hypot(relative[:, 2], relative[:, 3])
-        vertex_opens = opening > MOTION_TOL
-        opens = np.bincount(layout.vertex_interface, vertex_opens,
-                            minlength=layout.n_interfaces) > 0
-        closed = np.bincount(layout.vertex_interface, ~vertex_opens,
-                             minlength=layout.n_interfaces) > 0
-        slides = np.bincount(layout.vertex_interface, slip > MOTION_TOL,
-                             minlength=layout.n_interfaces) > 0
         gap, most_slip = np.zeros(layout.n_interfaces), np.zeros(layout.n_interfaces)
         np.maximum.at(gap, layout.vertex_interface, opening)
         np.maximum.at(most_slip, layout.vertex_interface, slip)
+        opens, slides = gap > MOTION_TOL, most_slip > MOTION_TOL
+        closed = np.bincount(layout.vertex_interface, opening <= MOTION_TOL,
+                             minlength=layout.n_interfaces) > 0
         # kinematic theorem on the normalised mechanism, in physical units
         free = system.free_block
         work_live = float(np.sum(load.reshape(-1, 6) * system.row_scale.reshape(-1, 6)
@@ -659,10 +655,11 @@ def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=Non
     mu : float
     density : float, kg/m^3
         Of the dead load (and of a lateral load built with the same density).
-    friction : None or 'non-associative'
-        None: associated friction, the LP above. ``'non-associative'``: the estimate of
-        :func:`fixed_capacity_factor` (friction capacities fixed from the last collapse,
-        re-solved: joints slide without dilating).
+    friction : None, 'associated' or 'non-associative'
+        ``Params.friction_law``'s values. ``associated`` (or None): the LP above.
+        ``non-associative``: the estimate of :func:`fixed_capacity_factor` (friction
+        capacities fixed from the last collapse, re-solved: joints slide without
+        dilating).
     dead_load_feasible : bool, optional
         Known verdict on the dead load alone (e.g. the RBE's); otherwise the LP decides it
         with ``lambda`` fixed at 0.
@@ -676,11 +673,12 @@ def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=Non
         raise ValueError(f"live load of shape {live.wrench.shape} for "
                          f"{model.blocks.n_blocks} blocks")
     problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit)
-    if friction is None:
+    if friction in (None, "associated"):
         return problem.solve(live, dead_load_feasible=dead_load_feasible)
     if friction == "non-associative":
         return fixed_capacity_factor(problem, live, dead_load_feasible=dead_load_feasible)
-    raise ValueError(f"friction must be None or 'non-associative', not {friction!r}")
+    raise ValueError(f"friction must be 'associated' (or None) or 'non-associative', not "
+                     f"{friction!r}")
 
 
 NON_ASSOCIATIVE_ROUNDS = 30
@@ -701,10 +699,10 @@ def fixed_capacity_factor(problem: CollapseLP, live: LiveLoad, *, dead_load_feas
     collapse. Between rounds a joint's friction may exceed ``mu`` times its compression,
     so only a settled factor is reported: after ``rounds`` (at least 2) re-solves
     without one, or a round whose capacities admit no equilibrium, the factor and the
-    mechanism are None (the status says which). The LP's optimum is degenerate, so the factor wanders by a few 1e-3 as it
-    settles (the small dome of docs/collapse.md: 0.586 to 0.590 from the 14th round).
-    ``friction_law`` of the result says ``non-associative``; ``associated_factor`` keeps
-    the starting factor.
+    mechanism are None (the status says which). The LP's optimum is degenerate, so the
+    factor wanders by a few 1e-3 as it settles (the small dome of docs/collapse.md: 0.586
+    to 0.590 from the 14th round). ``friction_law`` of the result says
+    ``non-associative``; ``associated_factor`` keeps the starting factor.
     """
     if rounds < 2:
         raise ValueError(f"rounds must be at least 2 (a factor settles over two), not "
@@ -712,19 +710,22 @@ def fixed_capacity_factor(problem: CollapseLP, live: LiveLoad, *, dead_load_feas
     start = time.perf_counter()
     associated = problem.solve(live, dead_load_feasible=dead_load_feasible)
     result, known = associated, associated.dead_load_feasible
-    settled, following, done = 0, associated, 0
-    for done in range(1, rounds + 1 if result.load_factor is not None else 1):
+    if associated.load_factor is None:  # nothing to iterate from
+        return dataclasses.replace(result, friction_law="non-associative",
+                                   time_s=time.perf_counter() - start)
+    settled = 0
+    for done in range(1, rounds + 1):
         compression = problem.system.to_scaled(result.x).reshape(-1, 4)[:, 0]
         following = problem.with_friction_capacity(problem.mu * compression).solve(
             live, dead_load_feasible=known)
         if following.load_factor is None:
             break
         previous, result = result.load_factor, following
-        settled = settled + 1 if abs(result.load_factor - previous) <= rtol * abs(
-            previous) else 0
+        close = abs(result.load_factor - previous) <= rtol * abs(previous)
+        settled = settled + 1 if close else 0
         if settled == 2:
             break
-    if associated.load_factor is not None and settled < 2:
+    if settled < 2:
         why = (f"round {done} has no equilibrium ({following.status})"
                if following.load_factor is None else f"not settled after {done} rounds")
         log.warning("non-associative estimate: %s; no factor", why)

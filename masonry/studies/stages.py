@@ -42,7 +42,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from masonry.blocks import BLOCK_CLASSES
-from masonry.export._text import format_floats
+from masonry.export._text import format_float
 from masonry.export.summaries import parameters_text
 from masonry.params import ParameterError, structure_id, validate
 from masonry.pipeline import Timer, model_record, run_model, versions, write_cache
@@ -75,11 +75,10 @@ STAGE_COLUMNS = ("stage", "course", "laid", "bricks", "feasible", "loose", "moi"
                  "moi_factor", "load_factor", "solve_s")
 """Columns of ``stages.csv``, one row per stage. ``laid``: the names of the blocks the
 stage lays, in a brick or block plan (a course plan's stage is its course). ``loose``: the
-laid blocks that touch
-nothing joining them to a support (:func:`loose_blocks`: the stage has no equilibrium at
-all, and no MoI). ``load_factor``: the collapse load factor of the stage under the
-lateral load of ``params.lateral`` (:func:`stage_load_factor`); empty without one, or
-where the stage does not stand under its own weight."""
+laid blocks that touch nothing joining them to a support (:func:`loose_blocks`: the stage
+has no equilibrium at all, and no MoI). ``load_factor``: the collapse load factor of the
+stage under the lateral load of ``params.lateral`` (:func:`stage_load_factor`); empty
+without one, or where the stage does not stand under its own weight."""
 
 NOT_LAID = -1
 """``StagePlan.block_stage`` of a block the plan never lays."""
@@ -323,9 +322,8 @@ def stage_load_factor(part: Model, params) -> float | None:
     if params.lateral is None:
         return None
     live = lateral(part, params.lateral, params.density)
-    friction = None if params.friction_law == "associated" else params.friction_law
     result = collapse_load(part, live, mu=params.mu, density=params.density,
-                           friction=friction, dead_load_feasible=True)
+                           friction=params.friction_law, dead_load_feasible=True)
     return result.load_factor
 
 
@@ -427,7 +425,7 @@ def stages_csv(rows) -> bytes:
     writer.writerow(STAGE_COLUMNS)
     for row in rows:
         writer.writerow(["" if row[c] is None else
-                         format_floats([row[c]])[0] if isinstance(row[c], float)
+                         format_float(row[c]) if isinstance(row[c], float)
                          else row[c] for c in STAGE_COLUMNS])
     return buf.getvalue().encode()
 
@@ -444,7 +442,7 @@ def held_csv(scene, row) -> bytes:
         course = int(blocks.block_course[block])
         writer.writerow((block, blocks.block_name[block],
                          BLOCK_CLASSES[blocks.block_class[block]],
-                         course or "", format_floats([newtons])[0]))
+                         course or "", format_float(newtons)))
     return buf.getvalue().encode()
 
 
@@ -620,8 +618,9 @@ def stage_pngs(scene, plan: StagePlan, rows) -> dict:
         [np.nan if r["moi_factor"] is None else r["moi_factor"] for r in rows],
         [bool(r["feasible"]) for r in rows],
         [np.nan if r["load_factor"] is None else r["load_factor"] for r in rows],
-        loose=[r["loose"] for r in rows], title=title, xlabel={"course": "stage (courses laid)", "brick": f"stage (bricks "
-                             f"of course {plan.course} laid, per web)"}.get(plan.by, "stage"))}
+        loose=[r["loose"] for r in rows], title=title,
+        xlabel={"course": "stage (courses laid)", "brick": f"stage (bricks of course "
+                f"{plan.course} laid, per web)"}.get(plan.by, "stage"))}
     first = first_unsupported(rows)
     if first is None:
         return out

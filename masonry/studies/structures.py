@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from masonry.export._text import format_floats
+from masonry.export._text import format_float
 from masonry.rbe.boundary import analysis_model
 from masonry.rbe.collapse import worst_lateral
 from masonry.rbe.equilibrium import VariableLayout
@@ -163,7 +163,7 @@ def table_csv(rows) -> bytes:
     empty cell."""
     columns = COLUMNS + (LATERAL_COLUMNS if any("lateral_factor" in r for r in rows) else ())
     lines = [",".join(columns)]
-    lines += [",".join(format_floats([v])[0] if isinstance(v, float) else _cell(v)
+    lines += [",".join(format_float(v) if isinstance(v, float) else _cell(v)
                        for v in (row.get(c) for c in columns)) for row in rows]
     return ("\n".join(lines) + "\n").encode()
 

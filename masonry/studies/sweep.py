@@ -321,7 +321,7 @@ def summary_csv(study: Study, rows) -> bytes:
         if floats:
             for i, printed in zip(floats, format_floats([values[i] for i in floats])):
                 text[i] = printed
-        texts.append(['"' + t.replace('"', '""') + '"' if any(c in t for c in ',"\n')
+        texts.append(['"' + t.replace('"', '""') + '"' if any(q in t for q in ',"\n')
                       else t for t in text])
     lines = [",".join(columns), *map(",".join, zip(*texts))]
     return ("\n".join(lines) + "\n").encode()
