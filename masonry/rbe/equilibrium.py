@@ -391,15 +391,17 @@ def equilibrium_columns(coefficients, side_rows, n_rows: int) -> sp.csc_array:
     increasing order (the side on the lower block first) and it stores no zeros.
     """
     n_vertices, _, width = coefficients.shape
-    swap = side_rows[:, 0] > side_rows[:, 1]
     rows = 6 * np.sort(side_rows, axis=1)[:, :, None] + np.arange(6)      # (IV, 2, 6)
-    sides = np.where(swap[:, None], np.arange(12).reshape(2, 6)[::-1].ravel(),
-                     np.arange(12))                                      # (IV, 12)
-    data = np.take_along_axis(coefficients, sides[:, :, None], axis=1)  # (IV, 12, width)
-    data = data.transpose(0, 2, 1)                                       # (IV, width, 12)
-    matrix = sp.csc_array(
-        (data.ravel(), np.broadcast_to(rows.reshape(n_vertices, 1, 12), data.shape).ravel(),
-         np.arange(0, data.size + 1, 12)), shape=(n_rows, n_vertices * width))
+    # (IV, width, 12), written once in place: the side on the lower block first
+    data = np.empty((n_vertices, width, 12))
+    data[:] = coefficients.transpose(0, 2, 1)
+    swap = np.flatnonzero(side_rows[:, 0] > side_rows[:, 1])
+    data[swap] = np.roll(coefficients[swap], 6, axis=1).transpose(0, 2, 1)
+    indices = np.empty(data.shape, dtype=np.int64)
+    indices[:] = rows.reshape(n_vertices, 1, 12)
+    matrix = sp.csc_array((data.reshape(-1), indices.reshape(-1),
+                           np.arange(0, data.size + 1, 12)),
+                          shape=(n_rows, n_vertices * width))
     # both sides on one block (cyclic symmetry routes an image onto the brick it copies)
     # add up; then the dropped coefficients go
     matrix.sum_duplicates()
