@@ -10,7 +10,9 @@ import numpy as np
 import pytest
 from scipy.optimize import linprog
 
+from masonry import forking
 from masonry.blocks import Blocks
+from masonry.rbe import collapse
 from masonry.params import ParameterError, Params, from_preset, validate
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
@@ -311,6 +313,35 @@ def test_worst_lateral_searches_the_symmetry_directions_with_one_model(method):
     alone = collapse_load(dome, lateral(dome, worst.azimuth_deg))
     assert alone.load_factor == pytest.approx(worst.load_factor, rel=1e-7)
     check_mechanism(dome, lateral(dome, worst.azimuth_deg), worst)
+
+
+@pytest.mark.skipif(not forking.can_fork(), reason="the azimuths share the cores by fork")
+@pytest.mark.parametrize("known", [None, True])
+def test_an_azimuth_search_on_two_cores_gives_every_azimuth_its_factor(monkeypatch, known):
+    """Two azimuths at once, every second one in a forked process: the block of
+    test_single_block_tips_at_b_over_h_or_slides_at_mu tips at b/h = 0.4 along x and
+    slides at mu = 0.7 along y, whichever process solved the azimuth (after the first,
+    here, when the dead load is not known to stand)."""
+    monkeypatch.setattr(collapse, "TWO_AT_ONCE_BLOCKS", 1)
+    monkeypatch.setattr(forking, "cores", lambda: 2)
+    forks = []
+    start = forking.Forked.start
+    monkeypatch.setattr(forking.Forked, "start",
+                        lambda self: forks.append(self) or start(self))
+    model = column(1, (0.2, 0.4, 0.5))
+    azimuths = [0.0, 90.0, 180.0, 270.0, 45.0]
+    worst = worst_lateral(model, azimuths, mu=0.7, density=DENSITY,
+                          dead_load_feasible=known)
+    assert len(forks) == 1
+    factors = dict(worst.azimuths)
+    assert list(factors) == azimuths
+    for azimuth, expected in ((0.0, 0.4), (90.0, 0.7), (180.0, 0.4), (270.0, 0.7)):
+        assert factors[azimuth] == pytest.approx(expected, rel=1e-6)
+    # along the diagonal its x part tips it about the far edge along y: lambda cos 45
+    # times h / 2 against b / 2
+    assert factors[45.0] == pytest.approx(0.1 / (0.25 * np.cos(np.pi / 4)), rel=1e-6)
+    assert worst.azimuth_deg == 0.0 and worst.load_factor == pytest.approx(0.4, rel=1e-6)
+    check_mechanism(model, lateral(model, 0.0, DENSITY), worst)
 
 
 @pytest.mark.parametrize("azimuth", [0.0, 45.0])

@@ -26,6 +26,7 @@ scaled units (force rows: a translation; moment rows: a rotation times ``length_
 """
 
 import dataclasses
+import functools
 import logging
 import time
 from dataclasses import dataclass, field
@@ -35,6 +36,7 @@ import highspy
 import numpy as np
 import scipy.sparse as sp
 
+from masonry import forking
 from masonry.rbe.equilibrium import assemble, friction_pyramid_edges
 from masonry.rbe.loads import LiveLoad, lateral
 from masonry.rbe.solve import interface_forces
@@ -76,6 +78,13 @@ HIGHS_METHODS = {
 
 METHOD = "interior"
 """The default of :data:`METHODS`."""
+
+TWO_AT_ONCE_BLOCKS = 500
+"""An azimuth search (:func:`worst_lateral`) by the interior point method on a model of at
+least this many free blocks solves two azimuths at once, one in a forked process, each
+factoring on one thread: the second core does far more there than as the second thread
+of one factorization (``docs/bench.md``, "Two azimuths at once"); on small models the
+fork costs more than their LPs."""
 
 ASSOCIATED_NOTE = (
     "sliding interfaces take part in this mechanism: the load factor assumes associated "
@@ -323,6 +332,14 @@ class CollapseLP:
         live = lateral(self.model, azimuth_deg, self.density)
         return self._result(self._lateral, live, float(azimuth_deg) % 360.0, start,
                             dead_load_feasible)
+
+    def one_factor_thread(self):
+        """The interior point method's system made now (a fork shares it then) and its
+        factorizations on one thread from now on (another process works on the second
+        core)."""
+        if self._newton_system is None:
+            self._newton_system = NewtonSystem(self.system, "net")
+        self._newton_system.symbolic.limit_threads(1)
 
     def _backend(self, loads, cost, tie=None):
         def clarabel_lp():
@@ -766,14 +783,17 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
     problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit,
                          method=method)
     start = time.perf_counter()
-    results, solved, known = [], {}, dead_load_feasible
-    for azimuth in azimuths:
-        key = round(float(azimuth) % period_deg, 9) if period_deg else float(azimuth)
-        if key not in solved:
-            solved[key] = problem.solve_lateral(float(azimuth), dead_load_feasible=known)
-            known = solved[key].dead_load_feasible
+    keys = [round(float(a) % period_deg, 9) if period_deg else float(a) for a in azimuths]
+    todo = {}
+    for key, azimuth in zip(keys, azimuths):
+        todo.setdefault(key, float(azimuth))
+    solved = _solve_azimuths(problem, list(todo.items()), dead_load_feasible)
+    results = []
+    for key in keys:
+        if key not in solved:  # the dead load cannot stand: the search ended
+            break
         results.append(solved[key])
-        if known is False:
+        if solved[key].dead_load_feasible is False:
             break
     log.info("lateral search: %d azimuths, %d solved", len(results), len(solved))
     factors = [(float(a), r.load_factor) for a, r in zip(azimuths, results)]
@@ -785,3 +805,59 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
                      if r.load_factor <= least + FACTOR_TIE_REL * abs(least))
     return dataclasses.replace(worst, azimuths=tuple(factors),
                                time_s=time.perf_counter() - start)
+
+
+def _solve_azimuths(problem, todo, known) -> dict:
+    """Solve the ``(key, azimuth)`` pairs of ``todo`` in order, each told what the earlier
+    ones found of the dead load; once it is known to stand, the rest two at once
+    (:data:`TWO_AT_ONCE_BLOCKS`). Returns key -> :class:`CollapseResult`; ends at the
+    first that finds the dead load cannot stand."""
+    solved = {}
+    for index, (key, azimuth) in enumerate(todo):
+        rest = todo[index:]
+        if known is True and len(rest) > 1 and _two_at_once_wanted(problem):
+            solved.update(_two_at_once(problem, rest))
+            break
+        solved[key] = problem.solve_lateral(azimuth, dead_load_feasible=known)
+        known = solved[key].dead_load_feasible
+        if known is False:
+            break
+    return solved
+
+
+def _two_at_once_wanted(problem) -> bool:
+    return (problem.method == "interior" and forking.can_fork() and forking.cores() >= 2
+            and len(problem.system.free_block) >= TWO_AT_ONCE_BLOCKS)
+
+
+def _two_at_once(problem, todo) -> dict:
+    """The ``(key, azimuth)`` pairs of ``todo`` (the dead load stands): every second one
+    in a forked copy of this process, the others here, both factoring on one thread.
+    Where the fork cannot start, all of them here."""
+    problem.one_factor_thread()
+    other = forking.Forked([functools.partial(_solve_quietly, problem, todo[1::2])])
+    try:
+        other.start()
+    except OSError as error:  # no memory or processes left for a fork
+        log.warning("the azimuth search cannot use the second core (%s)", error)
+        return _solve_each(problem, todo)
+    try:
+        solved = _solve_each(problem, todo[0::2])
+        solved.update(other.result())
+    except BaseException:
+        other.close(cancel=True)
+        raise
+    other.close()
+    return solved
+
+
+def _solve_each(problem, todo) -> dict:
+    return {key: problem.solve_lateral(azimuth, dead_load_feasible=True)
+            for key, azimuth in todo}
+
+
+def _solve_quietly(problem, todo) -> dict:
+    """:func:`_solve_each` in the forked process: its progress would mix with this
+    process's, so only warnings and errors are logged."""
+    logging.disable(logging.INFO)
+    return _solve_each(problem, todo)
