@@ -344,6 +344,22 @@ def test_an_azimuth_search_on_two_cores_gives_every_azimuth_its_factor(monkeypat
     check_mechanism(model, lateral(model, 0.0, DENSITY), worst)
 
 
+@pytest.mark.skipif(not forking.can_fork(), reason="the azimuths share the cores by fork")
+def test_azimuths_whose_forked_process_fails_are_solved_here(monkeypatch, caplog):
+    monkeypatch.setattr(collapse, "TWO_AT_ONCE_BLOCKS", 1)
+    monkeypatch.setattr(forking, "cores", lambda: 2)
+
+    def fails(problem, todo):
+        raise MemoryError("no room")
+
+    monkeypatch.setattr(collapse, "_solve_quietly", fails)
+    model = column(1, (0.2, 0.4, 0.5))
+    worst = worst_lateral(model, [0.0, 90.0], mu=0.7, density=DENSITY,
+                          dead_load_feasible=True)
+    assert dict(worst.azimuths) == pytest.approx({0.0: 0.4, 90.0: 0.7}, rel=1e-6)
+    assert "the azimuths on the second core failed (no room)" in caplog.text
+
+
 @pytest.mark.parametrize("azimuth", [0.0, 45.0])
 def test_interior_point_lp_finds_the_simplex_optimum_on_a_dome(azimuth):
     """The own interior point method against HiGHS's dual simplex (an exact vertex

@@ -773,7 +773,8 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
     One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: the interior point
     method and Clarabel keep their symbolic factorization, HiGHS's simplex restarts from
     the last basis), ``method`` one of :data:`METHODS`, and the dead load is checked once
-    (unless ``dead_load_feasible`` is given). ``period_deg``: the model repeats under a
+    (unless ``dead_load_feasible`` is given); on large models two azimuths at once
+    (:data:`TWO_AT_ONCE_BLOCKS`). ``period_deg``: the model repeats under a
     rotation by this angle about the z axis (a full dome of ``n`` webs: ``360 / n``), so
     azimuths that differ by it have the same factor and each is solved once. Returns the
     worst azimuth's result with every azimuth's factor in ``azimuths`` ((azimuth, factor
@@ -843,7 +844,12 @@ def _two_at_once(problem, todo) -> dict:
         return _solve_each(problem, todo)
     try:
         solved = _solve_each(problem, todo[0::2])
-        solved.update(other.result())
+        try:
+            solved.update(other.result())
+        except Exception as error:  # the forked process failed: its azimuths here
+            log.warning("the azimuths on the second core failed (%s); solving them here",
+                        error)
+            solved.update(_solve_each(problem, todo[1::2]))
     except BaseException:
         other.close(cancel=True)
         raise
