@@ -4,10 +4,14 @@ A forked process shares this one's memory at the moment of the fork (copy on wri
 it needs nothing pickled to start: the calls are closures over what this process
 already holds. Only their results travel back, pickled through a pipe. The run's
 exporters use it (the 3DM file and the plots beside the other files) and so does the
-rigid block equilibrium (friction+ beside friction-net, :mod:`masonry.rbe.solve`).
+rigid block equilibrium (friction+ beside friction-net, :mod:`masonry.rbe.solve`), and
+:func:`two_at_once` splits independent solves (a collapse search's azimuths, the
+construction stages) over two processes.
 """
 
+import contextlib
 import ctypes
+import logging
 import multiprocessing
 import os
 import signal
@@ -20,6 +24,17 @@ HELD_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 PR_SET_PDEATHSIG = 1
 """Linux ``prctl`` option: the signal a process gets when its parent ends (prctl.h)."""
 
+TWO_AT_ONCE_BLOCKS = 500
+"""Models of at least this many blocks split their independent solves over two processes
+(:func:`two_at_once`): a collapse LP of preset 1's full dome, or a stage of its section,
+does far more on the second core than its factorization's second thread does there
+(``docs/bench.md``, "Two azimuths at once"); on small models the fork costs more than
+their solves."""
+
+log = logging.getLogger(__name__)
+
+_one_core = False  # set by on_one_core()
+
 
 def can_fork() -> bool:
     """Whether a second process can start as a copy of this one: fork exists and is safe
@@ -31,10 +46,56 @@ def can_fork() -> bool:
 
 def cores() -> int:
     """The cores this process may run on (all of the machine's where the system does
-    not say: macOS, Windows)."""
+    not say: macOS, Windows); one inside :func:`on_one_core`."""
+    if _one_core:
+        return 1
     if hasattr(os, "sched_getaffinity"):
         return len(os.sched_getaffinity(0))
     return os.cpu_count() or 1
+
+
+@contextlib.contextmanager
+def on_one_core():
+    """Within it, this process (and any forked from it) counts one core: another process
+    of the same job works on the other, so neither starts threads or processes of its
+    own."""
+    global _one_core
+    before, _one_core = _one_core, True
+    try:
+        yield
+    finally:
+        _one_core = before
+
+
+def two_at_once(function, items) -> list:
+    """``[function(item) for item in items]`` on two cores: every second item in a forked
+    copy of this process, the others here, each process on one core
+    (:func:`on_one_core`). In order; all here when the process cannot fork or has one
+    core, and, with a warning, when the fork cannot start or its process fails."""
+    items = list(items)
+    if len(items) < 2 or not can_fork() or cores() < 2:
+        return [function(item) for item in items]
+    with on_one_core():
+        theirs = Forked([lambda: [function(item) for item in items[1::2]]])
+        try:
+            theirs.start()
+        except OSError as error:  # no memory or processes left for a fork
+            log.warning("the second core is out of reach (%s): one process does all", error)
+            return [function(item) for item in items]
+        try:
+            mine = [function(item) for item in items[0::2]]
+            try:
+                done = theirs.result()
+            except Exception as error:
+                log.warning("the second process failed (%s): its share is done here", error)
+                done = [function(item) for item in items[1::2]]
+        except BaseException:
+            theirs.close(cancel=True)
+            raise
+        theirs.close()
+    out = [None] * len(items)
+    out[0::2], out[1::2] = mine, done
+    return out
 
 
 class Forked:

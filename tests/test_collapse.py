@@ -12,7 +12,6 @@ from scipy.optimize import linprog
 
 from masonry import forking
 from masonry.blocks import Blocks
-from masonry.rbe import collapse
 from masonry.params import ParameterError, Params, from_preset, validate
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
@@ -322,8 +321,8 @@ def test_an_azimuth_search_on_two_cores_gives_every_azimuth_its_factor(monkeypat
     test_single_block_tips_at_b_over_h_or_slides_at_mu tips at b/h = 0.4 along x and
     slides at mu = 0.7 along y, whichever process solved the azimuth (after the first,
     here, when the dead load is not known to stand)."""
-    monkeypatch.setattr(collapse, "TWO_AT_ONCE_BLOCKS", 1)
-    monkeypatch.setattr(forking, "cores", lambda: 2)
+    monkeypatch.setattr(forking, "TWO_AT_ONCE_BLOCKS", 1)
+    monkeypatch.setattr(forking, "cores", lambda: 1 if forking._one_core else 2)
     forks = []
     start = forking.Forked.start
     monkeypatch.setattr(forking.Forked, "start",
@@ -342,22 +341,6 @@ def test_an_azimuth_search_on_two_cores_gives_every_azimuth_its_factor(monkeypat
     assert factors[45.0] == pytest.approx(0.1 / (0.25 * np.cos(np.pi / 4)), rel=1e-6)
     assert worst.azimuth_deg == 0.0 and worst.load_factor == pytest.approx(0.4, rel=1e-6)
     check_mechanism(model, lateral(model, 0.0, DENSITY), worst)
-
-
-@pytest.mark.skipif(not forking.can_fork(), reason="the azimuths share the cores by fork")
-def test_azimuths_whose_forked_process_fails_are_solved_here(monkeypatch, caplog):
-    monkeypatch.setattr(collapse, "TWO_AT_ONCE_BLOCKS", 1)
-    monkeypatch.setattr(forking, "cores", lambda: 2)
-
-    def fails(problem, todo):
-        raise MemoryError("no room")
-
-    monkeypatch.setattr(collapse, "_solve_quietly", fails)
-    model = column(1, (0.2, 0.4, 0.5))
-    worst = worst_lateral(model, [0.0, 90.0], mu=0.7, density=DENSITY,
-                          dead_load_feasible=True)
-    assert dict(worst.azimuths) == pytest.approx({0.0: 0.4, 90.0: 0.7}, rel=1e-6)
-    assert "the azimuths on the second core failed (no room)" in caplog.text
 
 
 @pytest.mark.parametrize("azimuth", [0.0, 45.0])

@@ -80,3 +80,37 @@ def test_the_forked_process_ends_with_a_killed_parent():
     else:
         os.kill(child, signal.SIGKILL)
         pytest.fail("the forked process outlived its killed parent")
+
+
+@pytest.fixture
+def two_cores(monkeypatch):
+    """Two cores for this process, whatever the machine has."""
+    monkeypatch.setattr(forking, "cores", lambda: 1 if forking._one_core else 2)
+
+
+def test_two_at_once_gives_every_second_item_to_another_process_in_order(two_cores):
+    here = os.getpid()
+    out = forking.two_at_once(lambda item: (item * item, os.getpid(), forking.cores()),
+                              range(5))
+    assert [square for square, _, _ in out] == [0, 1, 4, 9, 16]
+    pids = [pid for _, pid, _ in out]
+    assert pids[0::2] == [here] * 3 and len(set(pids[1::2])) == 1 and pids[1] != here
+    # each process counts one core while they share two, this one two again after
+    assert [count for _, _, count in out] == [1] * 5 and forking.cores() == 2
+
+
+def test_two_at_once_does_the_share_of_a_failed_process_here(two_cores, caplog):
+    here = os.getpid()
+
+    def square(item):
+        if os.getpid() != here:
+            raise MemoryError("no room")
+        return item * item
+
+    assert forking.two_at_once(square, range(4)) == [0, 1, 4, 9]
+    assert "the second process failed (no room): its share is done here" in caplog.text
+
+
+def test_two_at_once_on_one_core_does_all_here(monkeypatch):
+    monkeypatch.setattr(forking, "cores", lambda: 1)
+    assert forking.two_at_once(lambda item: os.getpid(), range(3)) == [os.getpid()] * 3

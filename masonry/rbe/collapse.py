@@ -79,13 +79,6 @@ HIGHS_METHODS = {
 METHOD = "interior"
 """The default of :data:`METHODS`."""
 
-TWO_AT_ONCE_BLOCKS = 500
-"""An azimuth search (:func:`worst_lateral`) by the interior point method on a model of at
-least this many free blocks solves two azimuths at once, one in a forked process, each
-factoring on one thread: the second core does far more there than as the second thread
-of one factorization (``docs/bench.md``, "Two azimuths at once"); on small models the
-fork costs more than their LPs."""
-
 ASSOCIATED_NOTE = (
     "sliding interfaces take part in this mechanism: the load factor assumes associated "
     "friction (the pyramid's normal as flow rule, joints that dilate as they slide) and "
@@ -332,14 +325,6 @@ class CollapseLP:
         live = lateral(self.model, azimuth_deg, self.density)
         return self._result(self._lateral, live, float(azimuth_deg) % 360.0, start,
                             dead_load_feasible)
-
-    def one_factor_thread(self):
-        """The interior point method's system made now (a fork shares it then) and its
-        factorizations on one thread from now on (another process works on the second
-        core)."""
-        if self._newton_system is None:
-            self._newton_system = NewtonSystem(self.system, "net")
-        self._newton_system.symbolic.limit_threads(1)
 
     def _backend(self, loads, cost, tie=None):
         def clarabel_lp():
@@ -774,7 +759,7 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
     method and Clarabel keep their symbolic factorization, HiGHS's simplex restarts from
     the last basis), ``method`` one of :data:`METHODS`, and the dead load is checked once
     (unless ``dead_load_feasible`` is given); on large models two azimuths at once
-    (:data:`TWO_AT_ONCE_BLOCKS`). ``period_deg``: the model repeats under a
+    (:func:`masonry.forking.two_at_once`). ``period_deg``: the model repeats under a
     rotation by this angle about the z axis (a full dome of ``n`` webs: ``360 / n``), so
     azimuths that differ by it have the same factor and each is solved once. Returns the
     worst azimuth's result with every azimuth's factor in ``azimuths`` ((azimuth, factor
@@ -810,14 +795,17 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
 
 def _solve_azimuths(problem, todo, known) -> dict:
     """Solve the ``(key, azimuth)`` pairs of ``todo`` in order, each told what the earlier
-    ones found of the dead load; once it is known to stand, the rest two at once
-    (:data:`TWO_AT_ONCE_BLOCKS`). Returns key -> :class:`CollapseResult`; ends at the
-    first that finds the dead load cannot stand."""
+    ones found of the dead load; once it is known to stand, the rest two at once on a
+    large model (:func:`masonry.forking.two_at_once`). Returns key ->
+    :class:`CollapseResult`; ends at the first that finds the dead load cannot stand."""
     solved = {}
     for index, (key, azimuth) in enumerate(todo):
         rest = todo[index:]
-        if known is True and len(rest) > 1 and _two_at_once_wanted(problem):
-            solved.update(_two_at_once(problem, rest))
+        if known is True and problem.method == "interior" and len(
+                problem.system.free_block) >= forking.TWO_AT_ONCE_BLOCKS:
+            results = forking.two_at_once(functools.partial(_lateral_standing, problem),
+                                          [a for _, a in rest])
+            solved.update(zip([k for k, _ in rest], results))
             break
         solved[key] = problem.solve_lateral(azimuth, dead_load_feasible=known)
         known = solved[key].dead_load_feasible
@@ -826,44 +814,5 @@ def _solve_azimuths(problem, todo, known) -> dict:
     return solved
 
 
-def _two_at_once_wanted(problem) -> bool:
-    return (problem.method == "interior" and forking.can_fork() and forking.cores() >= 2
-            and len(problem.system.free_block) >= TWO_AT_ONCE_BLOCKS)
-
-
-def _two_at_once(problem, todo) -> dict:
-    """The ``(key, azimuth)`` pairs of ``todo`` (the dead load stands): every second one
-    in a forked copy of this process, the others here, both factoring on one thread.
-    Where the fork cannot start, all of them here."""
-    problem.one_factor_thread()
-    other = forking.Forked([functools.partial(_solve_quietly, problem, todo[1::2])])
-    try:
-        other.start()
-    except OSError as error:  # no memory or processes left for a fork
-        log.warning("the azimuth search cannot use the second core (%s)", error)
-        return _solve_each(problem, todo)
-    try:
-        solved = _solve_each(problem, todo[0::2])
-        try:
-            solved.update(other.result())
-        except Exception as error:  # the forked process failed: its azimuths here
-            log.warning("the azimuths on the second core failed (%s); solving them here",
-                        error)
-            solved.update(_solve_each(problem, todo[1::2]))
-    except BaseException:
-        other.close(cancel=True)
-        raise
-    other.close()
-    return solved
-
-
-def _solve_each(problem, todo) -> dict:
-    return {key: problem.solve_lateral(azimuth, dead_load_feasible=True)
-            for key, azimuth in todo}
-
-
-def _solve_quietly(problem, todo) -> dict:
-    """:func:`_solve_each` in the forked process: its progress would mix with this
-    process's, so only warnings and errors are logged."""
-    logging.disable(logging.INFO)
-    return _solve_each(problem, todo)
+def _lateral_standing(problem, azimuth) -> CollapseResult:
+    return problem.solve_lateral(azimuth, dead_load_feasible=True)

@@ -29,6 +29,7 @@ A stage laid the same in every web is rotationally symmetric, so the cyclic sect
 
 import csv
 import dataclasses
+import functools
 import io
 import json
 import logging
@@ -41,6 +42,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
+from masonry import forking
 from masonry.blocks import BLOCK_CLASSES
 from masonry.export._text import format_float
 from masonry.export.summaries import parameters_text
@@ -397,19 +399,25 @@ def make_plan(scene, by: str = "course", order: str | None = None,
 
 
 def analyse_stages(model: Model, params, plan: StagePlan) -> list:
-    """:func:`analyse_stage` of stages ``1..N`` in order, logging ``stage k of N``."""
-    rows = []
-    for stage in range(1, plan.n_stages + 1):
-        row = analyse_stage(model, params, plan, stage)
-        verdict = ("stands" if row["feasible"] else
-                   f"needs support ({row['loose']} blocks touch nothing that holds them)"
-                   if row["loose"] else "needs support")
-        log.info("stage %d of %d: %d bricks, %s, MoI factor %s, %.2f s", stage,
-                 plan.n_stages, row["bricks"], verdict,
-                 "-" if row["moi_factor"] is None else f"{row['moi_factor']:.3g}",
-                 row["solve_s"])
-        rows.append(row)
-    return rows
+    """:func:`analyse_stage` of stages ``1..N``, in order, logging ``stage k of N``; two
+    at once on a large model (:func:`masonry.forking.two_at_once`: the stages are
+    independent)."""
+    analysed = functools.partial(_analysed, model, params, plan)
+    stages = range(1, plan.n_stages + 1)
+    if model.blocks.n_blocks < forking.TWO_AT_ONCE_BLOCKS:
+        return [analysed(stage) for stage in stages]
+    return forking.two_at_once(analysed, stages)
+
+
+def _analysed(model: Model, params, plan: StagePlan, stage: int) -> dict:
+    row = analyse_stage(model, params, plan, stage)
+    verdict = ("stands" if row["feasible"] else
+               f"needs support ({row['loose']} blocks touch nothing that holds them)"
+               if row["loose"] else "needs support")
+    log.info("stage %d of %d: %d bricks, %s, MoI factor %s, %.2f s", stage, plan.n_stages,
+             row["bricks"], verdict,
+             "-" if row["moi_factor"] is None else f"{row['moi_factor']:.3g}", row["solve_s"])
+    return row
 
 
 def first_unsupported(rows) -> dict | None:
