@@ -112,7 +112,7 @@ def test_block_cholesky_solves_and_refuses_indefinite_matrices(monkeypatch, orde
     sym = BlockCholesky(n, edges, block_size=6, ordering=ordering)
     assert sym.ordering == ordering
     if parallel:
-        threads, top = sym._parallel_schedule()
+        threads, top = sym._parallel_schedule(2)
         assert len(threads) == 2 and all(threads)
     dense = np.zeros((6 * n, 6 * n))
     values = np.empty((len(sym.lower_rows), 6, 6))
@@ -212,7 +212,7 @@ def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_upda
     sym = BlockCholesky(n, edges, block_size=bs, ordering=ordering)
     assert any(len(children) > 1 for children in sym._children)
     if parallel:
-        threads, top = sym._parallel_schedule()
+        threads, top = sym._parallel_schedule(2)
         assert len(threads) == 2 and all(threads) and top
     values, dense = _random_spd_blocks(sym, rng)
     order = sym._scalar_order
@@ -240,7 +240,7 @@ def test_batched_leaves_factor_and_solve_as_the_dense_cholesky(monkeypatch, para
     assert {k for k, _ in shapes} >= {3, 6, 9, 24} and max(g for _, g in shapes) >= 3
     assert sym._batched.sum() == sum(not children for children in sym._children)
     if parallel:  # the stacks first, then the other supernodes on two threads
-        threads, top = sym._parallel_schedule()
+        threads, top = sym._parallel_schedule(2)
         assert len(threads) == 2 and not any(sym._batched[s] for s in sum(threads, top))
     values, dense = _random_spd_blocks(sym, np.random.default_rng(3), shift=0.3)
     order = sym._scalar_order

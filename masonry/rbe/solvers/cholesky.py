@@ -534,7 +534,6 @@ class BlockCholesky:
         """Factor on at most ``threads`` threads from now on (None: :data:`FACTOR_THREADS`),
         e.g. one while another process works on the second core."""
         self._threads = threads
-        self._schedule = None
 
     def factor(self, values) -> "BlockFactor":
         """Numeric Cholesky factorization.
@@ -559,9 +558,11 @@ class BlockCholesky:
         values = np.asarray(values, dtype=float)[self._entry_order].reshape(-1)
         n = len(self._steps)
         state = ([None] * n, [None] * n, [None] * n)  # updates, pivots, below
-        if self._schedule is None:
-            self._schedule = self._parallel_schedule()
-        bins, top = self._schedule
+        threads = min(FACTOR_THREADS if self._threads is None else self._threads,
+                      forking.cores())
+        if self._schedule is None or self._schedule[0] != threads:
+            self._schedule = threads, self._parallel_schedule(threads)
+        bins, top = self._schedule[1]
         leaves = [self._factor_leaves(group, values, state[0])
                   for group in self._leaf_groups]
         if len(bins) > 1:
@@ -576,11 +577,12 @@ class BlockCholesky:
         self._factor_steps(top, values, state, 0)
         return BlockFactor(self, state[1], state[2], leaves)
 
-    def _parallel_schedule(self):
-        """Subtrees for the threads: (one list of supernodes per thread, in postorder;
-        the supernodes above them). Split the heaviest subtree at its root until it
-        holds at most a thread's share of the flops, then deal the subtrees out,
-        heaviest first, to the least loaded thread (longest processing time first)."""
+    def _parallel_schedule(self, threads):
+        """Subtrees for ``threads`` threads: (one list of supernodes per thread, in
+        postorder; the supernodes above them). Split the heaviest subtree at its root
+        until it holds at most a thread's share of the flops, then deal the subtrees
+        out, heaviest first, to the least loaded thread (longest processing time
+        first)."""
         bs = self.block_size
         n = len(self.supernodes)
         work = np.empty(n)
@@ -591,8 +593,6 @@ class BlockCholesky:
         for s, sn in enumerate(self.supernodes):  # postorder: children first
             if sn.parent >= 0:
                 subtree[sn.parent] += subtree[s]
-        threads = FACTOR_THREADS if self._threads is None else self._threads
-        threads = min(threads, forking.cores())
         if threads < 2 or work.sum() < PARALLEL_FLOPS:
             return [], range(n)
         share = work.sum() / threads
