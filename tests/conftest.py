@@ -9,6 +9,7 @@ import pytest
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
+from masonry import forking  # noqa: E402
 from masonry.params import from_preset  # noqa: E402
 from masonry.scenes import build  # noqa: E402
 
@@ -24,6 +25,19 @@ def scene_of(preset, **overrides):
 @pytest.fixture(scope="session")
 def fixtures_dir():
     return FIXTURES
+
+
+@pytest.fixture
+def two_processes(monkeypatch):
+    """:func:`masonry.forking.two_at_once` splits whatever the model and the machine: any
+    model is large enough and this process has two cores (one inside
+    :func:`~masonry.forking.on_one_core`). Returns the list of processes it starts."""
+    monkeypatch.setattr(forking, "TWO_AT_ONCE_BLOCKS", 1)
+    monkeypatch.setattr(forking, "cores", lambda: 1 if forking._one_core else 2)
+    forks = []
+    start = forking.Forked.start
+    monkeypatch.setattr(forking.Forked, "start", lambda self: forks.append(self) or start(self))
+    return forks
 
 
 def support_force(interfaces, forces, mask):

@@ -316,22 +316,16 @@ def test_worst_lateral_searches_the_symmetry_directions_with_one_model(method):
 
 @pytest.mark.skipif(not forking.can_fork(), reason="the azimuths share the cores by fork")
 @pytest.mark.parametrize("known", [None, True])
-def test_an_azimuth_search_on_two_cores_gives_every_azimuth_its_factor(monkeypatch, known):
+def test_an_azimuth_search_on_two_cores_gives_every_azimuth_its_factor(two_processes, known):
     """Two azimuths at once, every second one in a forked process: the block of
     test_single_block_tips_at_b_over_h_or_slides_at_mu tips at b/h = 0.4 along x and
     slides at mu = 0.7 along y, whichever process solved the azimuth (after the first,
     here, when the dead load is not known to stand)."""
-    monkeypatch.setattr(forking, "TWO_AT_ONCE_BLOCKS", 1)
-    monkeypatch.setattr(forking, "cores", lambda: 1 if forking._one_core else 2)
-    forks = []
-    start = forking.Forked.start
-    monkeypatch.setattr(forking.Forked, "start",
-                        lambda self: forks.append(self) or start(self))
     model = column(1, (0.2, 0.4, 0.5))
     azimuths = [0.0, 90.0, 180.0, 270.0, 45.0]
     worst = worst_lateral(model, azimuths, mu=0.7, density=DENSITY,
                           dead_load_feasible=known)
-    assert len(forks) == 1
+    assert len(two_processes) == 1
     factors = dict(worst.azimuths)
     assert list(factors) == azimuths
     for azimuth, expected in ((0.0, 0.4), (90.0, 0.7), (180.0, 0.4), (270.0, 0.7)):

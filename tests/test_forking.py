@@ -82,13 +82,7 @@ def test_the_forked_process_ends_with_a_killed_parent():
         pytest.fail("the forked process outlived its killed parent")
 
 
-@pytest.fixture
-def two_cores(monkeypatch):
-    """Two cores for this process, whatever the machine has."""
-    monkeypatch.setattr(forking, "cores", lambda: 1 if forking._one_core else 2)
-
-
-def test_two_at_once_gives_every_second_item_to_another_process_in_order(two_cores):
+def test_two_at_once_gives_every_second_item_to_another_process_in_order(two_processes):
     here = os.getpid()
     out = forking.two_at_once(lambda item: (item * item, os.getpid(), forking.cores()),
                               range(5))
@@ -99,7 +93,7 @@ def test_two_at_once_gives_every_second_item_to_another_process_in_order(two_cor
     assert [count for _, _, count in out] == [1] * 5 and forking.cores() == 2
 
 
-def test_two_at_once_does_the_share_of_a_failed_process_here(two_cores, caplog):
+def test_two_at_once_does_the_share_of_a_failed_process_here(two_processes, caplog):
     here = os.getpid()
 
     def square(item):

@@ -92,18 +92,12 @@ def test_overhanging_stack_fails_at_the_stage_statics_says(offsets, first_failin
 
 
 @pytest.mark.skipif(not forking.can_fork(), reason="the stages share the cores by fork")
-def test_stages_on_two_cores_fail_where_statics_says(monkeypatch):
+def test_stages_on_two_cores_fail_where_statics_says(two_processes):
     """Every second stage in a forked process (forking.two_at_once, forced on this small
     model): the verdicts of book stacking, in stage order."""
-    monkeypatch.setattr(forking, "TWO_AT_ONCE_BLOCKS", 1)
-    monkeypatch.setattr(forking, "cores", lambda: 1 if forking._one_core else 2)
-    forks = []
-    start = forking.Forked.start
-    monkeypatch.setattr(forking.Forked, "start",
-                        lambda self: forks.append(self) or start(self))
     blocks, centre = stack(np.full(5, 0.3))
     plan, rows = stage_verdicts(blocks, order="names")
-    assert len(forks) == 1
+    assert len(two_processes) == 1
     assert [r["stage"] for r in rows] == list(range(1, 7))
     assert [r["feasible"] for r in rows] == stands_by_statics(centre)
     assert [r["feasible"] for r in rows].index(False) == 3
