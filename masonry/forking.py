@@ -58,7 +58,7 @@ def cores() -> int:
 def on_one_core():
     """Within it, this process (and any forked from it) counts one core: another process
     of the same job works on the other, so neither starts threads or processes of its
-    own."""
+    own. A flag of the process: enter it from one thread."""
     global _one_core
     before, _one_core = _one_core, True
     try:
@@ -70,32 +70,51 @@ def on_one_core():
 def two_at_once(function, items) -> list:
     """``[function(item) for item in items]`` on two cores: every second item in a forked
     copy of this process, the others here, each process on one core
-    (:func:`on_one_core`). In order; all here when the process cannot fork or has one
-    core, and, with a warning, when the fork cannot start or its process fails."""
+    (:func:`on_one_core`). In order. All here when the process cannot fork or has one
+    core; with a warning, all here when the fork cannot start, and the forked share here
+    when its process ends without a result (:class:`ForkFailed`). An error of
+    ``function`` is raised here, from whichever process made it."""
     items = list(items)
     if len(items) < 2 or not can_fork() or cores() < 2:
         return [function(item) for item in items]
     with on_one_core():
-        theirs = Forked([lambda: [function(item) for item in items[1::2]]])
-        try:
-            theirs.start()
-        except OSError as error:  # no memory or processes left for a fork
-            log.warning("the second core is out of reach (%s): one process does all", error)
-            return [function(item) for item in items]
-        try:
-            mine = [function(item) for item in items[0::2]]
-            try:
-                done = theirs.result()
-            except Exception as error:
-                log.warning("the second process failed (%s): its share is done here", error)
-                done = [function(item) for item in items[1::2]]
-        except BaseException:
-            theirs.close(cancel=True)
-            raise
-        theirs.close()
+        split = _split(function, items)
+    if split is None:  # on the cores this process has
+        return [function(item) for item in items]
+    mine, done = split
+    if done is None:
+        done = [function(item) for item in items[1::2]]
     out = [None] * len(items)
     out[0::2], out[1::2] = mine, done
     return out
+
+
+def _split(function, items):
+    """:func:`two_at_once`'s work shared with a forked process: (this process's results,
+    the other's or None when its process failed), or None when it could not start."""
+    theirs = Forked([lambda: [function(item) for item in items[1::2]]])
+    try:
+        theirs.start()
+    except OSError as error:  # no memory or processes left for a fork
+        log.warning("the second core is out of reach (%s): one process does all", error)
+        return None
+    try:
+        mine = [function(item) for item in items[0::2]]
+        try:
+            done = theirs.result()
+        except ForkFailed as error:
+            log.warning("the second process failed (%s): its share is done here", error)
+            done = None
+    except BaseException:
+        theirs.close(cancel=True)
+        raise
+    theirs.close()
+    return mine, done
+
+
+class ForkFailed(RuntimeError):
+    """A forked process ended without a result, or its result or error could not come
+    back (not an error raised by the call itself)."""
 
 
 class Forked:
@@ -105,7 +124,8 @@ class Forked:
     or an interrupt); :meth:`start` and :meth:`close` do the same by hand.
 
     The process stops at the first call that raises: :meth:`result` raises that error
-    here (a :class:`RuntimeError` with its traceback when it does not pickle). On Linux
+    here (a :class:`ForkFailed` with its traceback when it does not pickle, and when
+    the process ends without a result). On Linux
     the process ends with the one that forked it, even when that one is killed.
     """
 
@@ -141,11 +161,11 @@ class Forked:
             ok, value = self.receiver.recv()
         except EOFError:
             self.process.join()
-            raise RuntimeError(f"the forked process ended without its result (exit code "
-                               f"{self.process.exitcode})") from None
+            raise ForkFailed(f"the forked process ended without its result (exit code "
+                             f"{self.process.exitcode})") from None
         except Exception as error:  # pickled there, but does not unpickle here
-            raise RuntimeError(f"the forked process's result does not unpickle: "
-                               f"{type(error).__name__}: {error}") from None
+            raise ForkFailed(f"the forked process's result does not unpickle: "
+                             f"{type(error).__name__}: {error}") from None
         if not ok:
             raise value
         return value
@@ -194,7 +214,7 @@ def _serve(calls, receiver, sender, parent):
         except Exception:  # an error or a result that does not pickle: the text
             error = outcome[1] if not outcome[0] else sys.exception()
             text = "".join(traceback.format_exception(error))
-            sender.send((False, RuntimeError(f"in the forked process:\n{text}")))
+            sender.send((False, ForkFailed(f"in the forked process:\n{text}")))
             return
         if not outcome[0]:
             return

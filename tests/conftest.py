@@ -30,10 +30,13 @@ def fixtures_dir():
 @pytest.fixture
 def two_processes(monkeypatch):
     """:func:`masonry.forking.two_at_once` splits whatever the model and the machine: any
-    model is large enough and this process has two cores (one inside
-    :func:`~masonry.forking.on_one_core`). Returns the list of processes it starts."""
+    model is large enough and the system lets this process run on two cores. Returns the
+    list of processes it starts."""
     monkeypatch.setattr(forking, "TWO_AT_ONCE_BLOCKS", 1)
-    monkeypatch.setattr(forking, "cores", lambda: 1 if forking._one_core else 2)
+    if hasattr(os, "sched_getaffinity"):
+        monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1})
+    else:
+        monkeypatch.setattr(os, "cpu_count", lambda: 2)
     forks = []
     start = forking.Forked.start
     monkeypatch.setattr(forking.Forked, "start", lambda self: forks.append(self) or start(self))

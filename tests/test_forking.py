@@ -93,16 +93,50 @@ def test_two_at_once_gives_every_second_item_to_another_process_in_order(two_pro
     assert [count for _, _, count in out] == [1] * 5 and forking.cores() == 2
 
 
-def test_two_at_once_does_the_share_of_a_failed_process_here(two_processes, caplog):
+def test_two_at_once_does_the_share_of_a_process_that_ends_without_a_result_here(
+        two_processes, caplog):
     here = os.getpid()
 
     def square(item):
         if os.getpid() != here:
-            raise MemoryError("no room")
+            os._exit(3)
         return item * item
 
     assert forking.two_at_once(square, range(4)) == [0, 1, 4, 9]
-    assert "the second process failed (no room): its share is done here" in caplog.text
+    assert ("the second process failed (the forked process ended without its result "
+            "(exit code 3)): its share is done here") in caplog.text
+    assert forking.cores() == 2  # the process's own cores again
+
+
+def test_an_error_of_the_function_in_the_other_process_is_raised_here(two_processes):
+    here = os.getpid()
+
+    def square(item):
+        if os.getpid() != here:
+            raise ValueError(f"no square of {item}")
+        return item * item
+
+    with pytest.raises(ValueError, match="no square of 1"):
+        forking.two_at_once(square, range(4))
+    assert len(two_processes) == 1
+
+
+def test_two_at_once_does_all_here_when_the_fork_cannot_start(two_processes, monkeypatch,
+                                                                caplog):
+    def no_fork(self):
+        raise OSError("no processes left")
+
+    monkeypatch.setattr(forking.Forked, "start", no_fork)
+    assert forking.two_at_once(lambda item: (item, os.getpid(), forking.cores()),
+                               range(3)) == [(i, os.getpid(), 2) for i in range(3)]
+    assert "the second core is out of reach (no processes left)" in caplog.text
+
+
+def test_two_at_once_inside_two_at_once_stays_in_its_process(two_processes):
+    inner = forking.two_at_once(
+        lambda item: forking.two_at_once(lambda _: os.getpid(), range(3)), range(2))
+    assert all(len(set(pids)) == 1 for pids in inner)  # no process of its own
+    assert inner[0][0] != inner[1][0] and len(two_processes) == 1
 
 
 def test_two_at_once_on_one_core_does_all_here(monkeypatch):

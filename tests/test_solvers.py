@@ -222,6 +222,31 @@ def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_upda
                                atol=1e-12 * np.abs(expected).max())
 
 
+def test_a_factorization_starts_threads_only_where_the_process_has_two_cores(
+        monkeypatch, two_processes):
+    # the same symbolic analysis factored on two cores, inside forking.on_one_core
+    # (another process of the job on the other core), and on two again: the thread
+    # pool only on two, the factor the same
+    monkeypatch.setattr(cholesky, "PARALLEL_FLOPS", 0.0)
+    pools = []
+    executor = cholesky.ThreadPoolExecutor
+    monkeypatch.setattr(cholesky, "ThreadPoolExecutor",
+                        lambda **kwargs: pools.append(kwargs) or executor(**kwargs))
+    n, bs = 40, 3
+    grid = [(i, i + 1) for i in range(n - 1) if (i + 1) % 8] + [(i, i + 8) for i in range(n - 8)]
+    sym = BlockCholesky(n, np.array(grid), block_size=bs, ordering="amd")
+    values, dense = _random_spd_blocks(sym, np.random.default_rng(5))
+    factors = [_dense_factor(sym.factor(values), bs * n)]
+    assert len(pools) == 1
+    with forking.on_one_core():
+        factors.append(_dense_factor(sym.factor(values), bs * n))
+    assert len(pools) == 1
+    factors.append(_dense_factor(sym.factor(values), bs * n))
+    assert len(pools) == 2
+    np.testing.assert_array_equal(factors[0], factors[1])
+    np.testing.assert_array_equal(factors[0], factors[2])
+
+
 @pytest.mark.parametrize("parallel", [False, True])
 def test_batched_leaves_factor_and_solve_as_the_dense_cholesky(monkeypatch, parallel):
     # leaves of one shape are factored and solved as one stack: on a 10 x 10 grid with

@@ -798,21 +798,19 @@ def _solve_azimuths(problem, todo, known) -> dict:
     ones found of the dead load; once it is known to stand, the rest two at once on a
     large model (:func:`masonry.forking.two_at_once`). Returns key ->
     :class:`CollapseResult`; ends at the first that finds the dead load cannot stand."""
+    # the interior point method factors on this process's cores; Clarabel and HiGHS
+    # keep their own threads, and HiGHS's simplex gains from one model's warm starts
+    split = (problem.method == "interior"
+             and len(problem.system.free_block) >= forking.TWO_AT_ONCE_BLOCKS)
     solved = {}
     for index, (key, azimuth) in enumerate(todo):
-        rest = todo[index:]
-        if known is True and problem.method == "interior" and len(
-                problem.system.free_block) >= forking.TWO_AT_ONCE_BLOCKS:
-            results = forking.two_at_once(functools.partial(_lateral_standing, problem),
-                                          [a for _, a in rest])
-            solved.update(zip([k for k, _ in rest], results))
+        if split and known is True:
+            keys, azimuths = zip(*todo[index:])
+            standing = functools.partial(problem.solve_lateral, dead_load_feasible=True)
+            solved.update(zip(keys, forking.two_at_once(standing, azimuths)))
             break
         solved[key] = problem.solve_lateral(azimuth, dead_load_feasible=known)
         known = solved[key].dead_load_feasible
         if known is False:
             break
     return solved
-
-
-def _lateral_standing(problem, azimuth) -> CollapseResult:
-    return problem.solve_lateral(azimuth, dead_load_feasible=True)

@@ -392,7 +392,8 @@ def equilibrium_columns(coefficients, side_rows, n_rows: int) -> sp.csc_array:
     """
     n_vertices, _, width = coefficients.shape
     rows = 6 * np.sort(side_rows, axis=1)[:, :, None] + np.arange(6)      # (IV, 2, 6)
-    # (IV, width, 12), written once in place: the side on the lower block first
+    # (IV, width, 12) in place, the side on the lower block first: every vertex as it
+    # comes, then the swapped ones again with their sides exchanged
     data = np.empty((n_vertices, width, 12))
     data[:] = coefficients.transpose(0, 2, 1)
     swap = np.flatnonzero(side_rows[:, 0] > side_rows[:, 1])

@@ -404,7 +404,7 @@ def analyse_stages(model: Model, params, plan: StagePlan) -> list:
     independent)."""
     analysed = functools.partial(_analysed, model, params, plan)
     stages = range(1, plan.n_stages + 1)
-    if model.blocks.n_blocks < forking.TWO_AT_ONCE_BLOCKS:
+    if (~model.blocks.block_is_support).sum() < forking.TWO_AT_ONCE_BLOCKS:
         return [analysed(stage) for stage in stages]
     return forking.two_at_once(analysed, stages)
 
