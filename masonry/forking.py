@@ -25,11 +25,11 @@ PR_SET_PDEATHSIG = 1
 """Linux ``prctl`` option: the signal a process gets when its parent ends (prctl.h)."""
 
 TWO_AT_ONCE_BLOCKS = 500
-"""Models of at least this many blocks split their independent solves over two processes
-(:func:`two_at_once`): a collapse LP of preset 1's full dome, or a stage of its section,
-does far more on the second core than its factorization's second thread does there
-(``docs/bench.md``, "Two azimuths at once"); on small models the fork costs more than
-their solves."""
+"""Models of at least this many free blocks split their independent solves over two
+processes (:func:`two_at_once`): a collapse LP of preset 1's full dome, or a stage of its
+section, does far more on the second core than its factorization's second thread does
+there (``docs/bench.md``, "Two azimuths, or two stages, at once"); on smaller models the
+fork costs more than their solves."""
 
 log = logging.getLogger(__name__)
 
@@ -67,15 +67,17 @@ def on_one_core():
         _one_core = before
 
 
-def two_at_once(function, items) -> list:
+def two_at_once(function, items, blocks: int) -> list:
     """``[function(item) for item in items]`` on two cores: every second item in a forked
     copy of this process, the others here, each process on one core
-    (:func:`on_one_core`). In order. All here when the process cannot fork or has one
-    core; with a warning, all here when the fork cannot start, and the forked share here
-    when its process ends without a result (:class:`ForkFailed`). An error of
+    (:func:`on_one_core`). In order. All here on a model of fewer than
+    :data:`TWO_AT_ONCE_BLOCKS` free ``blocks``, or when the process cannot fork or has
+    one core; with a warning, all here when the fork cannot start, and the forked share
+    here when its process ends without a result (:class:`ForkFailed`). An error of
     ``function`` is raised here, from whichever process made it."""
     items = list(items)
-    if len(items) < 2 or not can_fork() or cores() < 2:
+    if (len(items) < 2 or blocks < TWO_AT_ONCE_BLOCKS or not can_fork()
+            or cores() < 2):
         return [function(item) for item in items]
     with on_one_core():
         split = _split(function, items)
@@ -125,8 +127,8 @@ class Forked:
 
     The process stops at the first call that raises: :meth:`result` raises that error
     here (a :class:`ForkFailed` with its traceback when it does not pickle, and when
-    the process ends without a result). On Linux
-    the process ends with the one that forked it, even when that one is killed.
+    the process ends without a result). On Linux the process ends with the one that
+    forked it, even when that one is killed.
     """
 
     def __init__(self, calls):

@@ -85,7 +85,7 @@ def test_the_forked_process_ends_with_a_killed_parent():
 def test_two_at_once_gives_every_second_item_to_another_process_in_order(two_processes):
     here = os.getpid()
     out = forking.two_at_once(lambda item: (item * item, os.getpid(), forking.cores()),
-                              range(5))
+                              range(5), blocks=1)
     assert [square for square, _, _ in out] == [0, 1, 4, 9, 16]
     pids = [pid for _, pid, _ in out]
     assert pids[0::2] == [here] * 3 and len(set(pids[1::2])) == 1 and pids[1] != here
@@ -102,7 +102,7 @@ def test_two_at_once_does_the_share_of_a_process_that_ends_without_a_result_here
             os._exit(3)
         return item * item
 
-    assert forking.two_at_once(square, range(4)) == [0, 1, 4, 9]
+    assert forking.two_at_once(square, range(4), blocks=1) == [0, 1, 4, 9]
     assert ("the second process failed (the forked process ended without its result "
             "(exit code 3)): its share is done here") in caplog.text
     assert forking.cores() == 2  # the process's own cores again
@@ -117,7 +117,7 @@ def test_an_error_of_the_function_in_the_other_process_is_raised_here(two_proces
         return item * item
 
     with pytest.raises(ValueError, match="no square of 1"):
-        forking.two_at_once(square, range(4))
+        forking.two_at_once(square, range(4), blocks=1)
     assert len(two_processes) == 1
 
 
@@ -128,17 +128,18 @@ def test_two_at_once_does_all_here_when_the_fork_cannot_start(two_processes, mon
 
     monkeypatch.setattr(forking.Forked, "start", no_fork)
     assert forking.two_at_once(lambda item: (item, os.getpid(), forking.cores()),
-                               range(3)) == [(i, os.getpid(), 2) for i in range(3)]
+                               range(3), blocks=1) == [(i, os.getpid(), 2) for i in range(3)]
     assert "the second core is out of reach (no processes left)" in caplog.text
 
 
 def test_two_at_once_inside_two_at_once_stays_in_its_process(two_processes):
     inner = forking.two_at_once(
-        lambda item: forking.two_at_once(lambda _: os.getpid(), range(3)), range(2))
+        lambda item: forking.two_at_once(lambda _: os.getpid(), range(3), blocks=1), range(2),
+        blocks=1)
     assert all(len(set(pids)) == 1 for pids in inner)  # no process of its own
     assert inner[0][0] != inner[1][0] and len(two_processes) == 1
 
 
 def test_two_at_once_on_one_core_does_all_here(monkeypatch):
     monkeypatch.setattr(forking, "cores", lambda: 1)
-    assert forking.two_at_once(lambda item: os.getpid(), range(3)) == [os.getpid()] * 3
+    assert forking.two_at_once(lambda item: os.getpid(), range(3), blocks=1) == [os.getpid()] * 3

@@ -798,16 +798,15 @@ def _solve_azimuths(problem, todo, known) -> dict:
     ones found of the dead load; once it is known to stand, the rest two at once on a
     large model (:func:`masonry.forking.two_at_once`). Returns key ->
     :class:`CollapseResult`; ends at the first that finds the dead load cannot stand."""
-    # the interior point method factors on this process's cores; Clarabel and HiGHS
-    # keep their own threads, and HiGHS's simplex gains from one model's warm starts
-    split = (problem.method == "interior"
-             and len(problem.system.free_block) >= forking.TWO_AT_ONCE_BLOCKS)
     solved = {}
     for index, (key, azimuth) in enumerate(todo):
-        if split and known is True:
+        # the interior point method factors on this process's cores; Clarabel and HiGHS
+        # keep their own threads, and HiGHS's simplex gains from one model's warm starts
+        if known is True and problem.method == "interior":
             keys, azimuths = zip(*todo[index:])
             standing = functools.partial(problem.solve_lateral, dead_load_feasible=True)
-            solved.update(zip(keys, forking.two_at_once(standing, azimuths)))
+            solved.update(zip(keys, forking.two_at_once(
+                standing, azimuths, blocks=len(problem.system.free_block))))
             break
         solved[key] = problem.solve_lateral(azimuth, dead_load_feasible=known)
         known = solved[key].dead_load_feasible

@@ -402,11 +402,9 @@ def analyse_stages(model: Model, params, plan: StagePlan) -> list:
     """:func:`analyse_stage` of stages ``1..N``, in order, logging ``stage k of N``; two
     at once on a large model (:func:`masonry.forking.two_at_once`: the stages are
     independent)."""
-    analysed = functools.partial(_analysed, model, params, plan)
-    stages = range(1, plan.n_stages + 1)
-    if (~model.blocks.block_is_support).sum() < forking.TWO_AT_ONCE_BLOCKS:
-        return [analysed(stage) for stage in stages]
-    return forking.two_at_once(analysed, stages)
+    return forking.two_at_once(functools.partial(_analysed, model, params, plan),
+                               range(1, plan.n_stages + 1),
+                               blocks=int((~model.blocks.block_is_support).sum()))
 
 
 def _analysed(model: Model, params, plan: StagePlan, stage: int) -> dict:

@@ -10,7 +10,9 @@ on. The distributed engine is Dask (an optional extra); without it the study run
 serially.
 """
 
+import csv
 import dataclasses
+import io
 import itertools
 import json
 import logging
@@ -321,10 +323,12 @@ def summary_csv(study: Study, rows) -> bytes:
         if floats:
             for i, printed in zip(floats, format_floats([values[i] for i in floats])):
                 text[i] = printed
-        texts.append(['"' + t.replace('"', '""') + '"' if any(q in t for q in ',"\n')
-                      else t for t in text])
-    lines = [",".join(columns), *map(",".join, zip(*texts))]
-    return ("\n".join(lines) + "\n").encode()
+        texts.append(text)
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(columns)
+    writer.writerows(zip(*texts))
+    return buf.getvalue().encode()
 
 
 def summary_parquet(study: Study, rows):
@@ -335,8 +339,6 @@ def summary_parquet(study: Study, rows):
         import pyarrow.parquet as pq
     except ImportError:
         return None
-    import io
-
     columns = study.swept + list(SUMMARY_COLUMNS)
     table = pa.table({c: [None if r.get(c) is None else str(r.get(c))
                           if c in ("error", "status", "friction_used", "structure_id")
