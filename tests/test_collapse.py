@@ -18,6 +18,7 @@ from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
                                   collapse_load, fixed_capacity_factor, lateral_azimuths,
                                   worst_lateral)
 from masonry.rbe.loads import crown_load, lateral, point_loads
+from masonry.rbe.solvers.interior_lp import LoadFactorOptions
 from masonry.scenes import build
 from masonry.scenes.arch import arch_profile
 from masonry.studies.structures import lateral_record
@@ -27,6 +28,11 @@ from masonry_cli.main import main
 from test_rbe import HORIZONTAL, SUPPORT, box, make_interfaces
 
 DENSITY = 2000.0
+LP_RESIDUAL = LoadFactorOptions().primal_tol
+"""The collapse LP's documented accuracy: its interior point method stops once the primal
+rows hold to this fraction of the largest load entry (the factor itself is checked
+against statics to 1e-6); below it the residual depends on the BLAS kernels' rounding
+(OpenBLAS's Haswell kernels leave 4.6e-9 where others leave 1e-12)."""
 SMALL_DOME = dict(stretch=1.0, n=6, r=0, p=3, cut=0.5)  # 78 bricks in 6 webs
 
 
@@ -90,7 +96,7 @@ def test_single_block_tips_at_b_over_h_or_slides_at_mu(azimuth, expected, mode):
     live = lateral(model, azimuth, DENSITY)
     result = collapse_load(model, live, mu=0.7, density=DENSITY)
     assert result.load_factor == pytest.approx(expected, rel=1e-6)
-    assert result.dead_load_feasible and result.residual < 1e-7
+    assert result.dead_load_feasible and result.residual <= LP_RESIDUAL
     assert result.hinge.all() == (mode == "tips")
     assert result.slides.all() == (mode == "slides")
     assert (result.note is not None) == (mode == "slides")
@@ -126,7 +132,7 @@ def test_point_load_at_the_top_face_tips_a_block_at_the_lever_ratio(force):
     weight = DENSITY * G * 0.2 * 0.4 * 0.5
     result = collapse_load(model, live, mu=0.9, density=DENSITY)
     assert result.load_factor == pytest.approx(weight * 0.1 / (force * 0.5), rel=1e-6)
-    assert result.residual < 1e-9
+    assert result.residual <= LP_RESIDUAL
     check_mechanism(model, live, result)
 
 
@@ -347,7 +353,7 @@ def test_interior_point_lp_finds_the_simplex_optimum_on_a_dome(azimuth):
     simplex = CollapseLP(dome, method="simplex").solve(live, dead_load_feasible=True)
     assert ours.solver == "interior"
     assert ours.load_factor == pytest.approx(simplex.load_factor, rel=1e-7)
-    assert ours.residual <= 1e-6
+    assert ours.residual <= LP_RESIDUAL
     check_mechanism(dome, live, ours)
 
 
@@ -431,7 +437,7 @@ def test_non_associative_friction_lowers_a_sliding_collapse_and_keeps_a_tipping_
     assert 0 < estimate.load_factor < 0.95 * associated.load_factor
     forces = estimate.x.reshape(-1, 4)
     assert forces[:, 1].max() == 0  # no tension
-    assert estimate.residual < 1e-7
+    assert estimate.residual <= LP_RESIDUAL
     # settled: Coulomb's law holds at the estimate's forces (the fixed capacities of the
     # last round are those of its own compression) to within a fraction of a percent
     excess = np.abs(forces[:, 2:]).max(axis=1) - 0.7 * forces[:, 0]
