@@ -7,8 +7,8 @@ from masonry.pipeline import run
 from .options import (add_analysis_options, add_live_load_options, add_output_options,
                       check_print_size, collapse_summary, rbe_summary, summary)
 
-ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast", "print_size",
-            "lateral", "point_loads", "crown_load")
+ANALYSIS = ("mu", "density", "friction", "friction_cone", "accuracy", "solver", "fast",
+            "print_size", "lateral", "point_loads", "crown_load", "friction_law")
 
 
 def register(subparsers):

@@ -2,6 +2,7 @@
 feasibility, beside the thrust line's value."""
 
 from masonry.params import SOLVERS, Params, arch_radius, validate
+from masonry.rbe.solve import friction_model
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.thickness import folder_name, minimum_thickness, steps_csv
 from masonry.studies.thrust_line import thrust_line_minimum_thickness
@@ -10,7 +11,7 @@ from masonry.tolerances import THICKNESS_RTOL
 from .options import add_arch_options, add_material_options, add_verbosity
 
 ANALYSIS = ("arch_blocks", "arch_span", "arch_shape", "arch_rise", "arch_depth", "mu",
-            "density", "solver")
+            "density", "friction_cone", "solver")
 
 
 def register(subparsers):
@@ -42,6 +43,7 @@ def handle(args, report):
     inputs["arch_rise"] = arch_radius(params.arch_shape, params.arch_span,
                                       params.arch_rise)[1]  # the default resolved
     inputs["accuracy"] = params.solver_accuracy
+    inputs["friction_cone"] = friction_model(params.solver_accuracy, params.friction_cone).name
     record = {"params": inputs, "rtol": args.rtol,
               "rbe": {"t_over_r": result.t_over_r, "lower": result.lower,
                       "thickness_m": result.thickness, "radius_m": result.radius,

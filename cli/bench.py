@@ -2,7 +2,9 @@
 
 import resource
 
-from masonry.studies.bench import (SCENES, bench, collapse_bench, collapse_markdown,
+from masonry.friction import FrictionCone, FrictionModelError
+from masonry.studies.bench import (FRICTION_MODELS, SCENES, bench, collapse_bench,
+                                   collapse_markdown, friction_bench, friction_markdown,
                                    frontier_png, ratios_markdown, table_csv, table_markdown)
 from masonry.params import ACCURACIES, SOLVERS, ParameterError, Params, from_preset, validate
 from masonry.runfolder import RunFolder, check_output_root
@@ -33,6 +35,13 @@ def register(subparsers):
                              "each preset's full dome against its balanced RBE solve, and "
                              "the azimuth search (--lateral all) on a small dome against "
                              "independent solves; writes DIR/bench_collapse/collapse.md")
+    parser.add_argument("--friction-models", dest="friction_models", nargs="*",
+                        metavar="MODEL",
+                        help="instead: each friction model (default: "
+                             f"{' '.join(FRICTION_MODELS)}) on each preset's full dome: "
+                             "the RBE solve and the lateral collapse LP at azimuth 0, "
+                             "times against the square pyramid's and factors against the "
+                             "exact cone's; writes DIR/bench_friction/friction.md")
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root: writes DIR/bench/bench.csv, bench.md and "
                              "frontier.png (default exports)")
@@ -49,9 +58,14 @@ def handle(args, report):
         raise ParameterError("repeats", args.repeats, "an integer >= 1")
     if args.p is not None and args.p < 1:
         raise ParameterError("p", args.p, "an integer >= 1")
+    if args.collapse and args.friction_models is not None:
+        raise ParameterError("friction_models", args.friction_models,
+                             "one bench at a time: not with --collapse")
     check_output_root(args.out)
     if args.collapse:
         return _collapse(args, report)
+    if args.friction_models is not None:
+        return _friction(args, report)
     rows = bench(presets=args.presets, scenes=args.scenes, accuracies=args.accuracy,
                  repeats=args.repeats, solvers=args.solvers,
                  overrides=None if args.p is None else {"p": args.p},
@@ -85,6 +99,27 @@ def _collapse(args, report):
     markdown = collapse_markdown(rows)
     with RunFolder(args.out, "bench_collapse") as folder:
         folder.write("collapse.md", markdown)
+    report(markdown)
+    report(f"written: {folder.target}")
+    return 0
+
+
+def _friction(args, report):
+    models = args.friction_models or list(FRICTION_MODELS)
+    for name in models:
+        try:
+            FrictionCone.parse(name)
+        except FrictionModelError as error:
+            raise ParameterError("friction_models", name, str(error)) from None
+    overrides = {} if args.p is None else {"p": args.p}
+    named = "" if args.p is None else f" (p {args.p})"
+    domes = {f"preset {k} full dome{named}": from_preset(k, scene="dome", **overrides)
+             for k in args.presets}
+    rows = friction_bench(domes, models, repeats=args.repeats,
+                          progress=None if args.quiet else _progress)
+    markdown = friction_markdown(rows)
+    with RunFolder(args.out, "bench_friction") as folder:
+        folder.write("friction.md", markdown)
     report(markdown)
     report(f"written: {folder.target}")
     return 0

@@ -251,9 +251,17 @@ def collapse_summary(record, report):
 
 
 def add_material_options(group):
-    """``--mu`` and ``--density``, with their ranges and defaults."""
+    """``--mu``, ``--friction-cone`` and ``--density``, with their ranges and defaults."""
     group.add_argument("--mu", type=float, help=f"friction coefficient ({_range('mu')}; "
                                                 f"default {DEFAULTS.mu:g})")
+    group.add_argument("--friction-cone", dest="friction_cone",
+                       metavar="circle|polygon:K|square",
+                       help="friction model: circle (Coulomb's isotropic cone, exact; the "
+                            "default), polygon:K (the inscribed K-sided pyramid, 8 <= K <= "
+                            "256: safe, within 1 - cos(pi/K) of Coulomb; for linear "
+                            "solvers) or square (the thesis's pyramid |f1|, |f2| <= mu c: "
+                            "up to 41 %% more friction than Coulomb, direction dependent; "
+                            "to reproduce the thesis only)")
     group.add_argument("--density", type=float, help=f"kg/m^3 ({_range('density')}; "
                                                      f"default {DEFAULTS.density:g})")
 
@@ -343,9 +351,19 @@ def summary(record, report):
 def _verdict(rbe) -> str:
     """The verdict of a record written without one: a friction+ result always has a
     finite MoI, so one without is a solve that stopped short."""
-    if rbe.get("friction") == "plus" and not math.isfinite(rbe.get("moi", math.nan)):
+    if rbe.get("friction") == "plus" and _missing(rbe.get("moi")):
         return "not solved"
     return "feasible" if rbe["feasible"] else "infeasible"
+
+
+def _number(value) -> str:
+    """A residual for a report line: two digits, or 'none' without one."""
+    return "none" if _missing(value) else f"{value:.2g}"
+
+
+def _missing(value) -> bool:
+    """A number a record does not have: None (read from run.json) or NaN."""
+    return value is None or (isinstance(value, float) and not math.isfinite(value))
 
 
 def rbe_summary(record, report) -> int:
@@ -356,18 +374,23 @@ def rbe_summary(record, report) -> int:
     if verdict == "not solved":
         report(f"RBE: not solved (friction-{rbe['friction']}, mu {rbe['mu']:g}): "
                f"{rbe['solver']} stopped with status {rbe.get('status')!r}, residual "
-               f"{rbe['residual_eq']:.2g}; no verdict")
+               f"{_number(rbe['residual_eq'])}; no verdict")
         return 3
-    if (verdict == "infeasible" and rbe["friction"] == "plus" and rbe["moi"] is not None
-            and not math.isfinite(rbe["moi"])):
+    if verdict == "infeasible" and rbe["friction"] == "plus" and _missing(rbe["moi"]):
         # friction-net has no equilibrium, and friction+ was not solved: no MoI
         report(f"RBE: infeasible (friction-net has no equilibrium, mu {rbe['mu']:g}); MoI "
                f"not computed: {rbe['solver']} stopped with status {rbe.get('status')!r} "
-               f"on friction-{rbe['friction']}, residual {rbe['residual_eq']:.2g}")
+               f"on friction-{rbe['friction']}, residual {_number(rbe['residual_eq'])}")
         return 3
-    report(f"RBE: {verdict} (friction-{rbe['friction']}, mu {rbe['mu']:g}), "
-           f"MoI {rbe['moi']:.4g} N, MoI factor {rbe['moi_factor']:.4g}, "
-           f"residual {rbe['residual_eq']:.2g}, {rbe['solver']} {rbe['time_s']:.3g} s")
+    model = rbe.get("friction_model", "square")  # records written before the models
+    report(f"RBE: {verdict} (friction-{rbe['friction']}, mu {rbe['mu']:g}, friction model "
+           f"{model}), MoI {rbe['moi']:.4g} N, MoI factor "
+           f"{rbe['moi_factor']:.4g}, residual {rbe['residual_eq']:.2g}, {rbe['solver']} "
+           f"{rbe['time_s']:.3g} s")
+    if model == "square":
+        report("note: the square friction model is the thesis's pyramid: up to 41 % more "
+               "friction than Coulomb's cone where joints slide diagonally to their axes, "
+               "so this verdict depends on how the model is turned")
     if verdict == "infeasible" and record["params"].get("friction") == "net":
         report("friction-net has no equilibrium for this structure, so it has no measure "
                "of infeasibility: --friction auto (or plus) gives its MoI and forces")

@@ -6,7 +6,8 @@ from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS, run_stages
 
 from .options import add_analysis_options, add_model_options, add_verbosity, params_from_args
 
-ANALYSIS = ("mu", "density", "friction", "accuracy", "solver", "fast", "lateral")
+ANALYSIS = ("mu", "density", "friction", "friction_cone", "accuracy", "solver", "fast",
+            "lateral")
 
 
 def register(subparsers):

@@ -1,6 +1,7 @@
 """``masonry structures``: the thesis's table 4.1 and friction test, every boundary model
 side by side."""
 
+from masonry.friction import FrictionCone, FrictionModelError
 from masonry.params import ParameterError
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.structures import structures_table, table_csv, table_markdown
@@ -22,6 +23,11 @@ def register(subparsers):
     parser.add_argument("--lateral", action="store_true",
                         help="also the worst lateral load factor of each full dome (the "
                              "x.2 domes as a whole), over the azimuths its symmetry leaves")
+    parser.add_argument("--friction-cone", dest="friction_cone",
+                        metavar="circle|polygon:K|square",
+                        help="friction model (default circle, Coulomb's cone); square "
+                             "reproduces the thesis's pyramid; a model other than the "
+                             "default writes DIR/structures_<model>/")
     add_verbosity(parser)
     parser.set_defaults(handler=handle)
 
@@ -30,11 +36,17 @@ def handle(args, report):
     if args.lateral and not args.full_dome:
         raise ParameterError("lateral", True, "the full domes, whose factor it is: "
                              "not with --no-full-dome")
+    try:
+        cone = FrictionCone.parse(args.friction_cone or "circle")
+    except FrictionModelError as error:
+        raise ParameterError("friction_cone", args.friction_cone, str(error)) from None
     check_output_root(args.out)
     rows = structures_table(full_dome=args.full_dome, lp_check=args.lp_check,
-                            lateral=args.lateral)
+                            lateral=args.lateral, cone=cone)
     markdown = table_markdown(rows)
-    with RunFolder(args.out, "structures") as folder:
+    name = "structures" if args.friction_cone is None else (
+        f"structures_{cone.name.replace(':', '')}")
+    with RunFolder(args.out, name) as folder:
         folder.write("table.csv", table_csv(rows))
         folder.write("table.md", markdown)
     report(markdown)

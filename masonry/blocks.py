@@ -55,9 +55,11 @@ def tangent_basis(normal, reference=None):
     ``t1`` is horizontal (``z x n``) where the face is not horizontal; on a horizontal
     face it is ``reference`` projected into the plane (a direction of the face's own, so
     the basis turns with the model), or the x axis without one; ``t2 = n x t1``. The
-    friction pyramid of SPEC 6.3 is aligned with ``(t1, t2)``: a global x axis on the
-    ground slabs of a full dome would align the pyramids of some webs with their web and
-    turn those of others by 2 pi/n, and the dome would lose its rotational symmetry.
+    basis is the frame of the friction components in the results; the pyramids of
+    :mod:`masonry.friction` are aligned with it: a global x axis on the ground slabs of a
+    full dome would align the pyramids of some webs with their web and turn those of
+    others by 2 pi/n, and the dome would lose its rotational symmetry (Coulomb's cone
+    does not depend on the basis).
 
     Parameters
     ----------

@@ -12,6 +12,9 @@ import os
 import tomllib
 from dataclasses import dataclass
 
+from masonry.friction import FrictionCone, FrictionModelError
+from masonry.tolerances import MIN_LIVE_LOAD_N
+
 SCENES = ("section", "wall", "dome", "assembly", "arch")
 FRICTIONS = ("net", "plus", "auto")
 FRICTION_LAWS = ("associated", "non-associative")
@@ -77,7 +80,9 @@ class Params:
     ``arch_depth`` (along y), ``arch_shape``. Assembly scene: ``assembly``, the name of
     the imported model (``<file stem>_<content hash>``, set by ``masonry analyze``).
     Analysis: ``mu`` friction coefficient, ``density`` kg/m^3, ``friction`` net | plus |
-    auto, ``accuracy`` solver preset (fast | balanced | accurate; None: fast in fast
+    auto, ``friction_cone`` the friction model (``circle`` | ``polygon:K`` | ``square``,
+    :mod:`masonry.friction`; None: the accuracy preset's, an isotropic one), ``accuracy``
+    solver preset (fast | balanced | accurate; None: fast in fast
     mode, else balanced, SPEC 3), ``solver`` (None: the preset's; a name overrides it).
     Output: ``fast`` (one view, low resolution), ``cad_offset`` (units), ``print_size``
     (mm: the largest dimension of ``dome.3mf``; None writes no 3MF).
@@ -105,6 +110,7 @@ class Params:
     mu: float = 0.7
     density: float = 2000.0
     friction: str = "auto"
+    friction_cone: str | None = None
     accuracy: str | None = None
     solver: str | None = None
     fast: bool = False
@@ -282,6 +288,10 @@ def parse_point_load(spec: str) -> tuple:
         raise ParameterError("point_loads", spec, expected) from None
     if not all(math.isfinite(v) for v in force) or not any(force):
         raise ParameterError("point_loads", spec, "finite forces, not all zero")
+    if max(abs(v) for v in force) < MIN_LIVE_LOAD_N:
+        raise ParameterError("point_loads", spec, f"a force of at least {MIN_LIVE_LOAD_N:g} "
+                                                  "N (a smaller one has no finite load "
+                                                  "factor)")
     return pattern, force
 
 
@@ -308,8 +318,10 @@ def _live_loads(p: Params) -> Params:
     for spec in specs:
         parse_point_load(spec)
     if p.crown_load is not None:
-        _check("crown_load", p.crown_load, _number("crown_load", p.crown_load) > 0,
-               "> 0 (newtons, downward)")
+        _check("crown_load", p.crown_load,
+               _number("crown_load", p.crown_load) >= MIN_LIVE_LOAD_N,
+               f">= {MIN_LIVE_LOAD_N:g} (newtons, downward; a smaller load has no finite "
+               f"load factor)")
         _check("crown_load", p.crown_load, p.scene in ("section", "dome"),
                "a dome: --scene section or dome")
     given = [(name, value) for name, value, present in (
@@ -331,6 +343,30 @@ def _live_loads(p: Params) -> Params:
                              "a symmetric load on a cyclic section: this load breaks the "
                              "dome's rotational symmetry; use --scene dome")
     return dataclasses.replace(p, lateral=lateral, point_loads=specs)
+
+
+POLYHEDRAL_SOLVERS = ("osqp", "osqp-cvxpy")
+"""QP solvers that take linear constraints only (the pyramids, not the circle)."""
+
+
+def _friction_cone(p: Params) -> Params:
+    """Check ``friction_cone`` (and that the solver can state it); return it in its
+    canonical spelling."""
+    if p.friction_cone is None:
+        if p.solver in POLYHEDRAL_SOLVERS:
+            raise ParameterError("solver", p.solver, "a solver of Coulomb's cone (the "
+                                 "default friction model): newton, interior, clarabel or "
+                                 "clarabel-cvxpy; or a pyramid: --friction-cone polygon:16")
+        return p
+    try:
+        cone = FrictionCone.parse(p.friction_cone)
+    except FrictionModelError as error:
+        raise ParameterError("friction_cone", p.friction_cone, str(error)) from None
+    if p.solver in POLYHEDRAL_SOLVERS and not cone.is_polyhedral:
+        raise ParameterError("friction_cone", p.friction_cone, f"a pyramid (polygon:K or "
+                             f"square) with --solver {p.solver}, which takes linear "
+                             f"constraints only", related=("solver",))
+    return dataclasses.replace(p, friction_cone=cone.name)
 
 
 def _choice(name, value, choices, optional=False):
@@ -355,6 +391,7 @@ def validate(params: Params) -> Params:
     _choice("friction", p.friction, FRICTIONS)
     _choice("solver", p.solver, SOLVERS, optional=True)
     _choice("accuracy", p.accuracy, ACCURACIES, optional=True)
+    p = _friction_cone(p)
     _choice("arch_shape", p.arch_shape, ARCH_SHAPES)
     _check("fast", p.fast, isinstance(p.fast, bool), "true or false")
     _check("assembly", p.assembly, isinstance(p.assembly, str), "a name")
@@ -475,13 +512,15 @@ def structure_id(params: Params) -> str:
     if p.scene not in ("arch", "assembly"):  # no brick unit in these scenes
         head += f"_u{_n(p.unit)}"
     extras = [("boundary", "b"), ("mu", "mu"), ("density", "rho"), ("min_fill", "mf"),
-              ("accuracy", ""), ("solver", ""), ("cad_offset", "cad")]
+              ("friction_cone", "cone"), ("accuracy", ""), ("solver", ""),
+              ("cad_offset", "cad")]
     for name, tag in extras:
         value = getattr(p, name)
         if name == "boundary" and (p.scene == "wall" or value != "rigid"):
             continue  # dome0 / dome1 already say free / cyclic
         if value != getattr(default, name):
-            head += f"_{tag}{_n(value)}" if isinstance(value, float) else f"_{tag}{value}"
+            text = _n(value) if isinstance(value, float) else str(value).replace(":", "")
+            head += f"_{tag}{text}"
     return head + _live_load_tag(p) + _friction_law_tag(p)
 
 

@@ -26,7 +26,7 @@ from masonry.params import Params, structure_id, validate
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.collapse import CollapseResult, collapse_load, worst_lateral
 from masonry.rbe.loads import crown_load, lateral, point_loads
-from masonry.rbe.solve import RBEProblem, RBEResult
+from masonry.rbe.solve import RBEProblem, RBEResult, friction_model
 from masonry.runfolder import RunFolder, check_output_root, write_file_atomically
 from masonry.scenes import Scene, build, check_size
 from masonry.tolerances import MAX_BRICKS, G
@@ -494,7 +494,8 @@ def _solve(model: Model, params: Params, timer: Timer) -> RBEResult:
                              side_rotation=model.side_rotation)
     with timer.stage("solve"):
         return problem.solve(mu=params.mu, density=params.density, friction=params.friction,
-                             solver=params.solver, accuracy=params.solver_accuracy)
+                             solver=params.solver, accuracy=params.solver_accuracy,
+                             cone=params.friction_cone)
 
 
 def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> CollapseResult:
@@ -502,7 +503,8 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     stands for the dead load; otherwise the LP decides it. ``--crown-load`` is the load on
     the whole dome: a section carries its ``1/n`` share."""
     known = True if rbe is not None and rbe.feasible else None
-    options = dict(mu=params.mu, density=params.density)
+    options = dict(mu=params.mu, density=params.density,
+                   cone=friction_model(params.solver_accuracy, params.friction_cone))
     if params.lateral == "all":
         webs = params.n if params.scene in ("section", "dome") else None
         # the full dome repeats every 360/n degrees (tests/test_collapse.py checks it)

@@ -15,6 +15,7 @@ folder already there (see :meth:`RunFolder.publish`).
 
 import json
 import logging
+import math
 import os
 import re
 import shutil
@@ -269,7 +270,7 @@ class RunFolder:
 
     def write_json(self, relative, record):
         """Write ``record`` (a dict of JSON values, numpy scalars and arrays) to
-        ``relative`` as indented JSON; numpy values become plain numbers and lists.
+        ``relative`` as indented, strict JSON (:func:`strict_json`).
 
         Raises
         ------
@@ -277,8 +278,7 @@ class RunFolder:
             For a value JSON cannot hold (not a number, string, list, dict or numpy
             value).
         """
-        self.write(relative, json.dumps(record, indent=2, sort_keys=False, default=_jsonable)
-                   + "\n")
+        self.write(relative, strict_json(record))
 
     def publish(self):
         """Swap the temporary folder into place as :attr:`target` (called on a normal
@@ -299,11 +299,25 @@ class RunFolder:
         shutil.rmtree(self._old, ignore_errors=True)
 
 
-def _jsonable(value):
+def strict_json(record) -> str:
+    """``record`` as indented JSON that every reader takes (JavaScript, ``jq``): numpy
+    values become plain numbers and lists, and a missing or unbounded number (NaN,
+    infinity) becomes ``null``; the record's statuses say why."""
+    return json.dumps(_plain(record), indent=2, sort_keys=False, allow_nan=False) + "\n"
+
+
+def _plain(value):
+    """``value`` with numpy values as Python ones and non-finite floats as None."""
     import numpy as np
 
+    if isinstance(value, dict):
+        return {key: _plain(item) for key, item in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [_plain(item) for item in value]
     if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if value is None or isinstance(value, (bool, int, float, str)):
+        return value
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")

@@ -95,6 +95,11 @@ once when such a dome is built (:func:`masonry.scenes.section.build_section`): t
 thesis's structures have 0.8 to 2.0, and beyond the range the dome is unusually flat or
 tall. (:data:`masonry.params.RANGES` holds the range refused outright.)"""
 
+MIN_LIVE_LOAD_N = 1e-9
+"""Newtons. A point or crown load smaller than this is refused: its collapse load factor
+(the dead load's weight over the load) passes 1e13 for a 0.1 m brick and overflows to
+infinity below about 1e-300 N; no structure is asked about a nanonewton."""
+
 # ---------------------------------------------------------------------- model (dome/)
 UNIT_SLACK = 1e-9
 """Brick units. Positions along the flattened section (pattern cells, joints, the

@@ -157,4 +157,5 @@ def test_arch_thickness_command(capsys, tmp_path):
     assert record["params"] == {"arch_blocks": 16, "arch_span": 10.0,
                                 "arch_shape": "semicircular", "arch_rise": 5.0,
                                 "arch_depth": 1.0, "mu": 10.0, "density": 2000.0,
-                                "solver": None, "accuracy": "balanced"}
+                                "friction_cone": "circle", "solver": None,
+                                "accuracy": "balanced"}

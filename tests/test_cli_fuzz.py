@@ -353,6 +353,7 @@ PLAUSIBLE = {
     "--point-load": ["w0_*:1000,0,0", "*:0,0,-500", "w0_b0001*:0,0,-1e4", "w0:1,2", "x"],
     "--crown-load": ["500", "20000", "0", "-100"],
     "--friction-law": ["associated", "non-associative", "coulomb"],
+    "--friction-cone": ["circle", "polygon:16", "square", "polygon:4", "disc"],
 }
 INTEGER_OPTIONS = {"--n", "--r", "--p", "--wall-courses", "--blocks"}
 SCENE_OPTIONS = {
@@ -362,7 +363,7 @@ SCENE_OPTIONS = {
     "arch": ["--span", "--thickness", "--rise", "--depth", "--blocks", "--shape"],
 }
 EVERY_SCENE = ["--mu", "--density", "--friction", "--accuracy", "--print-size", "--lateral",
-               "--point-load", "--crown-load", "--friction-law"]
+               "--point-load", "--crown-load", "--friction-law", "--friction-cone"]
 
 
 def test_the_tables_cover_every_option_of_run():
@@ -377,7 +378,7 @@ def test_the_tables_cover_every_option_of_run():
 def value_of(option):
     plausible = st.sampled_from(PLAUSIBLE[option])
     if option in ("--shape", "--boundary", "--friction", "--accuracy", "--point-load",
-                  "--friction-law"):
+                  "--friction-law", "--friction-cone"):
         return plausible
     wild = WILD_INTEGERS if option in INTEGER_OPTIONS else WILD_FLOATS
     return st.one_of(plausible, plausible, plausible, wild)

@@ -12,8 +12,8 @@ ROOT = Path(masonry.__file__).parent
 
 # the pipeline's order: a module may import only from its own stage or earlier ones
 STAGES = (
-    ("masonry", "masonry.params", "masonry.tolerances", "masonry.runfolder",
-     "masonry.forking"),
+    ("masonry", "masonry.params", "masonry.tolerances", "masonry.friction",
+     "masonry.runfolder", "masonry.forking"),
     ("masonry.blocks", "masonry.meshing"),
     ("masonry.dome",),
     ("masonry.scenes",),

@@ -121,9 +121,10 @@ def test_any_parameters(stretch, n, r, p, cut, unit, mu, density, boundary):
     assert np.abs(wrench[:, :3]).max() <= limit * scale
     assert np.abs(wrench[:, 3:]).max() <= limit * scale * system.length_ref
     assert result.friction_violation <= limit
-    # the friction pyramid and the signs, vertex by vertex, in newtons
+    # Coulomb's cone and the signs, vertex by vertex, in newtons
     slack = limit * system.weight_ref
     c, t, f1, f2 = (result.layout.component(result.x, k) for k in ("c", "t", "f1", "f2"))
     reach = mu * (c - (t if result.friction == "net" else 0.0)) + slack
+    assert result.friction_model == "circle"
     assert np.all(c >= -slack) and np.all(t >= -slack)
-    assert np.all(np.abs(f1) <= reach) and np.all(np.abs(f2) <= reach)
+    assert np.all(np.hypot(f1, f2) <= reach)

@@ -179,7 +179,7 @@ def test_a_eq_routes_a_side_with_a_rotation():
 
 def test_supports_have_no_rows_and_friction_rows():
     blocks, interfaces = stack(3)
-    system = assemble(blocks, interfaces, mu=MU)
+    system = assemble(blocks, interfaces, mu=MU, cone="square")
     np.testing.assert_array_equal(system.free_block, [1, 2, 3])
     assert system.A_eq.shape == (18, 4 * 12)
     # vertex 0 with c = 1, t = 0.25, f1 = 0.5, f2 = -0.2 (solver units)
@@ -187,9 +187,10 @@ def test_supports_have_no_rows_and_friction_rows():
     x[:4] = [1.0, 0.25, 0.5, -0.2]
     net = system.A_fr["net"] @ x
     plus = system.A_fr["plus"] @ x
-    np.testing.assert_allclose(net[:4], [0.5 - 0.75 * MU, -0.5 - 0.75 * MU,
-                                         -0.2 - 0.75 * MU, 0.2 - 0.75 * MU])
-    np.testing.assert_allclose(plus[:4], [0.5 - MU, -0.5 - MU, -0.2 - MU, 0.2 - MU])
+    # the square's faces, normals at 90, 180, 270 and 360 degrees: +f2, -f1, -f2, +f1
+    np.testing.assert_allclose(net[:4], [-0.2 - 0.75 * MU, -0.5 - 0.75 * MU,
+                                         0.2 - 0.75 * MU, 0.5 - 0.75 * MU])
+    np.testing.assert_allclose(plus[:4], [-0.2 - MU, -0.5 - MU, 0.2 - MU, 0.5 - MU])
     np.testing.assert_allclose(net[4:], 0.0)
 
 
@@ -246,15 +247,18 @@ def test_stack_bed_joints_carry_the_weight_above():
     assert result.weight_N == pytest.approx(3 * weight, rel=1e-12)
 
 
-@pytest.mark.parametrize("solver", ["osqp", "clarabel"])
-def test_cantilever_is_infeasible_and_friction_plus_measures_it(solver):
+@pytest.mark.parametrize("solver, cone", [("osqp", "polygon:16"), ("clarabel", "circle"),
+                                          ("clarabel", "polygon:16")])
+def test_cantilever_is_infeasible_and_friction_plus_measures_it(solver, cone):
     blocks, interfaces = cantilever()
-    net = solve_rbe(blocks, interfaces, mu=MU, friction="net", solver=solver, lp_check=True)
+    net = solve_rbe(blocks, interfaces, mu=MU, friction="net", solver=solver, cone=cone,
+                    lp_check=True)
     assert not net.feasible and net.friction == "net"
     assert net.x is None and np.isnan(net.moi)  # no fake optimum
     assert net.lp_feasible is False
 
-    auto = solve_rbe(blocks, interfaces, mu=MU, friction="auto", solver=solver, lp_check=True)
+    auto = solve_rbe(blocks, interfaces, mu=MU, friction="auto", solver=solver, cone=cone,
+                     lp_check=True)
     assert not auto.feasible and auto.friction == "plus" and auto.lp_feasible is False
     assert auto.residual_eq < 1e-5 and auto.friction_violation < 1e-5
     # moments about the support's edge x = 0.3: the weight's arm is 0.2, the tension's
@@ -284,11 +288,11 @@ def test_moi_factor_and_feasibility_do_not_depend_on_the_unit():
 
 def test_osqp_and_clarabel_agree_on_a_feasible_case():
     # H is positive definite, so the minimiser is unique and both must find it; every
-    # vertex force within 1e-6 of the weight (measured: 3e-8)
+    # vertex force within 1e-6 of the weight (measured: 3e-8); OSQP takes the pyramids
     theta = np.arctan(0.25) - np.radians(2.0)
     blocks, interfaces = incline(theta, base=0.1, height=0.4)
-    osqp = solve_rbe(blocks, interfaces, mu=MU, solver="osqp")
-    clarabel = solve_rbe(blocks, interfaces, mu=MU, solver="clarabel")
+    osqp = solve_rbe(blocks, interfaces, mu=MU, solver="osqp", cone="polygon:16")
+    clarabel = solve_rbe(blocks, interfaces, mu=MU, solver="clarabel", cone="polygon:16")
     assert osqp.feasible and clarabel.feasible
     np.testing.assert_allclose(osqp.x, clarabel.x, rtol=0, atol=1e-6 * osqp.weight_N)
     assert osqp.objective == pytest.approx(clarabel.objective, rel=1e-6)

@@ -1,7 +1,7 @@
 """The text summaries of a run: ``00_parameters.txt`` and ``RBE/00_objective.txt``."""
 
 from masonry.params import arch_radius, structure_id
-from masonry.rbe.solve import ACCURACY
+from masonry.rbe.solve import ACCURACY, friction_model
 from masonry.tolerances import MECHANISM_MAIN, MOTION_TOL
 
 # the inputs of each scene, with their units, in the order they are printed
@@ -45,7 +45,9 @@ def parameters_text(params) -> str:
     lines = [f"structure id: {structure_id(params)}", "", _line("scene", params.scene, "")]
     lines += [_line(name, _value(params, name), note)
               for name, note in _GEOMETRY.get(params.scene, ())]
+    cone = friction_model(params.solver_accuracy, params.friction_cone)
     lines += ["", *(_line(name, getattr(params, name), note) for name, note in _ANALYSIS),
+              _line("friction_cone", cone.name, cone.describe()),
               _line("accuracy", preset.name, f"solver preset; residual <= {preset.residual:g}"),
               _line("solver", solvers, "" if params.solver is None else "set by --solver"),
               ""]
@@ -90,6 +92,7 @@ def objective_text(result) -> str:
         f"feasibility:        {verdict} ({meaning})",
         f"friction method:    friction-{d['friction']} (mu = {d['mu']:g}; the problem "
         "whose solution is reported)",
+        f"friction model:     {result.cone.describe()}",
         f"objective:          {d['objective']:.6g} N^2 (1/2 x^T H x, weights: tension 1, "
         "compression and friction 1e-3)",
         f"MoI:                {d['moi']:.6g} N (sum of all vertex tensions)",
@@ -120,6 +123,10 @@ def collapse_text(result) -> str:
         + ", ".join(f"{k} {_readable(v)}" for k, v in live.items() if k != "kind"),
         f"azimuth:            {d['azimuth_deg']}",
         f"mu:                 {d['mu']:g}",
+        f"friction model:     {result.cone.describe()}",
+        f"friction law:       {d['friction_law']}"
+        + ("" if d["associated_factor"] is None
+           else f" (associated factor {d['associated_factor']:.6g})"),
         f"mechanism:          {d['main_hinges']} hinges, {d['main_sliding']} sliding joints "
         f"(opening or slipping by {MECHANISM_MAIN:.0%} of the largest or more)",
         f"joints that move:   {d['opening']} open ({d['hinges']} hinges), {d['sliding']} "

@@ -6,20 +6,25 @@ same row scaling)::
 
     maximize    lambda
     subject to  A_eq E g + lambda l = -f_dead        6 rows per free block
-                g >= 0                                 edge rays of the pyramid
+                g in K                                 every vertex's friction model
 
-``x = E g`` are the vertex forces ``(c, 0, f1, f2)`` with no tension and
-``|f1|, |f2| <= mu c`` (:func:`~masonry.rbe.equilibrium.friction_pyramid_edges`, the
-friction-net pyramid of SPEC 6.3 with ``t = 0``). HiGHS solves it by the dual simplex, whose
-basis warm-starts the next load case (:class:`CollapseLP`: a lateral load at another
-azimuth changes two coefficients and two costs, SPEC 6.8's "reuse work").
+``x = E g`` are the vertex forces ``(c, 0, f1, f2)`` with no tension and the friction
+within the model (:class:`~masonry.friction.FrictionCone`, SPEC 6.3 with ``t = 0``):
+for Coulomb's cone ``g = (c, f1, f2)`` with ``||(f1, f2)|| <= mu c`` (a second-order cone
+program), for a pyramid ``g >= 0`` the weights of its edge rays
+(:func:`~masonry.rbe.equilibrium.friction_edges`; a linear program). The own interior
+point method (:mod:`masonry.rbe.solvers.interior_lp`) solves both; Clarabel both;
+HiGHS the pyramids, by the dual simplex, whose basis warm-starts the next load case
+(:class:`CollapseLP`: a lateral load at another azimuth changes two coefficients and two
+costs, SPEC 6.8's "reuse work").
 
 The dual of the equilibrium rows is the collapse mechanism (SPEC 6.9): per free block a
 virtual translation ``u`` and rotation ``theta`` about the centroid. The dual constraints
-``E^T A_eq^T y >= 0`` say that every edge ray does non-negative work on the relative motion
-at its vertex: the motion opens the joint at least ``mu`` times its slip (associated
-flow), so no interface penetrates; and at the optimum ``lambda l^T y = -f_dead^T y``: the
-live load's virtual work balances the dead load's (the kinematic theorem).
+``E^T A_eq^T y in K*`` say that the relative motion at every vertex lies in the normal
+cone of its friction model: it opens the joint at least ``mu`` times its slip, with the
+slip along the friction force (associated flow), so no interface penetrates; and at the
+optimum ``lambda l^T y = -f_dead^T y``: the live load's virtual work balances the dead
+load's (the kinematic theorem).
 
 Glossary: ``lambda`` -> ``load_factor``; ``y`` -> the dual of the equilibrium rows, in
 scaled units (force rows: a translation; moment rows: a rotation times ``length_ref``).
@@ -37,7 +42,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from masonry import forking
-from masonry.rbe.equilibrium import assemble, friction_pyramid_edges
+from masonry.rbe.equilibrium import assemble, friction_edges
+from masonry.friction import FrictionCone
 from masonry.rbe.loads import LiveLoad, lateral
 from masonry.rbe.solve import interface_forces
 from masonry.rbe.solvers.base import OPTIMAL
@@ -56,10 +62,11 @@ METHODS = ("interior", "clarabel", "ipm", "ipm-crossover", "simplex")
 matrix (:mod:`masonry.rbe.solvers.interior_lp`; Clarabel decides when it finds no
 optimum: a dead load that cannot stand, a live load carried at every factor), Clarabel's
 interior point (direct LDL factorization of the whole KKT system), or HiGHS
-(``HIGHS_METHODS``). HiGHS decides the small scenes of the tests at once, and its dual
-simplex warm-starts across azimuths, but gave no verdict on preset 1's sections and dome
-within minutes; Clarabel stopped 0.3 % short of the optimum on preset 1's cyclic
-section (docs/collapse.md). ``interior`` is the default."""
+(``HIGHS_METHODS``, for the pyramids only: HiGHS solves linear programs). HiGHS decides
+the small scenes of the tests at once, and its dual simplex warm-starts across azimuths,
+but gave no verdict on preset 1's sections and dome within minutes; Clarabel stopped 0.3 %
+short of the optimum on preset 1's cyclic section (docs/collapse.md). ``interior`` is the
+default."""
 
 CLARABEL_SETTINGS = {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8}
 """Clarabel's tolerances for the collapse LP (its defaults; scaled rows of order one);
@@ -81,8 +88,13 @@ METHOD = "interior"
 
 ASSOCIATED_NOTE = (
     "sliding interfaces take part in this mechanism: the load factor assumes associated "
-    "friction (the pyramid's normal as flow rule, joints that dilate as they slide) and "
-    "can overestimate the collapse load of real, non-dilatant joints (SPEC 6.8)")
+    "friction (the friction cone's normal as flow rule, joints that dilate as they slide) "
+    "and can overestimate the collapse load of real, non-dilatant joints (SPEC 6.8)")
+
+ANISOTROPIC_NOTE = (
+    "the friction model is the thesis's square pyramid: it carries up to 41 % more "
+    "friction than Coulomb's cone where joints slide diagonally to their axes, so this "
+    "factor depends on how the model is turned and may be too high")
 
 UNBOUNDED_NOTE = (
     "the live load stands at any factor: rigid blocks pass it to the supports in "
@@ -90,9 +102,9 @@ UNBOUNDED_NOTE = (
     "ring; a lateral load on a section whose rigid boundary holds it)")
 
 RESULT_KEYS = ("load_factor", "dead_load_feasible", "status", "solver", "iterations",
-               "time_s", "residual", "work_balance", "mu", "azimuth_deg", "opening",
-               "sliding", "hinges", "main_hinges", "main_sliding", "friction_law",
-               "associated_factor", "note")
+               "time_s", "residual", "work_balance", "mu", "friction_model",
+               "friction_capacity_error", "azimuth_deg", "opening", "sliding", "hinges",
+               "main_hinges", "main_sliding", "friction_law", "associated_factor", "note")
 """Scalar fields of :class:`CollapseResult` in run.json, in order (plus ``live_load``)."""
 
 
@@ -146,6 +158,8 @@ class CollapseResult:
         :func:`fixed_capacity_factor`).
     associated_factor : float or None
         With ``non-associative``: the associated factor it started from.
+    cone : FrictionCone
+        The friction model.
     """
 
     load_factor: float | None
@@ -170,6 +184,17 @@ class CollapseResult:
     azimuths: tuple = field(default=())
     friction_law: str = "associated"
     associated_factor: float | None = None
+    cone: FrictionCone = FrictionCone("circle")
+
+    @property
+    def friction_model(self) -> str:
+        return self.cone.name
+
+    @property
+    def friction_capacity_error(self) -> float:
+        """The model's bound on the error of the friction capacity (see
+        :attr:`~masonry.friction.FrictionCone.capacity_error`)."""
+        return self.cone.capacity_error
 
     @property
     def opening(self) -> int:
@@ -203,12 +228,17 @@ class CollapseResult:
 
     @property
     def note(self) -> str | None:
-        """:data:`ASSOCIATED_NOTE` when sliding takes part in an associated mechanism,
-        :data:`UNBOUNDED_NOTE` when no factor bounds the live load."""
+        """:data:`UNBOUNDED_NOTE` when no factor bounds the live load, else
+        :data:`ASSOCIATED_NOTE` when sliding takes part in an associated mechanism, and
+        :data:`ANISOTROPIC_NOTE` for a model that is not isotropic."""
+        notes = []
         if self.status == "unbounded":
-            return UNBOUNDED_NOTE
-        return (ASSOCIATED_NOTE if self.sliding > 0 and self.friction_law == "associated"
-                else None)
+            notes.append(UNBOUNDED_NOTE)
+        elif self.sliding > 0 and self.friction_law == "associated":
+            notes.append(ASSOCIATED_NOTE)
+        if not self.cone.is_isotropic:
+            notes.append(ANISOTROPIC_NOTE)
+        return "; ".join(notes) if notes else None
 
     def to_dict(self) -> dict:
         """Plain values for run.json: :data:`RESULT_KEYS`, ``live_load`` and, after a
@@ -236,59 +266,157 @@ def _main(flags, motion) -> np.ndarray:
     return flags & (motion >= MECHANISM_MAIN * motion[flags].max())
 
 
+@dataclass(frozen=True, eq=False)
+class _Columns:
+    """The LP's columns ``g`` and their constraints, for the general solvers.
+
+    Parameters
+    ----------
+    edges : (4 IV, n) scipy.sparse.csr_array
+        ``x = edges g``: the vertex forces in the
+        :class:`~masonry.rbe.equilibrium.VariableLayout` order.
+    G : (k, n) scipy.sparse.csc_array
+    h : (k,) float
+        The cone constraints ``h - G g in cones`` (Clarabel's form).
+    cones : list
+        Clarabel's cones of those rows, in order.
+    is_rays : bool
+        ``g >= 0`` is every constraint (a pyramid's edge rays): HiGHS takes it as
+        column bounds.
+    """
+
+    edges: sp.csr_array
+    G: sp.csc_array
+    h: np.ndarray
+    cones: list
+    is_rays: bool
+
+
+def _selection(layout) -> sp.csr_array:
+    """(4 IV, 3 IV): the columns ``(c, f1, f2)`` of every vertex, in that order."""
+    picked = np.stack([layout.columns(name) for name in ("c", "f1", "f2")], axis=1)
+    count = picked.size
+    return sp.csr_array((np.ones(count), (picked.ravel(), np.arange(count))),
+                        shape=(layout.n_columns, count))
+
+
+def _cone_columns(system) -> _Columns:
+    """The friction model's columns: a pyramid's edge ray weights ``g >= 0``, or the
+    forces ``(c, f1, f2)`` with ``(mu c, f1, f2)`` in the second-order cone."""
+    n_vertices, cone, mu = system.layout.n_vertices, system.cone, system.mu
+    if cone.is_polyhedral:
+        edges = friction_edges(n_vertices, cone, mu)
+        n = edges.shape[1]
+        return _Columns(edges, sp.csc_array(-sp.identity(n)), np.zeros(n),
+                        [clarabel.NonnegativeConeT(n)], is_rays=True)
+    scale = sp.kron(sp.identity(n_vertices), sp.diags_array([mu, 1.0, 1.0]))
+    return _Columns(_selection(system.layout), sp.csc_array(-scale),
+                    np.zeros(3 * n_vertices),
+                    [clarabel.SecondOrderConeT(3)] * n_vertices, is_rays=False)
+
+
+def _capacity_columns(system, capacity) -> _Columns:
+    """The forces ``(c, f1, f2)`` with ``c >= 0`` and the friction within the model at a
+    fixed capacity ``capacity`` ((IV,) float) instead of ``mu c``: a disc of that radius
+    (the circle), the pyramid's polygon at that radius (its faces ``f . normal_k <=
+    capacity rho cos(pi / K)``)."""
+    n_vertices, cone = system.layout.n_vertices, system.cone
+    capacity = np.asarray(capacity, dtype=float)
+    vertex = np.arange(n_vertices)
+    # c >= 0: -(-c) in the nonnegative cone
+    rows = [sp.csc_array((-np.ones(n_vertices), (vertex, 3 * vertex)),
+                         shape=(n_vertices, 3 * n_vertices))]
+    h = [np.zeros(n_vertices)]
+    if cone.is_polyhedral:
+        normals = cone.face_normals()                       # (K, 2)
+        sides = len(normals)
+        row = np.arange(n_vertices * sides)
+        owner = np.repeat(vertex, sides)
+        data = np.tile(normals, (n_vertices, 1))
+        rows.append(sp.csc_array(
+            (data.ravel(), (np.repeat(row, 2), (3 * owner[:, None] + [1, 2]).ravel())),
+            shape=(len(row), 3 * n_vertices)))
+        h.append(np.repeat(capacity * cone.apothem(1.0), sides))
+        cones = [clarabel.NonnegativeConeT(n_vertices + len(row))]
+    else:
+        # (capacity, f1, f2) in the second-order cone
+        row = 3 * vertex[:, None] + [1, 2]
+        rows.append(sp.csc_array((-np.ones(2 * n_vertices),
+                                  (row.ravel(), (3 * vertex[:, None] + [1, 2]).ravel())),
+                                 shape=(3 * n_vertices, 3 * n_vertices)))
+        cone_h = np.zeros((n_vertices, 3))
+        cone_h[:, 0] = capacity
+        h.append(cone_h.ravel())
+        cones = ([clarabel.NonnegativeConeT(n_vertices)]
+                 + [clarabel.SecondOrderConeT(3)] * n_vertices)
+    return _Columns(_selection(system.layout), sp.csc_array(sp.vstack(rows)),
+                    np.concatenate(h), cones, is_rays=False)
+
+
 class CollapseLP:
-    """One model's collapse LP, kept in HiGHS between load cases.
+    """One model's collapse LP, kept by its solver between load cases.
 
     The matrix ``A_eq E`` is built once. :meth:`solve` takes any live load;
-    :meth:`solve_lateral` keeps a second HiGHS model whose two load columns are the
-    lateral loads along x and y, tied by one row ``-sin a lambda_x + cos a lambda_y = 0``
-    and maximising ``cos a lambda_x + sin a lambda_y``: another azimuth changes two
-    coefficients and two costs, and the dual simplex restarts from the last basis.
+    :meth:`solve_lateral` keeps a second model whose two load columns are the lateral
+    loads along x and y, tied by one row ``-sin a lambda_x + cos a lambda_y = 0`` and
+    maximising ``cos a lambda_x + sin a lambda_y``: another azimuth changes two
+    coefficients and two costs (HiGHS's dual simplex restarts from the last basis, the
+    interior point methods keep their symbolic factorization).
 
     Parameters
     ----------
     model : masonry.rbe.boundary.Model
     mu : float
     density : float, kg/m^3
+    cone : FrictionCone or str
+        The friction model (:mod:`masonry.friction`; default Coulomb's cone).
     time_limit : float, s
-        HiGHS's limit per solve.
+        HiGHS's and Clarabel's limit per solve.
+    method : str, optional
+        One of :data:`METHODS`; default :data:`METHOD`.
+
+    Raises
+    ------
+    ValueError
+        A HiGHS method for the circle (HiGHS solves linear programs only).
     """
 
-    def __init__(self, model, *, mu=0.7, density=2000.0, time_limit=600.0, method=None):
+    def __init__(self, model, *, mu=0.7, density=2000.0, cone="circle", time_limit=600.0,
+                 method=None):
         self.model = model
         self.system = assemble(model.blocks, model.interfaces, mu=mu, density=density,
                                side_block=model.side_block,
-                               side_rotation=model.side_rotation)
-        self.edges = friction_pyramid_edges(self.system.layout.n_vertices, float(mu))
-        self.matrix = sp.csc_array(self.system.A_eq @ self.edges)
+                               side_rotation=model.side_rotation, cone=cone)
+        self.method = METHOD if method is None else method
+        if self.method not in METHODS:
+            raise ValueError(f"unknown collapse method {self.method!r}; choose from "
+                             f"{list(METHODS)}")
+        if self.method in HIGHS_METHODS and not self.system.cone.is_polyhedral:
+            raise ValueError(f"HiGHS ({self.method}) solves linear programs: the friction "
+                             f"model {self.system.cone} needs interior or clarabel, or a "
+                             f"polygon:K model")
+        self.columns = _cone_columns(self.system)
+        self.matrix = sp.csc_array(self.system.A_eq @ self.columns.edges)
         self.mu, self.density, self.time_limit = float(mu), float(density), time_limit
         self._lateral = None
         self._newton_system = None  # the interior point method's, made on first use
-        self.method = METHOD if method is None else method
-        # bounds of the columns: edge rays are >= 0
-        self.lower = np.zeros(self.matrix.shape[1])
-        self.upper = np.full(self.matrix.shape[1], np.inf)
+
+    @property
+    def cone(self) -> FrictionCone:
+        return self.system.cone
 
     def with_friction_capacity(self, capacity) -> "CollapseLP":
-        """The same LP with a fixed friction capacity: at every vertex ``c >= 0`` and
-        ``|f1|, |f2| <= capacity`` ((IV,) float, scaled units), the variables ``(c, f1,
-        f2)`` themselves instead of the pyramid's edge rays. A capacity that does not
-        grow with ``c`` has a purely tangential flow rule: joints slide without dilating
-        (non-associative friction, see :func:`fixed_capacity_factor`)."""
-        layout = self.system.layout
-        picked = np.stack([layout.columns(name) for name in ("c", "f1", "f2")], axis=1)
-        count = picked.size
-        edges = sp.csr_array((np.ones(count), (picked.ravel(), np.arange(count))),
-                             shape=(layout.n_columns, count))
-        capacity = np.asarray(capacity, dtype=float)
-        lower = np.column_stack([np.zeros_like(capacity), -capacity, -capacity])
-        upper = np.column_stack([np.full_like(capacity, np.inf), capacity, capacity])
+        """The same LP with a fixed friction capacity: at every vertex ``c >= 0`` and the
+        friction within the model at radius ``capacity`` ((IV,) float, scaled units; see
+        :func:`_capacity_columns`), the variables ``(c, f1, f2)`` themselves. A capacity
+        that does not grow with ``c`` has a purely tangential flow rule: joints slide
+        without dilating (non-associative friction, see :func:`fixed_capacity_factor`).
+        Clarabel solves it."""
+        columns = _capacity_columns(self.system, capacity)
         out = CollapseLP.__new__(CollapseLP)
-        # the own interior point method knows the pyramid only: Clarabel takes the bounds
-        method = "clarabel" if self.method == "interior" else self.method
-        out.__dict__.update(self.__dict__, edges=edges, _lateral=None, method=method,
-                            matrix=sp.csc_array(self.system.A_eq @ edges),
-                            lower=lower.ravel(), upper=upper.ravel())
+        out.__dict__.update(self.__dict__, columns=columns, _lateral=None,
+                            method="clarabel",
+                            matrix=sp.csc_array(self.system.A_eq @ columns.edges))
         return out
 
     def scaled(self, live: LiveLoad) -> np.ndarray:
@@ -329,14 +457,15 @@ class CollapseLP:
     def _backend(self, loads, cost, tie=None):
         def clarabel_lp():
             return _ClarabelLP(self.matrix, loads, -self.system.f_ext, cost, tie,
-                               self.time_limit, self.lower, self.upper)
+                               self.time_limit, self.columns)
 
         if self.method == "clarabel":
             return clarabel_lp()
         if self.method == "interior":
             if self._newton_system is None:
                 self._newton_system = NewtonSystem(self.system, "net")
-            return _InteriorLP(self._newton_system, loads, cost, clarabel_lp)
+            return _InteriorLP(self._newton_system, self.system.layout, loads, cost,
+                               clarabel_lp)
         return _HighsLP(*self._highs(loads, cost, tie), self)
 
     def _load_columns(self, loads):
@@ -384,8 +513,8 @@ class CollapseLP:
         col_cost = np.zeros(A.shape[1])
         col_cost[heads] = cost
         free = np.full(A.shape[1] - n, highspy.kHighsInf)
-        highs = highs_lp(A, col_cost, np.concatenate([self.lower, -free]),
-                         np.concatenate([np.minimum(self.upper, highspy.kHighsInf), free]),
+        highs = highs_lp(A, col_cost, np.concatenate([np.zeros(n), -free]),
+                         np.concatenate([np.full(n, highspy.kHighsInf), free]),
                          lower, lower,
                          (*HIGHS_METHODS[self.method].items(),
                           ("time_limit", float(self.time_limit)),
@@ -396,9 +525,9 @@ class CollapseLP:
     def _result(self, lp, live, azimuth, start, dead_load_feasible,
                 per_unit=1.0) -> CollapseResult:
         """The result of ``lp`` run, whose factor times ``per_unit`` is ``live``'s."""
-        status, factor, values, dual, iterations = lp.run()
+        status, factor, x_scaled, dual, iterations = lp.run()
         common = dict(solver=lp.name, mu=self.mu, live=live, azimuth_deg=azimuth,
-                      iterations=iterations)
+                      iterations=iterations, cone=self.cone)
         if status != "optimal":
             feasible = False if status == "dead load infeasible" else dead_load_feasible
             if status == "unbounded" and feasible is None:
@@ -408,8 +537,6 @@ class CollapseLP:
             return CollapseResult(None, feasible, status, time_s=time.perf_counter() - start,
                                   residual=np.nan, work_balance=np.nan, **common)
         factor *= per_unit
-        n = self.matrix.shape[1]
-        x_scaled = self.edges @ values[:n]
         load = self.scaled(live)
         total = self.system.f_ext + factor * load
         residual = float(np.abs(self.system.A_eq @ x_scaled + total).max()
@@ -475,7 +602,7 @@ class _HighsLP:
     def __init__(self, highs, heads, tie_row, parent):
         self.highs, self.heads, self.tie_row = highs, heads, tie_row
         self.name = parent.method
-        self.columns, self.time_limit = parent.matrix.shape[1], parent.time_limit
+        self.edges, self.time_limit = parent.columns.edges, parent.time_limit
 
     def _status(self) -> str:
         # HiGHS's time limit counts from its creation: give every run its own
@@ -494,14 +621,16 @@ class _HighsLP:
                     status, self.highs.modelStatusToString(status))
 
     def run(self):
-        """``(status, factor, column values, row duals, iterations)``."""
+        """``(status, factor, vertex forces (scaled, the layout's order), row duals,
+        iterations)``."""
         status = self._status()
         info = self.highs.getInfo()
         iterations = int(info.simplex_iteration_count + info.ipm_iteration_count)
         if status != "optimal":
             return status, None, None, None, iterations
         solution = self.highs.getSolution()
-        return (status, float(info.objective_function_value), np.array(solution.col_value),
+        values = np.array(solution.col_value)[:self.edges.shape[1]]
+        return (status, float(info.objective_function_value), self.edges @ values,
                 np.array(solution.row_dual), iterations)
 
     def stands_unloaded(self) -> bool | None:
@@ -525,8 +654,9 @@ class _InteriorLP:
     same LP, which tells infeasible from unbounded; ``make_fallback`` builds that one
     when it is first needed (on preset 1's dome its KKT matrix takes half a second)."""
 
-    def __init__(self, newton_system, loads, cost, make_fallback):
+    def __init__(self, newton_system, layout, loads, cost, make_fallback):
         self.ns, self.loads, self.make_fallback = newton_system, loads, make_fallback
+        self.layout = layout
         self.cost = np.asarray(cost, dtype=float)
         self.name, self._fallback = "interior", None
 
@@ -539,7 +669,8 @@ class _InteriorLP:
         return self._fallback
 
     def run(self):
-        """``(status, factor, edge ray weights, equilibrium-row duals, iterations)``."""
+        """``(status, factor, vertex forces (scaled, the layout's order),
+        equilibrium-row duals, iterations)``."""
         outcome = load_factor(self.ns, self.loads @ self.cost, LoadFactorOptions())
         self.name = "interior"
         if outcome.status != OPTIMAL:
@@ -547,8 +678,8 @@ class _InteriorLP:
                      "Clarabel decides", outcome.status)
             self.name = "interior+clarabel"
             return self.fallback().run()
-        return ("optimal", outcome.info["load_factor"], outcome.x.ravel(), outcome.y,
-                outcome.iterations)
+        return ("optimal", outcome.info["load_factor"],
+                self.ns.full_vector(outcome.x, self.layout), outcome.y, outcome.iterations)
 
     def stands_unloaded(self) -> bool | None:
         """The feasible factors are an interval: ``lambda = 0`` lies in it when the
@@ -565,10 +696,11 @@ class _InteriorLP:
 class _ClarabelLP:
     """A collapse LP held by Clarabel (interior point, direct LDL): ``minimize -cost .
     lambda`` over ``[g, lambda]`` with the equilibrium (and tie) rows in the zero cone and
-    ``g >= 0`` in the nonnegative cone. A new lateral direction updates two entries of
-    ``A`` and the costs in place, which keeps the symbolic factorization."""
+    the columns' cone constraints (:class:`_Columns`) after them. A new lateral direction
+    updates two entries of ``A`` and the costs in place, which keeps the symbolic
+    factorization."""
 
-    def __init__(self, matrix, loads, rhs, cost, tie, time_limit, lower, upper):
+    def __init__(self, matrix, loads, rhs, cost, tie, time_limit, columns: _Columns):
         n, m = matrix.shape[1], loads.shape[1]
         top = sp.hstack([matrix, sp.csc_array(loads)])
         rows = [top]
@@ -576,17 +708,14 @@ class _ClarabelLP:
             rows.append(sp.csc_array((np.asarray(tie, dtype=float), ([0, 0], [n, n + 1])),
                                      shape=(1, n + m)))
         self.n_eq = sum(r.shape[0] for r in rows)
-        # bounds as rows: -g <= -lower, g <= upper (finite ones)
-        low, high = np.flatnonzero(np.isfinite(lower)), np.flatnonzero(np.isfinite(upper))
-        for index, sign in ((low, -1.0), (high, 1.0)):
-            rows.append(sp.csc_array((np.full(len(index), sign),
-                                      (np.arange(len(index)), index)), shape=(len(index), n + m)))
-        self.n_bounds = len(low) + len(high)
+        rows.append(sp.hstack([columns.G, sp.csc_array((columns.G.shape[0], m))]))
+        self.cones = [clarabel.ZeroConeT(self.n_eq), *columns.cones]
         self.A = sp.csc_matrix(sp.vstack(rows, format="csc"))
         self.A.sort_indices()
-        self.b = np.concatenate([rhs, np.zeros(self.n_eq - len(rhs)), -lower[low], upper[high]])
+        self.b = np.concatenate([rhs, np.zeros(self.n_eq - len(rhs)), columns.h])
         self.q = np.concatenate([np.zeros(n), -np.asarray(cost, dtype=float)])
         self.n, self.m, self.time_limit = n, m, time_limit
+        self.edges = columns.edges
         if tie is not None:  # where the tie row's two entries sit in A.data
             self.tie_at = [self.A.indptr[c] + np.flatnonzero(
                 self.A.indices[self.A.indptr[c]:self.A.indptr[c + 1]] == self.n_eq - 1)[0]
@@ -604,12 +733,12 @@ class _ClarabelLP:
         return settings
 
     def run(self):
-        """``(status, factor, variable values, equality-row duals, iterations)``."""
+        """``(status, factor, vertex forces (scaled, the layout's order), equality-row
+        duals, iterations)``."""
         if self.solver is None:
-            cones = [clarabel.ZeroConeT(self.n_eq), clarabel.NonnegativeConeT(self.n_bounds)]
             size = self.n + self.m
             self.solver = clarabel.DefaultSolver(sp.csc_matrix((size, size)), self.q,
-                                                 self.A, self.b, cones, self._settings())
+                                                 self.A, self.b, self.cones, self._settings())
         solution = self.solver.solve()
         status = str(solution.status)
         words = {"Solved": "optimal", "AlmostSolved": "optimal",
@@ -626,15 +755,14 @@ class _ClarabelLP:
         if words != "optimal":
             return words, None, None, None, int(solution.iterations)
         x = np.array(solution.x)
-        return (words, float(-self.q[self.n:] @ x[self.n:]), x, np.array(solution.z),
-                int(solution.iterations))
+        return (words, float(-self.q[self.n:] @ x[self.n:]), self.edges @ x[:self.n],
+                np.array(solution.z), int(solution.iterations))
 
     def stands_unloaded(self) -> bool | None:
         """The dead load alone: the load columns dropped, a zero objective."""
         A = sp.csc_matrix(self.A[:, : self.n])
-        cones = [clarabel.ZeroConeT(self.n_eq), clarabel.NonnegativeConeT(self.n_bounds)]
         solver = clarabel.DefaultSolver(sp.csc_matrix((self.n, self.n)), np.zeros(self.n),
-                                        A, self.b, cones, self._settings())
+                                        A, self.b, self.cones, self._settings())
         status = str(solver.solve().status)
         return {"Solved": True, "PrimalInfeasible": False}.get(status)
 
@@ -645,8 +773,8 @@ class _ClarabelLP:
             self.solver.update(q=self.q, A=self.A)
 
 
-def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=None,
-                  dead_load_feasible=None, time_limit=600.0) -> CollapseResult:
+def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, cone="circle",
+                  friction=None, dead_load_feasible=None, time_limit=600.0) -> CollapseResult:
     """The collapse load factor of ``live`` on ``model``, and its mechanism (SPEC 6.8-6.9).
 
     Parameters
@@ -657,6 +785,8 @@ def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=Non
     mu : float
     density : float, kg/m^3
         Of the dead load (and of a lateral load built with the same density).
+    cone : FrictionCone or str
+        The friction model (:mod:`masonry.friction`).
     friction : None, 'associated' or 'non-associative'
         ``Params.friction_law``'s values. ``associated`` (or None): the LP above.
         ``non-associative``: the estimate of :func:`fixed_capacity_factor` (friction
@@ -674,7 +804,7 @@ def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, friction=Non
     if live.wrench.shape != (model.blocks.n_blocks, 6):
         raise ValueError(f"live load of shape {live.wrench.shape} for "
                          f"{model.blocks.n_blocks} blocks")
-    problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit)
+    problem = CollapseLP(model, mu=mu, density=density, cone=cone, time_limit=time_limit)
     if friction in (None, "associated"):
         return problem.solve(live, dead_load_feasible=dead_load_feasible)
     if friction == "non-associative":
@@ -750,8 +880,8 @@ def lateral_azimuths(n_webs=None, count=24) -> np.ndarray:
     return np.unique(np.round(angles % 360.0, 9))
 
 
-def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
-                  period_deg=None, dead_load_feasible=None, time_limit=600.0,
+def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle",
+                  n_webs=None, period_deg=None, dead_load_feasible=None, time_limit=600.0,
                   method=None) -> CollapseResult:
     """The smallest lateral load factor over ``azimuths`` (``--lateral all``).
 
@@ -766,7 +896,7 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, n_webs=None,
     or None) pairs).
     """
     azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
-    problem = CollapseLP(model, mu=mu, density=density, time_limit=time_limit,
+    problem = CollapseLP(model, mu=mu, density=density, cone=cone, time_limit=time_limit,
                          method=method)
     start = time.perf_counter()
     keys = [round(float(a) % period_deg, 9) if period_deg else float(a) for a in azimuths]

@@ -14,8 +14,10 @@ Glossary (thesis 3.3 symbol -> name here)
 - ``f_ext`` / ``f_weight`` (eq. 3.14, 3.20), external loads -> ``f_ext``: self weight only.
   The thesis's hoop term (eq. 3.19-3.20) is not reproduced (SPEC 6.4); the cyclic and
   rigid boundary modes route interface forces instead (``side_block``, ``side_rotation``).
-- ``A_fr`` (eq. 3.24-3.26), friction pyramid -> ``A_fr['net']`` (friction-net, eq. 3.26)
-  and ``A_fr['plus']`` (friction+, eq. 3.25), 4 rows per vertex, ``A_fr x <= 0``.
+- ``A_fr`` (eq. 3.24-3.26), the thesis's friction pyramid -> the friction model
+  :class:`~masonry.friction.FrictionCone` (``cone``): Coulomb's isotropic cone by
+  default; a polyhedral model's faces as rows ``A_fr['net']`` (friction-net) and
+  ``A_fr['plus']`` (friction+), ``A_fr x <= 0``, for the solvers that take rows.
 - ``alpha`` (eq. 3.25), static friction coefficient -> ``mu``.
 - ``H`` (eq. 3.27), diagonal penalty -> ``h`` (its diagonal): 1 for tension, 1e-3 for
   compression and friction. The solver minimises with ``h_solver``, ``h`` times 1e3.
@@ -46,6 +48,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
+from masonry.friction import FrictionCone
 from masonry.tolerances import COEFFICIENT_NOISE, G
 
 TENSION_WEIGHT = 1.0
@@ -55,8 +58,9 @@ OTHER_WEIGHT = 1e-3
 """Diagonal of ``H`` for compression and friction (thesis eq. 3.27)."""
 
 FRICTION_METHODS = ("net", "plus")
-"""``net``: friction-net, ``|f1|, |f2| <= mu (c - t)`` (thesis eq. 3.26);
-``plus``: friction+, ``|f1|, |f2| <= mu c`` (thesis eq. 3.25)."""
+"""``net``: friction-net, the friction within the model's cone at ``c - t`` (thesis eq.
+3.26: no tension carried at a point that stands); ``plus``: friction+, within it at ``c``
+(thesis eq. 3.25: tension allowed and measured)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,7 +133,7 @@ class EquilibriumSystem:
     With ``x_s = x / weight_ref`` (``x`` in newtons, layout :class:`VariableLayout`)::
 
         A_eq x_s + f_ext = 0          (6 rows per free block)
-        A_fr[method] x_s <= 0         (4 rows per vertex)
+        (c, f1, f2) of every vertex in ``cone`` at mu (c - t) or mu c
         x_s >= lower
 
     Parameters
@@ -169,9 +173,11 @@ class EquilibriumSystem:
         Force rows in units of ``weight_ref``, moment rows (about each block's centroid)
         in units of ``weight_ref * length_ref``; built from ``vertex_coefficients`` on
         first use (the Newton method and :meth:`times_A_eq` do without it).
-    A_fr : dict str -> (4 IV, n) scipy.sparse.csr_array
-        ``'net'`` and ``'plus'`` friction pyramids (thesis eq. 3.26, 3.25), for ``mu``.
-        Rows of vertex ``i``: ``4 i + (0, 1, 2, 3)`` bound ``+f1, -f1, +f2, -f2``.
+    A_fr : dict str -> (K IV, n) scipy.sparse.csr_array
+        A polyhedral ``cone``'s faces as rows for ``'net'`` and ``'plus'`` (thesis eq.
+        3.26, 3.25), at ``mu``; rows ``K i .. K i + K - 1`` are vertex ``i``'s.
+    cone : masonry.friction.FrictionCone
+        The friction model (default Coulomb's cone).
     """
 
     layout: VariableLayout
@@ -187,12 +193,14 @@ class EquilibriumSystem:
     vertex_coefficients: np.ndarray
 
     density: float = 1.0
+    cone: FrictionCone = FrictionCone("circle")
 
-    def with_material(self, mu=None, density=None) -> "EquilibriumSystem":
-        """The same scene with another friction coefficient or density, without
-        assembling again: ``mu`` changes only the pyramids, and ``density`` only the
-        newtons per solver unit (the scaled ``A_eq`` and ``f_ext`` depend on neither,
-        since the reference weight grows with the density).
+    def with_material(self, mu=None, density=None, cone=None) -> "EquilibriumSystem":
+        """The same scene with another friction coefficient, density or friction model,
+        without assembling again: ``mu`` and ``cone`` change only the friction
+        constraints, and ``density`` only the newtons per solver unit (the scaled ``A_eq``
+        and ``f_ext`` depend on none of them, since the reference weight grows with the
+        density).
 
         Parameters
         ----------
@@ -200,6 +208,8 @@ class EquilibriumSystem:
             Friction coefficient; default unchanged.
         density : float, kg/m^3, optional
             Default unchanged.
+        cone : FrictionCone or str, optional
+            Friction model; default unchanged.
 
         Returns
         -------
@@ -207,6 +217,8 @@ class EquilibriumSystem:
             ``self`` when nothing changes.
         """
         out = self
+        if cone is not None and FrictionCone.parse(cone) != self.cone:
+            out = dataclasses.replace(out, cone=FrictionCone.parse(cone))
         if mu is not None and float(mu) != self.mu:
             out = dataclasses.replace(out, mu=float(mu))
         if density is not None and float(density) != self.density:
@@ -242,9 +254,9 @@ class EquilibriumSystem:
 
     @cached_property
     def A_fr(self) -> dict:
-        """The friction pyramids (see :func:`friction_pyramids`), built on first use: the
-        solvers other than the cvxpy reference do not need them as matrices."""
-        return friction_pyramids(self.layout.n_vertices, self.mu)
+        """A polyhedral model's faces as rows (see :func:`friction_rows`), built on first
+        use: only the solvers that take rows need them."""
+        return friction_rows(self.layout.n_vertices, self.cone, self.mu)
 
     @property
     def total_weight(self) -> float:
@@ -285,7 +297,7 @@ class EquilibriumSystem:
 
 
 def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
-             side_rotation=None) -> EquilibriumSystem:
+             side_rotation=None, cone="circle") -> EquilibriumSystem:
     """Assemble the scaled RBE matrices: the per-vertex coefficients of ``A_eq``
     (vectorized); the sparse ``A_eq`` is built from them when a solver asks for it.
 
@@ -307,6 +319,8 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
         ``side_block``: that side's force ``Q (+-F)`` acts at the point ``Q v``. Default
         identity. Cyclic symmetry (SPEC 6.4) routes the side on the rotated copy of a
         section block back onto that block with the inverse rotation.
+    cone : FrictionCone or str
+        The friction model (:mod:`masonry.friction`).
 
     Returns
     -------
@@ -345,7 +359,8 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
                              lower=lower, h=h, mu=float(mu), block_weight=block_weight,
                              weight_ref=weight_ref, length_ref=length_ref,
                              side_row=block_row[side_block],
-                             vertex_coefficients=coefficients, density=float(density))
+                             vertex_coefficients=coefficients, density=float(density),
+                             cone=FrictionCone.parse(cone))
 
 
 def _vertex_coefficients(blocks, interfaces, layout: VariableLayout, vertex_side_block,
@@ -410,53 +425,55 @@ def equilibrium_columns(coefficients, side_rows, n_rows: int) -> sp.csc_array:
     return matrix
 
 
-def friction_pyramids(n_vertices: int, mu: float) -> dict:
-    """``A_fr['net']`` and ``A_fr['plus']`` (thesis eq. 3.26, 3.25): 4 rows per vertex,
-    ``A_fr x <= 0``, rows ``+f1, -f1, +f2, -f2`` over columns ``(c, t, f1, f2)``.
+def friction_rows(n_vertices: int, cone: FrictionCone, mu: float) -> dict:
+    """A polyhedral model's faces as rows ``A_fr x <= 0`` over every vertex's ``(c, t,
+    f1, f2)`` (thesis eq. 3.24-3.26 for the square).
 
     Parameters
     ----------
     n_vertices : int
         ``IV``, interface vertices.
+    cone : FrictionCone
+        A polyhedral model (``polygon:K`` or ``square``).
     mu : float
         Friction coefficient (thesis ``alpha``), dimensionless.
 
     Returns
     -------
-    dict str -> (4 IV, 4 IV) scipy.sparse.csr_array
-        ``'net'``: ``|f1|, |f2| <= mu (c - t)``; ``'plus'``: ``|f1|, |f2| <= mu c``.
-        Dimensionless, so valid for ``x`` in newtons or in solver units.
+    dict str -> (K IV, 4 IV) scipy.sparse.csr_array
+        ``'net'``: ``f . normal_k <= apothem (c - t)``; ``'plus'``: ``f . normal_k <=
+        apothem c``. Dimensionless, so valid for ``x`` in newtons or in solver units.
+
+    Raises
+    ------
+    ValueError
+        For the circle, which has no faces (its solvers take it as a second-order cone).
     """
-    pyramid_net = np.array([[-mu, mu, 1.0, 0.0],
-                            [-mu, mu, -1.0, 0.0],
-                            [-mu, mu, 0.0, 1.0],
-                            [-mu, mu, 0.0, -1.0]])
-    pyramid_plus = pyramid_net.copy()
-    pyramid_plus[:, 1] = 0.0  # friction+: tension is decoupled (thesis eq. 3.25)
+    if not cone.is_polyhedral:
+        raise ValueError("the circle has no faces: it is a second-order cone")
+    faces = cone.faces(mu)                    # (K, 3) over (c, f1, f2)
+    net = np.column_stack([faces[:, 0], -faces[:, 0], faces[:, 1], faces[:, 2]])
+    plus = net.copy()
+    plus[:, 1] = 0.0  # friction+: tension is decoupled (thesis eq. 3.25)
     eye = sp.identity(n_vertices, format="csr")
-    return {
-        "net": sp.csr_array(sp.kron(eye, pyramid_net, format="csr")),
-        "plus": sp.csr_array(sp.kron(eye, pyramid_plus, format="csr")),
-    }
+    return {"net": sp.csr_array(sp.kron(eye, net, format="csr")),
+            "plus": sp.csr_array(sp.kron(eye, plus, format="csr"))}
 
 
-def friction_pyramid_edges(n_vertices: int, mu: float) -> sp.csr_array:
-    """The friction-net pyramid with ``t = 0`` by its edge rays (SPEC 6.3, 6.8).
+def friction_edges(n_vertices: int, cone: FrictionCone, mu: float) -> sp.csr_array:
+    """A polyhedral model with ``t = 0`` by its edge rays (SPEC 6.3, 6.8).
 
-    A vertex force with ``|f1|, |f2| <= mu c`` and no tension is a nonnegative
-    combination of the four edge rays ``(c, t, f1, f2) = (1, 0, +-mu, +-mu)``, so
-    ``x = E g`` with ``g >= 0`` states the pyramid without inequality rows. Fixing
-    ``t = 0`` loses nothing: a friction-net point with ``0 < t <= c`` stays one with
-    ``(c - t, 0)``.
+    A vertex force with no tension inside the model is a nonnegative combination of its
+    ``K`` edge rays (:meth:`~masonry.friction.FrictionCone.rays`), so ``x = E g`` with
+    ``g >= 0`` states it without inequality rows. Fixing ``t = 0`` loses nothing: a
+    friction-net point with ``0 < t <= c`` stays one with ``(c - t, 0)``.
 
     Returns
     -------
-    E : (4 IV, 4 IV) scipy.sparse.csr_array
-        Column ``4 i + e`` is edge ``e`` of vertex ``i`` in the
-        :class:`VariableLayout` order; edges ``(+f1 +f2, +f1 -f2, -f1 +f2, -f1 -f2)``.
+    E : (4 IV, K IV) scipy.sparse.csr_array
+        Column ``K i + k`` is ray ``k`` of vertex ``i`` in the :class:`VariableLayout`
+        order.
     """
-    edges = np.array([[1.0, 1.0, 1.0, 1.0],    # c
-                      [0.0, 0.0, 0.0, 0.0],    # t
-                      [mu, mu, -mu, -mu],      # f1
-                      [mu, -mu, mu, -mu]])     # f2
+    rays = cone.rays(mu)                      # (3, K) over (c, f1, f2)
+    edges = np.vstack([rays[0], np.zeros(rays.shape[1]), rays[1], rays[2]])
     return sp.csr_array(sp.kron(sp.identity(n_vertices), edges, format="csr"))

@@ -17,6 +17,7 @@ is solved there while the load-path LP decides friction-net (:class:`_Alongside`
 
 import dataclasses
 import logging
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -26,7 +27,8 @@ import scipy.sparse as sp
 
 from masonry import forking
 from masonry.rbe.equilibrium import (FRICTION_METHODS, EquilibriumSystem, VariableLayout,
-                                     assemble, friction_pyramid_edges)
+                                     assemble, friction_edges)
+from masonry.friction import FrictionCone
 from masonry.rbe.solvers import BACKENDS, FAMILY, net_feasibility
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL
 from masonry.rbe.solvers.highs import highs_lp
@@ -58,6 +60,8 @@ class AccuracyPreset:
         the load-path LP on Newton's matrix (:mod:`masonry.rbe.solvers.net_feasibility`)
         before Clarabel: its certificate ends friction-net; a feasible verdict resumes
         Newton from where it stopped, then Clarabel.
+    cone : str
+        The friction model (:mod:`masonry.friction`) unless one is given.
     polish : bool
         Refine an accepted interior-point or ADMM point with Newton steps started from
         its multipliers (:mod:`masonry.rbe.solvers.newton`): one or two steps find the exact
@@ -73,26 +77,31 @@ class AccuracyPreset:
     plus_solver: str
     residual: float
     lp_check: bool | str
+    cone: str = "circle"
     load_path: bool = False
     polish: bool = False
     options: dict = field(default_factory=dict)
 
 
-POLISH_STEPS = 10
-"""Newton steps a polish may take (2 sufficed from Clarabel at 1e-8 on the thesis's
-sections, friction+ included; preset 2's full dome took 6 from Clarabel at 1e-10, and
-5 left 2.4e-6 of the weight as tension; from 1e-5, 8 did not)."""
+POLISH_STEPS = 20
+"""Newton steps a polish may take. From a pyramid's interior point 1 or 2 steps find the
+exact active set (Clarabel at 1e-8 on the thesis's sections, friction+ included;
+preset 2's full dome took 6 from Clarabel at 1e-10). Coulomb's cone has no active set to
+find: its interior point stops at a gap of about 1e-7 of the objective (the cone's
+scaling spans more decades than double precision holds), and Newton's first steps from
+there are damped before it converges quadratically (preset 1's free section: 8 steps)."""
 
-POLISH_STALL = 3
+POLISH_STALL = 8
 """... and it ends after this many steps without halving the residual: a polish that
-converges halves it at every step, one that does not creeps at 1e-9 with tiny steps
-(preset 1's free section at mu 1.0: 10 steps, none kept)."""
+converges halves it within a few damped steps, one that does not creeps at 1e-9 with
+tiny steps (preset 1's free section at mu 1.0 under the square pyramid: 10 steps, none
+kept)."""
 
 
 ACCURACY = {
     # Newton for friction-net, the interior point method on the Newton system for
-    # friction+ (both factor the 6-rows-per-block matrix): Newton's steps are exact once
-    # the active pyramid faces are found, so a looser stop saves little; the savings are
+    # friction+ (both factor the 6-rows-per-block matrix): Newton converges fast once the
+    # active set of the friction cones is found, so a looser stop saves little; the savings are
     # the interior point's last iterations and the acceptance of OSQP's ADMM points.
     "fast": AccuracyPreset(
         "fast", "newton", "interior", residual=1e-4, lp_check=False, load_path=True,
@@ -159,8 +168,8 @@ this rule."""
 SOLVERS = tuple(BACKENDS)
 """Every solver name :func:`solve_rbe` accepts."""
 
-RESULT_KEYS = ("verdict", "feasible", "friction", "mu", "objective", "moi", "moi_factor",
-               "weight_N",
+RESULT_KEYS = ("verdict", "feasible", "friction", "mu", "friction_model",
+               "friction_capacity_error", "objective", "moi", "moi_factor", "weight_N",
                "solver", "status", "iterations", "residual_eq", "friction_violation",
                "net_friction_violation", "time_s", "lp_feasible", "accuracy", "lp_time_s")
 """Scalar fields of :class:`RBEResult` written to run.json, in order."""
@@ -175,11 +184,12 @@ class RBEResult:
     Parameters
     ----------
     feasible : bool
-        ``x`` satisfies equilibrium and the friction-net pyramid, both within
+        ``x`` satisfies equilibrium and the friction-net constraints, both within
         ``tol.residual`` (relative equilibrium residual, and friction violation relative
         to the reference weight): the structure stands without tension.
     friction : str
-        ``'net'`` or ``'plus'``: the friction model whose solution ``x`` is.
+        ``'net'`` or ``'plus'``: the problem (friction-net or friction+) whose solution
+        ``x`` is.
     mu : float
     objective : float, N^2
         ``1/2 x^T H x`` (thesis eq. 3.27); only an optimality criterion. NaN without ``x``.
@@ -219,6 +229,8 @@ class RBEResult:
         Every QP solved (and the load-path LP, :data:`LOAD_PATH`), in order: friction
         model, solver, status, iterations, setup and solve seconds (a fallback shows as
         a second attempt of the same model).
+    cone : FrictionCone
+        The friction model (:mod:`masonry.friction`).
     verdict : {'feasible', 'infeasible', 'not solved'}
         ``'feasible'``: ``feasible`` is True. ``'infeasible'``: friction-net has no
         accepted point, and either a solver certified that (a Farkas certificate, an
@@ -248,6 +260,17 @@ class RBEResult:
     lp_time_s: float = 0.0
     attempts: tuple = ()
     verdict: str = "not solved"
+    cone: FrictionCone = FrictionCone("circle")
+
+    @property
+    def friction_model(self) -> str:
+        return self.cone.name
+
+    @property
+    def friction_capacity_error(self) -> float:
+        """The model's bound on the error of the friction capacity (see
+        :attr:`~masonry.friction.FrictionCone.capacity_error`)."""
+        return self.cone.capacity_error
 
     def to_dict(self) -> dict:
         """The scalar fields (:data:`RESULT_KEYS`) as plain Python values, for run.json."""
@@ -310,11 +333,14 @@ class RBEProblem:
         self._workspaces = {}
 
     def solve(self, mu=0.7, density=2000.0, friction="auto", solver=None, tol=None, *,
-              accuracy="balanced", lp_check=None, lp_time_limit=60.0) -> RBEResult:
+              accuracy="balanced", cone=None, lp_check=None,
+              lp_time_limit=60.0) -> RBEResult:
         """Solve at ``mu`` and ``density``; see :func:`solve_rbe` for the parameters."""
         start = time.perf_counter()
         preset, tol, lp_check = _settings(friction, solver, tol, accuracy, lp_check)
-        system = self.system.with_material(mu=mu, density=density)
+        cone = friction_model(preset.name, cone)
+        _check_solver(solver, cone)
+        system = self.system.with_material(mu=mu, density=density, cone=cone)
         attempts = []
         alongside = (_Alongside(self, system, _candidates("plus", solver, preset), preset, tol)
                      if _Alongside.wanted(friction, solver, preset) else None)
@@ -433,11 +459,11 @@ class RBEProblem:
         run_lp = ((lp_check == "infeasible" and not feasible) if isinstance(lp_check, str)
                   else bool(lp_check))
         lp_start = time.perf_counter()
-        lp_feasible = _lp_feasible(system, lp_time_limit) if run_lp else None
+        lp_feasible = _lp_feasible(system, lp_time_limit, feasible) if run_lp else None
         lp_time = time.perf_counter() - lp_start if run_lp else 0.0
         if feasible and solved.method == "plus" and friction == "auto":
             log.warning("friction-net was not solved, yet the friction+ solution meets the "
-                        "friction-net pyramid: reported feasible")
+                        "friction-net constraints: reported feasible")
         if lp_feasible is not None and lp_feasible != feasible:
             log.warning("the friction-net LP says %s, the %s QP says %s (status %r)",
                         "feasible" if lp_feasible else "infeasible", solved.name,
@@ -455,7 +481,7 @@ class RBEProblem:
             net_friction_violation=float(net_violation), time_s=0.0,
             lp_feasible=lp_feasible, x=x, layout=system.layout, accuracy=accuracy,
             lp_time_s=lp_time, attempts=tuple(attempts),
-            verdict=_verdict(feasible, x, attempts, lp_feasible))
+            verdict=_verdict(feasible, x, attempts, lp_feasible), cone=system.cone)
 
     def _workspace(self, name):
         """The workspace of a backend; the Newton-system backends (semismooth Newton,
@@ -572,6 +598,23 @@ def _settings(friction, solver, tol, accuracy, lp_check):
     return preset, tol, preset.lp_check if lp_check is None else lp_check
 
 
+def friction_model(accuracy="balanced", cone=None) -> FrictionCone:
+    """The friction model of a solve: ``cone`` (a name or a :class:`FrictionCone`) if
+    given, else the accuracy preset's."""
+    return FrictionCone.parse(ACCURACY[accuracy].cone if cone is None else cone)
+
+
+POLYHEDRAL_ONLY = ("osqp", "osqp-cvxpy")
+"""Solvers that take linear constraints only: the pyramids, not Coulomb's cone."""
+
+
+def _check_solver(solver, cone):
+    """Refuse a solver that cannot state the friction model (``ValueError``)."""
+    if solver in POLYHEDRAL_ONLY and not cone.is_polyhedral:
+        raise ValueError(f"{solver} takes linear constraints only: the friction model "
+                         f"{cone} needs newton, interior or clarabel, or a polygon:K model")
+
+
 def _candidates(method, solver, preset) -> list:
     """Solvers to try for ``method``, in order: the explicit ``solver`` alone, else the
     preset's, followed by Clarabel when the preset's is one of the fast methods on the
@@ -608,8 +651,8 @@ def _verdict(feasible, x, attempts, lp_feasible) -> str:
 
 
 def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solver=None,
-              tol=None, *, accuracy="balanced", lp_check=None, lp_time_limit=60.0,
-              side_block=None, side_rotation=None) -> RBEResult:
+              tol=None, *, accuracy="balanced", cone=None, lp_check=None,
+              lp_time_limit=60.0, side_block=None, side_rotation=None) -> RBEResult:
     """Rigid block equilibrium as a quadratic program (thesis 3.3.4).
 
     With ``x`` the vertex forces ``(c, t, f1, f2)`` of every interface vertex (thesis
@@ -617,13 +660,16 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
 
         minimize    1/2 x^T H x                  H = diag(1e-3 c, 1 t, 1e-3 f1, 1e-3 f2)
         subject to  A_eq x + f_ext = 0           force and moment balance of free blocks
-                    A_fr x <= 0                  friction pyramid, net or plus
+                    (f1, f2) in the friction model at mu (c - t) (net) or mu c (plus)
                     c >= 0, t >= 0
 
-    friction-net: ``|f1|, |f2| <= mu (c - t)`` (eq. 3.26, infeasible when the structure
-    cannot stand without tension); friction+: ``|f1|, |f2| <= mu c`` (eq. 3.25, always
-    feasible; the sum of tension is the measure of infeasibility, eq. 3.28). The problem
-    is solved scaled (:mod:`masonry.rbe.equilibrium`), results are in newtons.
+    friction-net: the friction within the model at ``c - t`` (eq. 3.26, infeasible when
+    the structure cannot stand without tension); friction+: within it at ``c`` (eq.
+    3.25, always feasible; the sum of tension is the measure of infeasibility, eq.
+    3.28). The friction model (``cone``) is Coulomb's isotropic cone ``||(f1, f2)|| <= mu
+    c`` unless another is asked for (:mod:`masonry.friction`; the thesis's pyramid
+    ``|f1|, |f2| <= mu c`` is ``square``). The problem is solved scaled
+    (:mod:`masonry.rbe.equilibrium`), results are in newtons.
 
     Parameters
     ----------
@@ -644,6 +690,9 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
         violation of an accepted solution. Default: the preset's ``residual``.
     accuracy : {'fast', 'balanced', 'accurate'}
         The :data:`ACCURACY` preset.
+    cone : FrictionCone or str, optional
+        The friction model: ``'circle'``, ``'polygon:K'`` or ``'square'``; default the
+        preset's (an isotropic one).
     lp_check : bool or 'infeasible', optional
         Run the independent friction-net feasibility LP (HiGHS, zero objective): always,
         never, or only when the verdict is infeasible. Default: the preset's
@@ -660,7 +709,7 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
         ``feasible`` is decided from the returned point, not from a solver status: a
         solution is accepted when its residuals are below ``tol.residual``, and the
         structure is feasible when the accepted ``x`` meets equilibrium and the
-        friction-net pyramid within that tolerance.
+        friction-net constraints within that tolerance.
 
     Notes
     -----
@@ -670,7 +719,7 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
     ``solver_error`` return none. Under ``'auto'`` any friction-net outcome without an
     accepted point moves on to friction+, so a spurious "infeasible" on a nearly
     feasible structure is caught when the friction+ point meets the friction-net
-    pyramid (then ``feasible`` is True and a warning is logged), and the LP's verdict
+    constraints (then ``feasible`` is True and a warning is logged), and the LP's verdict
     is reported beside the QP's (a disagreement is logged). For several solves of one
     scene use :class:`RBEProblem`.
     """
@@ -678,7 +727,7 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
     problem = RBEProblem(blocks, interfaces, side_block=side_block,
                          side_rotation=side_rotation)
     result = problem.solve(mu=mu, density=density, friction=friction, solver=solver,
-                           tol=tol, accuracy=accuracy, lp_check=lp_check,
+                           tol=tol, accuracy=accuracy, cone=cone, lp_check=lp_check,
                            lp_time_limit=lp_time_limit)
     return dataclasses.replace(result, time_s=time.perf_counter() - start)
 
@@ -696,35 +745,57 @@ def _check(system: EquilibriumSystem, x_scaled, method: str):
     residual_eq = (np.abs(system.times_A_eq(x_scaled) + system.f_ext).max()
                    / np.abs(system.f_ext).max())
     bound = max(0.0, float((system.lower - x_scaled).max()))
-    # the rows of A_fr, vertex by vertex: max(|f1|, |f2|) - mu (c - t) (friction-net) or
-    # - mu c (friction+), without building the matrices
     c, t, f1, f2 = np.asarray(x_scaled).reshape(-1, 4).T
-    friction = np.maximum(np.abs(f1), np.abs(f2))
 
     def violation(name):
         load = c - t if name == "net" else c
-        return max(bound, float((friction - system.mu * load).max(initial=0.0)))
+        excess = system.cone.excess(load, f1, f2, system.mu)
+        return max(bound, float(excess.max(initial=0.0)))
 
     return float(residual_eq), violation(method), violation("net")
 
 
-def _lp_feasible(system: EquilibriumSystem, time_limit: float):
-    """Friction-net feasibility by linear programming (HiGHS, zero objective).
+LP_CHECK_SIDES = 16
+"""Coulomb's cone is checked by linear programming on a 16-sided pyramid: the inscribed
+one (1.9 % short of the cone) for a feasible verdict, the circumscribed one (1.9 % over)
+for an infeasible one."""
 
-    The pyramid is written by its edges instead of its faces: a vertex force with
-    ``t = 0`` and ``|f1|, |f2| <= mu c`` is a nonnegative combination of the four edge
-    rays ``(c, f1, f2) = (1, +-mu, +-mu)``, so the LP is ``A_eq G lam = -f_ext,
-    lam >= 0`` with 4 unknowns per vertex and no inequality rows. Fixing ``t = 0`` loses
-    nothing: a friction-net point with ``0 < t <= c`` stays one with ``(c - t, 0)``.
-    The edge form is also a second, independent way to state the constraints. HiGHS's
-    interior point method decides it, without crossover (a vertex solution is not
-    needed, only the verdict; crossover and the dual simplex were measured slower,
-    docs/bench.md). Proving feasibility takes far longer than proving infeasibility and
-    grows faster than linearly, hence ``time_limit``.
 
-    Returns True, False, or None when HiGHS ends without a verdict (time limit).
+def _lp_feasible(system: EquilibriumSystem, time_limit: float, verdict: bool):
+    """Friction-net feasibility by linear programming (HiGHS, zero objective), to check
+    the QP's ``verdict``.
+
+    A pyramid is written by its edge rays instead of its faces: a vertex force with
+    ``t = 0`` inside it is a nonnegative combination of its rays
+    (:func:`~masonry.rbe.equilibrium.friction_edges`), so the LP is ``A_eq E lam =
+    -f_ext, lam >= 0`` with ``K`` unknowns per vertex and no inequality rows. Fixing
+    ``t = 0`` loses nothing: a friction-net point with ``0 < t <= c`` stays one with
+    ``(c - t, 0)``. The edge form is also a second, independent way to state the
+    constraints. Coulomb's cone is not a pyramid: it lies between the inscribed and the
+    circumscribed :data:`LP_CHECK_SIDES`-sided ones, so a feasible verdict is checked
+    on the inscribed one (feasible there proves it) and an infeasible one on the
+    circumscribed one (infeasible there proves it); a structure within 2 % of its friction
+    limit gets no second opinion (None). HiGHS's interior point method decides, without
+    crossover (a vertex solution is not needed, only the verdict; crossover and the dual
+    simplex were measured slower, docs/bench.md). Proving feasibility takes far longer
+    than proving infeasibility and grows faster than linearly, hence ``time_limit``.
+
+    Returns True, False, or None when HiGHS ends without a verdict (time limit) or the
+    pyramid cannot decide for the cone.
     """
-    generators = friction_pyramid_edges(system.layout.n_vertices, system.mu)
+    if system.cone.is_polyhedral:
+        return _edges_feasible(system, system.cone, system.mu, time_limit)
+    pyramid = FrictionCone.parse(f"polygon:{LP_CHECK_SIDES}")
+    if verdict:
+        return True if _edges_feasible(system, pyramid, system.mu, time_limit) else None
+    outer_mu = system.mu / math.cos(math.pi / LP_CHECK_SIDES)
+    return False if _edges_feasible(system, pyramid, outer_mu, time_limit) is False else None
+
+
+def _edges_feasible(system, cone, mu, time_limit):
+    """Whether the pyramid ``cone`` at ``mu`` carries the dead load (:func:`_lp_feasible`):
+    True, False or None (no verdict)."""
+    generators = friction_edges(system.layout.n_vertices, cone, mu)
     A = sp.csc_array(system.A_eq @ generators)
     solver = highs_lp(A, np.zeros(A.shape[1]), np.zeros(A.shape[1]),
                       np.full(A.shape[1], highspy.kHighsInf), -system.f_ext, -system.f_ext,

@@ -390,3 +390,91 @@ def collapse_markdown(rows) -> str:
                  for c in COLLAPSE_COLUMNS]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n\n" + COLLAPSE_NOTE + "\n"
+
+
+FRICTION_MODELS = ("circle", "polygon:16", "square")
+"""The friction models :func:`friction_bench` compares by default: the exact cone (the
+default), the inscribed 16-sided pyramid, and the thesis's square pyramid (the model
+before Coulomb's)."""
+
+FRICTION_COLUMNS = ("structure", "model", "capacity_error", "rbe_s", "rbe_steps",
+                    "rbe_vs_square", "collapse_s", "collapse_iterations",
+                    "collapse_vs_square", "load_factor", "vs_circle", "solver")
+"""Columns of a friction-model bench row (:data:`FRICTION_NOTE` says what they hold)."""
+
+FRICTION_NOTE = """One row per structure and friction model (`masonry bench
+--friction-models`). `rbe_s`: the balanced RBE solve (its Newton steps in `rbe_steps`),
+`collapse_s`: the collapse LP of a lateral load at the azimuth, each a median over the
+repeats with its assembly; `*_vs_square`: the time over the square pyramid's (the model
+the project used before Coulomb's cone; the target for the default model: at most 1.5).
+`load_factor` and `vs_circle`, its relative difference from the exact cone's:
+a polygon's is below it by at most its `capacity_error`, the square's above it."""
+
+
+def friction_bench(structures, models=FRICTION_MODELS, azimuth=0.0, repeats=1,
+                   progress=None) -> list:
+    """Time and factor of every friction model (:mod:`masonry.friction`) on each
+    structure: the balanced RBE solve and the collapse LP of the lateral load at
+    ``azimuth``, side by side.
+
+    Parameters
+    ----------
+    structures : dict str -> Params
+    models : sequence of str
+        Friction model names; ``circle`` and ``square`` are measured in any case (the
+        references of ``vs_circle`` and ``*_vs_square``).
+    azimuth : float, degrees
+    repeats : int
+        Runs per row; times are medians.
+
+    Returns
+    -------
+    list of dict
+        Keys :data:`FRICTION_COLUMNS`.
+    """
+    names = list(dict.fromkeys(["circle", *models, "square"]))
+    rows = []
+    for structure, params in structures.items():
+        model = analysis_model(build(params))
+        live = lateral(model, azimuth, params.density)
+        measured = {}
+        for name in names:
+            rbe, collapse = [], []
+            for _ in range(repeats):
+                start = time.perf_counter()
+                result = RBEProblem(model.blocks, model.interfaces,
+                                    side_block=model.side_block,
+                                    side_rotation=model.side_rotation).solve(
+                    mu=params.mu, density=params.density, cone=name)
+                rbe.append(time.perf_counter() - start)
+                start = time.perf_counter()
+                lp = CollapseLP(model, mu=params.mu, density=params.density, cone=name)
+                factor = lp.solve(live, dead_load_feasible=result.feasible or None)
+                collapse.append(time.perf_counter() - start)
+            if progress:
+                progress(f"{structure}, {name}: RBE {rbe[-1]:.3g} s, collapse LP "
+                         f"{collapse[-1]:.3g} s, lambda {factor.load_factor}")
+            measured[name] = dict(rbe_s=statistics.median(rbe), rbe_steps=result.iterations,
+                                  collapse_s=statistics.median(collapse),
+                                  collapse_iterations=factor.iterations,
+                                  load_factor=factor.load_factor, solver=factor.solver,
+                                  capacity_error=lp.cone.capacity_error)
+        exact, square = measured["circle"]["load_factor"], measured["square"]
+        for name in names:
+            row = dict(structure=structure, model=name, **measured[name])
+            row["rbe_vs_square"] = row["rbe_s"] / square["rbe_s"]
+            row["collapse_vs_square"] = row["collapse_s"] / square["collapse_s"]
+            row["vs_circle"] = (None if exact is None or row["load_factor"] is None
+                                else row["load_factor"] / exact - 1.0)
+            rows.append(row)
+    return rows
+
+
+def friction_markdown(rows) -> str:
+    """A Markdown table of friction-model bench rows, and what its columns hold."""
+    lines = ["| " + " | ".join(FRICTION_COLUMNS) + " |", "|" + "---|" * len(FRICTION_COLUMNS)]
+    for row in rows:
+        cells = ["" if row[c] is None else f"{row[c]:.4g}" if isinstance(row[c], float)
+                 else str(row[c]) for c in FRICTION_COLUMNS]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n\n" + FRICTION_NOTE + "\n"

@@ -51,7 +51,7 @@ from masonry.pipeline import Timer, model_record, run_model, versions, write_cac
 from masonry.rbe.boundary import Model, restrict
 from masonry.rbe.collapse import collapse_load
 from masonry.rbe.loads import lateral
-from masonry.rbe.solve import ACCURACY, RBEProblem
+from masonry.rbe.solve import ACCURACY, RBEProblem, friction_model
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.scenes import check_size
 from masonry.tolerances import MAX_BRICKS, Tolerances
@@ -279,7 +279,7 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
                              side_rotation=part.side_rotation)
         result = problem.solve(mu=params.mu, density=params.density,
                                friction=params.friction, solver=params.solver,
-                               accuracy=params.solver_accuracy)
+                               accuracy=params.solver_accuracy, cone=params.friction_cone)
         floor = ACCURACY[params.solver_accuracy].residual * result.weight_N / row["bricks"]
         row.update(feasible=result.feasible, moi=_number(result.moi),
                    moi_factor=_number(result.moi_factor),
@@ -325,6 +325,7 @@ def stage_load_factor(part: Model, params) -> float | None:
         return None
     live = lateral(part, params.lateral, params.density)
     result = collapse_load(part, live, mu=params.mu, density=params.density,
+                           cone=friction_model(params.solver_accuracy, params.friction_cone),
                            friction=params.friction_law, dead_load_feasible=True)
     return result.load_factor
 

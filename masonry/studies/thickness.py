@@ -53,7 +53,8 @@ def is_feasible(params: Params) -> bool:
     scene = build_arch(params)
     interfaces = detect(scene.blocks, up=scene.block_up)
     result = solve_rbe(scene.blocks, interfaces, mu=params.mu, density=params.density,
-                       friction="net", solver=params.solver, lp_check=False)
+                       friction="net", solver=params.solver, cone=params.friction_cone,
+                       lp_check=False)
     return bool(result.feasible)
 
 

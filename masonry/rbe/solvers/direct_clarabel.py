@@ -1,8 +1,8 @@
 """Clarabel (interior point, homogeneous embedding) on the standard form, without cvxpy.
 
 Clarabel writes constraints as ``A x + s = b, s in K``: the equilibrium rows are a zero
-cone, the friction and ``t >= 0`` rows a nonnegative cone (``t`` enters as ``-t + s =
-0``). One solver per scene; friction+ and other friction coefficients update the matrix
+cone, a pyramid's friction rows a nonnegative cone and Coulomb's cone a second-order
+cone per vertex, the ``t >= 0`` rows a nonnegative cone (``t`` enters as ``-t + s = 0``). One solver per scene; friction+ and other friction coefficients update the matrix
 values in place, which keeps Clarabel's KKT ordering (data updates need presolve off;
 presolve only drops rows with infinite bounds, and this problem has none).
 """
@@ -50,8 +50,13 @@ def solve(system, method, options, workspace) -> QPOutcome:
         matrix = form.rows.copy()
         matrix.data = values
         b = np.concatenate([form.b, np.zeros(form.n_friction + form.n_tension)])
-        cones = [clarabel.ZeroConeT(form.n_eq),
-                 clarabel.NonnegativeConeT(form.n_friction + form.n_tension)]
+        if form.cone.is_polyhedral:
+            cones = [clarabel.ZeroConeT(form.n_eq),
+                     clarabel.NonnegativeConeT(form.n_friction + form.n_tension)]
+        else:
+            cones = [clarabel.ZeroConeT(form.n_eq),
+                     *[clarabel.SecondOrderConeT(3)] * (form.n_friction // 3),
+                     clarabel.NonnegativeConeT(form.n_tension)]
         solver = clarabel.DefaultSolver(form.P, np.zeros(form.P.shape[0]), matrix, b,
                                         cones, settings)
         workspace.update(solver=solver, options=options, values=values)

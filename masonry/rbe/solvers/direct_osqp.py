@@ -1,6 +1,7 @@
 """OSQP (ADMM, the thesis's solver) on the standard form, without cvxpy.
 
-One OSQP object per scene: friction-net, friction+ and other friction coefficients only
+OSQP takes linear constraints: the pyramids (``polygon:K``, ``square``), not Coulomb's
+cone. One OSQP object per scene: friction-net, friction+ and other friction coefficients only
 change matrix values, so later solves update them in place (OSQP refactors numerically,
 reusing its ordering) and warm start from the last solution of the same model.
 """
@@ -35,6 +36,9 @@ def solve(system, method, options, workspace) -> QPOutcome:
     """One OSQP solve; ``options`` are OSQP settings, ``workspace`` a dict kept per scene."""
     import osqp
 
+    if not system.cone.is_polyhedral:
+        raise ValueError(f"OSQP takes linear constraints only: the friction model "
+                         f"{system.cone} needs another solver, or a polygon:K model")
     start = time.perf_counter()
     form = kept_form(system, workspace)
     values = form.values(method, system.mu)

@@ -3,29 +3,33 @@
 The collapse LP of :mod:`masonry.rbe.collapse`, in the scaled rows of
 :mod:`masonry.rbe.equilibrium`::
 
-    maximize lambda   subject to   M g + lambda l = b,   g >= 0
+    maximize lambda   subject to   M g + lambda l = b,   g in K
 
-``b = -f_dead``, ``l`` the live load, ``M = A E``: ``A`` the equilibrium matrix over the
+``b = -f_dead``, ``l`` the live load, ``M = A T``: ``A`` the equilibrium matrix over the
 vertex forces ``(c, f1, f2)`` (the friction-net columns of
-:class:`~masonry.rbe.solvers.newton.NewtonSystem`) and ``E`` the four edge rays
-``(1, +-mu, +-mu)`` of every vertex's friction pyramid. Its dual::
+:class:`~masonry.rbe.solvers.newton.NewtonSystem`) and ``T`` the map from every vertex's
+cone variables ``g`` to its force (:class:`ConeVariables`): for a pyramid, its ``K`` edge
+rays (``g >= 0`` their weights), for Coulomb's cone ``diag(1 / mu, 1, 1)`` (``g = (mu c,
+f1, f2)`` in the second-order cone). Its dual::
 
-    minimize -b^T y   subject to   s = -M^T y >= 0,   l^T y = -1
+    minimize -b^T y   subject to   s = -M^T y in K,   l^T y = -1
 
 ``y`` is the collapse mechanism (a virtual motion of every block) and ``s`` the work of
-every edge ray on it: ``s >= 0`` is the associated flow rule, no interface penetrates.
+the vertex forces on it: ``s`` in the (self-dual) cone is the associated flow rule, the
+relative motion at every vertex lies in the normal cone of the friction model, so no
+interface penetrates.
 
 Mehrotra's predictor-corrector (S. Mehrotra, SIAM J. Optim. 2, 1992; S. Wright,
 *Primal-Dual Interior-Point Methods*, SIAM 1997, ch. 10) with separate primal and dual
-step lengths, and Gondzio's multiple centrality correctors (J. Gondzio, Comput. Optim.
-Appl. 6, 1996): a few products ``g s`` far from the target stop the corrector's steps
-short, and further solves with the same factor move them back. Every iteration solves
-the normal equations ::
+step lengths and Nesterov-Todd scaling (:mod:`.cones`), and for the pyramids Gondzio's
+multiple centrality correctors (J. Gondzio, Comput. Optim. Appl. 6, 1996): a few products
+``g s`` far from the target stop the corrector's steps short, and further solves with
+the same factor move them back. Every iteration solves the normal equations ::
 
-    M D M^T dy = r,   D = diag(g / s)
+    M D M^T dy = r,   D = W^2 (diag(g / s) for the rays)
 
-``M D M^T = A (E D E^T) A^T`` has one 3 x 3 block ``E D E^T`` per vertex, so it is the
-Newton method's matrix ``A J A^T`` (six rows per free block) with ``J = E D E^T``: the
+``M D M^T = A (T D T^T) A^T`` has one 3 x 3 block ``T D T^T`` per vertex, so it is the
+Newton method's matrix ``A J A^T`` (six rows per free block) with ``J = T D T^T``: the
 same :class:`~masonry.rbe.solvers.cholesky.BlockCholesky` symbolic analysis factors it.
 The live load's column touches every loaded block; it stays out of the factor
 (``lambda`` is eliminated by a second solve with ``l``, a bordered system). A general
@@ -43,9 +47,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.rbe.equilibrium import friction_pyramid_edges
 from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
-from masonry.rbe.solvers.interior import centred_start, max_step
+from masonry.rbe.solvers.cones import Lorentz, Orthant, centred_start
 from masonry.rbe.solvers.newton import NewtonSystem, one_blas_thread
 
 log = logging.getLogger(__name__)
@@ -68,8 +71,11 @@ class LoadFactorOptions:
         within the gap of the primal one while the primal rows hold. The residual is
         recomputed and reported with every collapse result.
     max_iter : int
+        Iterations before the method gives up (Clarabel then decides). The pyramids'
+        many edge rays make the LP degenerate: a 16-sided pyramid took 111 iterations
+        on preset 1's full dome, the cone and the square about 50.
     step_fraction : float
-        Fraction of the largest step to the boundary of ``g, s >= 0`` that is taken.
+        Fraction of the largest step to the boundary of the cone that is taken.
     regularization : float
         Shift of the normal matrix relative to its mean diagonal. Near the optimum
         ``D`` spans 20 decades and the mean is set by its largest entries: a shift of
@@ -85,7 +91,7 @@ class LoadFactorOptions:
 
     tol: float = 1e-8
     primal_tol: float = 1e-5
-    max_iter: int = 100
+    max_iter: int = 200
     step_fraction: float = 0.99
     regularization: float = 1e-16
     min_step: float = 1e-6
@@ -113,21 +119,42 @@ REGULARIZATION_RAISES = 3
 factor each time."""
 
 
-def pyramid_rays(mu) -> np.ndarray:
-    """``E_v`` ((3, 4) float): the edge rays of a vertex's friction pyramid as columns, in
-    ``(c, f1, f2)`` and in the order of
-    :func:`~masonry.rbe.equilibrium.friction_pyramid_edges`."""
-    return friction_pyramid_edges(1, mu).toarray()[[0, 2, 3]]
+class ConeVariables:
+    """The LP's unknowns at every vertex and the forces they make: ``x_v = T g_v`` with
+    ``g_v`` in :attr:`cone` (module docstring), from the friction model and ``mu`` of the
+    friction-net :class:`~masonry.rbe.solvers.newton.NewtonSystem` ``ns``."""
 
+    def __init__(self, ns: NewtonSystem):
+        self.ns = ns
+        if ns.cone.is_polyhedral:
+            self.T = ns.cone.rays(ns.mu)                     # (3, K) edge rays
+            self.cone = Orthant(self.T.shape[1])
+            self._rays = _RayProducts(ns, self.T)
+        else:
+            self.T = np.diag([1.0 / ns.mu, 1.0, 1.0])        # g = (mu c, f1, f2)
+            self.cone = Lorentz()
+            self._rays = None
 
-def times_m(ns: NewtonSystem, rays, g) -> np.ndarray:
-    """``M g`` ((6 F,)): the loads the edge ray weights ``g`` ((IV, 4)) balance."""
-    return ns.A @ (g @ rays.T).ravel()
+    @property
+    def shape(self) -> tuple:
+        """``(IV, m)``: the shape of ``g`` and ``s``."""
+        return len(self.ns.h), self.cone.m
 
+    def times_m(self, g) -> np.ndarray:
+        """``M g`` ((6 F,)): the loads the cone variables ``g`` ((IV, m)) balance."""
+        return self.ns.A @ (g @ self.T.T).ravel()
 
-def times_mt(ns: NewtonSystem, rays, y) -> np.ndarray:
-    """``M^T y`` ((IV, 4)): the work of every edge ray on the motion ``y`` ((6 F,))."""
-    return (ns.AT @ y).reshape(-1, 3) @ rays
+    def times_mt(self, y) -> np.ndarray:
+        """``M^T y`` ((IV, m)): the work of every vertex's unknowns on the motion ``y``."""
+        return (self.ns.AT @ y).reshape(-1, 3) @ self.T
+
+    def normal_sums(self, scaling) -> np.ndarray:
+        """(K, 144): the interfaces' blocks of ``M W^2 M^T`` (the Newton system's
+        :meth:`~masonry.rbe.solvers.newton.NewtonSystem.interface_sums` with ``J_v = T
+        W_v^2 T^T``; for the rays, by :class:`_RayProducts`)."""
+        if self._rays is not None:
+            return self._rays.sums(scaling.d)
+        return self.ns.interface_sums(self.T @ scaling.D @ self.T.T)
 
 
 class _RayProducts:
@@ -139,11 +166,10 @@ class _RayProducts:
     to call (fresh ones fault their pages in every time; docs/bench.md)."""
 
     def __init__(self, ns: NewtonSystem, rays):
-        self.rays = rays
         self.out = np.zeros((ns.n_interfaces, 12, 12))
         self.groups = []
         for faces, vertices, left in ns.groups:
-            # (F, 12, n, 3) coefficients times the rays: (F, 12, 4 n), vertex by vertex
+            # (F, 12, n, 3) coefficients times the rays: (F, 12, K n), vertex by vertex
             columns = (left.reshape(len(faces), 12, -1, ns.width) @ rays).reshape(
                 len(faces), 12, -1)
             rows = np.ascontiguousarray(columns.transpose(0, 2, 1))
@@ -151,7 +177,7 @@ class _RayProducts:
                                 np.empty((len(faces), 12, 12))))
 
     def sums(self, d) -> np.ndarray:
-        """(K, 144) float: the interfaces' blocks for ``d`` ((IV, 4)), valid until the
+        """(K, 144) float: the interfaces' blocks for ``d`` ((IV, K)), valid until the
         next call."""
         for faces, vertices, rows, columns, scaled, product in self.groups:
             weights = d[vertices].reshape(len(faces), 1, -1)
@@ -160,18 +186,34 @@ class _RayProducts:
         return self.out.reshape(-1, 144)
 
 
+class _Unit:
+    """The scaling ``W = I`` of the starting point (least-norm ``g`` and ``s``)."""
+
+    def __init__(self, shape, cone):
+        self.d = np.ones(shape)
+        self.D = np.broadcast_to(np.eye(3), (shape[0], 3, 3))
+        self.lam = cone.identity(shape[0])
+
+    @staticmethod
+    def times_w(v):
+        return v
+
+    times_w_inverse = times_w2 = times_w
+
+
 class _Normal:
-    """The normal equations at one interior point: ``K = M D M^T`` factored once, the
+    """The normal equations at one interior point: ``K = M W^2 M^T`` factored once, the
     live load's solve ``K^-1 l`` made with the first direction's and kept for the
     others of the iteration."""
 
-    def __init__(self, ns: NewtonSystem, products: _RayProducts, d, regularization, load):
-        self.ns, self.rays, self.d, self.load = ns, products.rays, d, load
-        matrix = ns.scatter_sums(products.sums(d), 0.0)
+    def __init__(self, variables: ConeVariables, scaling, regularization, load):
+        ns = variables.ns
+        self.variables, self.scaling, self.load = variables, scaling, load
+        matrix = ns.scatter_sums(variables.normal_sums(scaling), 0.0)
         diagonal = matrix[ns.diagonal_blocks]
         scale = float(np.mean(np.trace(diagonal, axis1=1, axis2=2))) / 6.0
-        # near the optimum D spans many decades and K is singular to working precision
-        # where no edge ray of a block carries force: a shift relative to K's diagonal,
+        # near the optimum W^2 spans many decades and K is singular to working precision
+        # where no vertex of a block carries force: a shift relative to K's diagonal,
         # raised until the factorization succeeds (the primal passes of refine()
         # recover the digits it costs)
         for attempt in range(REGULARIZATION_RAISES + 1):
@@ -196,36 +238,33 @@ class _Normal:
         self.v, self.lv = both[:, 1], float(self.load @ both[:, 1])
         return both[:, 0]
 
-    def times_m(self, g):
-        return times_m(self.ns, self.rays, g)
-
-    def times_mt(self, y):
-        return times_mt(self.ns, self.rays, y)
-
-    def direction(self, r_primal, r_dual, r_factor, r_comp, g, s):
+    def direction(self, r_primal, r_dual, r_factor, r_comp):
         """Newton direction for the residuals ``M g + lambda l - b``, ``M^T y + s``,
-        ``l^T y + 1`` and the complementarity target ``g s - r_comp`` (elementwise):
+        ``l^T y + 1`` and the scaled complementarity ``lam o (W^-1 dg + W ds) = -r_comp``:
         ``(dg, dlambda, dy, ds)``."""
-        rhs = -r_primal + self.times_m(r_comp / s - self.d * r_dual)
+        scaling, variables = self.scaling, self.variables
+        wq = scaling.times_w(-variables.cone.divide(scaling.lam, r_comp))
+        rhs = -r_primal - variables.times_m(wq + scaling.times_w2(r_dual))
         dy, d_factor = self._bordered(rhs, float(r_factor))
-        ds = -r_dual - self.times_mt(dy)
-        return -r_comp / s - self.d * ds, d_factor, dy, ds
+        ds = -r_dual - variables.times_mt(dy)
+        return wq - scaling.times_w2(ds), d_factor, dy, ds
 
     def refine(self, direction, r_primal, floor):
         """``direction`` after up to :data:`PRIMAL_PASSES` passes that solve for what it
-        leaves of the primal rows (``D`` amplifies the errors of ``dy`` in ``dg``), while
+        leaves of the primal rows (``W^2`` amplifies the errors of ``dy`` in ``dg``), while
         that is above :data:`PASS_RATIO` of their residual and above ``floor``; the
-        correction ``D M^T dy'`` keeps the other rows exact, as ``S D = G``."""
+        correction ``W^2 M^T dy'`` keeps the other rows exact."""
         dg, d_factor, dy, ds = direction
+        variables = self.variables
         bound = max(PASS_RATIO * np.abs(r_primal).max(), floor)
         for _ in range(PRIMAL_PASSES):
-            left = self.times_m(dg) + d_factor * self.load + r_primal
+            left = variables.times_m(dg) + d_factor * self.load + r_primal
             if np.abs(left).max() <= bound:
                 break
             correction, d_extra = self._bordered(-left, 0.0)
             dy, d_factor = dy + correction, d_factor + d_extra
-            correction = self.times_mt(correction)
-            dg, ds = dg + self.d * correction, ds - correction
+            correction = variables.times_mt(correction)
+            dg, ds = dg + self.scaling.times_w2(correction), ds - correction
         return dg, d_factor, dy, ds
 
     def _bordered(self, rhs, r_factor):
@@ -235,14 +274,14 @@ class _Normal:
         return u - d_factor * self.v, d_factor
 
 
-def _start(ns, products, load, regularization):
+def _start(variables, load, regularization):
     """Mehrotra's starting point: the least-norm ``g`` with ``M g = b`` (``lambda = 0``),
     the least-norm dual slacks ``s = -M^T y`` with ``l^T y = -1``, both shifted inside
-    the orthant and balanced (:func:`~masonry.rbe.solvers.interior.centred_start`)."""
-    unit = _Normal(ns, products, np.ones((len(ns.h), 4)), regularization, load)
-    g = unit.times_mt(unit.solve(ns.b))
+    the cone and balanced (:func:`centred_start`)."""
+    unit = _Normal(variables, _Unit(variables.shape, variables.cone), regularization, load)
+    g = variables.times_mt(unit.solve(variables.ns.b))
     y = -unit.v / unit.lv
-    g, s = centred_start(g, -unit.times_mt(y))
+    (g,), (s,) = centred_start([variables.cone], [g], [-variables.times_mt(y)])
     return g, y, s
 
 
@@ -250,7 +289,8 @@ def _start(ns, products, load, regularization):
 def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
                 stop=None) -> QPOutcome:
     """The largest ``lambda`` of the collapse LP (module docstring) on the friction-net
-    system ``ns``, for the live load ``load`` ((6 F,) float, scaled rows).
+    system ``ns`` (its friction model and ``mu``), for the live load ``load`` ((6 F,)
+    float, scaled rows).
 
     Parameters
     ----------
@@ -264,23 +304,22 @@ def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
     Returns
     -------
     QPOutcome
-        ``x`` the edge rays' weights ``g`` ((IV, 4), scaled), ``y`` the mechanism (the
-        equilibrium rows' multipliers), ``info["load_factor"]`` and
-        ``info["dual_bound"]`` (``-b^T y``: with exact dual rows, an upper bound of the factor);
-        status ``optimal``, ``user_limit`` (no optimum found: see the module docstring)
-        or ``solver_error``.
+        ``x`` the vertex forces ``T g`` ((IV, 3): ``c, f1, f2``, scaled), ``y`` the
+        mechanism (the equilibrium rows' multipliers), ``info["load_factor"]`` and
+        ``info["dual_bound"]`` (``-b^T y``: with exact dual rows, an upper bound of the
+        factor); status ``optimal``, ``user_limit`` (no optimum found: see the module
+        docstring) or ``solver_error``.
     """
     start = time.perf_counter()
     if rhs is not None:
         ns = ns.with_rhs(rhs)
     load = np.asarray(load, dtype=float)
-    products = _RayProducts(ns, pyramid_rays(ns.mu))
-    rays = products.rays
+    variables = ConeVariables(ns)
     scale = max(np.abs(ns.b).max(), np.abs(load).max())
-    g, y, s = _start(ns, products, load, options.regularization)
+    g, y, s = _start(variables, load, options.regularization)
     factor, status, iterations, stopped = 0.0, USER_LIMIT, 0, False
     for iterations in range(options.max_iter + 1):
-        residuals = _residuals(ns, rays, load, g, y, s, factor)
+        residuals = _residuals(variables, load, g, y, s, factor)
         if stop is not None and stop(factor, g, y):
             stopped = True
             break
@@ -290,7 +329,8 @@ def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
         if iterations == options.max_iter:
             break
         try:
-            normal = _Normal(ns, products, g / s, options.regularization, load)
+            normal = _Normal(variables, variables.cone.scaling(g, s),
+                             options.regularization, load)
         except np.linalg.LinAlgError as error:
             log.warning("collapse LP: normal equations not positive definite: %s", error)
             status = SOLVER_ERROR
@@ -308,17 +348,18 @@ def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
                   np.abs(residuals[0]).max() / scale,
                   np.abs(residuals[1]).max() / max(residuals[3], 1.0), abs(residuals[2]),
                   float(g.ravel() @ s.ravel()), primal, dual)
-    return QPOutcome(status=status, x=g, iterations=iterations, y=y,
+    return QPOutcome(status=status, x=g @ variables.T.T, iterations=iterations, y=y,
                      solve_time=time.perf_counter() - start,
                      info={"factorizations": iterations + 1, "load_factor": factor,
-                           "dual_bound": -float(ns.b @ y), "stopped": stopped})
+                           "dual_bound": -float(ns.b @ y), "stopped": stopped,
+                           "cone_variables": g})
 
 
-def _residuals(ns, rays, load, g, y, s, factor):
+def _residuals(variables, load, g, y, s, factor):
     """``(M g + lambda l - b, M^T y + s, l^T y + 1, |M^T y|_inf)``."""
-    mty = times_mt(ns, rays, y)
-    return (times_m(ns, rays, g) + factor * load - ns.b, mty + s, float(load @ y) + 1.0,
-            float(np.abs(mty).max()))
+    mty = variables.times_mt(y)
+    return (variables.times_m(g) + factor * load - variables.ns.b, mty + s,
+            float(load @ y) + 1.0, float(np.abs(mty).max()))
 
 
 def _converged(residuals, g, s, factor, scale, options) -> bool:
@@ -331,23 +372,28 @@ def _converged(residuals, g, s, factor, scale, options) -> bool:
 
 
 def _mehrotra(normal, residuals, g, s, floor, options):
-    """Predictor (affine scaling), Mehrotra's corrector and Gondzio's centrality
-    correctors, all with the same factor: ``((primal step, dual step), (dg, dlambda,
-    dy, ds))``."""
-    gap = float(g.ravel() @ s.ravel()) / g.size
-    dg, _, _, ds = normal.direction(*residuals, g * s, g, s)
-    primal, dual = _steps(g, s, dg, ds)
-    predicted = float((g + primal * dg).ravel() @ (s + dual * ds).ravel()) / g.size
+    """Predictor (affine scaling), Mehrotra's corrector and, on the orthant, Gondzio's
+    centrality correctors, all with the same factor: ``((primal step, dual step), (dg,
+    dlambda, dy, ds))``."""
+    cone, scaling = normal.variables.cone, normal.scaling
+    count = len(g) * cone.degree
+    gap = float(g.ravel() @ s.ravel()) / count
+    lam_square = cone.product(scaling.lam, scaling.lam)
+    dg, _, _, ds = normal.direction(*residuals, lam_square)
+    primal, dual = _steps(cone, g, s, dg, ds)
+    predicted = float((g + primal * dg).ravel() @ (s + dual * ds).ravel()) / count
     target = (predicted / gap) ** 3 * gap
-    r_comp = g * s + dg * ds - target
-    direction = normal.direction(*residuals, r_comp, g, s)
-    steps = _steps(g, s, direction[0], direction[3])
+    r_comp = (lam_square + cone.product(scaling.times_w_inverse(dg), scaling.times_w(ds))
+              - target * cone.identity(len(g)))
+    direction = normal.direction(*residuals, r_comp)
+    steps = _steps(cone, g, s, direction[0], direction[3])
     log.debug("  affine %.3f %.3f sigma %.2e, corrector %.3f %.3f", primal, dual,
               target / gap, *steps)
-    direction = _centrality_correctors(normal, residuals, g, s, r_comp, target,
-                                       direction, steps, options.correctors)
+    if isinstance(cone, Orthant):
+        direction = _centrality_correctors(normal, residuals, g, s, r_comp, target,
+                                           direction, steps, options.correctors)
     direction = normal.refine(direction, residuals[0], floor)
-    steps = _steps(g, s, direction[0], direction[3])
+    steps = _steps(cone, g, s, direction[0], direction[3])
     return tuple(options.step_fraction * step for step in steps), direction
 
 
@@ -357,13 +403,14 @@ def _centrality_correctors(normal, residuals, g, s, r_comp, target, direction, s
     ``steps``): each moves the products ``g s`` of the point that a longer step would
     reach into ``[BOX[0], BOX[1]] x target``, and is kept while it lengthens the
     shorter step by :data:`ACCEPT` x :data:`ASPIRATION` at least."""
+    cone = normal.variables.cone
     for _ in range(count):
         aspired = [min(1.0, step + ASPIRATION) for step in steps]
         products = (g + aspired[0] * direction[0]) * (s + aspired[1] * direction[3])
         push = np.clip(products, BOX[0] * target, BOX[1] * target) - products
         push = np.maximum(push, -BOX[1] * target)
-        trial = normal.direction(*residuals, r_comp - push, g, s)
-        trial_steps = _steps(g, s, trial[0], trial[3])
+        trial = normal.direction(*residuals, r_comp - push)
+        trial_steps = _steps(cone, g, s, trial[0], trial[3])
         log.debug("  centrality corrector %.3f %.3f", *trial_steps)
         if min(trial_steps) < min(steps) + ACCEPT * ASPIRATION:
             return trial if min(trial_steps) > min(steps) else direction
@@ -371,6 +418,6 @@ def _centrality_correctors(normal, residuals, g, s, r_comp, target, direction, s
     return direction
 
 
-def _steps(g, s, dg, ds):
-    """The largest steps ``<= 1`` that keep ``g`` and ``s`` nonnegative."""
-    return max_step(g.ravel(), dg.ravel()), max_step(s.ravel(), ds.ravel())
+def _steps(cone, g, s, dg, ds):
+    """The largest steps ``<= 1`` that keep ``g`` and ``s`` in the cone."""
+    return cone.max_step(g, dg), cone.max_step(s, ds)

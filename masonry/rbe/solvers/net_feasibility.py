@@ -1,37 +1,41 @@
 """Friction-net feasibility decided by a load-path LP on the Newton method's matrix.
 
-Friction-net is feasible when the dead load is carried by edge rays of the friction
-pyramids alone: ``M g = b`` for some ``g >= 0`` (``M = A E`` and ``b`` as in
-:mod:`masonry.rbe.solvers.interior_lp`). A reference load that is surely carried,
-``r = M g0`` with ``g0 = 1`` (every edge ray at unit weight), is moved towards ``b``::
+Friction-net is feasible when the dead load is carried by vertex forces within the
+friction model alone: ``M g = b`` for some ``g`` in the cone ``K`` (``M = A T`` and ``b``
+as in :mod:`masonry.rbe.solvers.interior_lp`). A reference load that is surely carried,
+``r = M g0`` with ``g0 = e`` the cone's identity (every edge ray of a pyramid at unit
+weight; a normal force and no friction at every vertex of Coulomb's cone), is moved
+towards ``b``::
 
-    maximize lambda   subject to   M g = r + lambda (b - r),   g >= 0
+    maximize lambda   subject to   M g = r + lambda (b - r),   g in K
 
 which is the collapse LP of :func:`~masonry.rbe.solvers.interior_lp.load_factor` with
 right-hand side ``r`` and live load ``l = r - b``. ``lambda = 0`` is feasible (``g0``),
 so the LP is never infeasible:
 
-- ``lambda >= 1``: ``g' = g / lambda + (1 - 1 / lambda) g0 >= 0`` has ``M g' = b``, a
-  friction-net point. Its residual is recomputed here: within the QP's acceptance
+- ``lambda >= 1``: ``g' = g / lambda + (1 - 1 / lambda) g0`` (in ``K``) has ``M g' =
+  b``, a friction-net point. Its residual is recomputed here: within the QP's acceptance
   residual the verdict is ``feasible``, else (the iterate's primal rows not yet met)
   ``likely feasible``, which proves nothing but tells the caller that a certificate is
   not coming soon (near the threshold it would take as many iterations again).
-- an optimum below 1: the dual point has ``M^T y <= 0`` and ``b^T y = r^T y + 1 > 0``
-  (``l^T y = -1``, and ``-r^T y`` bounds ``lambda``), a Farkas certificate: no ``g >=
-  0`` has ``M g = b``.
+- an optimum below 1: the dual point has ``-M^T y`` in ``K`` and ``b^T y = r^T y + 1 >
+  0`` (``l^T y = -1``, and ``-r^T y`` bounds ``lambda``), a Farkas certificate: no ``g``
+  in ``K`` has ``M g = b``.
 
 The interior point method stops at the first iterate that decides either way (it need
 not converge; the LP is unbounded when ``b - r`` itself is carried, and the stop at
 ``lambda >= 1`` comes first). The certificate is checked on ``M^T y`` and ``b^T y``
-recomputed from the matrices, with the margins the QP's acceptance allows: for
-``M g = b + e``, ``g >= 0``, ``b^T y <= ||g||_1 max(M^T y)_+ + ||e||_inf ||y||_1``. So
-when
+recomputed from the matrices, with the margins the QP's acceptance allows. Let
+``delta`` be how far ``-M^T y`` lies outside ``K`` (its most negative eigenvalue: the
+largest entry of ``M^T y`` for the orthant of a pyramid's rays); then for ``M g = b +
+e``, ``g`` in ``K``, ``b^T y <= tr(g) delta + ||e||_inf ||y||_1`` (``tr(g) = e . g``:
+the sum of the ray weights, or of ``mu c``). So when
 
-    max(M^T y)_+ ||b||_1 / infeasibility_tol + residual ||b||_inf ||y||_1 < b^T y
+    delta ||b||_1 / infeasibility_tol + residual ||b||_inf ||y||_1 < b^T y
 
-no edge weights with ``||g||_1`` (the sum of the normal forces, in reference weights) up
-to ``||b||_1 / infeasibility_tol`` balance the loads within the relative residual
-``residual``: the Newton method's certificate
+no vertex forces with ``tr(g)`` (of the order of the sum of the normal forces, in
+reference weights) up to ``||b||_1 / infeasibility_tol`` balance the loads within the
+relative residual ``residual``: the Newton method's certificate
 (:func:`~masonry.rbe.solvers.newton.certifies_infeasibility`), plus the residual margin
 of an accepted point. Without either verdict the outcome is ``user_limit`` and the
 caller asks another solver.
@@ -48,8 +52,7 @@ import time
 import numpy as np
 
 from masonry.rbe.solvers.base import INFEASIBLE, USER_LIMIT, QPOutcome
-from masonry.rbe.solvers.interior_lp import (LoadFactorOptions, load_factor, pyramid_rays,
-                                             times_m, times_mt)
+from masonry.rbe.solvers.interior_lp import ConeVariables, LoadFactorOptions, load_factor
 from masonry.rbe.solvers.newton import NewtonSystem
 
 log = logging.getLogger(__name__)
@@ -64,9 +67,10 @@ class _LoadPath:
 
     def __init__(self, ns: NewtonSystem, infeasibility_tol, residual):
         self.ns, self.infeasibility_tol, self.residual = ns, infeasibility_tol, residual
-        self.rays = pyramid_rays(ns.mu)
-        self.start = np.ones((len(ns.h), len(self.rays.T)))
-        self.reference = times_m(ns, self.rays, self.start)
+        self.variables = ConeVariables(ns)
+        cone = self.variables.cone
+        self.start = cone.identity(len(ns.h))
+        self.reference = self.variables.times_m(self.start)
         self.b_inf, self.b_one = np.abs(ns.b).max(), np.abs(ns.b).sum()
         self.verdict, self.quality = UNDECIDED, np.inf
         self.point, self.point_error = None, np.nan
@@ -86,7 +90,7 @@ class _LoadPath:
 
     def point_residual(self, g) -> float:
         """``||M g - b||_inf / ||b||_inf``."""
-        return float(np.abs(times_m(self.ns, self.rays, g) - self.ns.b).max() / self.b_inf)
+        return float(np.abs(self.variables.times_m(g) - self.ns.b).max() / self.b_inf)
 
     def certificate_quality(self, y) -> float:
         """The left side of the certificate's test (module docstring) over ``b^T y``:
@@ -94,10 +98,16 @@ class _LoadPath:
         gain = float(self.ns.b @ y)
         if gain <= 0:
             return np.inf
-        excess = max(float(times_mt(self.ns, self.rays, y).max()), 0.0)
+        work = -self.variables.times_mt(y)
+        excess = max(-float(self.variables.cone.min_eigenvalue(work).min()), 0.0)
         bound = (excess * self.b_one / self.infeasibility_tol
                  + self.residual * self.b_inf * float(np.abs(y).sum()))
         return bound / gain
+
+    def forces(self) -> np.ndarray | None:
+        """(IV, 3) float: the vertex forces ``(c, f1, f2)`` of the feasible point, scaled;
+        None without one."""
+        return None if self.point is None else self.point @ self.variables.T.T
 
 
 OPTIONS = LoadFactorOptions(correctors=1)
@@ -124,9 +134,9 @@ def decide(ns: NewtonSystem, infeasibility_tol, residual, options=OPTIONS) -> QP
     QPOutcome
         ``x`` None (the LP's point is not the QP's optimum). Status ``infeasible`` with
         ``y`` the certificate, else ``user_limit``. ``info``: ``verdict`` (``feasible``,
-        ``likely feasible``, ``infeasible`` or ``undecided``), ``weights`` (the edge
-        weights ``g'`` ((IV, 4), scaled) of a (likely) feasible verdict, else None),
-        ``residual`` (their ``||M g' - b||_inf / ||b||_inf``, else NaN),
+        ``likely feasible``, ``infeasible`` or ``undecided``), ``forces`` (the vertex
+        forces ``(c, f1, f2)`` ((IV, 3), scaled) of a (likely) feasible verdict, else
+        None), ``residual`` (their ``||A x - b||_inf / ||b||_inf``, else NaN),
         ``certificate_quality`` (the last iterate's, see
         :meth:`_LoadPath.certificate_quality`), ``load_factor``.
     """
@@ -142,7 +152,8 @@ def decide(ns: NewtonSystem, infeasibility_tol, residual, options=OPTIONS) -> QP
         iterations=outcome.iterations,
         y=outcome.y if path.verdict == INFEASIBLE else None,
         solve_time=time.perf_counter() - start,
-        info={"verdict": path.verdict, "weights": path.point, "residual": path.point_error,
+        info={"verdict": path.verdict, "forces": path.forces(),
+              "residual": path.point_error,
               "certificate_quality": path.quality,
               "load_factor": outcome.info["load_factor"],
               "factorizations": outcome.info["factorizations"]})

@@ -5,10 +5,11 @@ The thesis's QP (eq. 3.27, SPEC 6.5), scaled as in :mod:`masonry.rbe.equilibrium
     minimize 1/2 x^T H x   subject to   A x = b,   x in K
 
 where ``b = -f_ext`` and ``K`` is a product of one small cone per interface vertex:
-the friction pyramid ``|f1|, |f2| <= mu c`` on ``(c, f1, f2)``, times ``t >= 0`` for
-friction+. friction-net (``|f| <= mu (c - t)``) has ``t = 0`` at its optimum: any point
-with ``t > 0`` stays feasible with ``(c - t, 0)`` in place of ``(c, t)`` (same force,
-same pyramid) and has a smaller objective, so it is solved without ``t``.
+the friction model on ``(c, f1, f2)`` (:class:`~masonry.friction.FrictionCone`:
+Coulomb's cone ``||(f1, f2)|| <= mu c`` or a pyramid), times ``t >= 0`` for friction+.
+friction-net (friction within the model at ``c - t``) has ``t = 0`` at its optimum: any
+point with ``t > 0`` stays feasible with ``(c - t, 0)`` in place of ``(c, t)`` (same
+force, same cone) and has a smaller objective, so it is solved without ``t``.
 
 Its dual is unconstrained, concave and once differentiable::
 
@@ -21,8 +22,10 @@ entry per equilibrium row (six per free block: a virtual displacement and rotati
 generalized Hessian ``-(A J A^T + eps I)``, ``J`` the Jacobian of the projection
 (block-diagonal, one 3 x 3 or 4 x 4 block per vertex), factored by
 :class:`masonry.rbe.solvers.cholesky.BlockCholesky` on the contact graph; a backtracking
-(Armijo) line search on ``g`` globalizes them. Once the set of active pyramid faces is
-found the step is exact, so the method ends with residuals near rounding.
+(Armijo) line search on ``g`` globalizes them. A pyramid's projection is piecewise
+linear: once the set of active faces is found the step is exact. The cone's projection
+is strongly semismooth (its Jacobian varies smoothly on the cone's surface), so the
+steps converge quadratically instead; both end with residuals near rounding.
 
 Why: an interior point solver (Clarabel) factors the whole KKT system, one row per
 unknown and constraint (790,000 rows on preset 1's full dome), at every iteration, and
@@ -126,60 +129,6 @@ class NewtonOptions:
     damping_ceiling: float = 1e-2
 
 
-def project_pyramid(p, mu):
-    """Euclidean projection onto ``{(c, f1, f2) : |f1|, |f2| <= mu c}`` and its Jacobian.
-
-    Parameters
-    ----------
-    p : (V, 3) float
-        Points ``(c, f1, f2)``.
-    mu : float
-
-    Returns
-    -------
-    x : (V, 3) float
-        Projections.
-    jacobian : (V, 3, 3) float
-        An element of the generalized Jacobian: identity inside, the projector onto the
-        face or the edge where the projection lands, zero at the apex.
-    """
-    c = p[:, 0]
-    sign = np.where(p[:, 1:] >= 0, 1.0, -1.0)
-    # by symmetry work with |f1|, |f2|; the signs are put back on the faces' normals
-    a, b = np.abs(p[:, 1]), np.abs(p[:, 2])
-    norm = 1.0 + mu * mu
-    x = np.zeros_like(p)
-    jacobian = np.zeros((len(p), 3, 3))
-
-    inside = np.flatnonzero((a <= mu * c) & (b <= mu * c))
-    x[inside] = p[inside]
-    jacobian[inside] = np.eye(3)
-    todo = np.ones(len(p), bool)
-    todo[inside] = False
-    # one face active (|f1| = mu c): move along its normal (-mu, +-1, 0)
-    for axis, (u, v) in ((1, (a, b)), (2, (b, a))):
-        k = (u - mu * c) / norm
-        c_face = c + mu * k
-        face = np.flatnonzero(todo & (k > 0) & (c_face > 0) & (v <= mu * c_face))
-        x[face, 0] = c_face[face]
-        x[face, axis] = mu * c_face[face] * sign[face, axis - 1]
-        x[face, 3 - axis] = p[face, 3 - axis]
-        normal = np.zeros((len(face), 3))
-        normal[:, 0], normal[:, axis] = -mu, sign[face, axis - 1]
-        jacobian[face] = np.eye(3) - normal[:, :, None] * normal[:, None, :] / norm
-        todo[face] = False
-    # both faces active: the edge (1, +-mu, +-mu), if the multipliers are nonnegative
-    s = (c + mu * a + mu * b) / (1.0 + 2.0 * mu * mu)
-    edge = np.flatnonzero(todo & (s > 0) & (a >= mu * s) & (b >= mu * s))
-    direction = np.ones((len(edge), 3))
-    direction[:, 1:] = mu * sign[edge]
-    x[edge] = s[edge, None] * direction
-    direction /= np.sqrt(1.0 + 2.0 * mu * mu)
-    jacobian[edge] = direction[:, :, None] * direction[:, None, :]
-    # the rest is in the polar cone: projects to the apex, x = 0, J = 0
-    return x, jacobian
-
-
 class NewtonSystem:
     """What the Newton method keeps for one :class:`~masonry.rbe.equilibrium.EquilibriumSystem`
     and friction model: the column subset of ``A_eq`` (``A``, and ``AT`` its transpose),
@@ -195,13 +144,13 @@ class NewtonSystem:
         width = len(columns)
         self.width = width
         self.h = system.h_solver.reshape(-1, layout.WIDTH)[:, columns]
-        pyramid = [i for i, c in enumerate(columns) if c != TENSION]
-        self.pyramid = np.asarray(pyramid)
+        # the columns of (c, f1, f2), which the friction model constrains
+        self.friction = np.asarray([i for i, c in enumerate(columns) if c != TENSION])
         self.tension = [i for i, c in enumerate(columns) if c == TENSION]
-        if np.ptp(self.h[:, self.pyramid]) != 0:
-            raise ValueError("the pyramid projection needs equal weights on c, f1, f2")
+        if np.ptp(self.h[:, self.friction]) != 0:
+            raise ValueError("the cone's projection needs equal weights on c, f1, f2")
         self.b = -system.f_ext
-        self.mu = system.mu
+        self.mu, self.cone = system.mu, system.cone
         # (IV, 12, width): rows of side 0's block, then side 1's
         self.coefficients = np.ascontiguousarray(
             system.vertex_coefficients[:, :, :, columns].reshape(layout.n_vertices, 12, width))
@@ -261,10 +210,10 @@ class NewtonSystem:
     # ------------------------------------------------------------------ kernels
     def project(self, w):
         """``x(y)`` for ``w = A^T y`` ((IV, width)) and the projection's Jacobian."""
-        p = self.pyramid
-        x_p, j_p = project_pyramid(w[:, p] / self.h[:, p[:1]], self.mu)
+        p = self.friction
+        x_p, j_p = self.cone.project(w[:, p] / self.h[:, p[:1]], self.mu)
         j_p /= self.h[:, p[:1], None]
-        if not self.tension:  # friction-net: the pyramid is every column
+        if not self.tension:  # friction-net: the cone is every column
             return x_p, j_p
         x = np.zeros_like(w)
         jacobian = np.zeros((len(w), self.width, self.width))
@@ -282,8 +231,8 @@ class NewtonSystem:
     def newton_blocks(self, jacobian, shift, incremental=True):
         """Stored blocks of ``A J A^T + shift I``.
 
-        The Jacobian is piecewise constant: from one Newton step to the next only the
-        vertices that moved to another face of their cone change it (preset 1's full
+        A pyramid's Jacobian is piecewise constant: from one Newton step to the next only
+        the vertices that moved to another face of their cone change it (preset 1's full
         dome: 18,000 of 75,000 vertices at the second step, 500 at the ninth), so the
         per-interface sums of the last call are updated with those vertices alone, unless
         ``incremental`` is False (the interior point method changes every vertex) or
@@ -554,7 +503,14 @@ class _Run:
 
     def _line_search(self, residual, direction, w_step) -> bool:
         """Backtracking (Armijo) along ``direction``, then the damping update; False
-        when no step length gives a sufficient increase."""
+        when no step length gives a sufficient increase.
+
+        Near the optimum the increase of ``g`` that a step makes falls below the
+        rounding of ``g`` itself (a residual of 1e-9 changes ``g`` by about 1e-18 of its
+        value), so the Armijo test can refuse the very steps that converge: a full step
+        that at least halves the residual is taken without it (the cone's projection,
+        whose Newton steps converge quadratically instead of ending exactly, meets this
+        on most polishes)."""
         options = self.options
         slope = float(residual @ direction)
         length = 1.0
@@ -563,6 +519,9 @@ class _Run:
             y_new = self.y + length * direction
             if (self._value(y_new, projected[0])
                     >= self.value + options.sufficient_increase * length * slope):
+                break
+            if length == 1.0 and (np.abs(self.ns.b - self.ns.A @ projected[0].ravel()).max()
+                                  <= 0.5 * np.abs(residual).max()):
                 break
             length *= 0.5
         else:
@@ -598,7 +557,7 @@ def prepared_system(system, method, workspace) -> NewtonSystem:
         symbolic = next((s.symbolic for s in prepared.values()), None)
         prepared[method] = NewtonSystem(system, method, symbolic=symbolic)
     ns = prepared[method]
-    ns.mu = system.mu
+    ns.mu, ns.cone = system.mu, system.cone
     return ns
 
 

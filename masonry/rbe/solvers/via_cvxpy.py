@@ -1,7 +1,8 @@
 """The RBE QP through cvxpy: the readable reference path (thesis 3.3.4).
 
-The problem is written as the thesis states it (every sign bound, both pyramids as
-cvxpy constraints) and cvxpy canonicalizes it for OSQP or Clarabel. The direct paths
+The problem is written as the model states it (every sign bound, the friction model as
+cvxpy constraints: a pyramid's faces as rows, Coulomb's cone as second-order cones) and
+cvxpy canonicalizes it for OSQP (pyramids only) or Clarabel. The direct paths
 (:mod:`.direct_osqp`, :mod:`.direct_clarabel`) must agree with it (tests/test_solvers.py).
 """
 
@@ -33,9 +34,13 @@ def _solve(system, method, name, options) -> QPOutcome:
     bounded = np.flatnonzero(np.isfinite(system.lower))
     # H is a constant positive diagonal: psd_wrap skips cvxpy's eigenvalue check
     objective = cp.Minimize(0.5 * cp.quad_form(x, cp.psd_wrap(sp.diags_array(system.h_solver))))
-    constraints = [system.A_eq @ x == -system.f_ext,
-                   system.A_fr[method] @ x <= 0,
-                   x[bounded] >= system.lower[bounded]]
+    constraints = [system.A_eq @ x == -system.f_ext, x[bounded] >= system.lower[bounded]]
+    if system.cone.is_polyhedral:
+        constraints.append(system.A_fr[method] @ x <= 0)
+    else:
+        vertex = cp.reshape(x, (system.layout.n_vertices, 4), order="C")
+        load = vertex[:, 0] - vertex[:, 1] if method == "net" else vertex[:, 0]
+        constraints.append(cp.SOC(system.mu * load, vertex[:, 2:], axis=1))
     problem = cp.Problem(objective, constraints)
     try:
         problem.solve(solver=name, **options)
