@@ -295,3 +295,37 @@ def test_the_collapse_lp_of_the_cone_finds_clarabels_optimum(azimuth):
     # the square pyramid's factor is higher: it carries more friction diagonally
     square = CollapseLP(dome, cone="square").solve(live, dead_load_feasible=True)
     assert square.load_factor > 1.1 * ours.load_factor
+
+
+# ---------------------------------------------------------------------- outputs
+def test_every_output_of_a_run_states_the_friction_model(tmp_path, capsys):
+    """run.json, RBE/00_objective.txt and collapse/00_collapse.txt name the model and its
+    bound; the square's results say they depend on the joints' axes; the folder of a
+    model other than the preset's carries its name."""
+    from masonry_cli.main import main
+    import json
+
+    common = ["run", "--scene", "dome", "--stretch", "1", "--n", "6", "--r", "0", "--p", "3",
+              "--cut", "0.5", "--lateral", "0", "--no-plots", "--no-printable", "--out",
+              str(tmp_path)]
+    assert main(common) == 0
+    assert main(common + ["--friction-cone", "square"]) == 0
+    out = capsys.readouterr().out
+    assert "friction model circle" in out and "friction model square" in out
+    assert out.count("note: the square friction model is the thesis's pyramid") == 1
+    (default,) = [p for p in tmp_path.glob("fulldome_*") if "_cone" not in p.name]
+    (square,) = tmp_path.glob("fulldome_*_conesquare_lat0")
+    for folder, name, error in ((default, "circle", 0.0), (square, "square", np.sqrt(2) - 1)):
+        record = json.loads((folder / "run.json").read_text())
+        for key in ("rbe", "collapse"):
+            assert record[key]["friction_model"] == name
+            assert record[key]["friction_capacity_error"] == pytest.approx(error)
+        objective = (folder / "RBE" / "00_objective.txt").read_text()
+        collapse = (folder / "collapse" / "00_collapse.txt").read_text()
+        for text in (objective, collapse):
+            assert f"friction model:     {name}" in text
+            assert ("41 %" in text) == (name == "square")
+    square_record = json.loads((square / "run.json").read_text())["collapse"]
+    assert "41 %" in square_record["note"]
+    default_record = json.loads((default / "run.json").read_text())["collapse"]
+    assert square_record["load_factor"] > default_record["load_factor"]

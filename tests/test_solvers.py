@@ -20,7 +20,7 @@ from masonry.studies.bench import (COLUMNS, bench, frontier_png, ratios, ratios_
                                    table_csv, table_markdown)
 from masonry.rbe.boundary import analysis_model
 from masonry.friction import FrictionCone
-from masonry.rbe.equilibrium import assemble, friction_edges
+from masonry.rbe.equilibrium import assemble
 from masonry.params import ACCURACIES, SOLVERS, ParameterError, Params, from_preset, structure_id
 from masonry.scenes import build
 from masonry.rbe import solve as solve_module

@@ -566,6 +566,8 @@ def _record(scene, model, plan, rows, outputs, cached, source) -> dict:
         "plan": {**plan.record(), "described": _described(plan)},
         **model_record(scene),
         "cache": {"geometry": cached},
+        "friction_model": friction_model(params.solver_accuracy,
+                                         params.friction_cone).record(),
         "stages": {
             "count": plan.n_stages,
             "standing": int(sum(bool(row["feasible"]) for row in rows)),

@@ -31,8 +31,8 @@ from masonry.rbe.solvers.newton import use_one_blas_thread
 
 log = logging.getLogger(__name__)
 
-SUMMARY_COLUMNS = ("variant", "status", "error", "feasible", "friction_used", "moi",
-                   "moi_factor",
+SUMMARY_COLUMNS = ("variant", "status", "error", "feasible", "friction_used",
+                   "friction_model", "moi", "moi_factor",
                    "objective", "weight_N", "bricks", "interfaces", "residual_eq",
                    "load_factor", "load_azimuth_deg", "time_s", "structure_id")
 """Result columns of the summary; the swept inputs come first. ``load_factor`` (and the
@@ -148,6 +148,7 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
         row.update(
             status="reused" if record.get("reused") else "computed",
             feasible=rbe.get("feasible"), friction_used=rbe.get("friction"),
+            friction_model=rbe.get("friction_model"),
             moi=rbe.get("moi"), moi_factor=rbe.get("moi_factor"),
             objective=rbe.get("objective"), weight_N=record.get("weight_N"),
             bricks=record["counts"]["bricks"],
@@ -341,7 +342,8 @@ def summary_parquet(study: Study, rows):
         return None
     columns = study.swept + list(SUMMARY_COLUMNS)
     table = pa.table({c: [None if r.get(c) is None else str(r.get(c))
-                          if c in ("error", "status", "friction_used", "structure_id")
+                          if c in ("error", "status", "friction_used", "friction_model",
+                                   "structure_id")
                           else r.get(c) for r in rows] for c in columns})
     buf = io.BytesIO()
     pq.write_table(table, buf)

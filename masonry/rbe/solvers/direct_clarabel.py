@@ -2,9 +2,11 @@
 
 Clarabel writes constraints as ``A x + s = b, s in K``: the equilibrium rows are a zero
 cone, a pyramid's friction rows a nonnegative cone and Coulomb's cone a second-order
-cone per vertex, the ``t >= 0`` rows a nonnegative cone (``t`` enters as ``-t + s = 0``). One solver per scene; friction+ and other friction coefficients update the matrix
-values in place, which keeps Clarabel's KKT ordering (data updates need presolve off;
-presolve only drops rows with infinite bounds, and this problem has none).
+cone per vertex, the ``t >= 0`` rows a nonnegative cone (``t`` enters as ``-t + s =
+0``). One solver per scene and friction model; friction+ and other friction
+coefficients update the matrix values in place, which keeps Clarabel's KKT ordering
+(data updates need presolve off; presolve only drops rows with infinite bounds, and this
+problem has none).
 """
 
 import time
