@@ -1,14 +1,11 @@
 """``masonry analyze``: interfaces and rigid block equilibrium of blocks read from files."""
 
-from masonry.scenes.imported import load_assembly
 from masonry.params import Params, validate
 from masonry.pipeline import run
+from masonry.scenes.imported import load_assembly
 
 from .options import (add_analysis_options, add_live_load_options, add_output_options,
-                      check_print_size, collapse_summary, rbe_summary, summary)
-
-ANALYSIS = ("mu", "density", "friction", "friction_cone", "accuracy", "solver", "fast",
-            "print_size", "lateral", "point_loads", "crown_load", "friction_law")
+                      check_print_size, collapse_summary, given_inputs, rbe_summary, summary)
 
 
 def register(subparsers):
@@ -35,13 +32,14 @@ def register(subparsers):
 
 
 def handle(args, report):
-    given = {k: getattr(args, k) for k in ANALYSIS if getattr(args, k) is not None}
-    params = validate(Params(**given))
-    check_print_size(args, params)
-    scene, source = load_assembly(args.files, params, supports=args.support,
+    # the inputs are checked before any file is read: a placeholder name until then
+    given = given_inputs(args)
+    check_print_size(args, validate(Params.of(scene="assembly", assembly="-", **given)))
+    scene, source = load_assembly(args.files, supports=args.support,
                                   support_below=args.support_below, ground=args.ground)
-    record = run(scene.params, args.out, analyse=True, plots_wanted=args.plots,
-                 printable=args.printable, force=args.force, scene=scene, source=source)
+    params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **given))
+    record = run(params, args.out, analyse=True, force=args.force, scene=scene,
+                 source=source)
     report(f"read {scene.blocks.n_blocks} blocks ({source['supports']} supports) from "
            f"{len(source['files'])} file(s) in {source['read_s']:.3g} s")
     summary(record, report)

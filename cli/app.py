@@ -18,10 +18,8 @@ import traceback
 from pathlib import Path
 
 from masonry import __version__
-from masonry.params import ParameterError
-from masonry.rbe.boundary import UnsupportedError
+from masonry.errors import MasonryError
 from masonry.rbe.solvers.newton import use_one_blas_thread
-from masonry.scenes.imported import AssemblyError
 
 from . import analyze, arch_thickness, bench, build, run, stages, structures, sweep
 from .options import Parser, describe_error, option_names, typed_values
@@ -63,7 +61,7 @@ def main(argv=None) -> int:
     previous = _on_sigterm(_terminate)
     try:
         return args.handler(args, report)
-    except (ParameterError, AssemblyError, UnsupportedError) as error:
+    except MasonryError as error:
         print(f"masonry: error: {describe_error(error, args)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as interrupt:

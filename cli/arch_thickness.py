@@ -1,8 +1,9 @@
 """``masonry arch-thickness``: the minimum thickness t/R of an arch, by bisection on RBE
 feasibility, beside the thrust line's value."""
 
-from masonry.params import SOLVERS, Params, arch_radius, validate
-from masonry.rbe.solve import friction_model
+from masonry.params import Params, validate
+from masonry.rbe.solvers import BACKENDS
+from masonry.scenes.arch import arch_radius
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.thickness import folder_name, minimum_thickness, steps_csv
 from masonry.studies.thrust_line import thrust_line_minimum_thickness
@@ -21,8 +22,8 @@ def register(subparsers):
     add_arch_options(parser, thickness=False)
     g = parser.add_argument_group("analysis")
     add_material_options(g)
-    g.add_argument("--solver", choices=SOLVERS,
-                   help=f"QP solver (default: the balanced preset's): {', '.join(SOLVERS)}")
+    g.add_argument("--solver", choices=tuple(BACKENDS),
+                   help=f"QP solver (default: the balanced preset's): {', '.join(BACKENDS)}")
     g.add_argument("--rtol", type=float, default=THICKNESS_RTOL,
                    help="relative width of the final bisection bracket (default %(default)g)")
     parser.add_argument("--out", default="exports", metavar="DIR",
@@ -34,16 +35,17 @@ def register(subparsers):
 
 def handle(args, report):
     given = {k: getattr(args, k) for k in ANALYSIS if getattr(args, k) is not None}
-    params = validate(Params(scene="arch", **given))
+    params = validate(Params.of(scene="arch", **given))
     check_output_root(args.out)
     result = minimum_thickness(params, rtol=args.rtol)
-    line = thrust_line_minimum_thickness(params.arch_shape, params.arch_blocks,
-                                         params.arch_span, params.arch_rise, mu=params.mu)
-    inputs = {name: getattr(params, name) for name in ANALYSIS}
-    inputs["arch_rise"] = arch_radius(params.arch_shape, params.arch_span,
-                                      params.arch_rise)[1]  # the default resolved
-    inputs["accuracy"] = params.solver_accuracy
-    inputs["friction_cone"] = friction_model(params.solver_accuracy, params.friction_cone).name
+    arch, analysis = params.geometry, params.analysis
+    line = thrust_line_minimum_thickness(arch.arch_shape, arch.arch_blocks, arch.arch_span,
+                                         arch.arch_rise, mu=analysis.mu)
+    inputs = {name: params.inputs()[name] for name in ANALYSIS}
+    inputs["arch_rise"] = arch_radius(arch.arch_shape, arch.arch_span,
+                                      arch.arch_rise)[1]  # the default resolved
+    inputs["accuracy"] = analysis.accuracy
+    inputs["friction_cone"] = analysis.cone.name
     record = {"params": inputs, "rtol": args.rtol,
               "rbe": {"t_over_r": result.t_over_r, "lower": result.lower,
                       "thickness_m": result.thickness, "radius_m": result.radius,
@@ -54,8 +56,8 @@ def handle(args, report):
     with RunFolder(args.out, folder_name(params, args.rtol)) as folder:
         folder.write_json("result.json", record)
         folder.write("steps.csv", steps_csv(result))
-    report(f"{params.arch_shape} arch, {params.arch_blocks} voussoirs, span "
-           f"{params.arch_span:g} m, R = {result.radius:.6g} m, mu {params.mu:g}")
+    report(f"{arch.arch_shape} arch, {arch.arch_blocks} voussoirs, span "
+           f"{arch.arch_span:g} m, R = {result.radius:.6g} m, mu {analysis.mu:g}")
     report(f"minimum thickness (RBE bisection): t/R = {result.t_over_r:.6f} "
            f"(t = {result.thickness:.6g} m; falls at t/R = {result.lower:.6f}), "
            f"{len(result.steps)} solves, {result.time_s:.3g} s")

@@ -6,7 +6,10 @@ from masonry.friction import FrictionCone, FrictionModelError
 from masonry.studies.bench import (FRICTION_MODELS, SCENES, bench, collapse_bench,
                                    collapse_markdown, friction_bench, friction_markdown,
                                    frontier_png, ratios_markdown, table_csv, table_markdown)
-from masonry.params import ACCURACIES, SOLVERS, ParameterError, Params, from_preset, validate
+from masonry.errors import ParameterError
+from masonry.params import Params, from_preset, validate
+from masonry.rbe.solve import ACCURACY
+from masonry.rbe.solvers import BACKENDS
 from masonry.runfolder import RunFolder, check_output_root
 
 from .options import add_verbosity
@@ -21,9 +24,9 @@ def register(subparsers):
     parser.add_argument("--scenes", nargs="+", default=list(SCENES), choices=list(SCENES),
                         help="free section, cyclic section, full dome, full dome at mu 0.05 "
                              "(default all)")
-    parser.add_argument("--accuracy", nargs="+", default=list(ACCURACIES),
-                        choices=ACCURACIES, help="accuracy presets (default all)")
-    parser.add_argument("--solvers", nargs="+", default=[], choices=SOLVERS,
+    parser.add_argument("--accuracy", nargs="+", default=list(ACCURACY),
+                        choices=tuple(ACCURACY), help="accuracy presets (default all)")
+    parser.add_argument("--solvers", nargs="+", default=[], choices=tuple(BACKENDS),
                         help="extra rows: the balanced preset with another solver")
     parser.add_argument("--p", type=int, metavar="P",
                         help="override the presets' pattern bricks per rhombus side "
@@ -92,7 +95,7 @@ def _collapse(args, report):
     named = "" if args.p is None else f" (p {args.p})"
     domes = {f"preset {k} full dome{named}": from_preset(k, scene="dome", **overrides)
              for k in args.presets}
-    small = {"small dome (n 6, p 3)": validate(Params(**SMALL_DOME))}
+    small = {"small dome (n 6, p 3)": validate(Params.of(**SMALL_DOME))}
     progress = None if args.quiet else _progress
     rows = collapse_bench(domes, repeats=args.repeats, progress=progress)
     rows += collapse_bench(small, repeats=args.repeats, search=True, progress=progress)

@@ -15,7 +15,7 @@ def register(subparsers):
 
 
 def handle(args, report):
-    record = run(params_from_args(args), args.out, analyse=False, plots_wanted=args.plots,
-                 printable=args.printable, force=args.force, max_bricks=args.max_bricks)
+    record = run(params_from_args(args), args.out, analyse=False, force=args.force,
+                 max_bricks=args.max_bricks)
     summary(record, report)
     return 0

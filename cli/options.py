@@ -4,12 +4,21 @@ import argparse
 import math
 import shlex
 
+from masonry.errors import ParameterError
+from masonry.outputs import Outputs
+from masonry.parameters import declarations, defaults
+from masonry.params import PRESETS, Params, applies, from_preset, load, names, validate
+from masonry.rbe.settings import BOUNDARIES, FRICTION_LAWS, FRICTIONS, Analysis
+from masonry.rbe.solve import ACCURACY
+from masonry.rbe.solvers import BACKENDS
+from masonry.scenes import KINDS, kind_of
+from masonry.scenes.arch import ARCH_SHAPES
 from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS
-from masonry.params import (ACCURACIES, ARCH_SHAPES, BOUNDARIES, FRICTION_LAWS, FRICTIONS,
-                            PRESETS, RANGES, SCENE_FIELDS, SCENES, SOLVERS, ParameterError,
-                            Params, from_preset, load, validate)
 
-DEFAULTS = Params()
+ACCURACIES, SOLVERS = tuple(ACCURACY), tuple(BACKENDS)
+PARTS = (Analysis, Outputs, *(kind.geometry for kind in KINDS.values()))
+"""The declared parts whose defaults and ranges the options' help quotes."""
+DEFAULTS = {name: value for part in PARTS for name, value in defaults(part).items()}
 
 
 class Parser(argparse.ArgumentParser):
@@ -22,12 +31,14 @@ class Parser(argparse.ArgumentParser):
 def _preset_values(name) -> str:
     """``default X; presets 1 / 2 / 3: a / b / c`` for a dome parameter."""
     values = " / ".join(f"{PRESETS[k][name]:g}" for k in ("1", "2", "3"))
-    return f"default {getattr(DEFAULTS, name):g} (preset 1); presets 1 / 2 / 3: {values}"
+    return f"default {DEFAULTS[name]:g} (preset 1); presets 1 / 2 / 3: {values}"
 
 
 def _range(name) -> str:
-    low, high, _ = RANGES[name]
-    return f"{low:g} to {high:g}"
+    """``low to high`` of an input, from its declaration."""
+    declaration = next(declarations(part)[name] for part in PARTS
+                       if name in declarations(part))
+    return f"{declaration.low:g} to {declaration.high:g}"
 
 
 def option_names(parser) -> dict:
@@ -50,8 +61,8 @@ def describe_error(error, args) -> str:
     if not isinstance(error, ParameterError):
         return " ".join(str(error).split())
     name, value, expected = error.name, error.value, " ".join(str(error.expected).split())
-    names = getattr(args, "option_names", {})
-    option = names.get(name, f"--{name.replace('_', '-')}")
+    options = getattr(args, "option_names", {})
+    option = options.get(name, f"--{name.replace('_', '-')}")
     if error.where:
         return f"{error.where}: {name} = {value!r}: expected {expected}"
     if not option.startswith("--"):  # a positional argument: its value says it
@@ -61,7 +72,7 @@ def describe_error(error, args) -> str:
         return f"{option}: expected {expected}"
     if value is True and option not in typed:  # a flag given where it does not apply
         return f"{option}: expected {expected}"
-    if name not in Params.__dataclass_fields__ or _given(args, name):
+    if name not in names() or _given(args, name):
         return f"{option} {typed.get(option, _typed(value))}: expected {expected}"
     given = [r for r in error.related if _given(args, r)]
     origin = (f"from --params {args.params}" if getattr(args, "params", None) else
@@ -69,9 +80,9 @@ def describe_error(error, args) -> str:
               "the default")
     subject = f"{option} {_typed(value)} ({origin})"
     if given:
-        options = [names.get(r, r) for r in given]
+        typed_options = [options.get(r, r) for r in given]
         these = ", ".join(f"{o} {typed.get(o, _typed(getattr(args, r)))}"
-                          for o, r in zip(options, given))
+                          for o, r in zip(typed_options, given))
         subject = f"{these} with {subject}"
     return f"{subject}: expected {expected}"
 
@@ -121,9 +132,11 @@ def add_model_options(parser):
                         "validation wall; explicit options below override it (default: "
                         "preset 1's dome)")
     g.add_argument("--params", metavar="FILE",
-                   help="parameters from a TOML file (Params fields, as in fixtures/presets); "
+                   help="parameters from a TOML file (inputs named as these options, "
+                        "as in fixtures/presets); "
                         "options given next to it override it")
-    g.add_argument("--scene", choices=[s for s in SCENES if s != "assembly"],
+    g.add_argument("--scene", choices=[name for name, kind in KINDS.items()
+                                       if kind.from_parameters],
                    help="section (one web, default), dome (all n webs), wall (validation), "
                         "arch (voussoirs, see the arch options)")
     g.add_argument("--stretch", type=float,
@@ -139,15 +152,15 @@ def add_model_options(parser):
                    help=f"fraction of the height cut off, 0 <= cut < 1 "
                         f"({_preset_values('cut')})")
     g.add_argument("--unit", type=float,
-                   help=f"brick unit in metres ({_range('unit')}; default {DEFAULTS.unit:g})")
+                   help=f"brick unit in metres ({_range('unit')}; default {DEFAULTS['unit']:g})")
     g.add_argument("--min-fill", dest="min_fill", type=float, metavar="F",
                    help=f"shortest fill-in brick in units (0 < F <= 4; default "
-                        f"{DEFAULTS.min_fill:g})")
+                        f"{DEFAULTS['min_fill']:g})")
     g.add_argument("--wall-length", dest="wall_length", type=float, metavar="L",
-                   help=f"wall scene: length in units (>= 4; default {DEFAULTS.wall_length:g})")
+                   help=f"wall scene: length in units (>= 4; default {DEFAULTS['wall_length']:g})")
     g.add_argument("--wall-courses", dest="wall_courses", type=int, metavar="K",
                    help=f"wall scene: number of courses (>= 1; default "
-                        f"{DEFAULTS.wall_courses})")
+                        f"{DEFAULTS['wall_courses']})")
     g.add_argument("--fast", action="store_true", default=None,
                    help="reduced output: one view, lower resolution")
     g.add_argument("--max-bricks", dest="max_bricks", type=int, default=MAX_BRICKS,
@@ -160,14 +173,14 @@ def add_model_options(parser):
 def add_arch_options(parser, thickness=True):
     g = parser.add_argument_group("arch scene (metres; the span and rise of the centre line)")
     g.add_argument("--blocks", dest="arch_blocks", type=int, metavar="N",
-                   help=f"number of voussoirs (>= 2; default {DEFAULTS.arch_blocks}; even "
+                   help=f"number of voussoirs (>= 2; default {DEFAULTS['arch_blocks']}; even "
                         "for a pointed arch)")
     if thickness:
         g.add_argument("--thickness", dest="arch_thickness", type=float, metavar="T",
                        help=f"thickness t along the joints (at least 0.001 span; default "
-                            f"{DEFAULTS.arch_thickness:g})")
+                            f"{DEFAULTS['arch_thickness']:g})")
     g.add_argument("--span", dest="arch_span", type=float, metavar="S",
-                   help=f"span ({_range('arch_span')}; default {DEFAULTS.arch_span:g})")
+                   help=f"span ({_range('arch_span')}; default {DEFAULTS['arch_span']:g})")
     g.add_argument("--shape", dest="arch_shape", choices=ARCH_SHAPES,
                    help="semicircular (default), pointed or segmental")
     g.add_argument("--rise", dest="arch_rise", type=float, metavar="H",
@@ -175,7 +188,7 @@ def add_arch_options(parser, thickness=True):
                         "(< span/2 and at least 0.01 span, default span/4) arch")
     g.add_argument("--depth", dest="arch_depth", type=float, metavar="D",
                    help=f"depth along y (0.001 to 1000 spans; default "
-                        f"{DEFAULTS.arch_depth:g})")
+                        f"{DEFAULTS['arch_depth']:g})")
 
 
 def add_analysis_options(parser, boundary=True):
@@ -253,7 +266,7 @@ def collapse_summary(record, report):
 def add_material_options(group):
     """``--mu``, ``--friction-cone`` and ``--density``, with their ranges and defaults."""
     group.add_argument("--mu", type=float, help=f"friction coefficient ({_range('mu')}; "
-                                                f"default {DEFAULTS.mu:g})")
+                                                f"default {DEFAULTS['mu']:g})")
     group.add_argument("--friction-cone", dest="friction_cone",
                        metavar="circle|polygon:K|square",
                        help="friction model: circle (Coulomb's isotropic cone, exact; the "
@@ -263,7 +276,7 @@ def add_material_options(group):
                             "up to 41 %% more friction than Coulomb, direction dependent; "
                             "to reproduce the thesis only)")
     group.add_argument("--density", type=float, help=f"kg/m^3 ({_range('density')}; "
-                                                     f"default {DEFAULTS.density:g})")
+                                                     f"default {DEFAULTS['density']:g})")
 
 
 def add_output_options(parser):
@@ -293,16 +306,21 @@ def add_verbosity(parser):
                             "the output is redirected")
 
 
-def params_from_args(args) -> Params:
-    """Preset or file first, then every option the user gave; validated. Options that do
-    not apply to the resulting scene are refused (:data:`masonry.params.SCENE_FIELDS`)."""
-    given = {k: v for k, v in vars(args).items()
-             if k in Params.__dataclass_fields__ and v is not None}
+def given_inputs(args) -> dict:
+    """The inputs (flat names, :func:`masonry.params.names`) the user gave as options."""
+    known = {"scene", "fast", *names()}
+    given = {k: v for k, v in vars(args).items() if k in known and v is not None}
     if getattr(args, "dome", False):
         given.setdefault("boundary", "cyclic")
-    if args.params is not None:
-        params = load(args.params, **given)
-    elif args.preset:
+    return given
+
+
+def params_from_args(args) -> Params:
+    """Preset or file first, then every option the user gave; validated. Options that do
+    not apply to the resulting scene are refused (:func:`masonry.params.applies`)."""
+    given = given_inputs(args)
+    scene = given.get("scene")
+    if args.params is None and args.preset:
         # a preset's inputs are its scene's: another scene would take none of them
         scenes = ((PRESETS[args.preset]["scene"],) if "scene" in PRESETS[args.preset]
                   else ("section", "dome"))
@@ -310,27 +328,40 @@ def params_from_args(args) -> Params:
             raise ParameterError("scene", given["scene"], f"{' or '.join(scenes)} with "
                                  f"--preset {args.preset} (leave --preset out for another "
                                  f"scene)")
+        scene = scene or scenes[0]
+    if args.params is None:
+        _refuse_inapplicable(given, kind_of(scene or "section"))
+    if getattr(args, "dome", False) and (scene or "section") != "section":
+        raise ParameterError("dome", True, f"an option of a section, not of this "
+                                           f"{scene} scene")
+    if args.params is not None:
+        params = load(args.params, **given)
+        _refuse_inapplicable(given, params.kind)
+    elif args.preset:
         params = from_preset(args.preset, **given)
-    elif given.get("scene") == "wall":
+    elif scene == "wall":
         params = from_preset("wall", **given)
     else:
-        params = validate(Params(**given))
-    for name, value in given.items():
-        scenes = SCENE_FIELDS.get(name, (params.scene,))
-        if params.scene not in scenes:
-            raise ParameterError(name, value, f"an option of the {' or '.join(scenes)} "
-                                              f"scene, not of this {params.scene} scene")
-    if getattr(args, "dome", False) and params.scene != "section":
-        raise ParameterError("dome", True, f"an option of a section, not of this "
-                                           f"{params.scene} scene")
+        params = validate(Params.of(**given))
     check_print_size(args, params)
     return params
 
 
+def _refuse_inapplicable(given, kind):
+    """Refuse an option that does not apply to scenes of ``kind``."""
+    for name, value in given.items():
+        if name in ("scene", "fast") or applies(name, kind):
+            continue
+        scenes = [k.name for k in KINDS.values() if applies(name, k)]
+        raise ParameterError(name, value, f"an option of the {' or '.join(scenes)} "
+                                          f"scene, not of this {kind.name} scene")
+
+
 def check_print_size(args, params: Params):
     """Refuse ``--print-size`` beside ``--no-printable``: the 3MF is the printable body."""
-    if params.print_size is not None and not getattr(args, "printable", True):
-        raise ParameterError("print_size", params.print_size,
+    size = params.outputs.print_size
+    if size is not None and not params.outputs.printable:
+        raise ParameterError("print_size", size,
                              "no --no-printable beside it (dome.3mf is the printable body "
                              "at that size)")
 
@@ -340,7 +371,7 @@ def summary(record, report):
     counts = record["counts"]
     interfaces = sum(counts.get("interfaces", {}).values())
     state = "up to date, reused" if record.get("reused") else "written"
-    what = (f"{counts['bricks']} blocks" if record["scene"] in ("arch", "assembly") else
+    what = (f"{counts['bricks']} blocks" if kind_of(record["scene"]).block_word == "blocks" else
             f"{counts['bricks']} bricks ({counts['regular']} regular, {counts['pattern']} "
             f"pattern, {counts['fill_in']} fill-in) in {counts['courses']} courses")
     report(f"{record['structure_id']}: {what}, {interfaces} interfaces, "

@@ -18,8 +18,8 @@ def register(subparsers):
 
 
 def handle(args, report):
-    record = run(params_from_args(args), args.out, analyse=True, plots_wanted=args.plots,
-                 printable=args.printable, force=args.force, max_bricks=args.max_bricks)
+    record = run(params_from_args(args), args.out, analyse=True, force=args.force,
+                 max_bricks=args.max_bricks)
     summary(record, report)
     code = rbe_summary(record, report)
     if "collapse" in record:

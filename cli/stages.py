@@ -4,10 +4,8 @@ from masonry.params import Params, validate
 from masonry.scenes.imported import load_assembly
 from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS, run_stages
 
-from .options import add_analysis_options, add_model_options, add_verbosity, params_from_args
-
-ANALYSIS = ("mu", "density", "friction", "friction_cone", "accuracy", "solver", "fast",
-            "lateral")
+from .options import (add_analysis_options, add_model_options, add_verbosity, given_inputs,
+                      params_from_args)
 
 
 def register(subparsers):
@@ -55,35 +53,37 @@ def register(subparsers):
 
 def handle(args, report):
     if args.files:
-        given = {k: getattr(args, k) for k in ANALYSIS if getattr(args, k) is not None}
-        scene, source = load_assembly(args.files, validate(Params(**given)),
-                                      supports=args.support,
+        given = given_inputs(args)
+        validate(Params.of(scene="assembly", assembly="-", **given))  # before any reading
+        scene, source = load_assembly(args.files, supports=args.support,
                                       support_below=args.support_below, ground=args.ground)
-        params, by = scene.params, args.by or "block"
+        params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly,
+                                    **given))
+        by = args.by or "block"
     else:
         scene = source = None
         params, by = params_from_args(args), args.by or "course"
-        if params.scene == "arch" and args.by is None:
+        if not params.kind.has_courses and args.by is None:
             by = "block"
-        # a stage of the dome, not of a free-standing web: the section is cyclic unless
-        # the user says otherwise
-        if params.scene == "section" and args.boundary is None and not args.dome:
+        # a stage of the dome, not of a free-standing web: a section is cyclic unless the
+        # user says otherwise
+        if "cyclic" in params.kind.boundaries and args.boundary is None and not args.dome:
             params = validate(params.replace(boundary="cyclic"))
     record = run_stages(params, args.out, by=by, order=args.order, course=args.course,
-                        plots_wanted=args.plots, force=args.force, scene=scene,
-                        source=source, max_bricks=args.max_bricks)
+                        force=args.force, scene=scene, source=source,
+                        max_bricks=args.max_bricks)
     stages = record["stages"]
     state = "up to date, reused" if record.get("reused") else "written"
     report(f"{record['structure_id']}: {record['plan']['described']}")
     report(f"{stages['standing']} of {stages['count']} stages stand without support "
-           f"(mu {params.mu:g}, friction {params.friction}); stage solves "
+           f"(mu {params.analysis.mu:g}, friction {params.analysis.friction}); stage solves "
            f"{stages['solve_s']:.3g} s")
     factors = [(r["load_factor"], r["stage"]) for r in record["rows"]
                if r.get("load_factor") is not None] if "rows" in record else []
     if factors:
         low, at = min(factors)
-        report(f"lateral load factor at {params.lateral:g} deg: smallest {low:.4g} (stage "
-               f"{at}), {factors[-1][0]:.4g} at stage {factors[-1][1]} (stages.csv)")
+        report(f"lateral load factor at {params.load.azimuth_deg:g} deg: smallest {low:.4g} "
+               f"(stage {at}), {factors[-1][0]:.4g} at stage {factors[-1][1]} (stages.csv)")
     first = stages["first_unsupported"]
     if first is not None and first.get("loose"):
         report(f"first stage that needs support: {first['stage']} ({first['bricks']} "

@@ -6,7 +6,9 @@ import os
 import sys
 from pathlib import Path
 
-from masonry.params import PRESETS, ParameterError, Params, read_toml, validate
+from masonry.errors import ParameterError
+from masonry.parameters import read_toml
+from masonry.params import PRESETS, Params, validate
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.studies.sweep import (Study, execute, summary_csv, summary_parquet, summary_pngs,
                            summary_rows)
@@ -120,7 +122,7 @@ def _check_variants(study: Study, where):
     involves, a swept one first; one the study leaves at its default says so)."""
     for inputs in study.variants():
         try:
-            validate(Params(**inputs))
+            validate(Params.of(**inputs))
         except ParameterError as error:
             names = (error.name, *error.related)
             table, name = next(((t, n) for t in ("grid", "sample", "base") for n in names

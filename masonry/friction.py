@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from masonry.errors import MasonryError
 CIRCLE, POLYGON, SQUARE = "circle", "polygon", "square"
 KINDS = (CIRCLE, POLYGON, SQUARE)
 
@@ -38,7 +39,7 @@ MAX_SIDES = 256
 cheaper than the pyramid's rays."""
 
 
-class FrictionModelError(ValueError):
+class FrictionModelError(MasonryError, ValueError):
     """A friction model name that is not ``circle``, ``polygon:K`` or ``square``."""
 
 

@@ -22,12 +22,13 @@ import masonry
 from masonry import __version__, forking
 from masonry.blocks import BLOCK_CLASSES
 from masonry.export import EXPORTERS, RunOutputs
-from masonry.params import Params, structure_id, validate
+from masonry.params import FILE_OUTPUTS, Params, geometry_key, structure_id, validate
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.collapse import CollapseResult, collapse_load, worst_lateral
-from masonry.rbe.loads import crown_load, lateral, point_loads
-from masonry.rbe.solve import RBEProblem, RBEResult, friction_model
-from masonry.runfolder import RunFolder, check_output_root, write_file_atomically
+from masonry.rbe.loads import Lateral
+from masonry.rbe.solve import RBEProblem, RBEResult
+from masonry.runfolder import (Publication, RunFolder, check_output_root,
+                               write_file_atomically)
 from masonry.scenes import Scene, build, check_size
 from masonry.tolerances import MAX_BRICKS, G
 
@@ -96,12 +97,13 @@ class Timer:
             self.seconds[name] = round(total, 4)
 
 
-def model_record(scene) -> dict:
+def model_record(scene, density: float) -> dict:
     """Counts, volume and weight of a built scene, and its pattern report.
 
     Parameters
     ----------
     scene : masonry.scenes.base.Scene
+    density : float, kg/m^3
 
     Returns
     -------
@@ -111,7 +113,7 @@ def model_record(scene) -> dict:
         them ``layout`` (repeated joints, short fill-ins) and ``pattern`` (nodes, near
         nodes, boundary bounces, ended lines).
     """
-    blocks, params = scene.blocks, scene.params
+    blocks = scene.blocks
     free = ~blocks.block_is_support
     classes = {name: int(((blocks.block_class == i) & free).sum())
                for i, name in enumerate(BLOCK_CLASSES)}
@@ -125,7 +127,7 @@ def model_record(scene) -> dict:
             "courses": int(blocks.block_course.max()),
         },
         "volume_m3": volume,
-        "weight_N": volume * params.density * G,
+        "weight_N": volume * density * G,
     }
     if scene.layout is not None:
         record["layout"] = {
@@ -143,8 +145,8 @@ def model_record(scene) -> dict:
 
 
 # ---------------------------------------------------------------------------- cache
-GEOMETRY_SOURCES = ("params.py", "tolerances.py", "blocks.py", "meshing.py", "interfaces.py",
-                    "dome", "scenes", "rbe/boundary.py")
+GEOMETRY_SOURCES = ("params.py", "parameters.py", "tolerances.py", "blocks.py", "meshing.py",
+                    "interfaces.py", "dome", "scenes", "rbe/boundary.py")
 """The package's files (or folders) whose code decides a cached scene and model."""
 
 
@@ -170,24 +172,30 @@ def geometry_code_digest() -> str:
 
 
 def _geometry_key(params: Params) -> str:
-    key = json.dumps({**params.geometry_key, "version": __version__,
+    key = json.dumps({"geometry": geometry_key(params), "version": __version__,
                       "code": geometry_code_digest()}, sort_keys=True)
     return hashlib.sha1(key.encode()).hexdigest()[:16]
+
+
+def build_model(params: Params) -> tuple:
+    """``(scene, model)``: the scene of ``params`` and its analysis model, with the
+    analysis's boundary (no cache)."""
+    scene = build(params)
+    return scene, analysis_model(scene, params.analysis.boundary)
 
 
 def run_model(params: Params, out_root, timer: Timer, scene=None, check=None):
     """Scene and analysis model of a run: ``(scene, model, 'reused' | 'computed' |
     'given')``. Built from ``params`` through the geometry cache (:func:`_cached_model`),
-    or, when ``scene`` is given (blocks read from files), that scene with ``params``,
-    analysed as is and never cached. ``check(scene)`` runs before the interfaces are
-    detected, as in :func:`_cached_model`."""
+    or, when ``scene`` is given (blocks read from files), that scene, analysed as is and
+    never cached. ``check(scene)`` runs before the interfaces are detected, as in
+    :func:`_cached_model`."""
     if scene is None:
         return _cached_model(params, out_root, timer, check=check)
-    scene = dataclasses.replace(scene, params=params)
     if check is not None:
         check(scene)
     with timer.stage("interfaces"):
-        model = analysis_model(scene)
+        model = analysis_model(scene, params.analysis.boundary)
     return scene, model, "given"
 
 
@@ -200,17 +208,16 @@ def _cached_model(params: Params, out_root, timer: Timer, check=None):
     cached = _read_cache(_cache_path(params, out_root))
     if cached is not None:
         with timer.stage("model (cached)"):
-            # the cached scene carries the geometry; the rest of the inputs are this run's
-            scene = dataclasses.replace(cached[0], params=params)
+            scene, model = cached
         if check is not None:
             check(scene)
-        return scene, cached[1], "reused"
+        return scene, model, "reused"
     with timer.stage("model"):
         scene = build(params)
     if check is not None:
         check(scene)
     with timer.stage("interfaces"):
-        model = analysis_model(scene)
+        model = analysis_model(scene, params.analysis.boundary)
     return scene, model, "computed"
 
 
@@ -277,71 +284,35 @@ def write_cache(params: Params, out_root, scene: Scene, model: Model):
                     "model", path, error.strerror or error)
 
 
-OUTPUT_FIELDS = ("print_size",)
-"""``Params`` fields that only choose a file's form (the 3MF's size), not the results:
-they are not in the structure id, and a folder whose run differs only in them holds the
-same input."""
+def identity(params: Params) -> dict:
+    """What makes a run's result: its inputs as ``run.json`` records them, without those
+    that only choose files (:data:`~masonry.params.FILE_OUTPUTS`)."""
+    return {name: value for name, value in params.record().items()
+            if name not in FILE_OUTPUTS}
 
 
-def _input(fields) -> dict:
-    """A run's parameters without :data:`OUTPUT_FIELDS`."""
-    return {k: v for k, v in fields.items() if k not in OUTPUT_FIELDS}
+def _identify(record) -> dict:
+    return {"params": {name: value for name, value in record["params"].items()
+                       if name not in FILE_OUTPUTS}}
 
 
-def _previous(target: Path, params: Params):
-    """The record of a complete earlier run of the same input in ``target``, else None."""
-    try:
-        record = json.loads((target / "run.json").read_text())
-    except (OSError, ValueError):
-        return None
-    if not isinstance(record, dict) or not isinstance(record.get("params"), dict):
-        return None
-    same = (_input(record["params"]) == _input(json.loads(json.dumps(
-        dataclasses.asdict(params)))) and record.get("complete") is True)
-    return record if same else None
-
-
-def _print_size(record):
-    """The size (mm) of the ``dome.3mf`` a run record wrote, or None."""
-    printable = record.get("printable")
-    written = printable.get("print") if isinstance(printable, dict) else None
-    return written.get("size_mm") if isinstance(written, dict) else None
-
-
-def _covers(record, outputs: dict, print_size=None) -> bool:
-    """Whether a run record wrote at least ``outputs`` (solve, plots, printable body) and,
-    when ``print_size`` (mm) asks for a 3MF beside the printable body, one of that size."""
-    had = record.get("outputs") or {}
-    wrote = all(had.get(name) is True or not wanted for name, wanted in outputs.items())
-    return wrote and (print_size is None or not outputs.get("printable")
-                      or _print_size(record) == print_size)
-
-
-def _stamp(target: Path):
-    """Identity of the run.json in ``target`` (inode, mtime), or None: tells whether
-    another command published the folder while this run was computing."""
-    try:
-        stat = (target / "run.json").stat()
-    except OSError:
-        return None
-    return stat.st_ino, stat.st_mtime_ns
+def with_outputs(params: Params, outputs: dict) -> Params:
+    """``params`` writing ``outputs`` (:meth:`masonry.runfolder.Publication.outputs`)."""
+    chosen = {name: outputs[name] for name in ("plots", "printable", "quick", "print_size")}
+    return dataclasses.replace(params, outputs=dataclasses.replace(params.outputs, **chosen))
 
 
 # ---------------------------------------------------------------------------- the run
-def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
-        printable=True, force=False, scene=None, source=None,
-        max_bricks=MAX_BRICKS) -> dict:
+def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=None,
+        source=None, max_bricks=MAX_BRICKS) -> dict:
     """Build, analyse and export ``params`` into ``out_root/<structure id>``.
 
-    A run folder only grows (no command degrades another's results): a folder that
-    already holds a complete run of the same input with at least the outputs asked for
-    is reused as it is (``masonry build`` after ``masonry run``, a sweep variant after a
-    full run); otherwise the run writes what is asked for *and* what the folder held
-    (``masonry run`` after a sweep writes the plots and the solve, ``--force`` after a
-    run with plots writes the plots again). ``print_size`` is an output choice here
-    (:data:`OUTPUT_FIELDS`): a run without it keeps the folder's ``dome.3mf``, a run with
-    another size writes the 3MF at that size. When another command publishes the same
-    folder while this one computes, the richer of the two stays.
+    The run folder is published by the run-folder protocol
+    (:class:`masonry.runfolder.Publication`): a folder that already holds a complete run
+    of the same input with at least the outputs asked for (``params.outputs``) is
+    reused as it is; otherwise the run writes what is asked for and what the folder
+    held (``print_size`` chooses a file, not the input: a run without it keeps the
+    folder's ``dome.3mf``).
 
     Parameters
     ----------
@@ -351,16 +322,12 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
     analyse : bool
         Solve the rigid block equilibrium (``masonry run``); False only builds the model
         and its interfaces (``masonry build``).
-    plots_wanted, printable : bool
-        Write the plots; unite and write the printable body.
     force : bool
-        Recompute even when the folder holds a complete run of the same input (with at
-        least the outputs that run wrote).
+        Recompute even when the folder holds a complete run of the same input.
     scene : Scene, optional
         An already built scene (``masonry analyze``: blocks read from files, see
         :func:`masonry.scenes.imported.load_assembly`), used as is instead of building
-        ``params``, and never cached; ``params`` (with its ``assembly`` name) still names
-        the run folder.
+        ``params``, and never cached.
     source : dict, optional
         Where such a scene came from (files, supports), recorded in run.json.
     max_bricks : int
@@ -376,54 +343,51 @@ def run(params: Params, out_root="exports", *, analyse=True, plots_wanted=True,
     check_output_root(out_root)
     if scene is None:
         check_size(params, max_bricks)
-    sid = structure_id(params)
-    target = Path(out_root) / sid
-    outputs = {"analyse": analyse, "plots": plots_wanted, "printable": printable}
-    previous, seen = _previous(target, params), _stamp(target)
-    if previous is not None:
-        if not force and _covers(previous, outputs, params.print_size):
-            log.info("%s is up to date (use --force to recompute)", sid)
-            return {**previous, "path": str(target), "reused": True}
-        # a run folder only grows: what the earlier run wrote is written again (its 3MF
-        # too, at its size, unless this run asks for another)
-        outputs = {name: wanted or (previous.get("outputs") or {}).get(name) is True
-                   for name, wanted in outputs.items()}
-        if params.print_size is None and _print_size(previous) is not None:
-            params = params.replace(print_size=_print_size(previous))
-
+    out = params.outputs
+    job = Publication(out_root, structure_id(params), {"params": identity(params)},
+                      {"analyse": analyse, "plots": out.plots, "printable": out.printable,
+                       "quick": out.quick, "print_size": out.print_size},
+                      force=force, identify=_identify)
+    reused = job.reusable()
+    if reused is not None:
+        return reused
+    outputs = job.outputs()
+    params = with_outputs(params, outputs)
     timer = Timer()
     scene, model, cached = run_model(params, out_root, timer, scene)
-    record = run_record(scene, model, outputs, cached, source)
-    result = _solve(model, params, timer) if outputs["analyse"] else None
-    if result is not None:
-        record["rbe"] = {**result.to_dict(), "attempts": list(result.attempts)}
+    record = run_record(params, scene, model, outputs, cached, source)
+    result = solve(model, params, timer) if outputs["analyse"] else None
     collapse = None
-    if outputs["analyse"] and params.live_load_kind is not None:
+    if result is not None and params.load is not None:
         with timer.stage("collapse"):
             collapse = collapse_of(model, params, result)
-        record["collapse"] = collapse.to_dict()
-    made = RunOutputs(scene, model, result,
-                      result.per_interface() if result is not None and result.x is not None
-                      else None, plots=outputs["plots"], printable=outputs["printable"],
-                      collapse=collapse)
-
-    def keep(existing):
-        # another command published this input meanwhile, with at least these outputs
-        other = _previous(existing, params)
-        return (_stamp(existing) != seen and other is not None
-                and _covers(other, outputs, params.print_size))
-
-    with RunFolder(out_root, sid, keep=keep) as folder:
-        write_exports(folder, made, record, timer)
-        record["coordinates"] = _held(record["coordinates"], folder)
-        record["timings_s"] = timer.seconds
-        record["versions"] = versions()
-        record["complete"] = True
-        folder.write_json("run.json", record)
+    record.update(results_record(result, collapse))
+    made = RunOutputs(params, scene, model, result, collapse=collapse,
+                      title=structure_id(params))
+    folder = job.publish(lambda folder: write_run(folder, made, record, timer))
     if cached == "computed":  # only a model whose run completed is cached
         write_cache(params, out_root, scene, model)
-    record["path"] = str(folder.target)
-    return record
+    return {**record, "path": str(folder.target)}
+
+
+def results_record(result: RBEResult | None, collapse: CollapseResult | None) -> dict:
+    """run.json's ``rbe`` and ``collapse``, where the run has them."""
+    out = {}
+    if result is not None:
+        out["rbe"] = {**result.to_dict(), "attempts": list(result.attempts)}
+    if collapse is not None:
+        out["collapse"] = collapse.to_dict()
+    return out
+
+
+def write_run(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer):
+    """Every file of a run and, last, its ``run.json`` (``record``, completed)."""
+    write_exports(folder, made, record, timer)
+    record["coordinates"] = _held(record["coordinates"], folder)
+    record["timings_s"] = timer.seconds
+    record["versions"] = versions()
+    record["complete"] = True
+    folder.write_json("run.json", record)
 
 
 def _held(coordinates: dict, folder: RunFolder) -> dict:
@@ -433,16 +397,18 @@ def _held(coordinates: dict, folder: RunFolder) -> dict:
             if isinstance(value, list) else value for key, value in coordinates.items()}
 
 
-def run_record(scene: Scene, model: Model, outputs: dict, cached: str, source=None) -> dict:
+def run_record(params: Params, scene: Scene, model: Model, outputs: dict, cached: str,
+               source=None) -> dict:
     """The run.json record of a built model, before any solve.
 
     Parameters
     ----------
+    params : Params
     scene : masonry.scenes.base.Scene
     model : masonry.rbe.boundary.Model
         Its analysis model; its interface counts by kind go into ``counts``.
     outputs : dict str -> bool
-        What the run writes (``analyse``, ``plots``, ``printable``).
+        What the run writes (``analyse``, ``plots``, ``printable``, ``quick``).
     cached : str
         ``'reused'``, ``'computed'`` or ``'given'``: where the geometry came from.
     source : dict, optional
@@ -454,14 +420,14 @@ def run_record(scene: Scene, model: Model, outputs: dict, cached: str, source=No
         Structure id, scene name, parameters, outputs, :func:`model_record`, cache
         state and source.
     """
-    params = scene.params
     record = {
         "structure_id": structure_id(params),
         "scene": params.scene,
-        "params": dataclasses.asdict(params),
-        "outputs": outputs,
-        **model_record(scene),
-        "coordinates": coordinates_record(scene),
+        "params": params.record(),
+        "outputs": {name: outputs[name] for name in ("analyse", "plots", "printable",
+                                                     "quick")},
+        **model_record(scene, params.analysis.density),
+        "coordinates": coordinates_record(scene, params.outputs.cad_offset),
         "cache": {"geometry": cached},
     }
     if source is not None:
@@ -471,57 +437,52 @@ def run_record(scene: Scene, model: Model, outputs: dict, cached: str, source=No
 
 
 MOVED_FILES = ("locations.csv", "dome.stl", "dome.obj", "dome.3mf")
-"""The files whose bricks are moved inward by the CAD offset (SPEC 7, thesis 3.4.1)."""
+"""The files whose bricks are moved inward by the CAD offset (docs/model.md 7, thesis
+3.4.1)."""
 
 
-def coordinates_record(scene: Scene) -> dict:
+def coordinates_record(scene: Scene, cad_offset: float) -> dict:
     """run.json's ``coordinates``: which files hold model coordinates and which are moved
-    inward by ``cad_offset`` (metres, along each brick's inward normal), so that files
-    imported together line up once the user knows it."""
-    params = scene.params
-    moved = scene.block_inward is not None and params.cad_offset != 0
+    inward by ``cad_offset`` units (metres in the record, along each brick's inward
+    normal), so that files imported together line up once the user knows it."""
+    moved = scene.block_inward is not None and cad_offset != 0
     return {
-        "cad_offset_m": params.cad_offset * params.unit if moved else 0.0,
+        "cad_offset_m": cad_offset * scene.unit if moved else 0.0,
         "moved_inward": list(MOVED_FILES) if moved else [],
         "model": ["bricks.obj", "bricks.3dm", "interfaces.csv", "RBE/forces.csv",
                   "RBE/interfaces.vtu"] + ([] if moved else list(MOVED_FILES)),
     }
 
 
-def _solve(model: Model, params: Params, timer: Timer) -> RBEResult:
+def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
+    """The rigid block equilibrium of a run's model (docs/model.md 6)."""
+    analysis = params.analysis
     with timer.stage("assembly"):
         problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
                              side_rotation=model.side_rotation)
     with timer.stage("solve"):
-        return problem.solve(mu=params.mu, density=params.density, friction=params.friction,
-                             solver=params.solver, accuracy=params.solver_accuracy,
-                             cone=params.friction_cone)
+        return problem.solve(mu=analysis.mu, density=analysis.density,
+                             friction=analysis.friction, solver=analysis.solver,
+                             accuracy=analysis.accuracy, cone=analysis.friction_cone)
 
 
 def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> CollapseResult:
-    """The collapse load factor of the run's live load (SPEC 6.8). A feasible RBE verdict
-    stands for the dead load; otherwise the LP decides it. ``--crown-load`` is the load on
-    the whole dome: a section carries its ``1/n`` share."""
+    """The collapse load factor of the run's live load (docs/model.md 6.8). A feasible RBE
+    verdict stands for the dead load; otherwise the program decides it. A lateral search
+    uses the scene's symmetry; a crown load on a part of the dome (a section) is its
+    share of the whole dome's."""
     known = True if rbe is not None and rbe.feasible else None
-    options = dict(mu=params.mu, density=params.density,
-                   cone=friction_model(params.solver_accuracy, params.friction_cone))
-    if params.lateral == "all":
-        webs = params.n if params.scene in ("section", "dome") else None
-        # the full dome repeats every 360/n degrees (tests/test_collapse.py checks it)
-        period = 360.0 / params.n if params.scene == "dome" else None
-        return worst_lateral(model, n_webs=webs, period_deg=period,
+    analysis, load = params.analysis, params.load
+    options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone)
+    symmetry = params.kind.symmetry(params.geometry)
+    if isinstance(load, Lateral) and load.azimuth_deg == "all":
+        return worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
                              dead_load_feasible=known, **options)
-    if params.lateral is not None:
-        live = lateral(model, params.lateral, params.density)
-    elif params.point_loads:
-        live = point_loads(model.blocks, params.point_loads)
-    else:
-        live = crown_load(model.blocks, params.crown_load,
-                          copies=params.n if params.scene == "section" else 1)
+    live = load.on(model, analysis.density, copies=symmetry.order if symmetry.unit else 1)
     result = collapse_load(model, live, dead_load_feasible=known,
-                           friction=params.friction_law, **options)
-    if params.lateral is not None:
-        result = dataclasses.replace(result, azimuth_deg=float(params.lateral))
+                           friction=analysis.friction_law, **options)
+    if isinstance(load, Lateral):
+        result = dataclasses.replace(result, azimuth_deg=float(load.azimuth_deg))
     return result
 
 

@@ -35,6 +35,7 @@ import time
 import numpy as np
 
 from masonry.blocks import Blocks, concatenate, rotated_web, rotation_z
+from masonry.errors import MasonryError
 from masonry.meshing import merge_vertices
 from masonry.tolerances import MIN_CORNER_DET, OVERLAP_REL, Tolerances
 
@@ -45,7 +46,7 @@ _CLEAN_ROUNDS = 4
 clean."""
 
 
-class PrintableError(ValueError):
+class PrintableError(MasonryError, ValueError):
     """The united body is not printable: not watertight, not one body, degenerate, or
     manifold3d reported an error. ``report`` holds the measured checks."""
 
@@ -379,14 +380,15 @@ def _require_ok(body, what):
         raise PrintableError(f"manifold3d reported {status} for the {what}")
 
 
-def printable_blocks(scene):
-    """Blocks and CAD-offset vertices of the printable body: the whole dome in dome mode
-    (a section with a boundary, or the dome scene; SPEC 7), else the scene itself."""
-    params = scene.params
-    if params.scene == "section" and params.boundary != "free":
-        n = params.n
-        cad = scene.cad_vertices()
+def printable_blocks(scene, boundary="free", cad_offset=1.0):
+    """Blocks and CAD-offset vertices of the printable body (``cad_offset`` units inward):
+    the whole dome when the scene is one part of it analysed with its neighbours (a
+    section with a boundary; docs/model.md 7), else the scene itself."""
+    cad = scene.cad_vertices(cad_offset)
+    symmetry = scene.symmetry
+    if symmetry.unit and boundary != "free":
+        n = symmetry.order
         blocks = concatenate([rotated_web(scene.blocks, k, n) for k in range(n)])
         vertices = np.concatenate([cad @ rotation_z(2 * np.pi * k / n).T for k in range(n)])
         return blocks, vertices
-    return scene.blocks, scene.cad_vertices()
+    return scene.blocks, cad

@@ -1,4 +1,5 @@
-"""The one place that writes a run's files, atomically (SPEC 7).
+"""The one place that writes a run's files, atomically, and the protocol by which every
+command publishes a run folder (docs/model.md 7).
 
 A run writes into a hidden temporary folder beside its target and swaps it into place
 only when everything is written. A failed or interrupted run removes its temporary folder
@@ -11,6 +12,12 @@ leftovers of a killed run (its process is gone) and never those of a run still g
 Publishing happens under an exclusive lock on the output root, so two commands writing
 into the same root at once never see a half-swapped folder; a caller may ask to keep the
 folder already there (see :meth:`RunFolder.publish`).
+
+:class:`Publication` is the protocol every command that publishes a run folder follows
+(``masonry run``, ``build``, ``stages``, a sweep's variants): a folder holding a complete
+run of the same input with at least the outputs asked for is reused as it is; otherwise
+the run writes what is asked for *and* what the folder held (a run folder only grows);
+when another command publishes the same folder meanwhile, the richer of the two stays.
 """
 
 import json
@@ -25,7 +32,7 @@ import uuid
 from contextlib import contextmanager
 from pathlib import Path
 
-from masonry.params import ParameterError
+from masonry.errors import ParameterError
 
 try:
     import fcntl
@@ -321,3 +328,126 @@ def _plain(value):
     if value is None or isinstance(value, (bool, int, float, str)):
         return value
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+class Publication:
+    """One command's results for ``root/name``, published by the run-folder protocol.
+
+    Parameters
+    ----------
+    root : str or Path
+        The output root.
+    name : str
+        The run folder's name (a structure id, with a study's suffix).
+    identity : dict
+        What makes the folder's result (its ``params`` in ``run.json``, plus anything
+        else the command records as inputs, e.g. a stage plan): a JSON-able dict; an
+        earlier record with other keys or values is of another input.
+    wanted : dict
+        The outputs asked for, as ``run.json`` records them under ``outputs``: names ->
+        True/False (``plots``, ``printable``, ...), ``quick`` (figures in one view: they do
+        not stand for the full ones), and ``print_size`` (mm of ``dome.3mf`` or None: a
+        3MF of another size is not the one asked for).
+    force : bool
+        Recompute even when the folder holds what is asked for (it still only grows).
+    identify : callable, optional
+        ``identify(record) -> dict``: the part of a record compared with ``identity``
+        (default: its keys of ``identity``).
+    """
+
+    def __init__(self, root, name, identity: dict, wanted: dict, *, force=False,
+                 identify=None):
+        self.root, self.name = Path(root), name
+        self.target = self.root / name
+        self.identity = _round_trip(identity)
+        self._identify = identify or (lambda record: {key: record.get(key)
+                                                      for key in self.identity})
+        self.wanted, self.force = dict(wanted), force
+        self.previous = self._complete_record(self.target)
+        self._seen = _stamp(self.target)
+
+    def reusable(self) -> dict | None:
+        """The earlier record when it holds everything asked for (and not ``force``):
+        the command then writes nothing."""
+        if self.previous is None or self.force or not covers(self.previous, self.wanted):
+            return None
+        log.info("%s is up to date (use --force to recompute)", self.name)
+        return {**self.previous, "path": str(self.target), "reused": True}
+
+    def outputs(self) -> dict:
+        """What to write: the outputs asked for and those the folder held (a run folder
+        only grows; its 3MF at its size, unless another is asked for)."""
+        had = (self.previous or {}).get("outputs") or {}
+        grown = {name: (value or had.get(name) is True) if isinstance(value, bool) else value
+                 for name, value in self.wanted.items() if name not in ("quick",
+                                                                        "print_size")}
+        full_plots = had.get("plots") is True and had.get("quick") is not True
+        grown["quick"] = bool(self.wanted.get("quick")) and not full_plots
+        size = self.wanted.get("print_size")
+        grown["print_size"] = size if size is not None else printed_size(self.previous)
+        return grown
+
+    def publish(self, write) -> "RunFolder":
+        """Write the folder with ``write(folder)`` (a :class:`RunFolder`) and publish it,
+        unless another command published a record of the same input covering these
+        outputs while this one computed (then that folder stays)."""
+
+        def keep(existing):
+            other = self._complete_record(existing)
+            return (_stamp(existing) != self._seen and other is not None
+                    and covers(other, self.outputs()))
+
+        with RunFolder(self.root, self.name, keep=keep) as folder:
+            write(folder)
+        return folder
+
+    def _complete_record(self, target) -> dict | None:
+        try:
+            record = json.loads((Path(target) / "run.json").read_text())
+        except (OSError, ValueError):
+            return None
+        if not isinstance(record, dict) or record.get("complete") is not True:
+            return None
+        try:
+            same = _round_trip(self._identify(record)) == self.identity
+        except (AttributeError, TypeError):  # a record of another shape
+            return None
+        return record if same else None
+
+
+def covers(record: dict, wanted: dict) -> bool:
+    """Whether a run record wrote at least ``wanted`` (see :class:`Publication`)."""
+    had = record.get("outputs") or {}
+    for name, value in wanted.items():
+        if name == "quick":
+            if not value and had.get("plots") is True and had.get("quick") is True:
+                return False
+        elif name == "print_size":
+            if value is not None and wanted.get("printable") and printed_size(record) != value:
+                return False
+        elif value is True and had.get(name) is not True:
+            return False
+    return True
+
+
+def printed_size(record) -> float | None:
+    """The size (mm) of the ``dome.3mf`` a run record wrote, or None."""
+    printable = (record or {}).get("printable")
+    written = printable.get("print") if isinstance(printable, dict) else None
+    return written.get("size_mm") if isinstance(written, dict) else None
+
+
+def _stamp(target: Path):
+    """Identity of the run.json in ``target`` (inode, mtime), or None: tells whether
+    another command published the folder while this run was computing."""
+    try:
+        stat = (Path(target) / "run.json").stat()
+    except OSError:
+        return None
+    return stat.st_ino, stat.st_mtime_ns
+
+
+def _round_trip(value):
+    """``value`` as it reads back from ``run.json`` (tuples as lists, numpy values plain),
+    for comparisons with a record."""
+    return json.loads(strict_json(value))

@@ -23,19 +23,20 @@ THRUST_LINE = {16: 0.1070762, 32: 0.1071970, 64: 0.1073832}
 
 
 def arch_params(**changes):
-    return validate(Params(scene="arch", **changes))
+    return validate(Params.of(scene="arch", **changes))
 
 
 @pytest.mark.parametrize("shape, n", [("semicircular", 16), ("semicircular", 7),
                                       ("segmental", 9), ("pointed", 10)])
 def test_arch_geometry_and_joints(shape, n):
     params = arch_params(arch_shape=shape, arch_blocks=n, arch_thickness=0.5)
-    scene = build_arch(params)
+    scene = build_arch(params.geometry)
     blocks = scene.blocks
     assert blocks.n_blocks == n + 2 and blocks.block_is_support.sum() == 2
-    profile = arch_profile(shape, n, params.arch_span, 0.5)
+    profile = arch_profile(shape, n, params.geometry.arch_span, 0.5)
     area = shapely.area(shapely.polygons(profile.voussoirs))
-    np.testing.assert_allclose(blocks.block_volume[2:], area * params.arch_depth, rtol=1e-12)
+    np.testing.assert_allclose(blocks.block_volume[2:], area * params.geometry.arch_depth,
+                               rtol=1e-12)
     # every joint is a whole rectangle, t x depth (the vertical crown joint of a pointed
     # arch is longer); the joints between voussoirs are bed joints, however steep
     interfaces = detect(blocks, up=scene.block_up)
@@ -43,12 +44,12 @@ def test_arch_geometry_and_joints(shape, n):
     length = np.linalg.norm(profile.extrados - profile.intrados, axis=1)
     assert (~np.isclose(length, 0.5, rtol=1e-12)).sum() == (shape == "pointed")
     np.testing.assert_allclose(np.sort(interfaces.area),
-                               np.sort(length) * params.arch_depth, rtol=1e-9)
+                               np.sort(length) * params.geometry.arch_depth, rtol=1e-9)
     assert interfaces.counts()["horizontal"] == n - 1
     assert interfaces.counts()["support"] == 2
     # the centre line's span and rise
     mid = (profile.intrados + profile.extrados) / 2
-    assert mid[0, 0] == pytest.approx(params.arch_span / 2)
+    assert mid[0, 0] == pytest.approx(params.geometry.arch_span / 2)
     assert mid[:, 1].min() == pytest.approx(0.0, abs=1e-12)
     assert np.allclose(mid[::-1] * [-1, 1], mid)  # symmetric
 

@@ -164,10 +164,10 @@ def test_supports_by_name_by_height_and_ground(fixtures_dir):
     assert select_supports(blocks, below=0.0).sum() == 4  # and the two springers
     with pytest.raises(AssemblyError, match="'tower_\\*' matches no block"):
         select_supports(blocks, ["tower_*"])
-    scene, source = load_assembly([path], Params(), ground=True)
+    scene, source = load_assembly([path], ground=True)
     assert scene.blocks.block_name[0] == "ground" and source["supports"] == 1
-    assert scene.params.scene == "assembly"
-    assert scene.params.assembly.startswith("arch_rhino_")
+    assert scene.kind.name == "assembly"
+    assert scene.geometry.assembly.startswith("arch_rhino_")
 
 
 def test_voussoirs_alone_on_a_ground_slab_stand(fixtures_dir, tmp_path):
@@ -184,7 +184,7 @@ def test_voussoirs_alone_on_a_ground_slab_stand(fixtures_dir, tmp_path):
 
 def test_no_support_is_refused(fixtures_dir):
     with pytest.raises(AssemblyError, match="no support"):
-        load_assembly([fixtures_dir / "assembly" / "arch_rhino.obj"], validate(Params()))
+        load_assembly([fixtures_dir / "assembly" / "arch_rhino.obj"])
 
 
 # ---------------------------------------------------------------------- bad files

@@ -104,7 +104,7 @@ def test_cad_offset_moves_bricks_inward(tmp_path):
     # run.json says which files are moved and by how much
     from masonry.pipeline import coordinates_record
 
-    record = coordinates_record(scene)
+    record = coordinates_record(scene, cad_offset=1.0)
     assert record["cad_offset_m"] == pytest.approx(0.1, rel=1e-12)
     assert {"locations.csv", "dome.stl"} <= set(record["moved_inward"])
     assert {"bricks.obj", "bricks.3dm", "RBE/forces.csv"} <= set(record["model"])

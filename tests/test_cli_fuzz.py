@@ -23,7 +23,7 @@ import trimesh
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from masonry.params import Params, validate
+from masonry.params import Params, names, validate
 from masonry.pipeline import model_record
 from masonry.runfolder import check_output_root
 from masonry.scenes import build, check_size
@@ -72,11 +72,11 @@ def stub_pipeline(params, out_root, **kwargs):
     check_output_root(out_root)
     check_size(params, kwargs["max_bricks"])  # the fuzz keeps it at 1500: quick builds
     scene = build(params)
-    record = model_record(scene)
-    rbe = {"verdict": "not solved", "feasible": False, "friction": params.friction,
-           "mu": params.mu, "residual_eq": math.nan, "solver": "none", "status": "stub"}
+    record = model_record(scene, params.analysis.density)
+    rbe = {"verdict": "not solved", "feasible": False, "friction": params.analysis.friction,
+           "mu": params.analysis.mu, "residual_eq": math.nan, "solver": "none", "status": "stub"}
     return {**record, "structure_id": "fuzz", "scene": params.scene, "path": str(out_root),
-            "params": {"friction": params.friction}, "rbe": rbe}
+            "params": {"friction": params.analysis.friction}, "rbe": rbe}
 
 
 # ----------------------------------------------------------------------- listed cases
@@ -370,7 +370,7 @@ def test_the_tables_cover_every_option_of_run():
     # a new option of `masonry run` that sets a parameter is fuzzed, or at least listed
     parser = make_parser()._subparsers._group_actions[0].choices["run"]
     options = {action.option_strings[-1] for action in parser._actions
-               if action.dest in Params.__dataclass_fields__ and action.nargs != 0}
+               if action.dest in names() and action.nargs != 0}
     covered = set(PLAUSIBLE) | {a for args in LISTED + RUN_ONLY for a in args}
     assert "--print-size" in options and options <= covered, options - covered
 

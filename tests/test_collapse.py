@@ -13,14 +13,14 @@ from scipy.optimize import linprog
 
 from masonry import forking
 from masonry.blocks import Blocks
+from masonry.pipeline import build_model
 from masonry.params import ParameterError, Params, from_preset, validate
-from masonry.rbe.boundary import Model, analysis_model
+from masonry.rbe.boundary import Model
 from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
                                   collapse_load, fixed_capacity_factor, lateral_azimuths,
                                   worst_lateral)
 from masonry.rbe.loads import crown_load, lateral, point_loads
 from masonry.rbe.solvers.interior_lp import LoadFactorOptions
-from masonry.scenes import build
 from masonry.scenes.arch import arch_profile
 from masonry.studies.structures import lateral_record
 from masonry.studies.thrust_line import thrust_line_minimum_thickness
@@ -169,7 +169,7 @@ def test_a_point_load_on_no_block_is_refused_naming_the_option(tmp_path, capsys)
 
 def test_free_wall_overturns_out_of_plane_at_t_over_h():
     params = from_preset("wall")
-    model = analysis_model(build(params))
+    model = build_model(params)[1]
     free = ~model.blocks.block_is_support
     bounds = model.blocks.block_bounds[free]
     thickness = bounds[:, 1, 0].max() - bounds[:, 0, 0].min()
@@ -237,8 +237,8 @@ def arch_lp(profile, depth, mu, density=DENSITY):
 
 
 def arch_model(thickness, blocks=12):
-    params = validate(Params(scene="arch", arch_blocks=blocks, arch_thickness=thickness))
-    return params, analysis_model(build(params))
+    params = validate(Params.of(scene="arch", arch_blocks=blocks, arch_thickness=thickness))
+    return params, build_model(params)[1]
 
 
 @pytest.mark.parametrize("thickness, mu, method, cone", [
@@ -252,8 +252,8 @@ def test_arch_under_horizontal_load_matches_an_independent_2d_lp(thickness, mu, 
     params, model = arch_model(thickness)
     live = lateral(model, 0.0, DENSITY)
     result = CollapseLP(model, mu=mu, density=DENSITY, method=method, cone=cone).solve(live)
-    profile = arch_profile("semicircular", 12, params.arch_span, thickness)
-    assert result.load_factor == pytest.approx(arch_lp(profile, params.arch_depth, mu),
+    profile = arch_profile("semicircular", 12, params.geometry.arch_span, thickness)
+    assert result.load_factor == pytest.approx(arch_lp(profile, params.geometry.arch_depth, mu),
                                                rel=1e-6)
     assert result.hinges >= 3  # a hinge mechanism: four hinges, or sliding with fewer
     check_mechanism(model, live, result)
@@ -281,9 +281,9 @@ def test_crown_load_on_the_cyclic_section_equals_the_full_dome():
     """A downward crown load is carried at any factor by rigid blocks (the top ring
     carries it in compression: 'unbounded'); an upward one lifts the top course at a
     finite factor. Either way the cyclic section gives the full dome's answer."""
-    section = analysis_model(build(validate(Params(scene="section", boundary="cyclic",
-                                                   **SMALL_DOME))))
-    dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
+    section = build_model(validate(Params.of(scene="section", boundary="cyclic",
+                                                   **SMALL_DOME)))[1]
+    dome = build_model(validate(Params.of(scene="dome", **SMALL_DOME)))[1]
     down = [collapse_load(model, crown_load(model, 2000.0, copies=copies))
             for model, copies in ((section, 6), (dome, 1))]
     assert [r.status for r in down] == ["unbounded", "unbounded"]
@@ -300,7 +300,7 @@ def test_crown_load_on_the_cyclic_section_equals_the_full_dome():
 @pytest.mark.parametrize("method, cone", [("interior", "circle"), ("clarabel", "circle"),
                                           ("simplex", "polygon:16")])
 def test_worst_lateral_searches_the_symmetry_directions_with_one_model(method, cone):
-    dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
+    dome = build_model(validate(Params.of(scene="dome", **SMALL_DOME)))[1]
     azimuths = lateral_azimuths(6)
     assert len(azimuths) >= 24 and {30.0, 90.0, 150.0} <= set(azimuths)
     worst = worst_lateral(dome, azimuths, n_webs=6, method=method, cone=cone)
@@ -355,7 +355,7 @@ def test_an_azimuth_search_on_two_cores_gives_every_azimuth_its_factor(two_proce
 def test_interior_point_lp_finds_the_simplex_optimum_on_a_dome(azimuth, cone):
     """The own interior point method against HiGHS's dual simplex (an exact vertex
     solution) on the 78-brick dome, without falling back to Clarabel."""
-    dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
+    dome = build_model(validate(Params.of(scene="dome", **SMALL_DOME)))[1]
     live = lateral(dome, azimuth, DENSITY)
     ours = CollapseLP(dome, method="interior", cone=cone).solve(live, dead_load_feasible=True)
     simplex = CollapseLP(dome, method="simplex", cone=cone).solve(live,
@@ -437,7 +437,7 @@ def test_non_associative_friction_lowers_a_sliding_collapse_and_keeps_a_tipping_
         result = collapse_load(model, lateral(model, azimuth), friction="non-associative")
         assert result.load_factor == pytest.approx(expected, rel=1e-6)
         assert result.friction_law == "non-associative" and result.note is None
-    dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
+    dome = build_model(validate(Params.of(scene="dome", **SMALL_DOME)))[1]
     live = lateral(dome, 0.0)
     associated = collapse_load(dome, live)
     estimate = collapse_load(dome, live, friction="non-associative")
@@ -481,8 +481,8 @@ def test_the_dome_symmetry_leaves_azimuths_from_a_web_to_its_corner():
     """The worst lateral factor over 0..180/n (structures' search) is the worst over the
     whole circle: rotation by 360/n and the mirror in a web's mid-plane map every
     direction into that sector."""
-    params = validate(Params(scene="dome", **SMALL_DOME))
-    dome = analysis_model(build(params))
+    params = validate(Params.of(scene="dome", **SMALL_DOME))
+    dome = build_model(params)[1]
     sector = lateral_record(dome, params, count=3)  # 0, 15, 30 degrees
     circle = worst_lateral(dome, lateral_azimuths(6))  # every 15 degrees
     assert sector["lateral_factor"] == pytest.approx(circle.load_factor, rel=1e-6)

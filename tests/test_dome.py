@@ -23,8 +23,8 @@ SMALL = {3: (3, 3, 1), 4: (4, 3, 1), 8: (8, 3, 0)}
 def analysed(friction="auto", lp_check=False, **params):
     p = from_preset("1", **params)
     scene = build(p)
-    model = analysis_model(scene)
-    result = solve_rbe(model.blocks, model.interfaces, mu=p.mu, friction=friction,
+    model = analysis_model(scene, p.analysis.boundary)
+    result = solve_rbe(model.blocks, model.interfaces, mu=p.analysis.mu, friction=friction,
                        lp_check=lp_check, side_block=model.side_block,
                        side_rotation=model.side_rotation)
     return scene, model, result
@@ -108,7 +108,7 @@ def test_thesis_x2_structures_are_feasible_in_cyclic_mode(preset):
     """Thesis table 4.1: structures 1.2, 2.2, 3.2 (dome mode, friction-net) feasible."""
     p = from_preset(preset, boundary="cyclic")
     scene = build(p)
-    model = analysis_model(scene)
+    model = analysis_model(scene, p.analysis.boundary)
     result = solve_rbe(model.blocks, model.interfaces, friction="net", lp_check=False,
                        side_block=model.side_block, side_rotation=model.side_rotation)
     assert result.feasible

@@ -24,12 +24,12 @@ BASE = dict(stretch=1.0, n=8, r=1, p=5, cut=0.1, boundary="cyclic")
 
 def analyse(accuracy="balanced", **changes):
     """Build and solve; returns (params, model, result) or raises ParameterError."""
-    params = validate(Params(**{**BASE, **changes}))
+    params = validate(Params.of(**{**BASE, **changes}))
     scene = build(params)
-    model = analysis_model(scene)
+    model = analysis_model(scene, params.analysis.boundary)
     problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
                          side_rotation=model.side_rotation)
-    result = problem.solve(mu=params.mu, density=params.density, accuracy=accuracy)
+    result = problem.solve(mu=params.analysis.mu, density=params.analysis.density, accuracy=accuracy)
     check_valid(params, scene, model, result)
     return params, model, result
 
@@ -40,7 +40,7 @@ def check_valid(params, scene, model, result):
     free = ~blocks.block_is_support
     assert free.sum() > 0 and np.all(blocks.block_volume[free] > 0)
     assert result.weight_N == pytest.approx(
-        params.density * G * blocks.block_volume[free].sum(), rel=1e-12)
+        params.analysis.density * G * blocks.block_volume[free].sum(), rel=1e-12)
     limit = ACCURACY[result.accuracy].residual
     assert result.x is not None, result.attempts
     assert np.all(np.isfinite(result.x))

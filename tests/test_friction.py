@@ -11,6 +11,7 @@ from test_rbe import box
 from masonry.blocks import Blocks
 from masonry.friction import FrictionCone
 from masonry.interfaces import detect
+from masonry.pipeline import build_model
 from masonry.params import Params, from_preset, validate
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.collapse import ANISOTROPIC_NOTE, CollapseLP, collapse_load
@@ -168,7 +169,7 @@ def turned_axes(model, seed):
 
 def free_section():
     """Preset 3 with p = 5 as a free-standing section: 135 bricks, infeasible."""
-    return analysis_model(build(from_preset("3", p=5, boundary="free")))
+    return build_model(from_preset("3", p=5, boundary="free"))[1]
 
 
 @pytest.mark.parametrize("name", ["circle", "polygon:16"])
@@ -210,7 +211,7 @@ def test_the_square_pyramid_depends_on_the_joints_axes():
 @pytest.mark.parametrize("name", ["circle", "polygon:16"])
 @pytest.mark.parametrize("azimuth", [0.0, 17.0, 45.0])
 def test_the_collapse_factor_does_not_depend_on_the_joints_axes(name, azimuth):
-    dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
+    dome = build_model(validate(Params.of(scene="dome", **SMALL_DOME)))[1]
     live = lateral(dome, azimuth, DENSITY)
     factors = [collapse_load(m, live, mu=0.7, density=DENSITY, cone=name,
                              dead_load_feasible=True).load_factor
@@ -224,7 +225,7 @@ def test_a_dome_turned_about_z_with_its_load_gives_the_same_results(turn):
     """Turning the whole model about the vertical axis, and its lateral load with it,
     changes nothing: the verdict, the MoI factor of an infeasible section, the load
     factor and the mechanism's joints."""
-    scene = build(validate(Params(scene="dome", **SMALL_DOME)))
+    scene = build(validate(Params.of(scene="dome", **SMALL_DOME)))
     angle = np.radians(turn)
     motion = np.eye(4)
     motion[:2, :2] = [[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]]
@@ -233,7 +234,7 @@ def test_a_dome_turned_about_z_with_its_load_gives_the_same_results(turn):
                                  block_inward=scene.block_inward @ motion[:3, :3].T)
     results = []
     for s, azimuth in ((scene, 10.0), (turned, 10.0 + turn)):
-        model = analysis_model(s)
+        model = analysis_model(s, "free")
         rbe = RBEProblem(model.blocks, model.interfaces).solve(mu=0.7, density=DENSITY)
         collapse = collapse_load(model, lateral(model, azimuth, DENSITY), mu=0.7,
                                  density=DENSITY, dead_load_feasible=rbe.feasible)
@@ -251,7 +252,7 @@ def test_the_own_solvers_of_the_cone_find_clarabels_optimum(boundary):
     cone's projection; the interior point method with Nesterov-Todd scaling and a Newton
     polish for friction+) against Clarabel's second-order cone program, stated by cvxpy:
     the same verdict, MoI factor and vertex forces."""
-    model = analysis_model(build(from_preset("3", p=5, boundary=boundary)))
+    model = build_model(from_preset("3", p=5, boundary=boundary))[1]
 
     def solve(**options):
         return RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
@@ -280,7 +281,7 @@ def test_the_collapse_lp_of_the_cone_finds_clarabels_optimum(azimuth):
     (Nesterov-Todd scaling on the Newton system) against Clarabel's second-order cone
     program on the 78-brick dome, between the inscribed and circumscribed 16-sided
     pyramids' factors (HiGHS's dual simplex)."""
-    dome = analysis_model(build(validate(Params(scene="dome", **SMALL_DOME))))
+    dome = build_model(validate(Params.of(scene="dome", **SMALL_DOME)))[1]
     live = lateral(dome, azimuth, DENSITY)
     ours = CollapseLP(dome, cone="circle").solve(live, dead_load_feasible=True)
     reference = CollapseLP(dome, cone="circle", method="clarabel").solve(

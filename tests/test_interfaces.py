@@ -201,10 +201,10 @@ def test_wall_preset_counts_follow_its_bond_pattern():
     bricks at the ends of every second course) has the interfaces its bond implies."""
     params = from_preset("wall")
     scene = build(params)
-    n_full = params.wall_length / 4.0
+    n_full = params.geometry.wall_length / 4.0
     assert n_full == int(n_full)
     assert (detect(scene.blocks, up=scene.block_up).counts()
-            == bond_counts(params.wall_courses, int(n_full)))
+            == bond_counts(params.geometry.wall_courses, int(n_full)))
 
 
 @pytest.mark.parametrize("size", [1e-3, 1.0, 1e3])

@@ -12,17 +12,19 @@ ROOT = Path(masonry.__file__).parent
 
 # the pipeline's order: a module may import only from its own stage or earlier ones
 STAGES = (
-    ("masonry", "masonry.params", "masonry.tolerances", "masonry.friction",
-     "masonry.runfolder", "masonry.forking"),
+    ("masonry", "masonry.errors", "masonry.parameters", "masonry.tolerances",
+     "masonry.friction", "masonry.outputs", "masonry.runfolder", "masonry.forking"),
     ("masonry.blocks", "masonry.meshing"),
     ("masonry.dome",),
     ("masonry.scenes",),
     ("masonry.interfaces",),
     ("masonry.rbe",),
+    ("masonry.params",),
     ("masonry.printable", "masonry.plots"),
     ("masonry.export",),
     ("masonry.pipeline",),
     ("masonry.studies",),
+    ("masonry.api",),
 )
 
 

@@ -44,9 +44,9 @@ def _quartic_contact(a, c, x0, z0, h):
 @pytest.mark.parametrize("preset", PRESETS)
 def test_level_table_against_quartic(preset):
     params = from_preset(preset)
-    dims = Dimensions.of(params)
-    table = level_table(params)
-    x, z, h = table.x, table.z, params.unit
+    dims = Dimensions.of(params.geometry)
+    table = level_table(params.geometry)
+    x, z, h = table.x, table.z, params.geometry.unit
     on_ellipse = (x / dims.a) ** 2 + (z / dims.c) ** 2
     np.testing.assert_allclose(on_ellipse, 1.0, rtol=1e-9)
     np.testing.assert_allclose(np.hypot(np.diff(x), np.diff(z)), h, rtol=1e-9)
@@ -54,12 +54,12 @@ def test_level_table_against_quartic(preset):
     for level in range(1, table.n_courses + 1, 7):
         expected = _quartic_contact(dims.a, dims.c, x[level - 1], z[level - 1], h)
         np.testing.assert_allclose([x[level], z[level]], expected, rtol=1e-9)
-    np.testing.assert_allclose(table.y, x * np.tan(np.pi / params.n), rtol=1e-12)
+    np.testing.assert_allclose(table.y, x * np.tan(np.pi / params.geometry.n), rtol=1e-12)
     assert z[-1] <= dims.z_max * (1 + 1e-12)
 
 
 def test_dimensions_fix_the_thesis_typos():
-    dims = Dimensions.of(from_preset("1"))
+    dims = Dimensions.of(from_preset("1").geometry)
     assert dims.width == pytest.approx(4.4)
     assert dims.radius == pytest.approx(4.4 / (2 * np.sin(np.pi / 8)))  # not sin(pi/2)
     assert dims.z_max == pytest.approx(0.9 * dims.c)  # cut removes the top 10 %
@@ -67,7 +67,7 @@ def test_dimensions_fix_the_thesis_typos():
 
 @pytest.mark.parametrize("preset", PRESETS)
 def test_pattern_chord_stays_close_to_two_units(preset):
-    table = level_table(from_preset(preset))
+    table = level_table(from_preset(preset).geometry)
     deviation = np.nanmax(np.abs(table.pattern_height / 0.1 - 2))
     assert deviation < 4e-4  # documented in LevelTable
 
@@ -159,7 +159,7 @@ def _line_cover(blocks, ids, point):
 def test_every_course_is_covered_boundary_to_boundary(preset):
     scene = scene_of(preset)
     blocks, levels, u = scene.blocks, scene.levels, 0.1
-    tan = np.tan(np.pi / scene.params.n)
+    tan = np.tan(np.pi / scene.geometry.n)
     for k in range(1, levels.n_courses + 1):
         p0 = np.array([levels.x[k - 1], levels.z[k - 1]])
         p1 = np.array([levels.x[k], levels.z[k]])
@@ -242,9 +242,10 @@ def test_unit_scales_everything():
 @pytest.mark.parametrize("preset", (*PRESETS, "wall"))
 def test_golden_counts_and_volume(preset):
     from masonry.pipeline import model_record
+    from masonry.rbe.settings import Analysis
 
     golden = json.loads((FIXTURES / "golden_model.json").read_text())[preset]
-    record = model_record(scene_of(preset))
+    record = model_record(scene_of(preset), Analysis().density)
     assert record["counts"] == {k: golden[k] for k in
                                 ("bricks", "regular", "pattern", "fill_in", "courses")}
     assert record["volume_m3"] == pytest.approx(golden["volume_m3"], rel=1e-9)
@@ -267,4 +268,4 @@ def test_fixture_presets_agree_with_the_library(name):
         data = tomllib.load(f)
     key = name.removeprefix("preset")
     assert data == LIBRARY_PRESETS[key]
-    assert from_preset(key) == Params(**data)
+    assert from_preset(key) == Params.of(**data)

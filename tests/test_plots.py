@@ -1,19 +1,18 @@
 """Figures: units and colour scales chosen by the data, and the thrust line's points."""
 
-from types import SimpleNamespace
-
 import matplotlib
 import numpy as np
 import pytest
 
 from masonry.export.csv import tension_top
+from masonry.pipeline import build_model
 from masonry.params import Params, from_preset, validate
-from masonry.plots import (COLOUR_PERCENTILE, _rank_labels, azimuths_png, colour_scale,
-                           force_unit, mechanism_pngs)
-from masonry.rbe.boundary import analysis_model
+from masonry.plots import (COLOUR_PERCENTILE, azimuths_png, colour_scale, force_unit,
+                           mechanism_pngs)
+from masonry.plots.failure import _rank_labels
+from masonry.scenes import build
 from masonry.rbe.collapse import collapse_load, worst_lateral
 from masonry.rbe.loads import lateral, point_loads
-from masonry.scenes import build
 from masonry.tolerances import TENSION_REPORTED_REL
 from test_collapse import DENSITY, SMALL_DOME, column
 
@@ -85,7 +84,7 @@ def test_tension_top_orders_by_tension_and_drops_solver_noise():
 def test_mid_plane_cuts_a_joint_where_its_edges_cross_it():
     from test_rbe import make_interfaces
 
-    from masonry.plots import _cut_at_y
+    from masonry.plots.thrust import _cut_at_y
 
     # a joint tilted about y: (0, -1, 0) .. (1, 1, 0.5), cut at y = 0.25
     square = np.array([[0, -1, 0], [1, -1, 0.5], [1, 1, 0.5], [0, 1, 0]], float)
@@ -97,20 +96,21 @@ def test_mid_plane_cuts_a_joint_where_its_edges_cross_it():
 
 
 def test_cyclic_runs_get_whole_dome_views():
-    from conftest import scene_of
-
+    from masonry.export import RunOutputs
     from masonry.interfaces import detect
     from masonry.plots import force_pngs, structure_pngs
 
-    scene = scene_of("3", boundary="cyclic", p=4)
+    cyclic, free = (validate(from_preset("3", boundary=b, p=4)) for b in ("cyclic", "free"))
+    scene = build(cyclic)
+    webs = RunOutputs(cyclic, scene, None).webs
+    assert webs == 4 and RunOutputs(free, scene, None).webs is None
     interfaces = detect(scene.blocks, up=scene.block_up)
     forces = {key: np.ones(len(interfaces)) for key in
               ("compression", "tension", "normal", "t1", "t2", "friction")}
     assert {"05_dome/normal.png", "05_dome/tension.png"} <= set(
-        force_pngs(scene, scene.blocks, interfaces, forces, fast=True))
-    assert "05_dome/3_structure.png" in structure_pngs(scene, fast=True)
-    free = scene_of("3", p=4)
-    assert not any(k.startswith("05_dome") for k in structure_pngs(free, fast=True))
+        force_pngs(scene.blocks, interfaces, forces, fast=True, webs=webs))
+    assert "05_dome/3_structure.png" in structure_pngs(scene, fast=True, webs=webs)
+    assert not any(k.startswith("05_dome") for k in structure_pngs(scene, fast=True))
 
 
 def test_rank_labels_of_neighbouring_interfaces_share_one_label():
@@ -128,15 +128,14 @@ def test_mechanism_plots_are_written_in_the_four_views(load):
     live = (lateral(model, 0.0, DENSITY) if load == "lateral"
             else point_loads(model.blocks, specs[load]))
     result = collapse_load(model, live, mu=0.9, density=DENSITY)
-    scene = SimpleNamespace(params=from_preset("wall"))  # names the figures only
-    pngs = mechanism_pngs(scene, model.blocks, model.interfaces, result, "column")
+    pngs = mechanism_pngs(model.blocks, model.interfaces, result, "column")
     assert sorted(pngs) == [f"collapse/{v}_mechanism.png" for v in
                             ("01_angle", "02_front", "03_top", "04_side")]
     assert all(png.startswith(b"\x89PNG") for png in pngs.values())
 
 
 def test_the_azimuth_search_is_drawn_on_polar_axes():
-    params = validate(Params(scene="dome", **SMALL_DOME))
-    worst = worst_lateral(analysis_model(build(params)), n_webs=6, period_deg=60.0)
+    params = validate(Params.of(scene="dome", **SMALL_DOME))
+    worst = worst_lateral(build_model(params)[1], n_webs=6, period_deg=60.0)
     assert len(worst.azimuths) >= 24
-    assert azimuths_png(SimpleNamespace(params=params), worst).startswith(b"\x89PNG")
+    assert azimuths_png(worst).startswith(b"\x89PNG")

@@ -79,7 +79,7 @@ def deepest_overlap(corners, pairs):
        boundary=st.sampled_from(["free", "cyclic"]))
 def test_any_parameters(stretch, n, r, p, cut, unit, mu, density, boundary):
     try:
-        params = validate(Params(stretch=stretch, n=n, r=r, p=p, cut=cut, unit=unit, mu=mu,
+        params = validate(Params.of(stretch=stretch, n=n, r=r, p=p, cut=cut, unit=unit, mu=mu,
                                  density=density, boundary=boundary))
         scene = build(params)
     except ParameterError as error:
@@ -101,13 +101,13 @@ def test_any_parameters(stretch, n, r, p, cut, unit, mu, density, boundary):
     assert len(pairs) >= free.sum() - 1  # neighbours exist and are tested
     if len(pairs) > SAMPLE_PAIRS:
         pairs = pairs[np.random.default_rng(0).choice(len(pairs), SAMPLE_PAIRS, replace=False)]
-    assert deepest_overlap(corners, pairs) <= 1e-7 * params.unit
+    assert deepest_overlap(corners, pairs) <= 1e-7 * params.geometry.unit
 
     if free.sum() > SOLVE_LIMIT:
         event("built, too large to solve here")
         return
     event("built and solved")
-    model = analysis_model(scene)
+    model = analysis_model(scene, params.analysis.boundary)
     problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
                          side_rotation=model.side_rotation)
     result = problem.solve(mu=mu, density=density)

@@ -6,7 +6,8 @@ import pytest
 from test_rbe import MU, box, incline, make_interfaces, stack, vertex_forces
 
 from masonry.interfaces import INTERFACE_KINDS, detect
-from masonry.params import Params, arch_radius, validate
+from masonry.params import Params, validate
+from masonry.scenes.arch import arch_radius
 from masonry.rbe.equilibrium import VariableLayout
 from masonry.rbe.resultants import interface_resultants
 from masonry.rbe.solve import solve_rbe
@@ -107,12 +108,13 @@ def test_arch_at_its_minimum_thickness_has_hinges():
     """16 voussoirs at 1.001 times the thrust line's minimum t/R (tests/test_arch.py): the
     only thrust line touches intrados and extrados, so some joints carry their resultant
     at the edge (eccentricity 1) and none beyond."""
-    params = validate(Params(scene="arch", arch_blocks=16, mu=10.0))
-    radius, _ = arch_radius(params.arch_shape, params.arch_span, params.arch_rise)
+    params = validate(Params.of(scene="arch", arch_blocks=16, mu=10.0))
+    geometry = params.geometry
+    radius, _ = arch_radius(geometry.arch_shape, geometry.arch_span, geometry.arch_rise)
     params = validate(params.replace(arch_thickness=1.001 * 0.1070762 * radius))
-    scene = build_arch(params)
+    scene = build_arch(params.geometry)
     interfaces = detect(scene.blocks, up=scene.block_up)
-    result = solve_rbe(scene.blocks, interfaces, mu=params.mu, friction="net")
+    result = solve_rbe(scene.blocks, interfaces, mu=params.analysis.mu, friction="net")
     assert result.feasible
     e = interface_resultants(interfaces, result.layout, result.x)["eccentricity"]
     assert e.max() <= 1 + 1e-6

@@ -10,7 +10,7 @@ import pytest
 import trimesh
 
 from masonry.export import EXPORTERS, RunOutputs
-from masonry.params import Params, from_preset, validate
+from masonry.params import Params, from_preset, structure_id, validate
 from masonry.pipeline import Timer, run, write_exports
 from masonry.rbe.boundary import analysis_model
 from masonry.rbe.solve import RBEProblem
@@ -54,14 +54,13 @@ def test_run_writes_every_output(wall_run):
 
 def wall_outputs(plots, printable):
     """What ``masonry run --preset wall --fast`` makes, built here step by step."""
-    params = validate(from_preset("wall", fast=True))
+    params = validate(from_preset("wall", fast=True, plots=plots, printable=printable))
     scene = build(params)
-    model = analysis_model(scene)
+    model = analysis_model(scene, params.analysis.boundary)
     result = RBEProblem(model.blocks, model.interfaces).solve(
-        mu=params.mu, density=params.density, friction=params.friction,
-        solver=params.solver, accuracy=params.solver_accuracy)
-    return RunOutputs(scene, model, result, result.per_interface(), plots=plots,
-                      printable=printable)
+        mu=params.analysis.mu, density=params.analysis.density, friction=params.analysis.friction,
+        solver=params.analysis.solver, accuracy=params.analysis.accuracy)
+    return RunOutputs(params, scene, model, result, title=structure_id(params))
 
 
 class RecordingFolder:
@@ -241,8 +240,8 @@ def test_invalid_mu_writes_nothing(tmp_path, capsys):
 def test_run_json_names_only_the_files_the_folder_holds(tmp_path):
     """``coordinates`` lists files by coordinate system: a build without a solve or a
     printable body has no forces and no STL to list."""
-    record = run(validate(Params(scene="wall", wall_courses=2, wall_length=8)), tmp_path,
-                 analyse=False, plots_wanted=False, printable=False)
+    record = run(validate(Params.of(scene="wall", wall_courses=2, wall_length=8, plots=False,
+                                    printable=False)), tmp_path, analyse=False)
     folder = Path(record["path"])
     listed = record["coordinates"]["model"] + record["coordinates"]["moved_inward"]
     assert "bricks.obj" in listed and "RBE/forces.csv" not in listed

@@ -18,11 +18,11 @@ import scipy.sparse as sp
 from masonry import forking
 from masonry.studies.bench import (COLUMNS, bench, frontier_png, ratios, ratios_markdown,
                                    table_csv, table_markdown)
-from masonry.rbe.boundary import analysis_model
 from masonry.friction import FrictionCone
 from masonry.rbe.equilibrium import assemble
-from masonry.params import ACCURACIES, SOLVERS, ParameterError, Params, from_preset, structure_id
-from masonry.scenes import build
+from masonry.pipeline import build_model
+from masonry.errors import ParameterError
+from masonry.params import Params, from_preset, structure_id
 from masonry.rbe import solve as solve_module
 from masonry.rbe.solve import ACCURACY, LOAD_PATH, RBEProblem, _lp_feasible, solve_rbe
 from masonry.rbe.solvers import BACKENDS
@@ -39,7 +39,7 @@ from masonry_cli.main import main
 
 @functools.lru_cache(maxsize=None)
 def model(preset, **overrides):
-    return analysis_model(build(from_preset(preset, **overrides)))
+    return build_model(from_preset(preset, **overrides))[1]
 
 
 def small(boundary):
@@ -57,15 +57,10 @@ def scale(result):
 
 
 # ---------------------------------------------------------------------- registries
-def test_solver_and_accuracy_names_agree():
-    assert SOLVERS == tuple(BACKENDS)
-    assert ACCURACIES == tuple(ACCURACY)
-
-
 def test_params_accuracy_validation_and_structure_id():
-    assert Params().solver_accuracy == "balanced"
-    assert Params(fast=True).solver_accuracy == "fast"  # SPEC 3: fast mode, unless chosen
-    assert Params(fast=True, accuracy="accurate").solver_accuracy == "accurate"
+    assert Params.of().analysis.accuracy == "balanced"
+    assert Params.of(fast=True).analysis.accuracy == "fast"  # SPEC 3: fast mode, unless chosen
+    assert Params.of(fast=True, accuracy="accurate").analysis.accuracy == "accurate"
     assert structure_id(from_preset("1")) == "dome0_fast0_fricauto_s1_n8_r1_p10_c0.1_u0.1"
     assert structure_id(from_preset("1", accuracy="accurate")).endswith("_accurate")
     assert structure_id(from_preset("1", solver="osqp", friction_cone="polygon:16")).endswith(
@@ -533,7 +528,7 @@ def test_newton_certifies_infeasibility_and_the_lp_agrees():
     assert result.lp_feasible is False
 
 
-@pytest.mark.parametrize("accuracy", ACCURACIES)
+@pytest.mark.parametrize("accuracy", tuple(ACCURACY))
 @pytest.mark.parametrize("boundary", ["free", "cyclic"])
 def test_presets_meet_their_residuals(accuracy, boundary):
     result = solved(boundary, None, accuracy)

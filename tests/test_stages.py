@@ -52,7 +52,7 @@ def stands_by_statics(centre, width=1.0):
 
 
 def stage_verdicts(blocks, order="z", mu=0.7):
-    params = validate(Params(mu=mu))
+    params = validate(Params.of(mu=mu))
     model = Model(blocks, detect(blocks))
     plan = block_plan(blocks, order)
     return plan, analyse_stages(model, params, plan)
@@ -138,12 +138,12 @@ def half_arch_stands(radius, thickness, count, mu):
 def test_arch_laid_without_centering_fails_before_closure_and_stands_closed():
     # the default arch: semicircular, 16 voussoirs, span 10 m, t = 0.6 m: t/R = 0.12,
     # above Milankovitch's 0.1075, so the closed arch stands
-    params = validate(Params(scene="arch"))
+    params = validate(Params.of(scene="arch"))
     scene = build(params)
     plan = make_plan(scene, "block", "z")
     assert plan.n_stages == 8  # one voussoir on each side per stage
-    rows = analyse_stages(analysis_model(scene), params, plan)
-    expected = half_arch_stands(5.0, 0.6, 16, params.mu)
+    rows = analyse_stages(analysis_model(scene, "free"), params, plan)
+    expected = half_arch_stands(5.0, 0.6, 16, params.analysis.mu)
     assert expected[:2] == [True, True] and not expected[2]  # statics: third pair tips
     assert [r["feasible"] for r in rows[:-1]] == expected
     assert rows[-1]["feasible"] and rows[-1]["bricks"] == 16
@@ -154,7 +154,7 @@ def dome_stage(scene_kind, plan_of, stage):
     params = from_preset("1", **SMALL_DOME, **scene_kind)
     scene = build(params)
     plan = plan_of(scene)
-    model = analysis_model(scene)
+    model = analysis_model(scene, params.analysis.boundary)
     part = restrict(model, plan.is_present(stage))
     return scene, plan, part, analyse_stage(model, params, plan, stage)
 
@@ -179,14 +179,14 @@ def test_cyclic_section_stage_equals_full_dome_stage(plan_of, stage):
     for model in (part, whole_part):
         problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
                              side_rotation=model.side_rotation)
-        results.append(problem.solve(mu=params.mu, lp_check=False))
+        results.append(problem.solve(mu=params.analysis.mu, lp_check=False))
     assert results[1].weight_N == pytest.approx(n * results[0].weight_N, rel=1e-12)
     assert results[1].objective == pytest.approx(n * results[0].objective, rel=1e-5)
 
 
 def test_stage_model_keeps_only_interfaces_of_laid_blocks():
     scene = build(from_preset("1", **SMALL_DOME, boundary="cyclic"))
-    model = analysis_model(scene)
+    model = analysis_model(scene, "cyclic")
     plan = course_plan(scene.blocks)
     source = model.block_source
     for stage in (1, 3, plan.n_stages):
@@ -249,7 +249,7 @@ def test_brick_orders(order):
 
 def test_course_stages_need_courses():
     with pytest.raises(ParameterError, match="parameter by="):
-        course_plan(build(validate(Params(scene="arch"))).blocks)
+        course_plan(build(validate(Params.of(scene="arch"))).blocks)
 
 
 # ---------------------------------------------------------------------- command line
@@ -345,7 +345,7 @@ def test_lateral_load_factor_of_each_stage_matches_statics():
     # (b / h) or either joint slides (mu)
     b, h = 0.2, 0.4
     blocks, _ = stack([0.0], width=b, height=h)
-    params = validate(Params(mu=0.7, lateral=0.0))
+    params = validate(Params.of(mu=0.7, lateral=0.0))
     model = Model(blocks, detect(blocks))
     plan = block_plan(blocks, "z")
     rows = analyse_stages(model, params, plan)
@@ -357,7 +357,7 @@ def test_lateral_load_factor_of_each_stage_matches_statics():
 def test_lateral_load_factor_of_a_stage_that_slides():
     # mu 0.3 < b/h = 0.5: the single block slides at lambda = mu
     blocks, _ = stack([], width=0.2, height=0.4)
-    params = validate(Params(mu=0.3, lateral=180.0))
+    params = validate(Params.of(mu=0.3, lateral=180.0))
     rows = analyse_stages(Model(blocks, detect(blocks)), params, block_plan(blocks, "z"))
     assert rows[0]["load_factor"] == pytest.approx(0.3, abs=1e-6)
 
@@ -368,7 +368,7 @@ def test_a_block_laid_before_the_one_under_it_is_loose_and_has_no_moi():
     the column stands."""
     model = column(3, (0.2, 0.2, 0.1))
     plan = StagePlan(np.array([0, 2, 1, 1]), np.array([0, 0]), by="block", order="names")
-    params = validate(Params(scene="wall"))
+    params = validate(Params.of(scene="wall"))
     first, second = (analyse_stage(model, params, plan, k) for k in (1, 2))
     assert first["loose"] == 2 and first["loose_blocks"] == [2, 3]
     assert not first["feasible"] and first["moi"] is None
@@ -382,7 +382,7 @@ def test_a_sections_end_brick_laid_alone_is_loose_and_course_stages_are_not(boun
     included (a rigid neighbour's images are supports: they may hold it). Every brick of
     the first courses is joined to the ground, through the images too."""
     scene = build(from_preset("3", scene="section", boundary=boundary, p=4))
-    model = analysis_model(scene)
+    model = analysis_model(scene, boundary)
     count = scene.blocks.n_blocks
     ends = np.unique(model.block_source[count:])  # the bricks with an image
     top = ends[np.argmax(scene.blocks.block_course[ends])]

@@ -3,8 +3,12 @@
 from test_rbe import MU, cantilever, stack
 
 from masonry.export.summaries import lp_check_text, objective_text, parameters_text
-from masonry.params import Params, from_preset, validate
+from masonry.params import Params, from_preset, structure_id, validate
 from masonry.rbe.solve import solve_rbe
+
+
+def parameters(params):
+    return parameters_text(params, structure_id(params))
 
 
 def names(text):
@@ -12,16 +16,16 @@ def names(text):
 
 
 def test_parameters_list_the_scene_that_ran_and_the_values_it_used():
-    arch = names(parameters_text(validate(Params(scene="arch"))))
+    arch = names(parameters(validate(Params.of(scene="arch"))))
     assert {"arch_blocks", "arch_thickness", "mu", "accuracy", "solver"} <= arch
     assert not arch & {"stretch", "n", "wall_length", "boundary"}
     assert "cad_offset" not in arch  # voussoirs are not moved inward
-    section = parameters_text(from_preset("1"))
+    section = parameters(from_preset("1"))
     assert {"stretch", "n", "boundary", "cad_offset"} <= names(section)
     assert not names(section) & {"arch_blocks", "wall_courses"}
     # the preset the run used, not the unset option (None)
     assert "accuracy = balanced" in " ".join(section.split())
-    assert "accuracy = fast" in " ".join(parameters_text(from_preset("1", fast=True)).split())
+    assert "accuracy = fast" in " ".join(parameters(from_preset("1", fast=True)).split())
     assert "None" not in section.split("solver")[1].splitlines()[0]
 
 

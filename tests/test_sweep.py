@@ -55,7 +55,7 @@ def test_a_failing_variant_is_recorded_the_rest_complete_and_the_exit_says_so(
     import masonry.studies.sweep as sweep
 
     def run(params, *args, **kwargs):
-        if params.mu == 0.3:
+        if params.analysis.mu == 0.3:
             raise MemoryError("no memory for this variant")
         return real(params, *args, **kwargs)
 

@@ -14,7 +14,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from masonry.params import Params
 from masonry.tolerances import LEVEL_ANGLE_XTOL, LEVEL_TOP_REL
 
 
@@ -35,7 +34,9 @@ class Dimensions:
     z_max: float
 
     @classmethod
-    def of(cls, params: Params) -> "Dimensions":
+    def of(cls, params) -> "Dimensions":
+        """The dimensions of a polygonal dome's geometry (its ``stretch``, ``n``, ``r``,
+        ``p``, ``cut`` and ``unit``: :class:`masonry.scenes.polygonal.PolygonalDome`)."""
         width = 2 * (params.p + 1) * (params.r + 1) * params.unit
         radius = width / (2 * np.sin(np.pi / params.n))  # thesis eq. 3.3 prints sin(pi/2)
         a = width / 2 / np.tan(np.pi / params.n)
@@ -116,7 +117,7 @@ def _inclination(p0, p1):
     return np.arctan2(p0[0] - p1[0], p1[1] - p0[1])
 
 
-def level_table(params: Params, dims: Dimensions | None = None) -> LevelTable:
+def level_table(params, dims: Dimensions | None = None) -> LevelTable:
     """Contact points of every course up to ``z_max`` (SPEC 4.2).
 
     Levels stop where the next contact point would pass ``(1 - cut) c`` or the web gets

@@ -28,27 +28,53 @@ class RunOutputs:
 
     Parameters
     ----------
+    params : masonry.params.Params
+        The run's inputs; its ``outputs`` say what to write.
     scene : masonry.scenes.base.Scene
     model : masonry.rbe.boundary.Model
         The analysed blocks (the scene's, then any neighbour images) and interfaces.
     result : masonry.rbe.solve.RBEResult or None
         The rigid block equilibrium; None when the run only builds.
-    forces : dict str -> (K,) float or None, newtons
-        Per-interface force sums (:func:`masonry.rbe.solve.interface_forces`), None
-        without an accepted solution.
-    plots, printable : bool
-        The outputs the user asked for.
     collapse : masonry.rbe.collapse.CollapseResult or None
-        The collapse load factor of the run's live load (SPEC 6.8), if it has one.
+        The collapse load factor of the run's live load (docs/model.md 6.8), if it has
+        one.
+    title : str
+        The run's name in figures (its structure id).
     """
 
+    params: object
     scene: object
     model: object
     result: object = None
-    forces: dict | None = None
-    plots: bool = True
-    printable: bool = True
     collapse: object = None
+    title: str = ""
+
+    @property
+    def outputs(self):
+        """The run's :class:`~masonry.outputs.Outputs`."""
+        return self.params.outputs
+
+    @property
+    def figure_title(self) -> str:
+        """The line naming the structure and scene under every figure's title."""
+        return f"{self.scene.kind.describe(self.params.analysis.boundary)} | {self.title}"
+
+    @property
+    def webs(self) -> int | None:
+        """The webs of the whole dome a section stands for by rotation (a cyclic
+        section, docs/model.md 6.4), drawn as the whole dome; None otherwise."""
+        symmetry = self.scene.symmetry
+        if symmetry.unit and self.params.analysis.boundary == "cyclic":
+            return symmetry.order
+        return None
+
+    @functools.cached_property
+    def forces(self) -> dict | None:
+        """Per-interface force sums (:func:`masonry.rbe.solve.interface_forces`), newtons;
+        None without an accepted solution."""
+        if self.result is None or self.result.x is None:
+            return None
+        return self.result.per_interface()
 
 
 @dataclass(frozen=True)
@@ -89,8 +115,9 @@ class Exporter:
 def _model_files(made: RunOutputs) -> Export:
     scene, model = made.scene, made.model
     return Export({
-        "00_parameters.txt": summaries.parameters_text(scene.params),
-        "locations.csv": csv.locations_csv(scene.blocks, scene.cad_vertices()),
+        "00_parameters.txt": summaries.parameters_text(made.params, made.title),
+        "locations.csv": csv.locations_csv(scene.blocks,
+                                           scene.cad_vertices(made.outputs.cad_offset)),
         "bricks.obj": obj.blocks_obj(scene.blocks),
         "interfaces.csv": csv.interfaces_csv(model.blocks, model.interfaces),
     })
@@ -185,11 +212,12 @@ def _collapse_files(made: RunOutputs) -> Export:
 
 
 def _printable_files(made: RunOutputs) -> Export:
-    body, report = printable_body(*printable_blocks(made.scene))
+    body, report = printable_body(*printable_blocks(
+        made.scene, made.params.analysis.boundary, made.outputs.cad_offset))
     data = stl.stl_bytes(body)
     report["readback"] = stl.readback_check(data, report["volume_m3"])
     files = {"dome.stl": data, "dome.obj": stl.obj_body_bytes(body)}
-    size = made.scene.params.print_size
+    size = made.outputs.print_size
     if size is not None:
         files["dome.3mf"] = threemf.threemf_bytes(body, size)
         report["print"] = {"size_mm": size, "mm_per_m": threemf.print_scale(body, size),
@@ -206,10 +234,10 @@ def _mechanism_plots(made: RunOutputs) -> dict:
     title = (f"collapse mechanism: lambda = {collapse.load_factor:.4g}, "
              f"{collapse.live.description['kind']} load"
              + ("" if collapse.azimuth_deg is None else f" at {collapse.azimuth_deg:g} deg"))
-    files = plots.mechanism_pngs(made.scene, model.blocks, model.interfaces, collapse, title,
-                                 made.scene.params.fast)
+    files = plots.mechanism_pngs(model.blocks, model.interfaces, collapse, title,
+                                 made.outputs.quick, made.figure_title)
     if collapse.azimuths:
-        files["collapse/azimuths.png"] = plots.azimuths_png(made.scene, collapse)
+        files["collapse/azimuths.png"] = plots.azimuths_png(collapse, made.figure_title)
     return files
 
 
@@ -218,12 +246,12 @@ def _plot_files(made: RunOutputs) -> Export:
     # matplotlib takes most of a second to import: a run without plots never does
     from masonry import plots
 
-    scene, model, fast = made.scene, made.model, made.scene.params.fast
+    scene, model, fast, title = made.scene, made.model, made.outputs.quick, made.figure_title
     files = {}
     if scene.layout is not None:
-        files["00_pattern.png"] = plots.pattern_png(scene, fast)
-    files.update(plots.structure_pngs(scene, fast))
-    files.update(plots.interface_pngs(scene, model.blocks, model.interfaces, fast))
+        files["00_pattern.png"] = plots.pattern_png(scene, fast, title)
+    files.update(plots.structure_pngs(scene, fast, title, made.webs))
+    files.update(plots.interface_pngs(model.blocks, model.interfaces, fast, title))
     files.update(_mechanism_plots(made))
     return Export(files)
 
@@ -232,17 +260,20 @@ def _force_plot_files(made: RunOutputs) -> Export:
     """The forces' plots: per view, the thrust line and where it fails."""
     from masonry import plots
 
-    scene, model, fast = made.scene, made.model, made.scene.params.fast
-    pngs = plots.force_pngs(scene, model.blocks, model.interfaces, made.forces, fast)
+    scene, model, fast, title = made.scene, made.model, made.outputs.quick, made.figure_title
+    pngs = plots.force_pngs(model.blocks, model.interfaces, made.forces, fast, title,
+                            made.webs)
     files = {f"RBE/{name}": png for name, png in pngs.items()}
-    if scene.params.scene in ("arch", "section", "dome"):
-        png = plots.thrust_line_png(scene, model.interfaces, _resultants(made), fast)
+    section = scene.kind.thrust_section(scene)
+    if section is not None:
+        png = plots.thrust_line_png(model.interfaces, _resultants(made), section, fast,
+                                    title)
         if png is not None:
             files["RBE/thrust_line.png"] = png
     top = csv.tension_top(made.forces, made.result.weight_N)
     if len(top):
         files["RBE/where_it_fails.png"] = plots.failure_png(
-            scene, model.blocks, model.interfaces, top, made.forces, fast)
+            model.blocks, model.interfaces, top, made.forces, fast, title)
     return Export(files)
 
 
@@ -255,11 +286,12 @@ EXPORTERS = (
     Exporter("collapse", "exports", _collapse_files,
              wanted=lambda made: made.collapse is not None),
     Exporter("printable", "printable", _printable_files,
-             wanted=lambda made: made.printable),
+             wanted=lambda made: made.outputs.printable),
     # the model's plots beside the 3DM file in the second process, the forces' here: the
     # two take about as long
-    Exporter("plots", "plots", _plot_files, wanted=lambda made: made.plots, aside=True),
+    Exporter("plots", "plots", _plot_files, wanted=lambda made: made.outputs.plots,
+             aside=True),
     Exporter("force_plots", "plots", _force_plot_files,
-             wanted=lambda made: made.plots and made.forces is not None),
+             wanted=lambda made: made.outputs.plots and made.forces is not None),
 )
 """Every exporter, in the order a run writes them."""

@@ -83,6 +83,16 @@ FORCE_SUMS = ("compression", "tension", "normal", "t1", "t2", "friction")
 """The per-interface sums of :func:`masonry.rbe.solve.interface_forces`, in column order."""
 
 
+def forces_columns(blocks: Blocks, interfaces, forces: dict, resultants: dict) -> list:
+    """The columns of ``RBE/forces.csv`` (:func:`forces_csv`), ``(name, (K,) array)``."""
+    return (_interface_columns(blocks, interfaces)
+            + [(f"{n}_N", np.asarray(forces[n], dtype=float)) for n in FORCE_SUMS]
+            + _xyz("shear", resultants["shear"], "N")
+            + _xyz("point", resultants["point"], "m")
+            + [("eccentricity", resultants["eccentricity"]),
+               ("torsion_Nm", resultants["torsion"])])
+
+
 def forces_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict) -> bytes:
     """``RBE/forces.csv``: one row per interface (SPEC 7), in id order (the rows of
     ``interfaces.csv`` and the cells of ``RBE/interfaces.vtu``).
@@ -101,12 +111,7 @@ def forces_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict) -> by
     Forces act on the other block ``block_b``; ``block_a`` receives their opposite.
     README "Columns" names each column with its unit and sign.
     """
-    return _table(_interface_columns(blocks, interfaces)
-                  + [(f"{n}_N", np.asarray(forces[n], dtype=float)) for n in FORCE_SUMS]
-                  + _xyz("shear", resultants["shear"], "N")
-                  + _xyz("point", resultants["point"], "m")
-                  + [("eccentricity", resultants["eccentricity"]),
-                     ("torsion_Nm", resultants["torsion"])])
+    return _table(forces_columns(blocks, interfaces, forces, resultants))
 
 
 def tension_top(forces: dict, weight_N: float, count=TENSION_TOP_COUNT) -> np.ndarray:

@@ -1,34 +1,8 @@
 """The text summaries of a run: ``00_parameters.txt`` and ``RBE/00_objective.txt``."""
 
-from masonry.params import arch_radius, structure_id
-from masonry.rbe.solve import ACCURACY, friction_model
+from masonry.parameters import declarations, values
+from masonry.rbe.solve import ACCURACY
 from masonry.tolerances import MECHANISM_MAIN, MOTION_TOL
-
-# the inputs of each scene, with their units, in the order they are printed
-_GEOMETRY = {
-    "section": (("stretch", "dome height / circumradius"), ("n", "walls of the dome"),
-                ("r", "full rhombi across the section"),
-                ("p", "pattern bricks per rhombus side"),
-                ("cut", "fraction of the height cut off"), ("unit", "m, the brick unit"),
-                ("min_fill", "units, shortest fill-in brick"),
-                ("boundary", "what the section's end bricks bear on")),
-    "wall": (("wall_length", "units"), ("wall_courses", "courses"),
-             ("unit", "m, the brick unit")),
-    "arch": (("arch_shape", ""), ("arch_blocks", "voussoirs"),
-             ("arch_span", "m, of the centre line"),
-             ("arch_rise", "m, of the centre line"),
-             ("arch_thickness", "m"), ("arch_depth", "m, along y")),
-    "assembly": (("assembly", "the imported model"),),
-}
-_GEOMETRY["dome"] = _GEOMETRY["section"][:-1]
-_ANALYSIS = (("mu", "friction coefficient"), ("density", "kg/m^3"),
-             ("friction", "net | plus | auto (net, then plus if infeasible)"))
-_OUTPUT = (("fast", "one view, lower resolution"),
-           ("cad_offset", "units the CAD files move each brick inward"),
-           ("print_size", "mm, largest dimension of dome.3mf (None: no 3MF)"))
-_BRICK_SCENES = ("section", "dome", "wall")
-"""The scenes of bricks with an inward face, which the CAD offset moves (an arch's
-voussoirs and an imported assembly's blocks stay where they are)."""
 
 
 def _line(name, value, note) -> str:
@@ -36,31 +10,42 @@ def _line(name, value, note) -> str:
     return (f"{name:>14} = {value!s:<12} # {note}" if note else f"{name:>14} = {value}")
 
 
-def parameters_text(params) -> str:
+def _lines(part, shown, names) -> list:
+    """One line per input of a declared ``part``: its value as shown, what it means."""
+    docs = declarations(part)
+    return [_line(name, shown[name], docs[name].doc) for name in names]
+
+
+ANALYSIS_SHOWN = ("mu", "density", "friction")
+"""The analysis inputs printed with their values (the friction model, the accuracy
+preset and the solvers follow, as the run resolved them)."""
+
+OUTPUTS_SHOWN = ("quick", "cad_offset", "print_size")
+
+
+def parameters_text(params, structure_id: str) -> str:
     """``00_parameters.txt``: the structure id and the inputs of the scene that was run,
-    with the values the run used (the accuracy preset and solvers it resolved to)."""
-    preset = ACCURACY[params.solver_accuracy]
-    solvers = (params.solver if params.solver is not None
+    with the values the run used (a default resolved, the accuracy preset and solvers it
+    resolved to), each with what it means."""
+    analysis, kind, outputs = params.analysis, params.kind, params.outputs
+    preset = ACCURACY[analysis.accuracy]
+    solvers = (analysis.solver if analysis.solver is not None
                else f"{preset.net_solver} (friction-net), {preset.plus_solver} (friction+)")
-    lines = [f"structure id: {structure_id(params)}", "", _line("scene", params.scene, "")]
-    lines += [_line(name, _value(params, name), note)
-              for name, note in _GEOMETRY.get(params.scene, ())]
-    cone = friction_model(params.solver_accuracy, params.friction_cone)
-    lines += ["", *(_line(name, getattr(params, name), note) for name, note in _ANALYSIS),
+    shown = kind.shown(params.geometry)
+    lines = [f"structure id: {structure_id}", "", _line("scene", kind.name, "")]
+    lines += _lines(params.geometry, shown, shown)
+    if len(kind.boundaries) > 1:
+        lines += _lines(analysis, values(analysis), ("boundary",))
+    cone = analysis.cone
+    lines += ["", *_lines(analysis, values(analysis), ANALYSIS_SHOWN),
               _line("friction_cone", cone.name, cone.describe()),
               _line("accuracy", preset.name, f"solver preset; residual <= {preset.residual:g}"),
-              _line("solver", solvers, "" if params.solver is None else "set by --solver"),
+              _line("solver", solvers, "" if analysis.solver is None else "set by --solver"),
               ""]
-    lines += [_line(name, getattr(params, name), note) for name, note in _OUTPUT
-              if name != "cad_offset" or params.scene in _BRICK_SCENES]
+    moved = kind.moved_for_cad
+    lines += _lines(outputs, values(outputs),
+                    [name for name in OUTPUTS_SHOWN if name != "cad_offset" or moved])
     return "\n".join(lines) + "\n"
-
-
-def _value(params, name):
-    """A parameter's value as the run used it (an arch's default rise resolved)."""
-    if name == "arch_rise" and params.arch_rise is None:
-        return arch_radius(params.arch_shape, params.arch_span)[1]
-    return getattr(params, name)
 
 
 def lp_check_text(result) -> str:

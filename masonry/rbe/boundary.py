@@ -27,6 +27,7 @@ from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 
 from masonry.blocks import Blocks, concatenate, rotated_web, rotation_z
+from masonry.errors import MasonryError
 from masonry.interfaces import INTERFACE_KINDS, Interfaces, detect
 
 BOUNDARY = INTERFACE_KINDS.index("boundary")
@@ -62,7 +63,7 @@ class Model:
         return int((self.interfaces.kind == BOUNDARY).sum())
 
 
-class UnsupportedError(ValueError):
+class UnsupportedError(MasonryError, ValueError):
     """Some blocks have no path of contacts to a support: nothing can carry them, and no
     equilibrium (not even friction+) exists. The message names them."""
 
@@ -111,27 +112,36 @@ def _mark_web_boundaries(interfaces: Interfaces, blocks: Blocks) -> Interfaces:
     return dataclasses.replace(interfaces, kind=kind)
 
 
-def analysis_model(scene) -> Model:
+def analysis_model(scene, boundary: str) -> Model:
     """Blocks, interfaces and routing for the scene and its boundary mode.
+
+    Parameters
+    ----------
+    scene : masonry.scenes.base.Scene
+    boundary : {'free', 'rigid', 'cyclic'}
+        What a section's end bricks bear on (docs/model.md 6.4): nothing, immovable
+        neighbours, or its neighbours by rotational symmetry; one of the modes its kind
+        takes (``scene.kind.boundaries``).
 
     Raises
     ------
     UnsupportedError
         Some block has no path of contacts to a support (:func:`check_supported`).
     """
-    model = _model(scene)
+    if boundary not in scene.kind.boundaries:
+        raise ValueError(f"a {scene.kind.name} scene takes boundary "
+                         f"{' or '.join(scene.kind.boundaries)}, not {boundary!r}")
+    model = _model(scene, boundary)
     check_supported(model)
     return model
 
 
-def _model(scene) -> Model:
-    params = scene.params
-    mode = params.boundary if params.scene == "section" else "free"
+def _model(scene, mode) -> Model:
     if mode == "free":
         interfaces = detect(scene.blocks, up=scene.block_up)
         return Model(scene.blocks, _mark_web_boundaries(interfaces, scene.blocks))
 
-    n = params.n
+    n = scene.symmetry.order
     left, right = _end_masks(scene)
     # images of the next web's left end, and (rigid) of the previous web's right end
     images = [(1, left)] + ([(-1, right)] if mode == "rigid" else [])

@@ -10,16 +10,23 @@ load (they have no rows). The builders are the three load cases of the command l
 - :func:`point_loads`: forces at the centre of the top face of named blocks.
 - :func:`crown_load`: a downward load on the top course, shared by top-face area (a
   lantern on the oculus ring).
+
+What a run asks for is declared once, as one of the typed load cases :class:`Lateral`,
+:class:`PointLoads` and :class:`CrownLoad` (:func:`live_load` parses the options into
+one); the case builds its :class:`LiveLoad` on a model.
 """
 
 import fnmatch
+import hashlib
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from masonry.blocks import BLOCK_CLASSES
-from masonry.params import ParameterError, parse_point_load
-from masonry.tolerances import G
+from masonry.errors import ParameterError
+from masonry.parameters import text_of
+from masonry.tolerances import MIN_LIVE_LOAD_N, G
 
 PATTERN = BLOCK_CLASSES.index("pattern")
 
@@ -102,7 +109,7 @@ def point_loads(blocks, specs) -> LiveLoad:
     Parameters
     ----------
     blocks : masonry.blocks.Blocks (or a Model)
-    specs : sequence of str
+    specs : PointLoads or sequence of str
         ``'NAME_OR_PATTERN:FX,FY,FZ'``: a block name or an :mod:`fnmatch` pattern (e.g.
         ``b00*_pattern_c3*``) and a force in newtons applied to *every* matched free block.
 
@@ -111,13 +118,14 @@ def point_loads(blocks, specs) -> LiveLoad:
     ParameterError
         A spec that is malformed or matches no free block (named ``point_loads``).
     """
+    parsed = specs if isinstance(specs, PointLoads) else PointLoads.parse(specs)
+    specs = parsed.specs
     blocks = _blocks(blocks)
     free = ~np.asarray(blocks.block_is_support)
     names = [str(name) for name in blocks.block_name]
     top = top_faces(blocks)
     chosen, forces = [], []
-    for spec in specs:
-        pattern, force = parse_point_load(spec)
+    for spec, (pattern, force) in zip(specs, parsed.loads):
         matched = [i for i in np.flatnonzero(free) if fnmatch.fnmatchcase(names[i], pattern)]
         if not matched:
             example = names[int(np.flatnonzero(free)[0])]
@@ -171,3 +179,148 @@ def crown_load(blocks, newtons: float, copies: int = 1) -> LiveLoad:
     wrench = _at_points(blocks, chosen, blocks.face_centre[face], force)
     return LiveLoad(wrench, _describe("crown", wrench, newtons=float(newtons),
                                       copies=int(copies), blocks=len(chosen)))
+
+
+# ---------------------------------------------------------------------- load cases
+def parse_point_load(spec: str) -> tuple:
+    """``'NAME_OR_PATTERN:FX,FY,FZ'`` -> ``(pattern, (fx, fy, fz))`` in newtons; raises
+    :class:`~masonry.errors.ParameterError` naming ``point_loads`` (``--point-load``)."""
+    expected = "NAME_OR_PATTERN:FX,FY,FZ (a block name or fnmatch pattern, newtons)"
+    pattern, colon, numbers = str(spec).rpartition(":")
+    parts = numbers.split(",")
+    if not colon or not pattern or len(parts) != 3:
+        raise ParameterError("point_loads", spec, expected)
+    try:
+        force = tuple(float(v) for v in parts)
+    except ValueError:
+        raise ParameterError("point_loads", spec, expected) from None
+    if not all(math.isfinite(v) for v in force) or not any(force):
+        raise ParameterError("point_loads", spec, "finite forces, not all zero")
+    if max(abs(v) for v in force) < MIN_LIVE_LOAD_N:
+        raise ParameterError("point_loads", spec, f"a force of at least {MIN_LIVE_LOAD_N:g} "
+                                                  "N (a smaller one has no finite load "
+                                                  "factor)")
+    return pattern, force
+
+
+@dataclass(frozen=True)
+class Lateral:
+    """A horizontal body force of each block's weight at ``azimuth_deg`` (degrees from +x
+    toward +y, in [0, 360)), or ``'all'``: the worst azimuth of a search."""
+
+    azimuth_deg: float | str
+
+    kind = "lateral"
+
+    @property
+    def tag(self) -> str:
+        """Its part of a structure id: ``_latall`` or ``_lat<azimuth>``."""
+        return "_latall" if self.azimuth_deg == "all" else f"_lat{text_of(self.azimuth_deg)}"
+
+    def options(self) -> dict:
+        return {"lateral": self.azimuth_deg}
+
+    def on(self, model, density, copies=1) -> LiveLoad:
+        return lateral(model, self.azimuth_deg, density)
+
+
+@dataclass(frozen=True)
+class PointLoads:
+    """Forces at the top faces of named blocks: ``specs`` as the user wrote them
+    (``'NAME_OR_PATTERN:FX,FY,FZ'``) and ``loads`` parsed, ``(pattern, (fx, fy, fz))``."""
+
+    specs: tuple
+    loads: tuple
+
+    kind = "point"
+
+    @classmethod
+    def parse(cls, specs) -> "PointLoads":
+        specs = (specs,) if isinstance(specs, str) else tuple(specs)
+        if not all(isinstance(spec, str) for spec in specs):
+            raise ParameterError("point_loads", specs, "NAME_OR_PATTERN:FX,FY,FZ strings")
+        return cls(specs, tuple(parse_point_load(spec) for spec in specs))
+
+    @property
+    def tag(self) -> str:
+        """``_pl`` and a digest of the specs (they can be long)."""
+        return f"_pl{hashlib.sha1(chr(10).join(self.specs).encode()).hexdigest()[:8]}"
+
+    def options(self) -> dict:
+        return {"point_loads": self.specs}
+
+    def on(self, model, density, copies=1) -> LiveLoad:
+        return point_loads(_blocks(model), self)
+
+
+@dataclass(frozen=True)
+class CrownLoad:
+    """A downward load of ``newtons`` on the top course of a dome (the whole dome's)."""
+
+    newtons: float
+
+    kind = "crown"
+
+    @property
+    def tag(self) -> str:
+        return f"_crown{text_of(self.newtons)}"
+
+    def options(self) -> dict:
+        return {"crown_load": self.newtons}
+
+    def on(self, model, density, copies=1) -> LiveLoad:
+        """On a model that is one of ``copies`` equal parts of the dome (a section: its
+        share)."""
+        return crown_load(_blocks(model), self.newtons, copies=copies)
+
+
+LOAD_OPTIONS = ("lateral", "point_loads", "crown_load")
+"""The options that name a load case, in the order a run checks them."""
+
+
+def live_load(lateral=None, point_loads=(), crown_load=None):
+    """The load case of a run's options (one of :data:`LOAD_OPTIONS` at most), or None.
+
+    ``lateral`` an azimuth in degrees (a number or its text) or ``'all'``, ``point_loads``
+    ``'NAME_OR_PATTERN:FX,FY,FZ'`` strings, ``crown_load`` newtons. Raises
+    :class:`~masonry.errors.ParameterError` naming the option.
+    """
+    given = []
+    if lateral is not None:
+        given.append(("lateral", lateral, Lateral(_azimuth(lateral))))
+    if point_loads:
+        case = PointLoads.parse(point_loads)
+        given.append(("point_loads", case.specs[0], case))
+    elif not isinstance(point_loads, (tuple, list, str)):
+        raise ParameterError("point_loads", point_loads, "NAME_OR_PATTERN:FX,FY,FZ strings")
+    if crown_load is not None:
+        if isinstance(crown_load, bool) or not isinstance(crown_load, (int, float)):
+            raise ParameterError("crown_load", crown_load, "a number")
+        if not math.isfinite(crown_load):
+            raise ParameterError("crown_load", crown_load, "a finite number")
+        if not crown_load >= MIN_LIVE_LOAD_N:
+            raise ParameterError("crown_load", crown_load,
+                                 f">= {MIN_LIVE_LOAD_N:g} (newtons, downward; a smaller "
+                                 f"load has no finite load factor)")
+        given.append(("crown_load", crown_load, CrownLoad(float(crown_load))))
+    if len(given) > 1:
+        raise ParameterError(*given[1][:2], "one live load per run: --lateral, --point-load "
+                                            "or --crown-load", related=(given[0][0],))
+    return given[0][2] if given else None
+
+
+def _azimuth(value) -> float | str:
+    """An azimuth in [0, 360) degrees, or ``'all'``."""
+    expected = "an azimuth in degrees or 'all'"
+    if value == "all":
+        return "all"
+    if isinstance(value, str):
+        try:
+            value = float(value)
+        except ValueError:
+            raise ParameterError("lateral", value, expected) from None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ParameterError("lateral", value, expected)
+    if not math.isfinite(value):
+        raise ParameterError("lateral", value, "a finite number")
+    return float(value) % 360.0

@@ -20,13 +20,111 @@ The thrust line (:mod:`masonry.studies.thrust_line`) checks the RBE on this scen
 independently.
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from masonry.blocks import BLOCK, GROUND, Blocks
-from masonry.params import Params, arch_radius, check_arch
-from masonry.scenes.base import Scene
+from masonry.errors import ParameterError
+from masonry.parameters import declare
+from masonry.scenes.base import Scene, SceneKind, ThrustSection
+
+ARCH_SHAPES = ("semicircular", "pointed", "segmental")
+
+ARCH_RATIOS = {
+    # name: (low, high) as multiples of the span: the interface detector's tolerances are
+    # relative to the scene's size (1e-6), so a part 1e-9 of it would vanish in them
+    "arch_thickness": (1e-3, None),
+    "arch_depth": (1e-3, 1e3),
+    "arch_rise": (1e-2, 1e2),
+}
+
+
+@dataclass(frozen=True)
+class ArchGeometry:
+    """An arch of voussoirs on two supports, metres (Heyman's conventions; see the
+    module docstring): the span and rise of its centre line, its thickness along the
+    joints and its depth along y."""
+
+    arch_shape: str = declare("semicircular", "", kind="str", choices=ARCH_SHAPES, tag="",
+                              head=True, names_geometry=True)
+    arch_blocks: int = declare(
+        16, "voussoirs", kind="int", check=lambda v: v >= 2, tag="N", head=True,
+        names_geometry=True,
+        expected="an integer >= 2 (one voussoir is no arch, and a semicircular one is not "
+                 "convex)")
+    arch_span: float = declare(10.0, "m, of the centre line", low=0.01, high=1e4, tag="s",
+                               head=True, names_geometry=True,
+                               expected="0.01 to 10000 (metres)")
+    arch_thickness: float = declare(0.6, "m", check=lambda v: v > 0, tag="t", head=True,
+                                    names_geometry=True, expected="> 0 (metres)")
+    arch_depth: float = declare(1.0, "m, along y", check=lambda v: v > 0, tag="d",
+                                head=True, names_geometry=True, expected="> 0 (metres)")
+    arch_rise: float | None = declare(None, "m, of the centre line", optional=True,
+                                      check=lambda v: v > 0, tag="h", head=True,
+                                      names_geometry=True, expected="> 0 (metres) or none")
+
+
+def arch_radius(shape: str, span: float, rise=None) -> tuple:
+    """``(R, h)``: centre-line radius and rise of an arch of ``span`` (metres).
+
+    ``rise`` None takes the shape's default: ``span / 2`` (semicircular), ``span / 4``
+    (segmental), ``span * sqrt(3) / 2`` (pointed, equilateral).
+    """
+    if shape == "semicircular":
+        return span / 2, span / 2
+    if shape == "segmental":
+        h = span / 4 if rise is None else rise
+        return (span**2 / 4 + h**2) / (2 * h), h
+    h = span * math.sqrt(3) / 2 if rise is None else rise
+    return (span**2 / 4 + h**2) / span, h
+
+
+def check_arch(p: ArchGeometry) -> None:
+    """Refuse arch parameters that make no arch (:class:`~masonry.errors.ParameterError`):
+    thickness, depth and rise against the span (:data:`ARCH_RATIOS`), the rise against the
+    shape, an even number of voussoirs for a pointed arch, and a thickness that leaves an
+    intrados. (Each parameter's own range is checked with its declaration.)"""
+    span, rise, t = p.arch_span, p.arch_rise, p.arch_thickness
+    for name, (low, high) in ARCH_RATIOS.items():
+        value = getattr(p, name)
+        if value is None:
+            continue
+        if value < low * span or (high is not None and value > high * span):
+            bounds = f"{low:g} to {high:g}" if high is not None else f"at least {low:g}"
+            raise ParameterError(name, value, f"{bounds} times the span ({span:g} m): the "
+                                              "contact tolerances are relative to the arch's "
+                                              "size", related=("arch_span",))
+    _check_rise(p.arch_shape, span, rise, p.arch_blocks)
+    radius, _ = arch_radius(p.arch_shape, span, rise)
+    # the intrados must exist: radius R - t/2 > 0, and for a pointed arch it must still
+    # reach the crown, R - t/2 > R - span/2
+    limit = span if p.arch_shape == "pointed" else 2 * radius
+    if not t < limit:
+        raise ParameterError("arch_thickness", t, f"< {limit:g} m (the intrados of this "
+                                                  f"arch vanishes at t = {limit:g} m)",
+                             related=("arch_span", "arch_shape", "arch_rise"))
+
+
+def _check_rise(shape, span, rise, blocks):
+    """The rise against the shape, and an even number of voussoirs for a pointed arch."""
+    if shape == "semicircular" and rise is not None and rise != span / 2:
+        raise ParameterError("arch_rise", rise, f"none for a semicircular arch (its rise is "
+                                                f"span / 2 = {span / 2:g} m)",
+                             related=("arch_shape",))
+    if shape == "segmental" and rise is not None and not 0 < rise < span / 2:
+        raise ParameterError("arch_rise", rise, f"0 < rise < span / 2 = {span / 2:g} m for "
+                                                "a segmental arch",
+                             related=("arch_span", "arch_shape"))
+    if shape == "pointed":
+        if rise is not None and not rise > span / 2:
+            raise ParameterError("arch_rise", rise, f"> span / 2 = {span / 2:g} m for a "
+                                                    "pointed arch",
+                                 related=("arch_span", "arch_shape"))
+        if blocks % 2:
+            raise ParameterError("arch_blocks", blocks, "an even number for a pointed arch",
+                                 related=("arch_shape",))
 
 
 @dataclass(frozen=True)
@@ -72,8 +170,7 @@ def arch_profile(shape: str, n_blocks: int, span: float, thickness: float,
     """The joints of an arch of ``n_blocks`` voussoirs (see the module docstring).
 
     Parameters are in metres; ``rise`` None takes the shape's default
-    (:func:`~masonry.params.arch_radius`). Inputs are assumed valid
-    (:func:`~masonry.params.check_arch`).
+    (:func:`arch_radius`). Inputs are assumed valid (:func:`check_arch`).
     """
     radius, rise = arch_radius(shape, span, rise)
     half = thickness / 2
@@ -124,7 +221,7 @@ def polygon_area_centroid(polygons):
 
 
 # ---------------------------------------------------------------------- the scene
-def build_arch(params: Params):
+def build_arch(params: ArchGeometry) -> Scene:
     """The arch scene: support blocks 0 (right) and 1 (left), then voussoirs ``v000``,
     ... from the right springing to the left one, as hexahedra extruded along y.
 
@@ -163,4 +260,45 @@ def build_arch(params: Params):
     up = np.zeros((n + 2, 3))
     up[:2, 2] = 1.0
     up[2:, 0], up[2:, 2] = along[:, 0], along[:, 1]
-    return Scene(params, blocks, block_up=up)
+    return Scene(Arch, params, blocks, block_up=up)
+
+
+class Arch(SceneKind):
+    """``arch``: voussoirs on two supports, in the xz-plane."""
+
+    name = "arch"
+    geometry = ArchGeometry
+    block_word = "blocks"
+    has_courses = False
+    moved_for_cad = False
+    id_prefix_name = "arch"
+
+    @classmethod
+    def build(cls, geometry) -> Scene:
+        return build_arch(geometry)
+
+    @classmethod
+    def check(cls, geometry):
+        check_arch(geometry)
+
+    @classmethod
+    def estimate_blocks(cls, geometry) -> float:
+        return float(geometry.arch_blocks)
+
+    @classmethod
+    def thrust_section(cls, scene) -> ThrustSection:
+        bounds = scene.blocks.bounds
+        return ThrustSection(float(bounds[:, 1].mean()), 0,
+                             (float(bounds[:, 0].mean()), float(bounds[0, 2])), False,
+                             "the arch")
+
+    @classmethod
+    def shown(cls, geometry) -> dict:
+        """The arch's dimensions, the rise resolved to the shape's default, the span and
+        rise of the centre line first."""
+        shown = super().shown(geometry)
+        if geometry.arch_rise is None:
+            shown["arch_rise"] = arch_radius(geometry.arch_shape, geometry.arch_span)[1]
+        order = ("arch_shape", "arch_blocks", "arch_span", "arch_rise", "arch_thickness",
+                 "arch_depth")
+        return {name: shown[name] for name in order}

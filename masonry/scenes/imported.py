@@ -31,6 +31,7 @@ import io
 import logging
 import re
 import time
+from dataclasses import dataclass
 from fnmatch import fnmatchcase
 from pathlib import Path
 
@@ -40,9 +41,10 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from masonry.blocks import BLOCK, BLOCK_CLASSES, Blocks, concatenate, tangent_basis
+from masonry.errors import MasonryError
 from masonry.meshing import merge_vertices
-from masonry.params import validate
-from masonry.scenes.base import Scene
+from masonry.parameters import declare
+from masonry.scenes.base import Scene, SceneKind
 from masonry.tolerances import (COINCIDENT_ANGLE, COLLINEAR_SIN, CONVEXITY_REL,
                                 GROUND_MARGIN_REL, INTERPENETRATION_REL, PARALLEL_SIN,
                                 Tolerances)
@@ -56,7 +58,7 @@ OUR_NAME = re.compile(r"^b\d+_(" + "|".join(BLOCK_CLASSES) + r")_c(\d+)$")
 """Block names written by :func:`masonry.export.obj.blocks_obj`: class and course."""
 
 
-class AssemblyError(ValueError):
+class AssemblyError(MasonryError, ValueError):
     """A mesh file cannot be read, or one of its blocks is not a closed convex solid.
     The message names the file and, for a bad block, the block."""
 
@@ -190,17 +192,40 @@ def assembly_name(paths, blocks: Blocks) -> str:
     return f"{stem}_{digest.hexdigest()[:8]}"
 
 
-def load_assembly(paths, params, *, supports=(), support_below=None, ground=False):
+@dataclass(frozen=True)
+class AssemblyGeometry:
+    """The blocks read from mesh files, named after the files and their content
+    (:func:`assembly_name`)."""
+
+    assembly: str = declare("", "the imported model", kind="str",
+                            check=lambda v: bool(v), names_geometry=True,
+                            expected="the name of an imported model (masonry analyze "
+                                     "sets it)")
+
+
+class Assembly(SceneKind):
+    """``assembly``: any set of convex blocks read from mesh files, with its supports
+    (:func:`load_assembly`; not built from parameters alone)."""
+
+    name = "assembly"
+    geometry = AssemblyGeometry
+    block_word = "blocks"
+    has_courses = False
+    moved_for_cad = False
+    from_parameters = False
+
+    @classmethod
+    def id_prefix(cls, geometry, boundary) -> str:
+        return f"assembly_{geometry.assembly}"
+
+
+def load_assembly(paths, *, supports=(), support_below=None, ground=False):
     """The ``assembly`` scene of mesh files: blocks, supports, optional ground slab.
 
     Parameters
     ----------
     paths : sequence of str or Path
         Mesh files, see :func:`read_blocks`.
-    params : masonry.params.Params
-        Analysis inputs (``mu``, ``density``, ``friction``, ``solver``, ``fast``); the
-        scene's params are these with ``scene='assembly'`` and ``assembly`` set to
-        :func:`assembly_name`.
     supports, support_below : see :func:`select_supports`
     ground : bool
         Add a ground slab under the lowest blocks (:func:`with_ground`).
@@ -208,8 +233,8 @@ def load_assembly(paths, params, *, supports=(), support_below=None, ground=Fals
     Returns
     -------
     scene : masonry.scenes.Scene
-        No course directions (bed and head joints are named with respect to z) and no
-        CAD offset.
+        Of kind :class:`Assembly`, its geometry named by :func:`assembly_name`; no course
+        directions (bed and head joints are named with respect to z) and no CAD offset.
     source : dict
         Provenance for run.json: ``files``, ``support``, ``support_below``, ``ground``,
         the number of ``supports`` and the reading time ``read_s`` (seconds).
@@ -235,14 +260,14 @@ def load_assembly(paths, params, *, supports=(), support_below=None, ground=Fals
                             "nothing is left to analyse")
     _refuse_overlaps(blocks, paths)
     blocks = dataclasses.replace(blocks, block_is_support=is_support)
-    params = validate(params.replace(scene="assembly", assembly=assembly_name(paths, blocks)))
+    geometry = AssemblyGeometry(assembly_name(paths, blocks))
     source = {"files": [str(p) for p in paths], "support": list(supports),
               "support_below": support_below, "ground": bool(ground),
               "supports": int(is_support.sum()),
               "read_s": round(time.perf_counter() - start, 4)}
     log.info("read %d blocks (%d supports) in %.3g s", blocks.n_blocks, source["supports"],
              source["read_s"])
-    return Scene(params, blocks), source
+    return Scene(Assembly, geometry, blocks), source
 
 
 def _refuse_overlaps(blocks: Blocks, paths):

@@ -1,13 +1,15 @@
-"""The ``section`` scene (one web of the dome) and the ``dome`` scene (all ``n`` webs).
+"""The polygonal dome: the ``section`` scene (one web, facing +x) and the ``dome`` scene
+(all ``n`` webs).
 
-One web faces +x on its ground slab (SPEC 4.2 to 4.5): level table, pattern, courses, then
-posed bricks (:mod:`masonry.scenes.bricks`). End bricks are mitered: their end face lies in
-the corner plane ``y = +-x tan(pi/n)`` where this web meets the next, so ``n`` rotated
-copies close into the whole dome face to face (SPEC 4.6).
+One web faces +x on its ground slab (docs/model.md 4.2 to 4.5): level table, pattern,
+courses, then posed bricks (:mod:`masonry.scenes.bricks`). End bricks are mitered: their
+end face lies in the corner plane ``y = +-x tan(pi/n)`` where this web meets the next, so
+``n`` rotated copies close into the whole dome face to face (docs/model.md 4.6).
 """
 
 import dataclasses
 import logging
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -15,60 +17,179 @@ from masonry.blocks import concatenate, rotated_web, rotation_z
 from masonry.dome.courses import fill_courses
 from masonry.dome.levels import Dimensions, level_table
 from masonry.dome.pattern import build_pattern
-from masonry.params import ParameterError, Params
-from masonry.scenes.base import Scene, hexahedra_frames
+from masonry.errors import ParameterError
+from masonry.parameters import declare
+from masonry.scenes.base import Scene, SceneKind, Symmetry, ThrustSection, hexahedra_frames
 from masonry.scenes.bricks import blocks_from_layout, posed_corners
-from masonry.tolerances import STRETCH_USUAL_RANGE, Tolerances
+from masonry.tolerances import STRETCH_USUAL_RANGE, UNITS_PER_BRICK, Tolerances
 
 log = logging.getLogger(__name__)
 
-def build_section(params: Params) -> Scene:
-    """One web of the dome (SPEC 4.2 to 4.5) on its ground slab (block 0).
 
-    Raises :class:`ParameterError` when the dome is too small or too flat for its bricks:
-    consecutive courses would meet in wedges wider than the interface detector's
-    ``max_gap_angle`` closes, and the courses would not bear on each other.
+@dataclass(frozen=True)
+class PolygonalDome:
+    """A polygonal cloister vault of ``n`` webs with the double-helix pattern
+    (docs/model.md 3, 4); lengths in units of ``unit`` metres unless stated."""
+
+    stretch: float = declare(1.0, "dome height / circumradius", low=0.05, high=20.0,
+                             tag="s", head=True, names_geometry=True,
+                             expected="0.05 to 20 (dome height / circumradius)")
+    n: int = declare(8, "walls of the dome", kind="int", check=lambda v: v >= 3,
+                     expected="an integer >= 3", tag="n", head=True, names_geometry=True)
+    r: int = declare(1, "full rhombi across the section", kind="int",
+                     check=lambda v: v >= 0, expected="an integer >= 0", tag="r", head=True,
+                     names_geometry=True)
+    p: int = declare(10, "pattern bricks per rhombus side", kind="int",
+                     check=lambda v: v >= 1, expected="an integer >= 1", tag="p", head=True,
+                     names_geometry=True)
+    cut: float = declare(0.1, "fraction of the height cut off", check=lambda v: 0 <= v < 1,
+                         expected="0 <= cut < 1", tag="c", head=True, names_geometry=True)
+    unit: float = declare(0.1, "m, the brick unit", low=1e-3, high=1e2, tag="u", head=True,
+                          names_geometry=True,
+                          expected="0.001 to 100 (metres: bricks of 1 mm to 100 m; forces "
+                                   "scale with unit^3)")
+    min_fill: float = declare(1.0, "units, shortest fill-in brick",
+                              check=lambda v: 0 < v <= 4,
+                              expected="0 < min_fill <= 4 (units)", tag="mf",
+                              names_geometry=True)
+
+
+def build_web(geometry: PolygonalDome) -> Scene:
+    """One web of the dome (docs/model.md 4.2 to 4.5) on its ground slab (block 0).
+
+    Raises :class:`~masonry.errors.ParameterError` when the dome is too small or too flat
+    for its bricks: consecutive courses would meet in wedges wider than the interface
+    detector's ``max_gap_angle`` closes, and the courses would not bear on each other.
     """
-    dims = Dimensions.of(params)
-    levels = level_table(params, dims)
+    dims = Dimensions.of(geometry)
+    levels = level_table(geometry, dims)
+    _check_levels(geometry, levels)
+    low, high = STRETCH_USUAL_RANGE
+    if not low <= geometry.stretch <= high:
+        log.warning("stretch=%g is outside %g..%g: the dome is unusually flat or tall",
+                    geometry.stretch, low, high)
+    half_width = levels.y[1:] / geometry.unit
+    pattern = build_pattern(half_width, geometry.p, geometry.r)
+    layout = fill_courses(half_width, pattern, geometry.min_fill, miter=True)
+    tan = np.tan(np.pi / geometry.n)
+    u = geometry.unit
+    # ground slab: one mitered slab under course 1, as deep as a pattern brick
+    ground = posed_corners(np.array([[dims.a, -u]]), np.zeros(1), np.array([4 * u]),
+                           np.array([u]), np.zeros(1), np.zeros(1),
+                           np.array([tan]), np.array([tan]))[0]
+    blocks = blocks_from_layout(layout, levels, u, tan, ground)
+    return Scene(Section, geometry, blocks, levels, pattern, layout, dims,
+                 *hexahedra_frames(blocks))
+
+
+def _check_levels(geometry, levels):
+    """Refuse a dome of fewer than two courses, or whose courses meet in wedges the
+    interface detector cannot close."""
     if levels.n_courses < 2:
-        raise ParameterError("cut", params.cut, "a dome at least two courses high "
+        raise ParameterError("cut", geometry.cut, "a dome at least two courses high "
                              f"(this one holds {levels.n_courses}); lower cut or unit",
                              related=("unit", "stretch", "p", "r"))
     widest = float(levels.wedge_angles.max())
     limit = Tolerances().max_gap_angle
     if widest > limit:
         raise ParameterError(
-            "p", params.p,
+            "p", geometry.p,
             f"a dome large enough for its bricks: its courses meet in wedges of up to "
             f"{np.degrees(widest):.1f} degrees, more than the {np.degrees(limit):g} "
             f"degrees whose gaps can be closed; raise p or r, or the stretch",
             related=("stretch", "r", "n", "unit"))
-    low, high = STRETCH_USUAL_RANGE
-    if not low <= params.stretch <= high:
-        log.warning("stretch=%g is outside %g..%g: the dome is unusually flat or tall",
-                    params.stretch, low, high)
-    half_width = levels.y[1:] / params.unit
-    pattern = build_pattern(half_width, params.p, params.r)
-    layout = fill_courses(half_width, pattern, params.min_fill, miter=True)
-    tan = np.tan(np.pi / params.n)
-    u = params.unit
-    # ground slab: one mitered slab under course 1, as deep as a pattern brick
-    ground = posed_corners(np.array([[dims.a, -u]]), np.zeros(1), np.array([4 * u]),
-                           np.array([u]), np.zeros(1), np.zeros(1),
-                           np.array([tan]), np.array([tan]))[0]
-    blocks = blocks_from_layout(layout, levels, u, tan, ground)
-    return Scene(params, blocks, levels, pattern, layout, dims, *hexahedra_frames(blocks))
 
 
-def build_dome(params: Params) -> Scene:
-    """All ``n`` webs explicitly: the section rotated by ``2 pi k / n`` (SPEC 4.6). The
-    mitered end bricks of neighbouring webs meet face to face in the corner planes.
-    Blocks are ordered web after web; every web keeps its ground slab as a support."""
-    section = build_section(params)
-    n = params.n
-    blocks = concatenate([rotated_web(section.blocks, k, n) for k in range(n)])
-    turns = [rotation_z(2 * np.pi * k / n).T for k in range(n)]
-    up = np.concatenate([section.block_up @ q for q in turns])
-    inward = np.concatenate([section.block_inward @ q for q in turns])
-    return dataclasses.replace(section, blocks=blocks, block_up=up, block_inward=inward)
+def web_bricks(geometry: PolygonalDome) -> float:
+    """The number of blocks of one web, from its dimensions alone: its intrados area (the
+    web's width integrated along the quarter ellipse) over
+    :data:`~masonry.tolerances.UNITS_PER_BRICK`, within a factor 1.4."""
+    with np.errstate(all="ignore"):  # absurd inputs give inf, which is refused
+        d = Dimensions.of(geometry)
+        theta = np.linspace(0.0, np.arcsin(min(d.z_max / d.c, 1.0)), 257)
+        width = 2 * d.a * np.cos(theta) * np.tan(np.pi / geometry.n)
+        speed = np.hypot(d.a * np.sin(theta), d.c * np.cos(theta))
+        f = width * speed
+        area = np.sum((f[1:] + f[:-1]) / 2 * np.diff(theta)) / geometry.unit**2
+    return float(area) / UNITS_PER_BRICK
+
+
+class Section(SceneKind):
+    """``section``: one web of the dome, free-standing or with its neighbours as a
+    boundary (docs/model.md 6.4)."""
+
+    name = "section"
+    geometry = PolygonalDome
+    boundaries = ("free", "rigid", "cyclic")
+    crown = True
+
+    @classmethod
+    def build(cls, geometry) -> Scene:
+        return build_web(geometry)
+
+    @classmethod
+    def estimate_blocks(cls, geometry) -> float:
+        return web_bricks(geometry)
+
+    @classmethod
+    def id_prefix(cls, geometry, boundary) -> str:
+        return f"dome{int(boundary != 'free')}"
+
+    @classmethod
+    def symmetry(cls, geometry) -> Symmetry:
+        return Symmetry(order=geometry.n, unit=True)
+
+    @classmethod
+    def thrust_section(cls, scene) -> ThrustSection:
+        return ThrustSection(0.0, 2, (0.0, float(scene.blocks.bounds[0, 2])), True,
+                             "y = 0 m")
+
+    @classmethod
+    def describe(cls, boundary) -> str:
+        return f"section, boundary {boundary}"
+
+    @classmethod
+    def pattern_caption(cls, geometry) -> str:
+        return f"one web of {geometry.n}, flattened"
+
+
+class Dome(Section):
+    """``dome``: all ``n`` webs explicitly, the section rotated by ``2 pi k / n``
+    (docs/model.md 4.6). The mitered end bricks of neighbouring webs meet face to face in
+    the corner planes. Blocks are ordered web after web; every web keeps its ground slab
+    as a support."""
+
+    name = "dome"
+    boundaries = ("free",)
+    id_prefix_name = "fulldome"
+
+    @classmethod
+    def build(cls, geometry) -> Scene:
+        section = build_web(geometry)
+        n = geometry.n
+        blocks = concatenate([rotated_web(section.blocks, k, n) for k in range(n)])
+        turns = [rotation_z(2 * np.pi * k / n).T for k in range(n)]
+        up = np.concatenate([section.block_up @ q for q in turns])
+        inward = np.concatenate([section.block_inward @ q for q in turns])
+        return dataclasses.replace(section, kind=Dome, blocks=blocks, block_up=up,
+                                   block_inward=inward)
+
+    @classmethod
+    def estimate_blocks(cls, geometry) -> float:
+        return web_bricks(geometry) * geometry.n
+
+    @classmethod
+    def id_prefix(cls, geometry, boundary) -> str:
+        return cls.id_prefix_name
+
+    @classmethod
+    def symmetry(cls, geometry) -> Symmetry:
+        return Symmetry(order=geometry.n, unit=False)
+
+    @classmethod
+    def describe(cls, boundary) -> str:
+        return "dome"
+
+    @classmethod
+    def pattern_caption(cls, geometry) -> str:
+        return f"web 0 of {geometry.n}, flattened"

@@ -28,6 +28,7 @@ from masonry.export import force_tables
 from masonry.export.csv import interfaces_csv, locations_csv
 from masonry.export.obj import blocks_obj
 from masonry.params import from_preset
+from masonry.pipeline import build_model
 from masonry.scenes import build
 from masonry.rbe.collapse import CollapseLP, lateral_azimuths, worst_lateral
 from masonry.rbe.loads import lateral
@@ -130,14 +131,14 @@ def _run(params, accuracy, solver, exports=True):
     scene = build(params)
     seconds["model"] = time.perf_counter() - start
     start = time.perf_counter()
-    model = analysis_model(scene)
+    model = analysis_model(scene, params.analysis.boundary)
     seconds["interfaces"] = time.perf_counter() - start
     start = time.perf_counter()
     problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
                          side_rotation=model.side_rotation)
     seconds["assembly"] = time.perf_counter() - start
     start = time.perf_counter()
-    result = problem.solve(mu=params.mu, density=params.density, friction=params.friction,
+    result = problem.solve(mu=params.analysis.mu, density=params.analysis.density, friction=params.analysis.friction,
                            solver=solver, accuracy=accuracy)
     seconds["solve"] = time.perf_counter() - start
     seconds["lp"] = result.lp_time_s
@@ -340,18 +341,18 @@ def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None
     """
     rows = []
     for name, params in structures.items():
-        model = analysis_model(build(params))
+        _, model = build_model(params)
         bricks = int((~model.blocks.block_is_support).sum())
         rbe, one, factor = [], [], None
         for _ in range(repeats):
             start = time.perf_counter()
             RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
                        side_rotation=model.side_rotation).solve(
-                mu=params.mu, density=params.density, accuracy="balanced")
+                mu=params.analysis.mu, density=params.analysis.density, accuracy="balanced")
             rbe.append(time.perf_counter() - start)
             start = time.perf_counter()
-            problem = CollapseLP(model, mu=params.mu, density=params.density, method=method)
-            result = problem.solve(lateral(model, azimuth, params.density),
+            problem = CollapseLP(model, mu=params.analysis.mu, density=params.analysis.density, method=method)
+            result = problem.solve(lateral(model, azimuth, params.analysis.density),
                                    dead_load_feasible=True)
             one.append(time.perf_counter() - start)
             factor = result.load_factor
@@ -364,16 +365,17 @@ def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None
                          load_factor=factor, azimuth_deg=azimuth, solver=result.solver))
         if not search:
             continue
-        angles = lateral_azimuths(params.n if params.scene in ("section", "dome") else None)
+        symmetry = params.kind.symmetry(params.geometry)
+        angles = lateral_azimuths(symmetry.webs)
         start = time.perf_counter()
-        period = 360.0 / params.n if params.scene == "dome" else None
-        worst = worst_lateral(model, angles, mu=params.mu, density=params.density,
+        period = symmetry.period_deg
+        worst = worst_lateral(model, angles, mu=params.analysis.mu, density=params.analysis.density,
                               period_deg=period, dead_load_feasible=True, method=method)
         together = time.perf_counter() - start
         start = time.perf_counter()
         for angle in angles:
-            CollapseLP(model, mu=params.mu, density=params.density, method=method).solve(
-                lateral(model, angle, params.density), dead_load_feasible=True)
+            CollapseLP(model, mu=params.analysis.mu, density=params.analysis.density, method=method).solve(
+                lateral(model, angle, params.analysis.density), dead_load_feasible=True)
         apart = time.perf_counter() - start
         rows.append(dict(structure=name, bricks=bricks, unknowns=unknowns,
                          azimuths=len(angles), rbe_s=apart, collapse_s=together,
@@ -435,8 +437,8 @@ def friction_bench(structures, models=FRICTION_MODELS, azimuth=0.0, repeats=1,
     names = list(dict.fromkeys(["circle", *models, "square"]))
     rows = []
     for structure, params in structures.items():
-        model = analysis_model(build(params))
-        live = lateral(model, azimuth, params.density)
+        _, model = build_model(params)
+        live = lateral(model, azimuth, params.analysis.density)
         measured = {}
         for name in names:
             rbe, collapse = [], []
@@ -445,10 +447,10 @@ def friction_bench(structures, models=FRICTION_MODELS, azimuth=0.0, repeats=1,
                 result = RBEProblem(model.blocks, model.interfaces,
                                     side_block=model.side_block,
                                     side_rotation=model.side_rotation).solve(
-                    mu=params.mu, density=params.density, cone=name)
+                    mu=params.analysis.mu, density=params.analysis.density, cone=name)
                 rbe.append(time.perf_counter() - start)
                 start = time.perf_counter()
-                lp = CollapseLP(model, mu=params.mu, density=params.density, cone=name)
+                lp = CollapseLP(model, mu=params.analysis.mu, density=params.analysis.density, cone=name)
                 factor = lp.solve(live, dead_load_feasible=result.feasible or None)
                 collapse.append(time.perf_counter() - start)
             if progress:

@@ -31,12 +31,10 @@ import csv
 import dataclasses
 import functools
 import io
-import json
 import logging
 import re
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
@@ -44,15 +42,17 @@ from scipy.sparse.csgraph import connected_components
 
 from masonry import forking
 from masonry.blocks import BLOCK_CLASSES
+from masonry.errors import ParameterError
 from masonry.export._text import format_float
 from masonry.export.summaries import parameters_text
-from masonry.params import ParameterError, structure_id, validate
-from masonry.pipeline import Timer, model_record, run_model, versions, write_cache
+from masonry.params import FILE_OUTPUTS, structure_id, validate
+from masonry.pipeline import (Timer, identity, model_record, run_model, versions,
+                              write_cache)
 from masonry.rbe.boundary import Model, restrict
 from masonry.rbe.collapse import collapse_load
-from masonry.rbe.loads import lateral
-from masonry.rbe.solve import ACCURACY, RBEProblem, friction_model
-from masonry.runfolder import RunFolder, check_output_root
+from masonry.rbe.loads import Lateral
+from masonry.rbe.solve import ACCURACY, RBEProblem
+from masonry.runfolder import Publication, check_output_root
 from masonry.scenes import check_size
 from masonry.tolerances import MAX_BRICKS, Tolerances
 
@@ -277,10 +277,11 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
     else:
         problem = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
                              side_rotation=part.side_rotation)
-        result = problem.solve(mu=params.mu, density=params.density,
-                               friction=params.friction, solver=params.solver,
-                               accuracy=params.solver_accuracy, cone=params.friction_cone)
-        floor = ACCURACY[params.solver_accuracy].residual * result.weight_N / row["bricks"]
+        analysis = params.analysis
+        result = problem.solve(mu=analysis.mu, density=analysis.density,
+                               friction=analysis.friction, solver=analysis.solver,
+                               accuracy=analysis.accuracy, cone=analysis.friction_cone)
+        floor = ACCURACY[analysis.accuracy].residual * result.weight_N / row["bricks"]
         row.update(feasible=result.feasible, moi=_number(result.moi),
                    moi_factor=_number(result.moi_factor),
                    tension=tension_by_block(part, result, plan, floor))
@@ -321,12 +322,13 @@ def stage_load_factor(part: Model, params) -> float | None:
     params : masonry.params.Params
         ``lateral`` (degrees, not ``'all'``), ``mu`` and ``density``.
     """
-    if params.lateral is None:
+    if params.load is None:
         return None
-    live = lateral(part, params.lateral, params.density)
-    result = collapse_load(part, live, mu=params.mu, density=params.density,
-                           cone=friction_model(params.solver_accuracy, params.friction_cone),
-                           friction=params.friction_law, dead_load_feasible=True)
+    analysis = params.analysis
+    live = params.load.on(part, analysis.density)
+    result = collapse_load(part, live, mu=analysis.mu, density=analysis.density,
+                           cone=analysis.cone, friction=analysis.friction_law,
+                           dead_load_feasible=True)
     return result.load_factor
 
 
@@ -464,20 +466,27 @@ def check_live_load(params) -> None:
     """Refuse the live loads a stage study does not take (:class:`ParameterError`): point
     and crown loads (they name blocks a stage may not hold yet) and ``--lateral all``
     (an azimuth search at every stage: one azimuth per study)."""
-    if params.lateral == "all":
+    load = params.load
+    if load is None:
+        return
+    if not isinstance(load, Lateral):
+        name, value = next(iter(load.options().items()))
+        raise ParameterError(name, value, "none for stages (only --lateral AZIMUTH)")
+    if load.azimuth_deg == "all":
         raise ParameterError("lateral", "all", "an azimuth in degrees for stages (a "
                                                "search over azimuths at every stage is "
                                                "not offered: run one azimuth per study)")
-    for name in ("point_loads", "crown_load"):
-        if getattr(params, name):
-            raise ParameterError(name, getattr(params, name), "none for stages (only "
-                                                              "--lateral AZIMUTH)")
 
 
 def run_stages(params, out_root="exports", *, by="course", order=None, course=None,
-               plots_wanted=True, force=False, scene=None, source=None,
-               max_bricks=MAX_BRICKS) -> dict:
+               force=False, scene=None, source=None, max_bricks=MAX_BRICKS) -> dict:
     """Every construction stage of ``params`` (or of ``scene``) into its own run folder.
+
+    The folder is published by the run-folder protocol
+    (:class:`masonry.runfolder.Publication`), as a run's is: a folder holding this
+    input's complete study with at least the plots asked for (``params.outputs``) is
+    reused; one without plots gets them (the study is computed again), also with
+    ``force``: a run folder only grows.
 
     Parameters
     ----------
@@ -487,11 +496,8 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
         The run folder is ``out_root/<structure id>_stages_<plan>``.
     by, order, course
         The stage plan, see :func:`make_plan`.
-    plots_wanted, force : bool
-        Write the plots; recompute when the folder holds this input's complete study. A
-        folder holding the study with plots is reused by a study without; one without
-        plots gets them (the study is computed again), also with ``force``: a run folder
-        only grows.
+    force : bool
+        Recompute when the folder holds this input's complete study.
     scene : Scene, optional
         An already built scene (imported blocks, :func:`masonry.scenes.imported.load_assembly`).
     source : dict, optional
@@ -519,41 +525,57 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
         plan = make_plan(built, by, order, course)
 
     scene, model, cached = run_model(params, out_root, timer, scene, check=check)
-    target = Path(out_root) / stages_folder_name(params, plan)
-    previous = _previous(target, params, plan)
-    if previous is not None:
-        had_plots = (previous.get("outputs") or {}).get("plots") is True
-        if not force and (had_plots or not plots_wanted):
-            log.info("%s is up to date (use --force to recompute)", target.name)
-            return {**previous, "path": str(target), "reused": True}
-        plots_wanted = plots_wanted or had_plots  # a run folder only grows
-    outputs = {"plots": plots_wanted}
-
+    out = params.outputs
+    job = Publication(out_root, stages_folder_name(params, plan),
+                      {"params": identity(params), "plan": _plan_identity(plan)},
+                      {"plots": out.plots, "quick": out.quick}, force=force,
+                      identify=_identify)
+    reused = job.reusable()
+    if reused is not None:
+        return reused
+    params = dataclasses.replace(params, outputs=dataclasses.replace(
+        out, plots=job.outputs()["plots"], quick=job.outputs()["quick"]))
     with timer.stage("stages"):
         rows = analyse_stages(model, params, plan)
-    record = _record(scene, model, plan, rows, outputs, cached, source)
-    with RunFolder(out_root, target.name) as folder:
-        folder.write("00_parameters.txt", parameters_text(params))
-        folder.write("stages.csv", stages_csv(rows))
-        first = first_unsupported(rows)
-        if first is not None:
-            folder.write("first_unsupported/held.csv", held_csv(scene, first))
-        if plots_wanted:
-            with timer.stage("plots"):
-                for name, png in stage_pngs(scene, plan, rows).items():
-                    folder.write(name, png)
-        record["timings_s"] = timer.seconds
-        record["versions"] = versions()
-        record["complete"] = True
-        folder.write_json("run.json", record)
+    record = _record(params, scene, model, plan, rows, cached, source)
+    folder = job.publish(lambda folder: _write(folder, params, scene, plan, rows, record,
+                                               timer))
     if cached == "computed":  # only a model whose study completed is cached
         write_cache(params, out_root, scene, model)
     return {**record, "path": str(folder.target), "rows": rows}
 
 
-def _record(scene, model, plan, rows, outputs, cached, source) -> dict:
+def _plan_identity(plan) -> dict:
+    return {"stages": plan.n_stages, **{k: plan.record()[k] for k in ("by", "order", "course")}}
+
+
+def _identify(record) -> dict:
+    plan = record["plan"]
+    return {"params": {name: value for name, value in record["params"].items()
+                       if name not in FILE_OUTPUTS},
+            "plan": {"stages": plan.get("stages"),
+                     **{k: plan.get(k) for k in ("by", "order", "course")}}}
+
+
+def _write(folder, params, scene, plan, rows, record, timer):
+    """Every file of a stage study and, last, its ``run.json``."""
+    folder.write("00_parameters.txt", parameters_text(params, structure_id(params)))
+    folder.write("stages.csv", stages_csv(rows))
+    first = first_unsupported(rows)
+    if first is not None:
+        folder.write("first_unsupported/held.csv", held_csv(scene, first))
+    if params.outputs.plots:
+        with timer.stage("plots"):
+            for name, png in stage_pngs(params, scene, plan, rows).items():
+                folder.write(name, png)
+    record["timings_s"] = timer.seconds
+    record["versions"] = versions()
+    record["complete"] = True
+    folder.write_json("run.json", record)
+
+
+def _record(params, scene, model, plan, rows, cached, source) -> dict:
     """run.json of a stage study, before timings."""
-    params = scene.params
     first = first_unsupported(rows)
     held = [] if first is None else [
         {"block": block, "name": str(scene.blocks.block_name[block]), "tension_N": newtons}
@@ -561,13 +583,12 @@ def _record(scene, model, plan, rows, outputs, cached, source) -> dict:
     record = {
         "structure_id": structure_id(params),
         "scene": params.scene,
-        "params": dataclasses.asdict(params),
-        "outputs": outputs,
+        "params": params.record(),
+        "outputs": {"plots": params.outputs.plots, "quick": params.outputs.quick},
         "plan": {**plan.record(), "described": _described(plan)},
-        **model_record(scene),
+        **model_record(scene, params.analysis.density),
         "cache": {"geometry": cached},
-        "friction_model": friction_model(params.solver_accuracy,
-                                         params.friction_cone).record(),
+        "friction_model": params.analysis.cone.record(),
         "stages": {
             "count": plan.n_stages,
             "standing": int(sum(bool(row["feasible"]) for row in rows)),
@@ -596,32 +617,15 @@ def _described(plan: StagePlan) -> str:
     return BLOCK_ORDERS[plan.order]
 
 
-def _previous(target: Path, params, plan):
-    """The record of a complete earlier study of the same input and plan, else None."""
-    try:
-        record = json.loads((target / "run.json").read_text())
-    except (OSError, ValueError):
-        return None
-    if not isinstance(record, dict):
-        return None
-    same = (record.get("params") == json.loads(json.dumps(dataclasses.asdict(params)))
-            and record.get("plan", {}).get("stages") == plan.n_stages
-            and {k: record.get("plan", {}).get(k) for k in ("by", "order", "course")}
-            == {k: plan.record()[k] for k in ("by", "order", "course")}
-            and record.get("complete") is True)
-    return record if same else None
-
-
-def stage_pngs(scene, plan: StagePlan, rows) -> dict:
+def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
     """``stages.png`` (MoI factor of every stage, which stand) and, when a stage needs
     support, ``first_unsupported/<view>.png``: that stage with its held bricks marked."""
     from masonry import plots  # matplotlib, imported only by the runs that draw
 
-    params = scene.params
     what = {"course": "course stages", "brick": f"course {plan.course} brick by brick "
             f"({plan.order})", "block": f"block by block ({plan.order})"}[plan.by]
     title = f"{structure_id(params)}: {what}, {sum(bool(r['feasible']) for r in rows)} of " \
-            f"{len(rows)} stages stand (mu {params.mu:g})"
+            f"{len(rows)} stages stand (mu {params.analysis.mu:g})"
     out = {"stages.png": plots.stage_chart_png(
         [r["stage"] for r in rows],
         [np.nan if r["moi_factor"] is None else r["moi_factor"] for r in rows],
@@ -640,6 +644,7 @@ def stage_pngs(scene, plan: StagePlan, rows) -> dict:
         f"stage {first['stage']} of {plan.n_stages}: {first['bricks']} bricks, "
         f"{len(first['tension'])} carry tension", value_label="tension the brick carries "
         "[N] (hold it)", is_outlined=plan.block_stage == first["stage"],
-        outline_label=f"laid at stage {first['stage']}", fast=params.fast)
+        outline_label=f"laid at stage {first['stage']}", fast=params.outputs.quick,
+        subtitle=f"{scene.kind.describe(params.analysis.boundary)} | {structure_id(params)}")
     out.update({f"first_unsupported/{name}": png for name, png in views.items()})
     return out

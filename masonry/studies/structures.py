@@ -14,11 +14,10 @@ import time
 import numpy as np
 
 from masonry.export._text import format_float
-from masonry.rbe.boundary import analysis_model
 from masonry.rbe.collapse import worst_lateral
 from masonry.rbe.equilibrium import VariableLayout
 from masonry.params import from_preset
-from masonry.scenes import build
+from masonry.pipeline import build_model
 from masonry.tolerances import MECHANISM_MAIN
 
 log = logging.getLogger(__name__)
@@ -78,8 +77,9 @@ def lateral_record(model, params, count=3, cone="circle") -> dict:
     the mirror in a web's mid-plane unless the joints' axes are: its search is a
     reproduction, not a bound.)"""
     start = time.perf_counter()
-    worst = worst_lateral(model, symmetric_azimuths(params.n, count), mu=params.mu,
-                          density=params.density, cone=cone, n_webs=params.n,
+    n = params.geometry.n
+    worst = worst_lateral(model, symmetric_azimuths(n, count), mu=params.analysis.mu,
+                          density=params.analysis.density, cone=cone, n_webs=n,
                           dead_load_feasible=True)
     out = {"lateral_factor": worst.load_factor, "lateral_azimuth": worst.azimuth_deg,
            "hinge_webs": "", "hinge_courses": "", "sliding": worst.main_sliding,
@@ -129,23 +129,24 @@ def structures_table(rows=ROWS, full_dome=True, lp_check=False, lateral=False,
     cone = friction_model("balanced", cone)
     out = []
     for structure, preset, scene_name, boundary, friction, mu in rows:
-        if scene_name == "dome" and not full_dome:
+        params = from_preset(preset, scene=scene_name, boundary=boundary, mu=mu,
+                             friction=friction)
+        # the whole dome: the kind repeats by rotation and is not one part of it
+        whole = params.kind.symmetry(params.geometry).period_deg is not None
+        if whole and not full_dome:
             continue
         log.info("structure %s ...", structure)
         start = time.perf_counter()
-        params = from_preset(preset, scene=scene_name, boundary=boundary, mu=mu,
-                             friction=friction)
-        scene = build(params)
-        model = analysis_model(scene)
+        scene, model = build_model(params)
         result = solve_rbe(model.blocks, model.interfaces, mu=mu, friction=friction,
-                           density=params.density, solver=params.solver, cone=cone,
-                           lp_check=lp_check, side_block=model.side_block,
+                           density=params.analysis.density, solver=params.analysis.solver,
+                           cone=cone, lp_check=lp_check, side_block=model.side_block,
                            side_rotation=model.side_rotation)
         thesis = THESIS.get(structure, (None, None))
         d = result.to_dict()
         out.append({
             "structure": structure, "preset": preset, "scene": scene_name,
-            "boundary": boundary if scene_name == "section" else "-",
+            "boundary": boundary if len(params.kind.boundaries) > 1 else "-",
             "friction": d["friction"], "mu": mu, "friction_model": cone.name,
             "feasible": d["feasible"],
             "objective": d["objective"], "moi": d["moi"], "weight_N": d["weight_N"],
@@ -155,7 +156,7 @@ def structures_table(rows=ROWS, full_dome=True, lp_check=False, lateral=False,
             "residual_eq": d["residual_eq"], "time_s": round(time.perf_counter() - start, 2),
             "thesis_feasible": thesis[0], "thesis_moi_factor": thesis[1],
         })
-        if lateral and scene_name == "dome" and result.feasible:
+        if lateral and whole and result.feasible:
             log.info("structure %s: worst lateral load factor ...", structure)
             out[-1].update(lateral_record(model, params, cone=cone))
     return out

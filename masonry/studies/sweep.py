@@ -25,7 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonry.export._text import format_floats
-from masonry.params import Params, ParameterError, validate
+from masonry.errors import ParameterError
+from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run
 from masonry.rbe.solvers.newton import use_one_blas_thread
 
@@ -42,12 +43,12 @@ load (``lateral``, ``point-load`` or ``crown-load``, SPEC 6.8)."""
 
 @dataclass(frozen=True)
 class Study:
-    """A parameter study over :class:`~masonry.params.Params` fields.
+    """A parameter study over a run's inputs (:func:`masonry.params.names`).
 
     Parameters
     ----------
     base : dict
-        Fixed inputs (``Params`` field names).
+        Fixed inputs (flat input names, as :meth:`masonry.params.Params.of` takes them).
     grid : dict of lists
         Inputs whose Cartesian product gives the variants.
     sample : dict of (low, high)
@@ -78,16 +79,16 @@ class Study:
         Returns
         -------
         list of dict
-            ``Params`` fields of every variant: the grid's Cartesian product, each point
+            The inputs of every variant: the grid's Cartesian product, each point
             combined with every one of the ``count`` seeded draws.
 
         Raises
         ------
         ParameterError
-            For inputs that are not ``Params`` fields, a grid entry that is not a
+            For names that are no run's inputs, a grid entry that is not a
             non-empty list, or samples with ``count < 1``.
         """
-        fields = {f.name for f in dataclasses.fields(Params)}
+        fields = {"scene", "fast", *names()}
         unknown = (set(self.base) | set(self.grid) | set(self.sample)) - fields
         if unknown:
             raise ParameterError("study", sorted(unknown), "inputs named as run options")
@@ -120,11 +121,12 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     Parameters
     ----------
     inputs : dict
-        ``Params`` fields of the variant.
+        The variant's inputs (flat names).
     out_root : str or Path
         The study's output root; the variant's run folder is named by its structure id.
     analyse, plots, printable : bool
-        What the run does and writes (:func:`masonry.pipeline.run`).
+        What the run does and writes (:func:`masonry.pipeline.run`; ``plots`` and
+        ``printable`` unless the variant's inputs say otherwise).
 
     Returns
     -------
@@ -138,8 +140,8 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     start = time.perf_counter()
     row = {"status": "failed", "error": ""}
     try:
-        record = run(validate(Params(**inputs)), out_root, analyse=analyse,
-                     plots_wanted=plots, printable=printable)
+        params = Params.of(**{"plots": plots, "printable": printable, **inputs})
+        record = run(validate(params), out_root, analyse=analyse)
     except Exception as error:  # a variant's failure is data, not the study's end
         row["error"] = f"{type(error).__name__}: {error}"
         log.debug("variant failed: %s", traceback.format_exc())
@@ -177,16 +179,16 @@ def geometry_group(inputs: dict) -> str:
     Parameters
     ----------
     inputs : dict
-        ``Params`` fields of a variant.
+        A variant's inputs (flat names).
 
     Returns
     -------
     str
         JSON of the variant's geometric inputs; of all its inputs when they are not valid
-        ``Params`` (such a variant is a group of its own and fails on its own).
+        (such a variant is a group of its own and fails on its own).
     """
     try:
-        return json.dumps(Params(**inputs).geometry_key, sort_keys=True, default=str)
+        return geometry_key(Params.of(**inputs))
     except (TypeError, ValueError):  # an invalid variant: alone, to fail on its own
         return json.dumps(inputs, sort_keys=True, default=str)
 
@@ -352,9 +354,9 @@ def summary_parquet(study: Study, rows):
 
 def _fixed_inputs(study: Study) -> str:
     """The study's fixed inputs away from their defaults, for figure titles."""
-    default = Params()
+    default = Params.of().inputs()
     text = ", ".join(f"{key} {value}" for key, value in study.base.items()
-                     if key not in study.swept and getattr(default, key, None) != value)
+                     if key not in study.swept and default.get(key) != value)
     return text if len(text) <= 80 else text[:77] + "..."
 
 
@@ -369,7 +371,8 @@ def summary_pngs(study: Study, rows, label="") -> dict:
         ``moi_factor_<input>.png`` -> PNG bytes, one per name of ``study.swept``; failed
         variants are left out of the points and counted in the title.
     """
-    from masonry.plots import _png, plt  # matplotlib, imported only by the runs that draw
+    # matplotlib, imported only by the runs that draw
+    from masonry.plots.common import plt, png_bytes
 
     out = {}
     done = [r for r in rows if r["status"] != "failed"]
@@ -406,7 +409,7 @@ def summary_pngs(study: Study, rows, label="") -> dict:
         if labels is not None:
             bottom.set_xticks(range(len(labels)), labels)
         top.set_title(title, fontsize=9)
-        out[f"moi_factor_{name}.png"] = _png(fig, 100)
+        out[f"moi_factor_{name}.png"] = png_bytes(fig, 100)
         factors = [(v, r["load_factor"]) for v, r in zip(xs, done)
                    if r.get("load_factor") is not None]
         if factors:
@@ -418,5 +421,5 @@ def summary_pngs(study: Study, rows, label="") -> dict:
                 ax.set_xticks(range(len(labels)), labels)
             ax.set_ylim(bottom=0)
             ax.set_title(title, fontsize=9)
-            out[f"load_factor_{name}.png"] = _png(fig, 100)
+            out[f"load_factor_{name}.png"] = png_bytes(fig, 100)
     return out

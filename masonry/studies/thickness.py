@@ -14,9 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonry.interfaces import detect
-from masonry.params import ParameterError, Params, arch_radius, validate
+from masonry.errors import ParameterError
+from masonry.params import Params, validate
 from masonry.rbe.solve import solve_rbe
-from masonry.scenes.arch import build_arch
+from masonry.scenes.arch import arch_radius, build_arch
 from masonry.tolerances import THICKNESS_BRACKET, THICKNESS_LIMIT_FRACTION, THICKNESS_RTOL
 
 log = logging.getLogger(__name__)
@@ -50,10 +51,11 @@ class ThicknessResult:
 
 def is_feasible(params: Params) -> bool:
     """Whether the arch of ``params`` stands: friction-net RBE, no LP check."""
-    scene = build_arch(params)
+    scene = build_arch(params.geometry)
     interfaces = detect(scene.blocks, up=scene.block_up)
-    result = solve_rbe(scene.blocks, interfaces, mu=params.mu, density=params.density,
-                       friction="net", solver=params.solver, cone=params.friction_cone,
+    analysis = params.analysis
+    result = solve_rbe(scene.blocks, interfaces, mu=analysis.mu, density=analysis.density,
+                       friction="net", solver=analysis.solver, cone=analysis.friction_cone,
                        lp_check=False)
     return bool(result.feasible)
 
@@ -70,7 +72,7 @@ def minimum_thickness(params: Params, rtol=THICKNESS_RTOL,
     Parameters
     ----------
     params : Params
-        Scene ``arch`` (set here), shape, voussoirs, span, depth, ``mu``, ``density``,
+        Of an ``arch`` scene: shape, voussoirs, span, depth, ``mu``, ``density``,
         ``solver``.
     rtol : float
         Relative width of the final bracket.
@@ -90,9 +92,9 @@ def minimum_thickness(params: Params, rtol=THICKNESS_RTOL,
     if not (isinstance(rtol, float | int) and 0 < rtol < 1):
         raise ParameterError("rtol", rtol, "a relative width between 0 and 1 (exclusive)")
     start = time.perf_counter()
-    params = params.replace(scene="arch")
-    radius, _ = arch_radius(params.arch_shape, params.arch_span, params.arch_rise)
-    most = (params.arch_span if params.arch_shape == "pointed" else 2 * radius) / radius
+    arch = params.geometry
+    radius, _ = arch_radius(arch.arch_shape, arch.arch_span, arch.arch_rise)
+    most = (arch.arch_span if arch.arch_shape == "pointed" else 2 * radius) / radius
     lo, hi = bracket[0], min(bracket[1], THICKNESS_LIMIT_FRACTION * most)
     steps = []
 
@@ -103,9 +105,9 @@ def minimum_thickness(params: Params, rtol=THICKNESS_RTOL,
         return verdict
 
     if not feasible(hi):
-        raise ParameterError("mu", params.mu, f"a friction coefficient at which the arch "
-                                              f"stands: it falls even at t/R = {hi:g}, so "
-                                              "its voussoirs slide")
+        raise ParameterError("mu", params.analysis.mu,
+                             f"a friction coefficient at which the arch stands: it falls "
+                             f"even at t/R = {hi:g}, so its voussoirs slide")
     if feasible(lo):
         raise ValueError(f"the arch stands already at t/R = {lo:g}: lower the bracket")
     while hi / lo - 1 > rtol:
@@ -120,11 +122,11 @@ def minimum_thickness(params: Params, rtol=THICKNESS_RTOL,
 
 def folder_name(params: Params, rtol: float) -> str:
     """The run folder of a minimum-thickness search: every input but the thickness."""
-    p = params
+    p, a = params.geometry, params.analysis
     name = (f"arch-thickness_{p.arch_shape}_N{p.arch_blocks}_s{p.arch_span:g}"
             f"_d{p.arch_depth:g}" + ("" if p.arch_rise is None else f"_h{p.arch_rise:g}")
-            + f"_mu{p.mu:g}_rho{p.density:g}_rtol{rtol:g}")
-    return name + ("" if p.solver is None else f"_{p.solver}")
+            + f"_mu{a.mu:g}_rho{a.density:g}_rtol{rtol:g}")
+    return name + ("" if a.solver is None else f"_{a.solver}")
 
 
 def steps_csv(result: ThicknessResult) -> bytes:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
-from masonry.params import arch_radius
+from masonry.scenes.arch import arch_radius
 from masonry.scenes.arch import ArchProfile, arch_profile, polygon_area_centroid
 from masonry.tolerances import (THRUST_ACTIVE_REL, THRUST_MARGIN_XATOL_REL, THRUST_SCAN,
                                 THRUST_XTOL)

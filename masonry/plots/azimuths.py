@@ -1,0 +1,29 @@
+"""The lateral load factor against the load's azimuth (``--lateral all``) on polar axes,
+the worst azimuth marked."""
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from masonry.plots.common import png_bytes
+
+
+def azimuths_png(collapse, title="") -> bytes:
+    """``collapse/azimuths.png``: the lateral load factor against the load's azimuth
+    (``--lateral all``) on polar axes, the worst marked; ``title`` is the line under the
+    figure's own."""
+    angle = np.array([a for a, _ in collapse.azimuths])
+    factor = np.array([np.nan if f is None else f for _, f in collapse.azimuths])
+    order = np.argsort(angle)  # the line breaks where an azimuth has no factor
+    theta = np.radians(np.append(angle[order], angle[order][0]))
+    fig, ax = plt.subplots(figsize=(5.5, 5.5), subplot_kw={"projection": "polar"})
+    ax.plot(theta, np.append(factor[order], factor[order][0]), "-o", color="C0",
+            markersize=3, linewidth=1)
+    worst = np.radians(collapse.azimuth_deg)
+    ax.plot([worst], [collapse.load_factor], "o", color="#d62728", markersize=8,
+            label=f"worst: {collapse.load_factor:.4g} at {collapse.azimuth_deg:g} deg")
+    ax.set_ylim(0, 1.1 * np.nanmax(factor))
+    ax.set_rlabel_position(100)
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, -0.15), fontsize=8, frameon=False)
+    ax.set_title(f"lateral load factor against the load's azimuth (from +x toward +y)\n"
+                 f"{title}", fontsize=9, pad=20)
+    return png_bytes(fig, 110)

@@ -1,0 +1,55 @@
+"""Where it fails: the interfaces of largest tension, coloured by it and numbered by
+rank, over the faint rest of the interfaces."""
+
+import matplotlib
+import numpy as np
+
+from masonry.plots.colours import BAR_3D, force_unit
+from masonry.plots.common import add_polygons, axes_3d, interface_polygons, png_bytes
+
+RANKED = 10
+"""The interfaces of largest tension numbered in ``where_it_fails.png``."""
+
+
+def _rank_labels(centres, bounds, near=0.03):
+    """``(text, position)`` labels for the ranks 1, 2, ... of points ``centres``; points
+    within ``near`` of the bounding box's diagonal of an earlier label share it
+    (``'1, 4'``) instead of printing over it."""
+    size = float(np.linalg.norm(bounds[1] - bounds[0]))
+    labels = []
+    for rank, centre in enumerate(centres, start=1):
+        for label in labels:
+            if np.linalg.norm(label[1] - centre) <= near * size:
+                label[0].append(str(rank))
+                break
+        else:
+            labels.append(([str(rank)], centre))
+    return [(", ".join(ranks), at) for ranks, at in labels]
+
+
+def failure_png(blocks, interfaces, top, forces, fast=False, title="") -> bytes:
+    """Where it fails: every interface in light grey and the interfaces ``top`` (the
+    rows of ``RBE/tension_top.csv``, largest tension first) coloured by tension, the
+    first :data:`RANKED` numbered by their rank (neighbours share a label); ``title`` is the
+    line under the figure's own."""
+    fig, ax = axes_3d(blocks.bounds)
+    add_polygons(ax, "01_angle", interface_polygons(interfaces, range(len(interfaces))),
+                 (0.6, 0.6, 0.6, 0.2), edgecolors="none")
+    tension = np.asarray(forces["tension"], dtype=float)[top]
+    factor, unit = force_unit(tension.max())
+    norm = matplotlib.colors.Normalize(0, tension.max() * factor)
+    cmap = matplotlib.colormaps["inferno_r"]
+    colours = cmap(norm(tension * factor))
+    add_polygons(ax, "01_angle", interface_polygons(interfaces, top), colours, linewidths=1.0)
+    for ranks, at in _rank_labels(interfaces.centre[top[:RANKED]], blocks.bounds):
+        # above the polygons (mplot3d orders collections by depth after the texts)
+        ax.text(*at, ranks, fontsize=7, color="k", zorder=1e3,
+                bbox={"boxstyle": "round,pad=0.15", "facecolor": "white", "alpha": 0.8,
+                      "linewidth": 0})
+    bar = fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, **BAR_3D)
+    bar.set_label(f"tension [{unit}]", fontsize=8)
+    numbered = (f", the first {RANKED} numbered by rank" if len(top) > RANKED
+                else ", numbered by rank")
+    ax.set_title(f"where it fails: the {len(top)} interfaces with the largest tension"
+                 f"{numbered} (RBE/tension_top.csv)\n{title}", fontsize=9)
+    return png_bytes(fig, 60 if fast else 130)

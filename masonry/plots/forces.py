@@ -1,0 +1,113 @@
+"""Interfaces drawn as polygons coloured by one value each: their area (thesis figures
+3.12-3.13) and the forces they carry (figures 4.1-4.8), in the four views; for a cyclic
+section also the whole dome, the section's forces rotated into every web."""
+
+import numpy as np
+
+from masonry.blocks import concatenate, rotated_web, rotation_z
+from masonry.plots.colours import colour_bar, colour_scale
+from masonry.plots.common import (HORIZONTAL_KINDS, VIEWS, add_polygons, axes_3d,
+                                  interface_polygons, png_bytes, view_axes)
+
+
+def _interface_linewidth(count: int) -> float:
+    """Edge width of interface polygons: wide for a few (seen edge on they are lines),
+    thin for thousands (wide edges would cover their faces)."""
+    return float(np.clip(12.0 / np.sqrt(max(count, 1)), 0.3, 3.0))
+
+
+def _colour_plot(blocks, interfaces, index, values, title, view, fast, quantity,
+                 signed=False, is_force=True, subtitle="", unit=""):
+    """One view of the interfaces ``index`` coloured by ``values`` (SI units, or ``unit``
+    for values that are not forces)."""
+    fig, ax = view_axes(blocks.bounds, view)
+    scale = colour_scale(values, signed, is_force, unit)
+    shown = np.asarray(values, dtype=float) * scale["factor"]
+    colours = scale["cmap"](scale["norm"](shown))
+    # edges in the face colour: interfaces seen edge on stay visible as coloured lines
+    add_polygons(ax, view, interface_polygons(interfaces, index), colours,
+                 linewidths=_interface_linewidth(len(index)))
+    colour_bar(fig, ax, scale, quantity)
+    ax.set_title(f"{title} ({len(index)} interfaces)\n{subtitle}", fontsize=9)
+    return png_bytes(fig, 60 if fast else 110)
+
+
+def interface_pngs(blocks, interfaces, fast=False, title="") -> dict:
+    """Horizontal and vertical interfaces drawn as polygons (thesis figures 3.12-3.13),
+    coloured by area; a group without interfaces has no plot. ``title`` is the line under
+    each figure's own."""
+    out = {}
+    views = ["01_angle"] if fast else VIEWS
+    horizontal = np.isin(interfaces.kind, HORIZONTAL_KINDS)
+    groups = {"interfaces_horizontal": np.flatnonzero(horizontal),
+              "interfaces_vertical": np.flatnonzero(~horizontal)}
+    for view in views:
+        for name, index in groups.items():
+            if len(index):
+                out[f"{view}/{name}.png"] = _colour_plot(
+                    blocks, interfaces, index, interfaces.area[index] * 1e4,
+                    name.replace("_", " "), view, fast, "area", is_force=False,
+                    subtitle=title, unit="cm^2")
+    return out
+
+
+FORCE_PLOTS = (
+    # (file, result key, interface selection, title, signed): thesis figures 4.1-4.8; the
+    # friction components t1, t2 are in forces.csv, not drawn: a bed joint's in-plane
+    # axes follow its longest edge, so their signs have no common meaning across joints
+    ("compression_horizontal", "compression", "horizontal",
+     "bed joints and supports: compression", False),
+    ("compression_vertical", "compression", "vertical", "head joints: compression", False),
+    ("tension", "tension", "all", "all interfaces: tension", False),
+    ("normal", "normal", "all", "all interfaces: normal force (tension +)", True),
+    ("friction", "friction", "all", "all interfaces: friction", False),
+)
+FORCE_LABELS = {"compression": "compression", "tension": "tension",
+                "normal": "normal force", "t1": "friction along t1",
+                "t2": "friction along t2", "friction": "friction"}
+"""Colour bar labels of the force sums (each interface's sum over its vertices)."""
+
+
+def force_pngs(blocks, interfaces, forces: dict, fast=False, title="", webs=None) -> dict:
+    """Force plots (sums over each interface's vertices), per view
+    (``<view>/<name>.png``); with ``webs`` (a section that stands for the whole dome of
+    ``webs`` webs) also the whole dome (``05_dome/<name>.png``). A selection without
+    interfaces has no plot. ``title`` is the line under each figure's own."""
+    horizontal = np.isin(interfaces.kind, HORIZONTAL_KINDS)
+    select = {"horizontal": np.flatnonzero(horizontal),
+              "vertical": np.flatnonzero(~horizontal),
+              "all": np.arange(len(interfaces))}
+    out = {}
+    views = ["01_angle"] if fast else VIEWS
+    for view in views:
+        for name, key, group, heading, signed in FORCE_PLOTS:
+            index = select[group]
+            if len(index):
+                out[f"{view}/{name}.png"] = _colour_plot(
+                    blocks, interfaces, index, np.asarray(forces[key])[index], heading, view,
+                    fast, FORCE_LABELS[key], signed, subtitle=title)
+    if webs:
+        out.update(_whole_dome_pngs(blocks, interfaces, forces, fast, title, webs))
+    return out
+
+
+def _whole_dome_pngs(blocks, interfaces, forces, fast, title, n) -> dict:
+    """Normal force and tension on the whole dome: the section's interfaces (its boundary
+    interfaces with the next web included) rotated ``n`` times, each copy with the
+    section's forces (exact under the cyclic symmetry of SPEC 6.4)."""
+    polygons = [interfaces.polygon(k) @ rotation_z(2 * np.pi * w / n).T
+                for w in range(n) for k in range(len(interfaces))]
+    whole = concatenate([rotated_web(blocks, w, n) for w in range(n)])
+    out = {}
+    for name, heading, signed in (("normal", "normal force (tension +)", True),
+                                  ("tension", "tension", False)):
+        values = np.tile(np.asarray(forces[name], dtype=float), n)
+        fig, ax = axes_3d(whole.bounds)
+        scale = colour_scale(values, signed)
+        colours = scale["cmap"](scale["norm"](values * scale["factor"]))
+        add_polygons(ax, "01_angle", polygons, colours, linewidths=0.2)
+        colour_bar(fig, ax, scale, FORCE_LABELS[name])
+        ax.set_title(f"the whole dome ({n} webs by rotation): {heading}\n"
+                     f"{title}", fontsize=9)
+        out[f"05_dome/{name}.png"] = png_bytes(fig, 70 if fast else 130)
+    return out

@@ -1,0 +1,152 @@
+"""The collapse mechanism: the blocks displaced by it, drawn exaggerated over the
+undeformed structure in the four views, with the joints that carry it and the live
+load's direction."""
+
+import numpy as np
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+from matplotlib.transforms import ScaledTranslation
+
+from masonry.plots.colours import colour_bar, colour_scale
+from masonry.plots.common import (ELEVATIONS, NO_FILL, VIEWS, add_points, add_polygons,
+                                  interface_polygons, png_bytes, view_axes)
+from masonry.tolerances import MECHANISM_MAIN
+
+MECHANISM_SCALE = 0.08
+"""Drawn exaggeration of a collapse mechanism: the largest displacement (1 after
+normalising) is drawn as this fraction of the model's bounding-box diagonal."""
+
+
+def _mechanism_faces(blocks, mechanism):
+    """The free blocks' faces undeformed and displaced by ``mechanism`` drawn at
+    :data:`MECHANISM_SCALE`, and each face's block's largest vertex displacement."""
+    owner = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
+    arm = blocks.vertices - blocks.block_centroid[owner]
+    displacement = mechanism[owner, :3] + np.cross(mechanism[owner, 3:], arm)
+    size = float(np.linalg.norm(blocks.bounds[1] - blocks.bounds[0]))
+    moved = blocks.vertices + MECHANISM_SCALE * size * displacement
+    per_block = np.zeros(blocks.n_blocks)
+    np.maximum.at(per_block, owner, np.linalg.norm(displacement, axis=1))
+    faces = np.flatnonzero(~np.asarray(blocks.block_is_support)[blocks.face_block])
+    starts, ends = blocks.face_offsets[faces], blocks.face_offsets[faces + 1]
+    undeformed = [blocks.vertices[blocks.face_vertices[a:b]] for a, b in zip(starts, ends)]
+    deformed = [moved[blocks.face_vertices[a:b]] for a, b in zip(starts, ends)]
+    bounds = np.array([np.minimum(blocks.bounds[0], moved.min(axis=0)),
+                       np.maximum(blocks.bounds[1], moved.max(axis=0))])
+    return undeformed, deformed, per_block[blocks.face_block[faces]], bounds
+
+
+def _live_load_marks(ax, view, blocks, live, bounds) -> list:
+    """Where the live load acts: the loaded blocks marked when not every block is loaded
+    (a point or crown load), and its resultant's direction as an arrow, into them, or
+    from the plot's edge the load comes from (none for forces that cancel). Returns the
+    legend handles."""
+    handles = []
+    loaded = np.flatnonzero(np.abs(live.wrench[:, :3]).max(axis=1) > 0)
+    some = len(loaded) < int((~np.asarray(blocks.block_is_support)).sum())
+    if some:
+        add_points(ax, view, blocks.block_centroid[loaded], marker="v", color="k", s=18)
+        handles.append(Line2D([], [], marker="v", color="k", linestyle="none",
+                              label=f"loaded blocks ({len(loaded)})"))
+    total = live.total_force
+    if np.linalg.norm(total) <= 1e-9 * np.abs(live.wrench[:, :3]).sum():
+        return handles  # a couple, a push and a pull: no one direction
+    direction = total / float(np.linalg.norm(total))
+    start, end = _arrow(blocks.block_centroid[loaded].mean(axis=0) if some else None,
+                        direction, bounds)
+    if view not in ELEVATIONS:
+        ax.quiver(*start, *(end - start), color="k", linewidth=1.5, arrow_length_ratio=0.3)
+    else:
+        h, v, _, _ = ELEVATIONS[view]
+        if np.hypot(*direction[[h, v]]) < 0.1:  # seen along the load
+            return handles
+        ax.annotate("", xy=end[[h, v]], xytext=start[[h, v]], zorder=11,
+                    arrowprops=dict(arrowstyle="-|>", color="k", linewidth=1.5))
+    handles.append(Line2D([], [], marker=r"$\rightarrow$", color="k", linestyle="none",
+                          markersize=12, label="live load's direction"))
+    return handles
+
+
+def _arrow(target, direction, bounds):
+    """``(start, end)`` of an arrow along ``direction`` (a unit (3,)): into ``target``, as
+    long as the box ``bounds`` leaves room for behind it, or (None) from the box's edge."""
+    size = float(np.abs(direction) @ (bounds[1] - bounds[0]))  # the box along it
+    if target is None:
+        start = bounds.mean(axis=0) - 0.45 * size * direction
+        return start, start + 0.25 * size * direction
+    room = np.where(direction > 0, target - bounds[0], bounds[1] - target)
+    moving = np.abs(direction) > 1e-9  # not empty: a unit vector
+    length = min(0.25 * size, 0.9 * float((room[moving] / np.abs(direction[moving])).min()))
+    return target - length * direction, target
+
+
+def _joint_handles(collapse) -> list:
+    """Legend handles of the undeformed blocks and of the hinges and sliding joints
+    that carry the mechanism."""
+    share = f"\u2265 {MECHANISM_MAIN:.0%} of the largest"
+    handles = [Patch(facecolor="none", edgecolor="0.6", label="undeformed")]
+    if collapse.hinges:
+        handles.append(Patch(facecolor="red", edgecolor="red",
+                             label=f"hinges opening {share}: {collapse.main_hinges} of "
+                                   f"{collapse.hinges}"))
+    if collapse.sliding:
+        handles.append(Patch(facecolor="none", edgecolor="blue",
+                             label=f"sliding {share}: {collapse.main_sliding} of "
+                                   f"{collapse.sliding}"))
+    return handles
+
+
+def _legend(fig, ax, view, handles):
+    """The legend: below an elevation (which fills its axes), inside a 3D view."""
+    if view in ELEVATIONS:
+        # 0.45 inch below the axes, clear of the tick labels at any aspect
+        below = ax.transAxes + ScaledTranslation(0, -0.45, fig.dpi_scale_trans)
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0),
+                  bbox_transform=below, ncol=3, fontsize=7, frameon=False)
+    else:
+        ax.legend(handles=handles, loc="upper left", fontsize=7)
+
+
+def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="") -> dict:
+    """The collapse mechanism (SPEC 6.9) drawn exaggerated over the undeformed structure,
+    in the four views (``collapse/<view>_mechanism.png``; one view when ``fast``):
+    displaced blocks coloured by their largest vertex displacement, the undeformed ones as
+    grey outlines, the hinges and sliding joints that carry the mechanism
+    (:data:`~masonry.tolerances.MECHANISM_MAIN`) filled red and outlined blue, at their
+    undeformed places (seen through the blocks).
+
+    Parameters
+    ----------
+    blocks, interfaces : the analysed model's
+    collapse : masonry.rbe.collapse.CollapseResult
+        With a mechanism: ``mechanism`` ((B, 6), per block ``(u, theta)`` about its
+        centroid, largest vertex displacement 1) and the joints that carry it.
+    title, subtitle : str
+        The figure's title and the line under it.
+    """
+    undeformed, deformed, value, bounds = _mechanism_faces(
+        blocks, np.asarray(collapse.mechanism))
+    scale = colour_scale(value, signed=False, is_force=False)
+    colours = scale["cmap"](scale["norm"](value))
+    handles = _joint_handles(collapse)
+    joints = [(interface_polygons(interfaces, np.flatnonzero(mask)), face, edge, width)
+              for mask, face, edge, width in ((collapse.main_slides, NO_FILL, "blue", 0.6),
+                                              (collapse.main_hinge, "red", "red", 0.8))
+              if mask.any()]
+    out = {}
+    for view in ["01_angle"] if fast else list(VIEWS):
+        fig, ax = view_axes(bounds, view)
+        if view not in ELEVATIONS:
+            ax.computed_zorder = False  # in the order drawn: the joints on top
+        add_polygons(ax, view, undeformed, NO_FILL, edgecolors="0.6", linewidths=0.1)
+        add_polygons(ax, view, deformed, colours, edgecolors="k", linewidths=0.05)
+        for polygons, face, edge, width in joints:
+            add_polygons(ax, view, polygons, face, edgecolors=edge, linewidths=width)
+        shown = handles + (_live_load_marks(ax, view, blocks, collapse.live, bounds)
+                           if collapse.live is not None else [])
+        colour_bar(fig, ax, scale, "virtual displacement (largest = 1)")
+        _legend(fig, ax, view, shown)
+        ax.set_title(f"{title}; displacement drawn at {MECHANISM_SCALE:g} x size\n"
+                     f"{subtitle}", fontsize=9)
+        out[f"collapse/{view}_mechanism.png"] = png_bytes(fig, 60 if fast else 110)
+    return out

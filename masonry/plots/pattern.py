@@ -1,0 +1,41 @@
+"""The flattened pattern (thesis figures 3.8-3.9): one web's bricks laid out by position
+along the wall and course, by class, inside the web's half width."""
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.patches import Rectangle
+
+from masonry.blocks import BLOCK_CLASSES, PATTERN
+from masonry.plots.common import CLASS_COLOURS, png_bytes
+
+
+def pattern_png(scene, fast=False, title="") -> bytes:
+    """The flattened section (thesis figures 3.8-3.9): position along the wall (units)
+    against course, pattern, regular and fill-in bricks in distinct colours, the web's
+    half width at every course in blue; ``title`` is the line under the figure's own."""
+    layout, levels, unit = scene.layout, scene.levels, scene.unit
+    height = np.where(layout.klass == PATTERN, 2, 1)
+    # mitered ends reach the web's boundary (at the course's lower, wider edge)
+    w_low = levels.y[layout.course - 1] / unit
+    s0 = np.where(layout.miter_left, -w_low, layout.s0)
+    s1 = np.where(layout.miter_right, w_low, layout.s1)
+    fig, ax = plt.subplots(figsize=(6, 7.5))
+    for k, s0, s1, klass, h in zip(layout.course, s0, s1, layout.klass, height):
+        name = BLOCK_CLASSES[klass]
+        ax.add_patch(Rectangle((s0, k - 1), s1 - s0, h, facecolor=CLASS_COLOURS[name],
+                               edgecolor="k", linewidth=0.3, zorder=3 if h == 2 else 2))
+    w = levels.y / unit
+    z = np.arange(len(w))
+    ax.plot(w, z, "b-", -w, z, "b-", linewidth=1.2)
+    for name in ("pattern", "regular", "fill_in"):
+        ax.add_patch(Rectangle((0, 0), 0, 0, facecolor=CLASS_COLOURS[name],
+                               label=name.replace("_", "-")))
+    ax.legend(loc="upper right", fontsize=7)
+    ax.set_xlabel("position along the wall s [units]")
+    ax.set_ylabel("course")
+    ax.set_xlim(-w.max() - 1, w.max() + 1)
+    ax.set_ylim(-0.5, len(w) + 0.5)
+    pattern = int((layout.klass == PATTERN).sum())
+    what = scene.kind.pattern_caption(scene.geometry)
+    ax.set_title(f"{what}: {len(layout)} bricks ({pattern} pattern)\n{title}", fontsize=9)
+    return png_bytes(fig, 80 if fast else 130)

@@ -1,0 +1,137 @@
+"""Construction stages: the chart of every stage's MoI factor (and collapse load factor),
+which stand and which need support, and the structure views of one stage, its bricks
+coloured by the tension they carry and the bricks just laid outlined."""
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.colors import LogNorm, to_rgba
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+from matplotlib.ticker import MaxNLocator
+
+from masonry.blocks import BLOCK_CLASSES
+from masonry.plots.colours import BAR_3D
+from masonry.plots.common import (CLASS_COLOURS, ELEVATIONS, NO_FILL, VIEWS, add_points,
+                                  add_polygons, draw_outline, png_bytes, view_axes)
+
+OUTLINE_COLOUR = "#ff00ff"
+"""Edge colour of the outlined blocks of :func:`marked_structure_pngs`."""
+
+MARK_DECADES = 2
+"""Decades of the colour scale of :func:`marked_structure_pngs`: blocks whose value is
+below ``10**-MARK_DECADES`` of the largest keep their class colour."""
+
+
+def marked_structure_pngs(scene, is_present, value, title, value_label="value",
+                          is_outlined=None, outline_label="outlined", fast=False,
+                          subtitle="") -> dict:
+    """The structure views of a part of ``scene`` (e.g. a construction stage): the blocks
+    of ``is_present`` ((B,) bool), coloured by ``value`` ((B,) float >= 0, e.g. the
+    tension a brick carries, newtons) on a logarithmic scale over
+    :data:`MARK_DECADES` decades, in their class colours below it; the blocks of
+    ``is_outlined`` ((B,) bool, e.g. the ones just laid) with thick :data:`OUTLINE_COLOUR`
+    edges and a ring (legend ``outline_label``); the rest of the scene's blocks as faint
+    outlines. ``{view}.png`` per view, one view at lower resolution when ``fast``;
+    ``title`` and ``subtitle`` are the figure's title and the line under it."""
+    blocks = scene.blocks
+    owner = blocks.face_block
+    shown = np.flatnonzero(is_present[owner])
+    ghost = np.flatnonzero(~is_present[owner] & ~blocks.block_is_support[owner])
+    top = max(float(np.max(value[is_present], initial=0.0)), 1e-300)
+    norm = LogNorm(top * 10.0**-MARK_DECADES, top)
+    cmap = plt.get_cmap("viridis_r")
+    face_value = value[owner[shown]]
+    is_marked = face_value >= norm.vmin
+    face_colours = np.array([to_rgba(CLASS_COLOURS[BLOCK_CLASSES[k]])
+                             for k in blocks.block_class[owner[shown]]])
+    face_colours[is_marked] = cmap(norm(face_value[is_marked]))
+    out = {}
+    for view in ["01_angle"] if fast else list(VIEWS):
+        fig, ax = view_axes(blocks.bounds, view)
+        if view not in ELEVATIONS:
+            ax.computed_zorder = False  # draw in the order below: the rings on top
+        draw_outline(ax, view, scene)
+        if len(ghost):
+            add_polygons(ax, view, [blocks.face_polygon(f) for f in ghost], NO_FILL,
+                         edgecolors="0.87", linewidths=0.1)
+        add_polygons(ax, view, [blocks.face_polygon(f) for f in shown], face_colours,
+                     edgecolors="k", linewidths=0.1)
+        handles = [Patch(facecolor="none", edgecolor="0.7", label="not yet laid")]
+        if is_outlined is not None and is_outlined.any():
+            edged = np.flatnonzero(is_outlined[owner] & is_present[owner])
+            add_polygons(ax, view, [blocks.face_polygon(f) for f in edged], NO_FILL,
+                         edgecolors=OUTLINE_COLOUR, linewidths=2.0)
+            # a ring around each, so that a single brick shows at any scale
+            centre = blocks.block_centroid[is_outlined & is_present]
+            add_points(ax, view, centre, s=160, facecolors="none",
+                       edgecolors=OUTLINE_COLOUR, linewidths=1.5)
+            handles.append(Line2D([], [], color=OUTLINE_COLOUR, marker="o", markersize=9,
+                                  fillstyle="none", linewidth=2, label=outline_label))
+        if is_marked.any():
+            below = bool(((face_value > 0) & ~is_marked).any())
+            bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
+                               extend="min" if below else "neither",
+                               **(BAR_3D if view not in ELEVATIONS else dict(pad=0.05)))
+            bar.set_label(value_label)
+            handles.append(Patch(facecolor=CLASS_COLOURS["regular"], edgecolor="k",
+                                 label="laid, below the scale (class colours)"))
+        ax.legend(handles=handles, loc="upper left", fontsize=8)
+        ax.set_title(f"{title}\n{subtitle}", fontsize=9)
+        out[f"{view}.png"] = png_bytes(fig, 60 if fast else 110)
+    return out
+
+
+def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="",
+                    xlabel="stage", loose=None) -> bytes:
+    """MoI factor (and the collapse load factor, where given) against the construction
+    stage: stages that stand in green, those that need support in red, the first of
+    them marked by a dashed line; stages with loose blocks (no MoI) as red crosses at 0.
+
+    Parameters
+    ----------
+    stage : (N,) int
+    moi_factor : (N,) float (NaN: not solved)
+    feasible : (N,) bool
+    load_factor : (N,) float or None (NaN: not computed)
+    loose : (N,) int or None
+        Blocks per stage that touch nothing joining them to a support.
+    """
+    stage = np.asarray(stage)
+    moi = np.asarray(moi_factor, dtype=float)
+    feasible = np.asarray(feasible, dtype=bool)
+    loose = np.zeros(len(stage), int) if loose is None else np.asarray(loose)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(stage, moi, color="0.6", linewidth=0.8, zorder=1)
+    ax.scatter(stage[feasible], moi[feasible], s=14, color="#2ca02c",
+               label=f"stands ({int(feasible.sum())})", zorder=2)
+    ax.scatter(stage[~feasible], moi[~feasible], s=14, color="#d62728",
+               label=f"needs support ({int((~feasible).sum())})", zorder=2)
+    if loose.any():
+        ax.scatter(stage[loose > 0], np.zeros(int((loose > 0).sum())), marker="x", s=24,
+                   color="#d62728", zorder=2, label=f"a block touches nothing that holds "
+                   f"it, no MoI ({int((loose > 0).sum())})")
+    if not feasible.all():
+        first = stage[np.argmin(feasible)]
+        ax.axvline(first, color="#d62728", linestyle="--", linewidth=0.8,
+                   label=f"first needs support: {first}")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel("MoI factor (tension / weight)")
+    ax.set_ylim(bottom=min(-0.02 * max(np.nanmax(moi, initial=0), 0.05), 0))
+    handles, labels = ax.get_legend_handles_labels()
+    if load_factor is not None and np.isfinite(np.asarray(load_factor, float)).any():
+        right = ax.twinx()
+        right.plot(stage, np.asarray(load_factor, float), color="#1f77b4", marker=".",
+                   label="load factor")
+        right.set_ylabel("collapse load factor")
+        right.set_ylim(0, 1.1 * np.nanmax(np.asarray(load_factor, float)))
+        extra = right.get_legend_handles_labels()
+        handles, labels = handles + extra[0], labels + extra[1]
+        # below the plot: two axes' curves leave no free corner
+        ax.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=4,
+                  fontsize=8, frameon=False)
+    else:
+        ax.legend(handles, labels, loc="best", fontsize=8)
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    return png_bytes(fig, 110)

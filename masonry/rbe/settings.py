@@ -1,0 +1,75 @@
+"""The analysis of a run, declared (:mod:`masonry.parameters`): the material, the friction
+law and model, the boundary of a section, and the solvers' accuracy."""
+
+from dataclasses import dataclass
+
+from masonry.friction import FrictionCone, FrictionModelError
+from masonry.parameters import check_fields, declare
+from masonry.errors import ParameterError
+from masonry.rbe.solve import ACCURACY, POLYHEDRAL_ONLY
+from masonry.rbe.solvers import BACKENDS
+
+FRICTIONS = ("net", "plus", "auto")
+FRICTION_LAWS = ("associated", "non-associative")
+BOUNDARIES = ("free", "rigid", "cyclic")
+
+
+@dataclass(frozen=True)
+class Analysis:
+    """How a run's structure is analysed (docs/model.md 6).
+
+    ``mu`` the friction coefficient, ``density`` kg/m^3, ``friction`` the thesis's flow
+    (net | plus | auto), ``friction_cone`` the friction model (:mod:`masonry.friction`;
+    None: the accuracy preset's, an isotropic one), ``accuracy`` the solver preset
+    (:data:`masonry.rbe.solve.ACCURACY`), ``solver`` a solver in place of the preset's,
+    ``boundary`` what a section's end bricks bear on (free, rigid, cyclic; other scenes
+    are free), ``friction_law`` of the collapse load factor (associated: the cone
+    program; non-associative: joints that slide without dilating, an estimate).
+    """
+
+    mu: float = declare(0.7, "friction coefficient", low=0.01, high=10.0, tag="mu",
+                        expected="0.01 to 10 (friction coefficients of masonry are 0.3 "
+                                 "to 1; beyond these ends the friction cones are flat or "
+                                 "closed to the solvers' precision)")
+    density: float = declare(2000.0, "kg/m^3", low=1.0, high=1e7, tag="rho",
+                             expected="1 to 1e+07 (kg/m^3: forces scale with it exactly; "
+                                      "masonry is 1500 to 3000)")
+    friction: str = declare("auto", "net | plus | auto (net, then plus if infeasible)",
+                            kind="str", choices=FRICTIONS)
+    friction_cone: str | None = declare(None, "the friction model", kind="any",
+                                        optional=True, tag="cone")
+    accuracy: str = declare("balanced", "solver preset", kind="str",
+                            choices=tuple(ACCURACY), tag="")
+    solver: str | None = declare(None, "a solver in place of the preset's", kind="str",
+                                 choices=tuple(BACKENDS), optional=True, tag="")
+    boundary: str = declare("free", "what the section's end bricks bear on", kind="str",
+                            choices=BOUNDARIES, tag="b", names_geometry=True)
+    friction_law: str = declare("associated", "of the collapse load factor", kind="str",
+                                choices=FRICTION_LAWS)
+
+    def checked(self) -> "Analysis":
+        """This analysis validated, the friction model in its canonical spelling; raises
+        :class:`~masonry.errors.ParameterError`."""
+        check_fields(self)
+        if self.friction_cone is None:
+            if self.solver in POLYHEDRAL_ONLY:
+                raise ParameterError("solver", self.solver, "a solver of Coulomb's cone (the "
+                                     "default friction model): newton, interior, clarabel "
+                                     "or clarabel-cvxpy; or a pyramid: --friction-cone "
+                                     "polygon:16")
+            return self
+        try:
+            cone = FrictionCone.parse(self.friction_cone)
+        except FrictionModelError as error:
+            raise ParameterError("friction_cone", self.friction_cone, str(error)) from None
+        if self.solver in POLYHEDRAL_ONLY and not cone.is_polyhedral:
+            raise ParameterError("friction_cone", self.friction_cone, f"a pyramid (polygon:K "
+                                 f"or square) with --solver {self.solver}, which takes "
+                                 f"linear constraints only", related=("solver",))
+        return Analysis(**{**self.__dict__, "friction_cone": cone.name})
+
+    @property
+    def cone(self) -> FrictionCone:
+        """The friction model: :attr:`friction_cone`, else the accuracy preset's."""
+        return FrictionCone.parse(ACCURACY[self.accuracy].cone if self.friction_cone is None
+                                  else self.friction_cone)
