@@ -10,6 +10,7 @@ from masonry.errors import ParameterError
 from masonry.params import Params, from_preset, validate
 from masonry.rbe.solve import ACCURACY
 from masonry.rbe.solvers import BACKENDS
+from masonry.studies.reader_bench import reader_bench, readers_markdown
 from masonry.runfolder import RunFolder, check_output_root
 
 from .options import add_verbosity
@@ -45,6 +46,10 @@ def register(subparsers):
                              "the RBE solve and the lateral collapse LP at azimuth 0, "
                              "times against the square pyramid's and factors against the "
                              "exact cone's; writes DIR/bench_friction/friction.md")
+    parser.add_argument("--readers", nargs="+", metavar="FILE",
+                        help="instead: masonry's mesh reader against trimesh's and meshio's "
+                             "on each OBJ, STL or PLY file, medians of --repeats reads; "
+                             "writes DIR/bench_readers/readers.md")
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root: writes DIR/bench/bench.csv, bench.md and "
                              "frontier.png (default exports)")
@@ -64,11 +69,16 @@ def handle(args, report):
     if args.collapse and args.friction_models is not None:
         raise ParameterError("friction_models", args.friction_models,
                              "one bench at a time: not with --collapse")
+    if args.readers and (args.collapse or args.friction_models is not None):
+        raise ParameterError("readers", args.readers, "one bench at a time: not with "
+                             "--collapse or --friction-models")
     check_output_root(args.out)
     if args.collapse:
         return _collapse(args, report)
     if args.friction_models is not None:
         return _friction(args, report)
+    if args.readers:
+        return _readers(args, report)
     rows = bench(presets=args.presets, scenes=args.scenes, accuracies=args.accuracy,
                  repeats=args.repeats, solvers=args.solvers,
                  overrides=None if args.p is None else {"p": args.p},
@@ -123,6 +133,17 @@ def _friction(args, report):
     markdown = friction_markdown(rows)
     with RunFolder(args.out, "bench_friction") as folder:
         folder.write("friction.md", markdown)
+    report(markdown)
+    report(f"written: {folder.target}")
+    return 0
+
+
+def _readers(args, report):
+    rows = reader_bench(args.readers, repeats=args.repeats,
+                        progress=None if args.quiet else _progress)
+    markdown = readers_markdown(rows)
+    with RunFolder(args.out, "bench_readers") as folder:
+        folder.write("readers.md", markdown)
     report(markdown)
     report(f"written: {folder.target}")
     return 0

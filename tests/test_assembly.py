@@ -212,6 +212,9 @@ def bad_files(tmp_path, fixtures_dir):
                   ["bad_index.obj", "line 3", "vertex"]))
     cases.append((make("words.obj", b"v 0 zero 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
                   ["words.obj", "not a readable OBJ"]))
+    # a word where a coordinate belongs: refused, not read up to the word
+    cases.append((make("words.stl", ascii_stl.replace(b"vertex ", b"vertex x ", 1)),
+                  ["words.stl", "not a readable STL"]))
     cases.append((make("cut.ply", trimesh.creation.box().export(file_type="ply")[:300]),
                   ["cut.ply", "not a readable PLY"]))
     cases.append((fixtures_dir / "assembly" / "l_block.obj",
@@ -289,3 +292,45 @@ def test_overlapping_pairs_agree_with_the_intersection_volume():
             assert not found, trial
             judged[False] += 1
     assert judged[True] > 30 and judged[False] > 30, judged
+
+
+# ---------------------------------------------------------------------- reading
+def test_mesh_files_give_the_blocks_triangles_as_written(fixtures_dir, tmp_path):
+    from masonry.scenes.mesh_files import read_mesh
+
+    soup = read_mesh(fixtures_dir / "assembly" / "arch_rhino.obj")
+    assert soup.block_name[:3] == ["pier_east", "pier_west", "voussoir_01"]
+    assert not soup.split_bodies and len(soup.block_name) == 10
+    assert soup.vertices.dtype == np.float64 and soup.triangles.dtype == np.int64
+    assert soup.vertices[0].tolist() == [1.8, -0.25, -0.4]  # the digits of the file
+    np.testing.assert_array_equal(np.bincount(soup.triangle_block), 12)
+    # an STL of several solids is one soup of their triangles, in file order
+    boxes = [trimesh.creation.box().apply_translation([3 * k, 0, 0]) for k in range(2)]
+    path = tmp_path / "two.stl"
+    path.write_text("".join(b.export(file_type="stl_ascii") + "\n" for b in boxes))
+    soup = read_mesh(path)
+    assert soup.split_bodies and soup.block_name == [""]
+    np.testing.assert_array_equal(soup.vertices[soup.triangles],
+                                  np.concatenate([b.vertices[b.faces] for b in boxes]))
+
+
+def test_reader_bench_rows_and_command(wall, tmp_path, capsys):
+    from masonry.studies.reader_bench import READER_COLUMNS, reader_bench
+
+    obj, stl = tmp_path / "wall.obj", tmp_path / "wall.stl"
+    obj.write_bytes(blocks_obj(wall))
+    trimesh.util.concatenate(wall.meshes()).export(stl)
+    rows = reader_bench([obj, stl], repeats=1)
+    assert [(r["file"], r["reader"]) for r in rows] == [
+        (name, reader) for name in ("wall.obj", "wall.stl")
+        for reader in ("masonry", "trimesh", "meshio")]
+    for row in rows:
+        assert set(row) == set(READER_COLUMNS)
+        assert row["seconds"] > 0 and row["exact"] is True and row["triangles"] == 12 * 86
+    assert [r["names"] for r in rows] == [86, 86, 0, 0, 0, 0]  # meshio keeps no names
+    assert rows[0]["vs_masonry"] == rows[3]["vs_masonry"] == 1.0
+    assert main(["bench", "--readers", str(obj), "--repeats", "1", "--out", str(tmp_path),
+                 "-q"]) == 0
+    assert "| wall.obj | meshio |" in (tmp_path / "bench_readers" / "readers.md").read_text()
+    assert main(["bench", "--readers", str(obj), "--collapse", "--out", str(tmp_path)]) == 2
+    assert "one bench at a time" in capsys.readouterr().err

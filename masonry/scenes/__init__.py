@@ -7,8 +7,9 @@ listed once in :data:`KINDS`:
   (:mod:`.polygonal`); ``dome``: all ``n`` webs explicitly (:mod:`.polygonal`).
 - ``wall``: a straight running-bond wall on a ground slab, for validation (:mod:`.wall`).
 - ``arch``: voussoirs on two supports (:mod:`.arch`).
-- ``assembly``: blocks read from mesh files (:mod:`.imported`, built by
-  :func:`~masonry.scenes.imported.load_assembly`, not from parameters alone).
+- ``assembly``: blocks read from mesh files (:mod:`.mesh_files` reads them,
+  :mod:`.imported` checks them; built by :func:`~masonry.scenes.imported.load_assembly`,
+  not from parameters alone).
 
 :class:`~masonry.scenes.base.Scene` is what every kind builds.
 """

@@ -2,22 +2,23 @@
 
 The interface detector and the rigid block equilibrium serve blocks that did not come
 from our dome: an arch drawn in Rhino, a tower, a scan, a peer tool's model. This module
-turns mesh files into :class:`~masonry.blocks.Blocks`:
+turns the triangle soups that :mod:`masonry.scenes.mesh_files` reads into checked
+:class:`~masonry.blocks.Blocks`, and those into the scene:
 
-- OBJ: one block per object (``o``); a file without objects, one block per group
-  (``g``); a file with neither, one block per connected body. Names are kept (a name used
-  twice gets ``_2``, ``_3``, ...). The ``bricks.obj`` of our own runs is such a file, and
-  its names (``b0042_regular_c12``) give back each brick's class and course.
-- STL (binary or ASCII) and PLY: one block per connected body, named after the file
-  (``wall_0007``), or after the file alone when it holds one body, so one file per block
-  works too.
+- OBJ: one block per object or group, names kept (a name used twice gets ``_2``, ``_3``,
+  ...). The ``bricks.obj`` of our own runs is such a file, and its names
+  (``b0042_regular_c12``) give back each brick's class and course.
+- A file that names no blocks (STL, PLY, an OBJ of neither objects nor groups): one
+  block per connected body, named after the file (``wall_0007``), or after the file
+  alone when it holds one body, so one file per block works too.
 
 Every block must be a closed convex solid. A block that is open, non-manifold, inside
 out, flat, or concave beyond :data:`~masonry.tolerances.CONVEXITY_REL` raises
 :class:`AssemblyError` naming the block and its file; so does a file that cannot be
 read. Each accepted block is replaced by its convex hull, whose coplanar triangles are
 merged into whole planar polygons, so an interface is a whole face and not a triangle
-of it.
+of it. The scene then takes supports, an optional ground slab, and refuses blocks that
+overlap.
 
 Bodies in one STL or PLY that touch each other share vertices and edges: an edge where
 two blocks touch belongs to four triangles. Connectivity therefore pairs the triangles
@@ -27,7 +28,6 @@ face on either side), instead of joining everything that shares an edge.
 
 import dataclasses
 import hashlib
-import io
 import logging
 import re
 import time
@@ -41,26 +41,18 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from masonry.blocks import BLOCK, BLOCK_CLASSES, Blocks, concatenate, tangent_basis
-from masonry.errors import MasonryError
 from masonry.meshing import merge_vertices
 from masonry.parameters import declare
 from masonry.scenes.base import Scene, SceneKind
+from masonry.scenes.mesh_files import AssemblyError, TriangleSoup, read_mesh
 from masonry.tolerances import (COINCIDENT_ANGLE, COLLINEAR_SIN, CONVEXITY_REL,
                                 GROUND_MARGIN_REL, INTERPENETRATION_REL, PARALLEL_SIN,
                                 Tolerances)
 
 log = logging.getLogger(__name__)
 
-FORMATS = (".obj", ".stl", ".ply")
-"""File suffixes :func:`read_blocks` reads (case-insensitive)."""
-
 OUR_NAME = re.compile(r"^b\d+_(" + "|".join(BLOCK_CLASSES) + r")_c(\d+)$")
 """Block names written by :func:`masonry.export.obj.blocks_obj`: class and course."""
-
-
-class AssemblyError(MasonryError, ValueError):
-    """A mesh file cannot be read, or one of its blocks is not a closed convex solid.
-    The message names the file and, for a bad block, the block."""
 
 
 # ---------------------------------------------------------------------- public API
@@ -89,15 +81,15 @@ def read_blocks(paths, tol: Tolerances | None = None) -> Blocks:
     paths = [Path(p) for p in paths]
     if not paths:
         raise AssemblyError("no mesh file given")
-    soups = [_read_file(p) for p in paths]
+    soups = [read_mesh(p) for p in paths]
     points = np.concatenate([s.vertices for s in soups])
     if tol is None:
         tol = Tolerances.for_points(points)
     parts = []
     for path, soup in zip(paths, soups):
-        soup = soup.merged(tol.length)
+        soup = _merged(soup, tol.length)
         if soup.split_bodies:
-            soup = soup.bodies(path.stem)
+            soup = _bodies(soup, path.stem)
         parts.append(_convex_blocks(soup, path, tol))
     blocks = concatenate(parts)
     names = _unique_names(blocks.block_name)
@@ -283,58 +275,44 @@ def _refuse_overlaps(blocks: Blocks, paths):
 
 
 # ---------------------------------------------------------------------- triangle soups
-class _Soup:
-    """Triangles of named blocks, as read.
+def _merged(soup: TriangleSoup, distance) -> TriangleSoup:
+    """Per-block vertices (a vertex shared by two blocks is copied; blocks own contiguous
+    ranges) with coincident ones (within ``distance``, metres) merged, and the triangles
+    that collapse dropped. A soup still to be split keeps one pool, so that touching
+    bodies share their vertices until :func:`_bodies` pairs them."""
+    block = soup.triangle_block
+    if soup.split_bodies:
+        block = np.zeros_like(block)
+    key = block[:, None] * len(soup.vertices) + soup.triangles
+    unique, inverse = np.unique(key, return_inverse=True)
+    vertices = soup.vertices[unique % len(soup.vertices)]
+    owner = unique // len(soup.vertices)
+    triangles = inverse.reshape(-1, 3)
+    # coincident vertices of one block: a k-d tree over all, pairs kept within a block
+    pairs = cKDTree(vertices).query_pairs(distance, output_type="ndarray")
+    pairs = pairs[owner[pairs[:, 0]] == owner[pairs[:, 1]]]
+    # the smallest index of each cluster stands for it (same block: same range)
+    triangles, keep = merge_vertices(triangles, pairs, len(vertices))
+    used, triangles = np.unique(triangles, return_inverse=True)
+    return TriangleSoup(soup.block_name, vertices[used], triangles.reshape(-1, 3),
+                        soup.triangle_block[keep], soup.split_bodies)
 
-    ``vertices`` (V, 3) float; ``triangles`` (T, 3) int into ``vertices``; ``triangle_block``
-    (T,) int into ``names``; ``split_bodies``: the file names no blocks, so its connected
-    bodies are the blocks.
-    """
 
-    def __init__(self, names, vertices, triangles, triangle_block, split_bodies=False):
-        self.names = list(names)
-        self.vertices = np.asarray(vertices, dtype=float).reshape(-1, 3)
-        self.triangles = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
-        self.triangle_block = np.asarray(triangle_block, dtype=np.int64)
-        self.split_bodies = split_bodies
-
-    def merged(self, distance) -> "_Soup":
-        """Per-block vertices (a vertex shared by two blocks is copied; blocks own
-        contiguous ranges) with coincident ones (within ``distance``) merged, and the
-        triangles that collapse dropped. A soup still to be split keeps one pool, so
-        that touching bodies share their vertices until :meth:`bodies` pairs them."""
-        block = self.triangle_block
-        if self.split_bodies:
-            block = np.zeros_like(block)
-        key = block[:, None] * len(self.vertices) + self.triangles
-        unique, inverse = np.unique(key, return_inverse=True)
-        vertices = self.vertices[unique % len(self.vertices)]
-        owner = unique // len(self.vertices)
-        triangles = inverse.reshape(-1, 3)
-        # coincident vertices of one block: a k-d tree over all, pairs kept within a block
-        pairs = cKDTree(vertices).query_pairs(distance, output_type="ndarray")
-        pairs = pairs[owner[pairs[:, 0]] == owner[pairs[:, 1]]]
-        # the smallest index of each cluster stands for it (same block: same range)
-        triangles, keep = merge_vertices(triangles, pairs, len(vertices))
-        used, triangles = np.unique(triangles, return_inverse=True)
-        return _Soup(self.names, vertices[used], triangles.reshape(-1, 3),
-                     self.triangle_block[keep], self.split_bodies)
-
-    def bodies(self, stem) -> "_Soup":
-        """One block per connected body (see :func:`_body_labels`), named ``stem`` when
-        there is one body, else ``stem_0000``, ... (or ``<name>_0000`` when the file named
-        its only object)."""
-        label = _body_labels(self.vertices, self.triangles)
-        count = int(label.max()) + 1 if len(label) else 0
-        # bodies in the order of their first triangle in the file
-        first = np.full(count, len(label))
-        np.minimum.at(first, label, np.arange(len(label)))
-        rank = np.empty(count, int)
-        rank[np.argsort(first)] = np.arange(count)
-        base = self.names[0] if self.names and self.names[0] else stem
-        names = [base] if count == 1 else [f"{base}_{k:04d}" for k in range(count)]
-        # merging again gives every body its own copy of the vertices it shares
-        return _Soup(names, self.vertices, self.triangles, rank[label]).merged(0.0)
+def _bodies(soup: TriangleSoup, stem) -> TriangleSoup:
+    """One block per connected body (see :func:`_body_labels`) of a merged soup, named
+    ``stem`` when there is one body, else ``stem_0000``, ... (or ``<name>_0000`` when the
+    file named its only object)."""
+    label = _body_labels(soup.vertices, soup.triangles)
+    count = int(label.max()) + 1 if len(label) else 0
+    # bodies in the order of their first triangle in the file
+    first = np.full(count, len(label))
+    np.minimum.at(first, label, np.arange(len(label)))
+    rank = np.empty(count, int)
+    rank[np.argsort(first)] = np.arange(count)
+    base = soup.block_name[0] if soup.block_name and soup.block_name[0] else stem
+    names = [base] if count == 1 else [f"{base}_{k:04d}" for k in range(count)]
+    # merging again gives every body its own copy of the vertices it shares
+    return _merged(TriangleSoup(names, soup.vertices, soup.triangles, rank[label]), 0.0)
 
 
 def _body_labels(vertices, triangles):
@@ -402,240 +380,8 @@ def _pair_about_edge(vertices, lo, hi, third, forward, tri):
     return np.stack([tri[opening[ok]], tri[closing[partner[ok]]]], axis=1)
 
 
-def overlapping_pairs(blocks: Blocks) -> np.ndarray:
-    """Pairs of convex blocks that interpenetrate by more than
-    :data:`~masonry.tolerances.INTERPENETRATION_REL` of the smaller one's size (its
-    bounding box diagonal).
-
-    Decided by the separating axis theorem: pairs whose bounding boxes overlap are
-    projected on the face normals of both blocks, all at once (blocks in contact are
-    separated by their common face's normal); the few left are projected on the cross
-    products of their edges too, which makes the test exact.
-
-    Parameters
-    ----------
-    blocks : Blocks
-        Convex blocks (metres).
-
-    Returns
-    -------
-    (P, 2) int
-        Block index pairs, lower index first, sorted.
-    """
-    lo, hi = blocks.block_bounds[:, 0], blocks.block_bounds[:, 1]
-    size = np.linalg.norm(hi - lo, axis=1)
-    a, b = _box_pairs(lo, hi)
-    depth = INTERPENETRATION_REL * np.minimum(size[a], size[b])
-    boxes = (np.minimum(hi[a], hi[b]) - np.maximum(lo[a], lo[b])).min(axis=1) > depth
-    a, b, depth = a[boxes], b[boxes], depth[boxes]
-    points, normals = _padded(blocks)
-    deep = np.zeros(len(a), bool)
-    chunk = 4096  # pairs at a time: bounded memory
-    for start in range(0, len(a), chunk):
-        i, j = a[start:start + chunk], b[start:start + chunk]
-        axes = np.concatenate([normals[i], normals[j]], axis=1)
-        pa = np.einsum("pvk,pfk->pvf", points[i], axes)
-        pb = np.einsum("pvk,pfk->pvf", points[j], axes)
-        overlap = np.minimum(pa.max(axis=1) - pb.min(axis=1), pb.max(axis=1) - pa.min(axis=1))
-        deep[start:start + chunk] = overlap.min(axis=1) > depth[start:start + chunk]
-    found = [(min(i, j), max(i, j)) for i, j, d in zip(a[deep], b[deep], depth[deep])
-             if _overlap_on_edge_axes(blocks, i, j) > d]
-    return np.array(sorted(found), int).reshape(-1, 2)
-
-
-def _box_pairs(lo, hi):
-    """Index pairs ``(a, b)`` of boxes whose x ranges overlap (a sweep along x)."""
-    n = len(lo)
-    order = np.argsort(lo[:, 0], kind="stable")
-    start = lo[order, 0]
-    end = np.searchsorted(start, hi[order, 0], side="left")
-    counts = np.maximum(end - np.arange(n) - 1, 0)
-    first = np.repeat(np.arange(n), counts)
-    offset = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-    return order[first], order[first + 1 + offset]
-
-
-def _padded(blocks: Blocks):
-    """``(B, V, 3)`` vertices and ``(B, F, 3)`` face normals per block, each padded with
-    its block's first one (which changes no projection's range)."""
-    vertex_counts = np.diff(blocks.vertex_offsets)
-    rank = np.arange(len(blocks.vertices)) - np.repeat(blocks.vertex_offsets[:-1],
-                                                       vertex_counts)
-    points = np.repeat(blocks.vertices[blocks.vertex_offsets[:-1], None, :],
-                       vertex_counts.max(), axis=1)
-    points[np.repeat(np.arange(blocks.n_blocks), vertex_counts), rank] = blocks.vertices
-    face_counts = np.bincount(blocks.face_block, minlength=blocks.n_blocks)
-    first_face = np.concatenate([[0], np.cumsum(face_counts)[:-1]])
-    rank = np.arange(blocks.n_faces) - first_face[blocks.face_block]
-    normals = np.repeat(blocks.face_normal[first_face, None, :], face_counts.max(), axis=1)
-    normals[blocks.face_block, rank] = blocks.face_normal
-    return points, normals
-
-
-def _overlap_on_edge_axes(blocks: Blocks, a: int, b: int) -> float:
-    """Smallest overlap of two blocks along the cross products of their edges."""
-    edges_a, edges_b = _block_edges(blocks, a), _block_edges(blocks, b)
-    cross = np.cross(edges_a[:, None, :], edges_b[None, :, :]).reshape(-1, 3)
-    length = np.linalg.norm(cross, axis=1)
-    axes = cross[length > PARALLEL_SIN] / length[length > PARALLEL_SIN, None]
-    if len(axes) == 0:
-        return np.inf
-    pa, pb = blocks.block_vertices(a) @ axes.T, blocks.block_vertices(b) @ axes.T
-    return float(np.minimum(pa.max(axis=0) - pb.min(axis=0),
-                            pb.max(axis=0) - pa.min(axis=0)).min())
-
-
-def _block_edges(blocks: Blocks, block: int) -> np.ndarray:
-    """(E, 3) unit edge directions of one block (each edge once per face using it)."""
-    edges = []
-    for face in blocks.block_faces(block):
-        polygon = blocks.face_polygon(face)
-        edges.append(np.roll(polygon, -1, axis=0) - polygon)
-    edges = np.vstack(edges)
-    length = np.linalg.norm(edges, axis=1)
-    return edges[length > 0] / length[length > 0, None]
-
-
-# ---------------------------------------------------------------------- readers
-def _read_file(path: Path) -> _Soup:
-    suffix = path.suffix.lower()
-    if suffix not in FORMATS:
-        raise AssemblyError(f"{path}: unknown format {path.suffix!r}; masonry reads "
-                            f"{', '.join(FORMATS)}")
-    if path.exists() and not path.is_file():  # a folder, FIFO or device never ends well
-        raise AssemblyError(f"{path}: not a regular file")
-    try:
-        data = path.read_bytes()
-    except OSError as error:
-        raise AssemblyError(f"{path}: cannot be read: {error.strerror or error}") from None
-    if not data.strip():
-        raise AssemblyError(f"{path}: the file is empty")
-    reader = {".obj": _read_obj, ".stl": _read_stl, ".ply": _read_ply}[suffix]
-    try:
-        soup = reader(data)
-    except AssemblyError as error:
-        raise AssemblyError(f"{path}: {error}") from None
-    except (ValueError, IndexError, KeyError, TypeError, UnicodeDecodeError) as error:
-        raise AssemblyError(f"{path}: not a readable {suffix[1:].upper()} file "
-                            f"({type(error).__name__}: {error})") from None
-    if len(soup.triangles) == 0:
-        raise AssemblyError(f"{path}: no faces, so no block")
-    bad = ~np.isfinite(soup.vertices).all(axis=1)
-    if bad.any():
-        raise AssemblyError(f"{path}: {bad.sum()} vertices are not finite numbers (nan or "
-                            f"inf), the first at {soup.vertices[bad][0].tolist()}")
-    return soup
-
-
-def _read_obj(data: bytes) -> _Soup:
-    """Wavefront OBJ: ``v``, ``f`` (polygons, ``i``, ``i/t``, ``i/t/n``, ``i//n``,
-    negative indices), ``o`` and ``g``; everything else is skipped."""
-    vertices, faces, face_object, face_group = [], [], [], []
-    objects, groups = [], {}
-    current_object = current_group = -1
-    for number, line in enumerate(data.decode("utf-8", errors="replace").splitlines(), 1):
-        parts = line.split()
-        if not parts:
-            continue
-        tag = parts[0]
-        if tag == "v":
-            if len(parts) < 4:
-                raise AssemblyError(f"line {number}: a vertex needs three coordinates")
-            vertices.append(parts[1:4])
-        elif tag == "f":
-            if len(parts) < 4:
-                raise AssemblyError(f"line {number}: a face needs three vertices")
-            count = len(vertices)
-            ids = [int(p.split("/", 1)[0]) for p in parts[1:]]
-            ids = [i - 1 if i > 0 else count + i for i in ids]
-            if min(ids) < 0 or max(ids) >= count:
-                raise AssemblyError(f"line {number}: the face refers to a vertex that is not "
-                                    f"defined before it (the file has {count} by then)")
-            faces.append(ids)
-            face_object.append(current_object)
-            face_group.append(current_group)
-        elif tag == "o":
-            objects.append(" ".join(parts[1:]))
-            current_object = len(objects) - 1
-        elif tag == "g":
-            name = " ".join(parts[1:])
-            current_group = groups.setdefault(name, len(groups))
-    if not faces:
-        return _Soup([], np.array(vertices, dtype=float), np.zeros((0, 3)), np.zeros(0))
-    vertices = np.array(vertices, dtype=float)
-    counts = np.array([len(f) for f in faces])
-    flat = np.fromiter((i for f in faces for i in f), dtype=np.int64, count=int(counts.sum()))
-    triangles, face = _fan(flat, counts)
-    face_object, face_group = np.array(face_object), np.array(face_group)
-    if len(set(face_object)) >= 2:
-        names, key = objects, face_object
-    elif len(set(face_group)) >= 2:
-        names, key = list(groups), face_group
-    else:
-        named = (objects[face_object[0]] if face_object[0] >= 0
-                 else list(groups)[face_group[0]] if face_group[0] >= 0 else "")
-        return _Soup([named], vertices, triangles, np.zeros(len(triangles)),
-                     split_bodies=True)
-    # faces before the first object or group form a block of their own
-    if (key < 0).any():
-        names = names + ["unnamed"]
-        key = np.where(key < 0, len(names) - 1, key)
-    used, key = np.unique(key, return_inverse=True)
-    return _Soup([names[i] for i in used], vertices, triangles, key[face])
-
-
-def _fan(flat, counts):
-    """Polygons (flat indices, (n,) vertex counts) -> fan triangles (T, 3) and their
-    polygon (T,)."""
-    ntri = counts - 2
-    face = np.repeat(np.arange(len(counts)), ntri)
-    start = np.cumsum(counts) - counts
-    k = np.arange(len(face)) - np.repeat(np.cumsum(ntri) - ntri, ntri)
-    s = start[face]
-    return np.stack([flat[s], flat[s + k + 1], flat[s + k + 2]], axis=1), face
-
-
-_STL_RECORD = np.dtype([("normal", "<f4", 3), ("points", "<f4", (3, 3)), ("attr", "<u2")])
-
-
-def _read_stl(data: bytes) -> _Soup:
-    """Binary STL (exactly 84 + 50 n bytes) or ASCII STL (``vertex x y z`` lines)."""
-    if len(data) >= 84:
-        count = int.from_bytes(data[80:84], "little")
-        if len(data) == 84 + 50 * count:
-            points = np.frombuffer(data, _STL_RECORD, count=count, offset=84)["points"]
-            with np.errstate(invalid="ignore"):  # NaNs are refused after reading
-                return _soup_of_triangles(points.astype(float))
-    text = data.decode("ascii", errors="replace")
-    if not text.lstrip().startswith("solid"):
-        raise AssemblyError(f"not an STL file: {len(data)} bytes is not 84 + 50 n (binary "
-                            f"STL; truncated?) and the text does not start with 'solid'")
-    if "endsolid" not in text:
-        raise AssemblyError("ASCII STL without 'endsolid': the file is truncated")
-    values = re.findall(r"^\s*vertex\s+(\S+)\s+(\S+)\s+(\S+)", text, flags=re.MULTILINE)
-    if len(values) % 3:
-        raise AssemblyError(f"ASCII STL with {len(values)} vertices, not a multiple of 3")
-    return _soup_of_triangles(np.array(values, dtype=float).reshape(-1, 3, 3))
-
-
-def _read_ply(data: bytes) -> _Soup:
-    import trimesh
-
-    mesh = trimesh.load(io.BytesIO(data), file_type="ply", process=False)
-    if not isinstance(mesh, trimesh.Trimesh):
-        raise AssemblyError("no triangle mesh in the PLY file (a point cloud?)")
-    return _Soup([""], mesh.vertices, mesh.faces, np.zeros(len(mesh.faces)),
-                 split_bodies=True)
-
-
-def _soup_of_triangles(points):
-    """(T, 3, 3) triangle corners -> a soup to be split into bodies."""
-    return _Soup([""], points.reshape(-1, 3), np.arange(points.shape[0] * 3).reshape(-1, 3),
-                 np.zeros(points.shape[0]), split_bodies=True)
-
-
 # ---------------------------------------------------------------------- checks, hulls
-def _convex_blocks(soup: _Soup, path: Path, tol: Tolerances) -> Blocks:
+def _convex_blocks(soup: TriangleSoup, path: Path, tol: Tolerances) -> Blocks:
     """Check every block of a merged soup and rebuild it as its hull's planar faces.
 
     Raises
@@ -649,41 +395,41 @@ def _convex_blocks(soup: _Soup, path: Path, tol: Tolerances) -> Blocks:
     volume = _signed_volumes(soup, vstart)
     problem = _surface_problem(soup) or _volume_problem(volume, soup, vstart, tol)
     if problem is not None:
-        raise AssemblyError(f"{path}: block {soup.names[problem[0]]!r} {problem[1]}")
+        raise AssemblyError(f"{path}: block {soup.block_name[problem[0]]!r} {problem[1]}")
     hulls = []
-    for b in range(len(soup.names)):
+    for b in range(len(soup.block_name)):
         points = soup.vertices[vstart[b]:vstart[b + 1]]
         hull, why = _convex_hull(points, volume[b],
                                  soup.triangles[soup.triangle_block == b] - vstart[b])
         if why is not None:
-            raise AssemblyError(f"{path}: block {soup.names[b]!r} {why}")
+            raise AssemblyError(f"{path}: block {soup.block_name[b]!r} {why}")
         hulls.append((points, _hull_faces(points, hull, tol.contact), hull.volume))
-    blocks = _blocks_from_hulls(soup.names, [h[0] for h in hulls], [h[1] for h in hulls],
+    blocks = _blocks_from_hulls(soup.block_name, [h[0] for h in hulls], [h[1] for h in hulls],
                                 path)
     # the merged polygons must enclose the hull: faces that overlap or leave holes (a
     # surface too curved for tol.contact to tell its facets apart) change the volume
     mismatch = np.abs(blocks.block_volume / np.array([h[2] for h in hulls]) - 1.0)
     if (mismatch > CONVEXITY_REL).any():
         bad = int(np.argmax(mismatch > CONVEXITY_REL))
-        raise AssemblyError(f"{path}: block {soup.names[bad]!r} has faces that cannot be "
+        raise AssemblyError(f"{path}: block {soup.block_name[bad]!r} has faces that cannot be "
                             "merged into planar polygons (nearly coplanar facets: a curved "
                             "surface?)")
     return blocks
 
 
-def _vertex_ranges(soup: _Soup) -> np.ndarray:
+def _vertex_ranges(soup: TriangleSoup) -> np.ndarray:
     """(B + 1,) int: block ``b`` owns vertices ``vstart[b]:vstart[b + 1]`` (blocks own
-    contiguous vertex ranges after :meth:`_Soup.merged`)."""
+    contiguous vertex ranges after :func:`_merged`)."""
     vertex_block = np.empty(len(soup.vertices), int)
     vertex_block[soup.triangles.reshape(-1)] = np.repeat(soup.triangle_block, 3)
-    return np.searchsorted(vertex_block, np.arange(len(soup.names) + 1))
+    return np.searchsorted(vertex_block, np.arange(len(soup.block_name) + 1))
 
 
-def _surface_problem(soup: _Soup):
+def _surface_problem(soup: TriangleSoup):
     """``(block, why)`` of the first block that is not a closed, manifold, consistently
     oriented surface of at least four triangles (every edge used by exactly two
     triangles, once in each direction), else None."""
-    n_blocks = len(soup.names)
+    n_blocks = len(soup.block_name)
     tri_block = soup.triangle_block
     present = np.bincount(tri_block, minlength=n_blocks)
     for block in np.flatnonzero(present < 4)[:1]:
@@ -714,7 +460,7 @@ def _surface_problem(soup: _Soup):
     return None
 
 
-def _signed_volumes(soup: _Soup, vstart) -> np.ndarray:
+def _signed_volumes(soup: TriangleSoup, vstart) -> np.ndarray:
     """(B,) float, m^3: signed volume of every block, by the divergence theorem about
     the block's first vertex (which keeps the sum free of cancellation far from the
     origin); negative for a block whose faces point inward."""
@@ -722,10 +468,10 @@ def _signed_volumes(soup: _Soup, vstart) -> np.ndarray:
     tri = soup.vertices[soup.triangles]
     ref = soup.vertices[vstart[tri_block]]
     six = np.einsum("ij,ij->i", tri[:, 0] - ref, np.cross(tri[:, 1] - ref, tri[:, 2] - ref))
-    return np.bincount(tri_block, six, minlength=len(soup.names)) / 6.0
+    return np.bincount(tri_block, six, minlength=len(soup.block_name)) / 6.0
 
 
-def _volume_problem(volume, soup: _Soup, vstart, tol: Tolerances):
+def _volume_problem(volume, soup: TriangleSoup, vstart, tol: Tolerances):
     """``(block, why)`` of the first block that is inside out, then of the first that is
     flat (no ``volume`` within ``tol.length`` times its size squared), else None."""
     size = np.linalg.norm(np.maximum.reduceat(soup.vertices, vstart[:-1])
@@ -857,3 +603,98 @@ def _classes_from_names(names):
             block_class[i] = BLOCK_CLASSES.index(match.group(1))
             block_course[i] = int(match.group(2))
     return block_class, block_course
+
+
+# ---------------------------------------------------------------------- overlaps
+def overlapping_pairs(blocks: Blocks) -> np.ndarray:
+    """Pairs of convex blocks that interpenetrate by more than
+    :data:`~masonry.tolerances.INTERPENETRATION_REL` of the smaller one's size (its
+    bounding box diagonal).
+
+    Decided by the separating axis theorem: pairs whose bounding boxes overlap are
+    projected on the face normals of both blocks, all at once (blocks in contact are
+    separated by their common face's normal); the few left are projected on the cross
+    products of their edges too, which makes the test exact.
+
+    Parameters
+    ----------
+    blocks : Blocks
+        Convex blocks (metres).
+
+    Returns
+    -------
+    (P, 2) int
+        Block index pairs, lower index first, sorted.
+    """
+    lo, hi = blocks.block_bounds[:, 0], blocks.block_bounds[:, 1]
+    size = np.linalg.norm(hi - lo, axis=1)
+    a, b = _box_pairs(lo, hi)
+    depth = INTERPENETRATION_REL * np.minimum(size[a], size[b])
+    boxes = (np.minimum(hi[a], hi[b]) - np.maximum(lo[a], lo[b])).min(axis=1) > depth
+    a, b, depth = a[boxes], b[boxes], depth[boxes]
+    points, normals = _padded(blocks)
+    deep = np.zeros(len(a), bool)
+    chunk = 4096  # pairs at a time: bounded memory
+    for start in range(0, len(a), chunk):
+        i, j = a[start:start + chunk], b[start:start + chunk]
+        axes = np.concatenate([normals[i], normals[j]], axis=1)
+        pa = np.einsum("pvk,pfk->pvf", points[i], axes)
+        pb = np.einsum("pvk,pfk->pvf", points[j], axes)
+        overlap = np.minimum(pa.max(axis=1) - pb.min(axis=1), pb.max(axis=1) - pa.min(axis=1))
+        deep[start:start + chunk] = overlap.min(axis=1) > depth[start:start + chunk]
+    found = [(min(i, j), max(i, j)) for i, j, d in zip(a[deep], b[deep], depth[deep])
+             if _overlap_on_edge_axes(blocks, i, j) > d]
+    return np.array(sorted(found), int).reshape(-1, 2)
+
+
+def _box_pairs(lo, hi):
+    """Index pairs ``(a, b)`` of boxes whose x ranges overlap (a sweep along x)."""
+    n = len(lo)
+    order = np.argsort(lo[:, 0], kind="stable")
+    start = lo[order, 0]
+    end = np.searchsorted(start, hi[order, 0], side="left")
+    counts = np.maximum(end - np.arange(n) - 1, 0)
+    first = np.repeat(np.arange(n), counts)
+    offset = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    return order[first], order[first + 1 + offset]
+
+
+def _padded(blocks: Blocks):
+    """``(B, V, 3)`` vertices and ``(B, F, 3)`` face normals per block, each padded with
+    its block's first one (which changes no projection's range)."""
+    vertex_counts = np.diff(blocks.vertex_offsets)
+    rank = np.arange(len(blocks.vertices)) - np.repeat(blocks.vertex_offsets[:-1],
+                                                       vertex_counts)
+    points = np.repeat(blocks.vertices[blocks.vertex_offsets[:-1], None, :],
+                       vertex_counts.max(), axis=1)
+    points[np.repeat(np.arange(blocks.n_blocks), vertex_counts), rank] = blocks.vertices
+    face_counts = np.bincount(blocks.face_block, minlength=blocks.n_blocks)
+    first_face = np.concatenate([[0], np.cumsum(face_counts)[:-1]])
+    rank = np.arange(blocks.n_faces) - first_face[blocks.face_block]
+    normals = np.repeat(blocks.face_normal[first_face, None, :], face_counts.max(), axis=1)
+    normals[blocks.face_block, rank] = blocks.face_normal
+    return points, normals
+
+
+def _overlap_on_edge_axes(blocks: Blocks, a: int, b: int) -> float:
+    """Smallest overlap of two blocks along the cross products of their edges."""
+    edges_a, edges_b = _block_edges(blocks, a), _block_edges(blocks, b)
+    cross = np.cross(edges_a[:, None, :], edges_b[None, :, :]).reshape(-1, 3)
+    length = np.linalg.norm(cross, axis=1)
+    axes = cross[length > PARALLEL_SIN] / length[length > PARALLEL_SIN, None]
+    if len(axes) == 0:
+        return np.inf
+    pa, pb = blocks.block_vertices(a) @ axes.T, blocks.block_vertices(b) @ axes.T
+    return float(np.minimum(pa.max(axis=0) - pb.min(axis=0),
+                            pb.max(axis=0) - pa.min(axis=0)).min())
+
+
+def _block_edges(blocks: Blocks, block: int) -> np.ndarray:
+    """(E, 3) unit edge directions of one block (each edge once per face using it)."""
+    edges = []
+    for face in blocks.block_faces(block):
+        polygon = blocks.face_polygon(face)
+        edges.append(np.roll(polygon, -1, axis=0) - polygon)
+    edges = np.vstack(edges)
+    length = np.linalg.norm(edges, axis=1)
+    return edges[length > 0] / length[length > 0, None]
