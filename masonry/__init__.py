@@ -1,10 +1,32 @@
-"""masonry: double-helix masonry domes brick by brick, their contact interfaces and
-rigid block equilibrium (RBE).
+"""masonry: double-helix masonry domes brick by brick, their contact interfaces, rigid
+block equilibrium (RBE), collapse load and construction stages.
 
-Pipeline, one module per stage::
+The Python interface (:mod:`masonry.api`)::
 
-    params -> levels -> pattern -> courses -> scenes/blocks -> interfaces
-           -> equilibrium (matrices) -> solve -> results -> exports / plots
+    import masonry
+    dome = masonry.build(preset="3", boundary="cyclic")
+    dome.solve().verdict, dome.forces(), dome.collapse(lateral=0), dome.export()
+
+The package reads as the pipeline, one stage per module or folder::
+
+    params -> dome (levels, pattern, courses) -> scenes (blocks) -> interfaces
+           -> rbe (equilibrium, solve, collapse) -> printable, plots -> export
+           -> pipeline (the run) -> studies -> api
 """
 
 __version__ = "0.1.0"
+
+_API = ("build", "read", "Structure")
+
+
+def __getattr__(name):
+    # the interface imports the whole pipeline: ``import masonry`` alone stays light
+    if name in _API:
+        from masonry import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'masonry' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted([*globals(), *_API])

@@ -12,7 +12,7 @@ ROOT = Path(masonry.__file__).parent
 
 # the pipeline's order: a module may import only from its own stage or earlier ones
 STAGES = (
-    ("masonry", "masonry.errors", "masonry.parameters", "masonry.tolerances",
+    ("masonry.errors", "masonry.parameters", "masonry.tolerances",
      "masonry.friction", "masonry.outputs", "masonry.runfolder", "masonry.forking"),
     ("masonry.blocks", "masonry.meshing"),
     ("masonry.dome",),
@@ -24,7 +24,8 @@ STAGES = (
     ("masonry.export",),
     ("masonry.pipeline",),
     ("masonry.studies",),
-    ("masonry.api",),
+    # the package's __init__ hands out the Python interface (imported when first used)
+    ("masonry.api", "masonry"),
 )
 
 

@@ -1,0 +1,255 @@
+"""The Python interface: build a structure or read one from mesh files, solve its
+equilibrium, its collapse load and its construction stages, read the forces, export.
+
+A :class:`Structure` is what ``masonry run`` analyses, held in memory: its inputs
+(:class:`~masonry.params.Params`), the built scene and the analysed model (the scene's
+blocks and any neighbour images, and their contact interfaces). Every method answers
+one of the command line's questions with the same code and the same defaults.
+
+    >>> import masonry
+    >>> arch = masonry.build(scene="arch", arch_thickness=1.0)
+    >>> arch.solve().verdict
+    'feasible'
+    >>> forces = arch.forces()          # pandas: one row per interface, forces.csv's columns
+    >>> round(float(forces["compression_N"].max()))  # doctest: +SKIP
+"""
+
+import dataclasses
+import functools
+
+from masonry.errors import ParameterError
+from masonry.export.csv import forces_columns
+from masonry.params import Params, from_preset, names, structure_id, validate
+from masonry.pipeline import build_model, collapse_of, run
+from masonry.rbe.boundary import analysis_model
+from masonry.rbe.loads import LOAD_OPTIONS
+from masonry.rbe.resultants import interface_resultants
+from masonry.rbe.solve import RBEProblem
+from masonry.scenes import check_size
+from masonry.scenes.imported import load_assembly
+from masonry.studies.stages import STAGE_COLUMNS, analyse_stages, check_live_load, make_plan
+
+
+@dataclasses.dataclass(frozen=True, eq=False)
+class Structure:
+    """A built structure and its analysis model (:func:`build`, :func:`read`).
+
+    Parameters
+    ----------
+    params : masonry.params.Params
+        Its inputs, validated: geometry, analysis, live load, outputs.
+    scene : masonry.scenes.base.Scene
+        The blocks as built (or read), their supports and, for domes, their layout.
+    model : masonry.rbe.boundary.Model
+        The analysed blocks (the scene's, then a section's neighbour images) and their
+        interfaces (:attr:`blocks`, :attr:`interfaces`).
+    source : dict or None
+        Where read blocks came from (files, supports), as ``run.json`` records it.
+    """
+
+    params: Params
+    scene: object
+    model: object
+    source: dict | None = None
+
+    @property
+    def id(self) -> str:
+        """The structure id: the name of its run folder."""
+        return structure_id(self.params)
+
+    @property
+    def blocks(self):
+        """The analysed :class:`~masonry.blocks.Blocks` (arrays, metres)."""
+        return self.model.blocks
+
+    @property
+    def interfaces(self):
+        """The contact :class:`~masonry.interfaces.Interfaces` (arrays, metres)."""
+        return self.model.interfaces
+
+    @functools.cached_property
+    def _problem(self) -> RBEProblem:
+        model = self.model
+        return RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
+                          side_rotation=model.side_rotation)
+
+    @functools.cached_property
+    def _equilibrium(self):
+        analysis = self.params.analysis
+        return self._problem.solve(mu=analysis.mu, density=analysis.density,
+                                   friction=analysis.friction, solver=analysis.solver,
+                                   accuracy=analysis.accuracy, cone=analysis.friction_cone)
+
+    def solve(self):
+        """The rigid block equilibrium under self-weight (docs/model.md 6): its verdict
+        (``feasible``, ``infeasible``, ``not solved``), the MoI factor and the forces.
+
+        Returns
+        -------
+        masonry.rbe.solve.RBEResult
+            Computed once per structure; :meth:`forces` reads it.
+        """
+        return self._equilibrium
+
+    def forces(self):
+        """The forces of :meth:`solve` per interface, as ``RBE/forces.csv`` has them.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per interface, indexed by its id; the columns of ``forces.csv``
+            (docs/outputs.md "Columns"): the two blocks, kind, centre, normal, area,
+            the force sums in newtons (tension positive in ``normal_N``), the shear, the
+            point of application of the resultant, its eccentricity and the torsion.
+
+        Raises
+        ------
+        ValueError
+            The solve returned no forces (verdict ``not solved``).
+        """
+        import pandas  # a notebook's library, imported by the calls that return a frame
+
+        result = self.solve()
+        forces = result.per_interface()
+        resultants = interface_resultants(self.interfaces, result.layout, result.x)
+        columns = forces_columns(self.blocks, self.interfaces, forces, resultants)
+        return pandas.DataFrame(dict(columns)).set_index("id")
+
+    def collapse(self, **load):
+        """The collapse load factor of a live load and its mechanism (docs/model.md 6.8).
+
+        Parameters
+        ----------
+        **load
+            The live load, as the command line's options name it: ``lateral`` (an
+            azimuth in degrees, or ``"all"`` for the worst), ``point_loads`` (strings
+            ``"PATTERN:FX,FY,FZ"``, newtons) or ``crown_load`` (newtons). None given:
+            the structure's own (``params.load``).
+
+        Returns
+        -------
+        masonry.rbe.collapse.CollapseResult
+            ``load_factor``, the ``mechanism`` (per block ``(u, theta)``) and the joints
+            that carry it.
+
+        Raises
+        ------
+        masonry.errors.ParameterError
+            No live load, or one the scene does not take.
+        """
+        params = self.params if not load else validate(self.params.replace(
+            **{"lateral": None, "point_loads": (), "crown_load": None, **load}))
+        if params.load is None:
+            raise ParameterError("load", None, f"a live load: one of {', '.join(LOAD_OPTIONS)}")
+        # a solved equilibrium stands for the dead load; else the program decides it
+        return collapse_of(self.model, params, self.__dict__.get("_equilibrium"))
+
+    def stages(self, by="course", order=None, course=None):
+        """Whether it stands at every stage of its construction without centering
+        (docs/model.md 6.6): one row per stage.
+
+        Parameters
+        ----------
+        by : {'course', 'brick', 'block'}
+            Course by course; brick by brick within ``course`` (the courses below
+            laid); block by block in ``order``.
+        order : str, optional
+            The laying order of bricks or blocks (``masonry stages --help``).
+        course : int, optional
+            The course laid brick by brick.
+
+        Returns
+        -------
+        pandas.DataFrame
+            The columns of ``stages.csv``, one row per stage (docs/stages.md): blocks
+            laid, verdict, MoI factor, the load factor of the live load if the
+            structure has one.
+        """
+        import pandas
+
+        check_live_load(self.params)
+        plan = make_plan(self.scene, by, order, course)
+        rows = analyse_stages(self.model, self.params, plan)
+        frame = pandas.DataFrame(rows, columns=STAGE_COLUMNS)
+        return frame.set_index("stage")
+
+    def export(self, out="exports", **outputs) -> dict:
+        """Write the run folder ``out/<id>`` that ``masonry run`` writes (forces, CAD
+        files, plots, printable body), by the same protocol: a complete folder of the same
+        inputs is reused, a failed export leaves the previous one.
+
+        Parameters
+        ----------
+        out : str or Path
+            The output root.
+        **outputs
+            What to write (docs/model.md 7): ``plots``, ``quick``, ``printable``,
+            ``print_size``, ``cad_offset``.
+
+        Returns
+        -------
+        dict
+            The run record (``run.json``) and the folder's ``path``.
+        """
+        unknown = set(outputs) - {n for n, part in names().items() if part == "outputs"}
+        if unknown:
+            name = sorted(unknown)[0]
+            raise ParameterError(name, outputs[name], "an output option: plots, quick, "
+                                 "printable, print_size or cad_offset")
+        params = validate(self.params.replace(**outputs))
+        return run(params, out, scene=self.scene, source=self.source)
+
+
+def build(preset=None, **inputs) -> Structure:
+    """A structure from its inputs (docs/model.md 3, 4): a preset's with changes, or a
+    scene's defaults with changes.
+
+    Parameters
+    ----------
+    preset : {'1', '2', '3', 'wall'}, optional
+        The thesis's structures 1-3 (a section of the dome) or the straight wall.
+    **inputs
+        Flat input names as the command line's options (``scene``, ``n``, ``mu``,
+        ``boundary``, ``lateral`` ...; ``masonry run --help``).
+
+    Raises
+    ------
+    masonry.errors.ParameterError
+        An input out of its range or not of the scene, or a model too large
+        (:data:`masonry.scenes.MAX_BRICKS` bricks).
+    """
+    params = from_preset(preset, **inputs) if preset is not None \
+        else validate(Params.of(**inputs))
+    check_size(params)
+    scene, model = build_model(params)
+    return Structure(params, scene, model)
+
+
+def read(*paths, support=(), support_below=None, ground=False, **inputs) -> Structure:
+    """A structure of blocks read from mesh files (OBJ, STL, PLY; docs/assemblies.md).
+
+    Parameters
+    ----------
+    *paths : str or Path
+        The files; every closed convex body is a block.
+    support : sequence of str
+        Name patterns of the fixed blocks (``pier_*``).
+    support_below : float, optional
+        Every block reaching below this height (metres) is fixed.
+    ground : bool
+        Add a ground slab (a support) under the lowest blocks.
+    **inputs
+        Analysis, live-load and output inputs (``mu``, ``density``, ``lateral`` ...).
+
+    Raises
+    ------
+    masonry.scenes.imported.AssemblyError
+        A file or block that cannot be read, no support, overlapping blocks.
+    masonry.errors.ParameterError
+        An input out of its range.
+    """
+    validate(Params.of(scene="assembly", assembly="-", **inputs))  # before any file is read
+    scene, source = load_assembly(paths, supports=tuple(support),
+                                  support_below=support_below, ground=ground)
+    params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **inputs))
+    return Structure(params, scene, analysis_model(scene, params.analysis.boundary), source)
