@@ -9,9 +9,8 @@ from pathlib import Path
 from masonry.errors import ParameterError
 from masonry.parameters import read_toml
 from masonry.params import PRESETS, Params, validate
-from masonry.runfolder import RunFolder, check_output_root
-from masonry.studies.sweep import (Study, execute, summary_csv, summary_parquet, summary_pngs,
-                           summary_rows)
+from masonry.runfolder import check_output_root
+from masonry.studies.sweep import Study, execute, publish_summary, summary_rows
 
 from . import run as run_command
 from .options import Parser, add_verbosity
@@ -194,16 +193,10 @@ def handle(args, report):
         if show:
             sys.stderr.write("\n")
     rows = summary_rows(study, results)
-    name = f"sweep_{Path(args.study).stem}"
-    with RunFolder(args.out, name) as folder:
-        folder.write("summary.csv", summary_csv(study, rows))
-        parquet = summary_parquet(study, rows)
-        if parquet is not None:
-            folder.write("summary.parquet", parquet)
-        for png_name, png in summary_pngs(study, rows, Path(args.study).stem).items():
-            folder.write(png_name, png)
-    counts = {s: sum(r["status"] == s for r in rows) for s in ("computed", "reused", "failed")}
+    stem = Path(args.study).stem
+    record = publish_summary(study, rows, args.out, f"sweep_{stem}", stem)
+    counts = record["variants"]
     report(f"{total} variants: {counts['computed']} computed, {counts['reused']} reused, "
            f"{counts['failed']} failed")
-    report(f"summary: {folder.target}")
+    report(f"summary: {record['path']}")
     return 3 if counts["failed"] else 0

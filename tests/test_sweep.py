@@ -1,6 +1,7 @@
 """Parameter studies (``masonry sweep``): Dask against serial, failures, resuming."""
 
 import csv
+import json
 
 import pytest
 
@@ -45,9 +46,12 @@ def test_local_cluster_gives_the_serial_summary(tmp_path, study):
     serial, parallel = _summary(tmp_path / "a"), _summary(tmp_path / "b")
     assert len(serial) == 4 and all(r["status"] == "computed" for r in serial)
     assert _results(parallel) == _results(serial)
-    # every variant is an ordinary run folder
+    # every variant is an ordinary run folder; the study's folder says what it holds
     for row in serial:
         assert (tmp_path / "a" / row["structure_id"] / "run.json").is_file()
+    record = json.loads((tmp_path / "a" / "sweep_study" / "run.json").read_text())
+    assert record["complete"] is True and record["variants"]["computed"] == 4
+    assert record["study"]["grid"] == {"mu": [0.3, 0.7], "friction": ["net", "plus"]}
 
 
 def test_a_failing_variant_is_recorded_the_rest_complete_and_the_exit_says_so(

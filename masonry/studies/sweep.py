@@ -27,7 +27,8 @@ import numpy as np
 from masonry.export._text import format_floats
 from masonry.errors import ParameterError
 from masonry.params import Params, geometry_key, names, validate
-from masonry.pipeline import run
+from masonry.pipeline import run, versions
+from masonry.runfolder import Publication
 from masonry.rbe.solvers.newton import use_one_blas_thread
 
 log = logging.getLogger(__name__)
@@ -423,3 +424,32 @@ def summary_pngs(study: Study, rows, label="") -> dict:
             ax.set_title(title, fontsize=9)
             out[f"load_factor_{name}.png"] = png_bytes(fig, 100)
     return out
+
+
+def publish_summary(study: Study, rows, out_root, name: str, label="") -> dict:
+    """The study's folder ``out_root/name``: ``summary.csv``, ``summary.parquet`` (with
+    pyarrow), the summary plots and ``run.json``, published by the run-folder protocol
+    (:class:`masonry.runfolder.Publication`). It is always written again: it sums up this
+    run's variants, and a variant that ran before is reused, so nothing it held is lost.
+
+    Returns
+    -------
+    dict
+        The study's record (``run.json``) and the folder's ``path``.
+    """
+    counts = {s: sum(r["status"] == s for r in rows) for s in ("computed", "reused", "failed")}
+    identity = {"study": dataclasses.asdict(study)}
+    record = {**identity, "complete": True, "outputs": {"plots": True}, "variants": counts,
+              "versions": versions()}
+
+    def write(folder):
+        folder.write("summary.csv", summary_csv(study, rows))
+        parquet = summary_parquet(study, rows)
+        if parquet is not None:
+            folder.write("summary.parquet", parquet)
+        for png_name, png in summary_pngs(study, rows, label).items():
+            folder.write(png_name, png)
+        folder.write_json("run.json", record)
+
+    job = Publication(out_root, name, identity, record["outputs"], force=True)
+    return {**record, "path": str(job.publish(write).target)}
