@@ -183,7 +183,7 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
         Convex blocks; all of them are united.
     vertices : (V, 3) float, metres, optional
         Positions to use instead of ``blocks.vertices``, in the same layout: the
-        inward-offset CAD vertices (:func:`masonry.pipeline.cad_vertices`), whose
+        inward-offset CAD vertices (:meth:`masonry.scenes.base.Scene.cad_vertices`), whose
         consecutive courses overlap (thesis 3.4.1).
     overlap : float, metres, optional
         Outward growth of every face plane; default ``OVERLAP_REL * tol.scale``.
@@ -221,14 +221,7 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
 
     start = time.perf_counter()
     blocks, overlap, tol = _checked_inputs(blocks, vertices, overlap, tol)
-    points, offsets, by_halfspaces = grown_blocks(blocks, overlap, tol)
-    parts = [manifold3d.Manifold.hull_points(points[lo:hi])
-             for lo, hi in itertools.pairwise(offsets)]
-    flat = [i for i, part in enumerate(parts) if part.is_empty()]
-    if flat:
-        raise PrintableError(f"{len(flat)} blocks have no volume, first "
-                             f"{blocks.block_name[flat[0]]}")
-
+    parts, by_halfspaces = _grown_hulls(blocks, overlap, tol)
     union_start = time.perf_counter()
     union = manifold3d.Manifold.batch_boolean(parts, manifold3d.OpType.Add)
     union_volume = union.volume()  # evaluates the lazy boolean
@@ -256,6 +249,21 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
     log.info("printable body: %d triangles, %.6g m^3, union %.2f s", report["triangles"],
              report["volume_m3"], union_time)
     return mesh, report
+
+
+def _grown_hulls(blocks: Blocks, overlap, tol):
+    """The grown blocks (:func:`grown_blocks`) as manifold3d hulls, and which blocks were
+    grown by qhull; a block without volume is refused (:class:`PrintableError`)."""
+    import manifold3d
+
+    points, offsets, by_halfspaces = grown_blocks(blocks, overlap, tol)
+    parts = [manifold3d.Manifold.hull_points(points[lo:hi])
+             for lo, hi in itertools.pairwise(offsets)]
+    flat = [i for i, part in enumerate(parts) if part.is_empty()]
+    if flat:
+        raise PrintableError(f"{len(flat)} blocks have no volume, first "
+                             f"{blocks.block_name[flat[0]]}")
+    return parts, by_halfspaces
 
 
 def _checked_inputs(blocks: Blocks, vertices, overlap, tol):
