@@ -40,12 +40,6 @@ FILE_OUTPUTS = ("plots", "quick", "printable", "print_size")
 """Inputs that choose files, not results: a folder whose run differs only in them holds
 the same input (not in the structure id)."""
 
-ID_EXTRAS = ("boundary", "mu", "density", "min_fill", "friction_cone", "accuracy",
-             "solver", "cad_offset")
-"""The inputs a structure id names when they differ from their defaults, in this order
-(each with the tag its declaration gives)."""
-
-
 @dataclass(frozen=True)
 class Params:
     """Every input of a run, by concern.
@@ -224,8 +218,10 @@ def structure_id(params: Params) -> str:
     The thesis's form for defaults, e.g. ``dome0_fast0_fricauto_s1_n8_r1_p10_c0.1_u0.1``:
     the scene kind's prefix, the fast accuracy preset (0 or 1) and the friction flow,
     then the geometry's dimensions (their declarations' tags); inputs away from their
-    defaults are appended (``_mu0.3``, :data:`ID_EXTRAS`), then the live load and the
-    collapse's friction law, so a run overwrites only the folder of an identical input.
+    defaults are appended (``_mu0.3``: every other tagged input, the boundary first, then
+    the geometry's, the analysis's and the outputs' in their declarations' order), then
+    the live load and the collapse's friction law, so a run overwrites only the folder of
+    an identical input.
     """
     analysis, geometry = params.analysis, params.geometry
     head = (f"{params.kind.id_prefix(geometry, analysis.boundary)}"
@@ -234,10 +230,13 @@ def structure_id(params: Params) -> str:
         value = getattr(geometry, name)
         if declaration.head and value is not None:
             head += f"_{declaration.tag}{text_of(value)}"
-    parts = (geometry, analysis, params.outputs)
-    for name in ID_EXTRAS:
-        part = next((p for p in parts if name in declarations(p)), None)
-        if part is not None and _named(name, getattr(part, name), defaults(part)[name]):
+    extras = [("boundary", analysis)]
+    for part in (geometry, analysis, params.outputs):
+        extras += [(name, part) for name, declaration in declarations(part).items()
+                   if declaration.tag is not None and not declaration.head
+                   and name != "boundary"]
+    for name, part in extras:
+        if _named(name, getattr(part, name), defaults(part)[name]):
             tag = declarations(part)[name].tag
             head += f"_{tag}{text_of(getattr(part, name))}"
     if params.load is not None:
