@@ -17,7 +17,7 @@ from functools import cached_property
 
 import numpy as np
 
-from masonry.tolerances import HORIZONTAL_SIN, TIE_REL
+from masonry.tolerances import COLLINEAR_SIN, HORIZONTAL_SIN, TIE_REL
 
 BLOCK_CLASSES = ("ground", "regular", "pattern", "fill_in", "block")
 """Names of the ``block_class`` codes. ``block`` is an imported or scene block (arch)."""
@@ -378,6 +378,100 @@ class Blocks:
         matrix = np.asarray(matrix, dtype=float)
         vertices = self.vertices @ matrix[:3, :3].T + matrix[:3, 3]
         return dataclasses.replace(self, vertices=vertices)
+
+
+def hull_faces(points, hull, distance):
+    """Planar faces of a convex hull: ``(face_of_entry, point_of_entry, normal)``.
+
+    The points within ``distance`` of a hull triangle's plane form that triangle's face;
+    triangles with the same point set are one face (qhull's own merged facets, and
+    facets that rounding split). Returns, per (face, point) entry, the face index and the
+    point index ((e,) int each, by face), and (F, 3) outward unit normals.
+    """
+    normal, offset = hull.equations[:, :3], hull.equations[:, 3]
+    # only the hull's vertices: a point inside a face (a T-junction) is no corner
+    corner = hull.vertices
+    on = np.abs(normal @ points[corner].T + offset[:, None]) <= distance  # (T, n)
+    if on.shape[1] <= 62:
+        key = on @ (np.int64(1) << np.arange(on.shape[1], dtype=np.int64))
+    else:
+        key = np.packbits(on, axis=1).view(f"V{(on.shape[1] + 7) // 8}").reshape(-1)
+    _, first = np.unique(key, return_index=True)
+    entry_face, entry_corner = np.nonzero(on[first])
+    return entry_face, corner[entry_corner], normal[first]
+
+
+def blocks_from_hulls(hull_points, faces, block_class, block_name, **fields) -> Blocks:
+    """Convex :class:`Blocks` from per-block hull faces (:func:`hull_faces`): every
+    face's points ordered counter-clockwise about its outward normal, collinear points
+    dropped (vectorized over all faces of all blocks).
+
+    Parameters
+    ----------
+    hull_points : list of (n, 3) float
+        Each block's points.
+    faces : list of tuple
+        Each block's :func:`hull_faces`.
+    block_class, block_name, **fields
+        As :meth:`Blocks.from_arrays` takes them (``block_name`` is a list).
+
+    Raises
+    ------
+    ValueError
+        A face collapses to a line (a degenerate block), naming the block.
+    """
+    names = block_name
+    hull_faces = faces
+    point_base = np.cumsum([0] + [len(p) for p in hull_points])
+    face_base = np.cumsum([0] + [len(f[2]) for f in hull_faces])
+    points = np.concatenate(hull_points)
+    entry_face = np.concatenate([f[0] + face_base[b] for b, f in enumerate(hull_faces)])
+    entry_point = np.concatenate([f[1] + point_base[b] for b, f in enumerate(hull_faces)])
+    normal = np.concatenate([f[2] for f in hull_faces])
+    face_block = np.repeat(np.arange(len(names)), np.diff(face_base))
+
+    # counter-clockwise about the outward normal: angle in the face's (t1, t2) basis
+    t1, t2 = tangent_basis(normal)
+    n_faces = len(normal)
+    centre = np.zeros((n_faces, 3))
+    np.add.at(centre, entry_face, points[entry_point])
+    centre /= np.bincount(entry_face, minlength=n_faces)[:, None]
+    arm = points[entry_point] - centre[entry_face]
+    angle = np.arctan2(np.einsum("ij,ij->i", arm, t2[entry_face]),
+                       np.einsum("ij,ij->i", arm, t1[entry_face]))
+    order = np.lexsort((angle, entry_face))
+    entry_face, entry_point = entry_face[order], entry_point[order]
+    # drop points where the ring goes straight on (they lie inside an edge of the block
+    # and are dropped from both faces of that edge alike) or turns back (a point inside
+    # the face); repeat, as a point inside the face can hide a straight neighbour
+    while True:
+        count = np.bincount(entry_face, minlength=n_faces)
+        start = np.cumsum(count) - count
+        k = np.arange(len(entry_face)) - start[entry_face]
+        prev = start[entry_face] + (k - 1) % count[entry_face]
+        nxt = start[entry_face] + (k + 1) % count[entry_face]
+        p = points[entry_point]
+        a, b = p - p[prev], p[nxt] - p
+        turn = np.einsum("ij,ij->i", np.cross(a, b), normal[entry_face])
+        scale = np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1)
+        straight = turn <= COLLINEAR_SIN * scale
+        if not straight.any():
+            break
+        entry_face, entry_point = entry_face[~straight], entry_point[~straight]
+    count = np.bincount(entry_face, minlength=n_faces)
+    if (count < 3).any():
+        bad = int(face_block[np.flatnonzero(count < 3)[0]])
+        raise ValueError(f"block {names[bad]!r}: a face of its convex hull collapses to "
+                         "a line; the block is degenerate")
+    # keep only points used by a face, block after block
+    used, face_vertices = np.unique(entry_point, return_inverse=True)
+    point_block = np.repeat(np.arange(len(names)), np.diff(point_base))
+    vertex_offsets = np.searchsorted(point_block[used], np.arange(len(names) + 1))
+    return Blocks.from_arrays(
+        vertices=points[used], vertex_offsets=vertex_offsets,
+        face_vertices=face_vertices.reshape(-1),
+        face_offsets=np.concatenate([[0], np.cumsum(count)]), face_block=face_block,
+        block_class=block_class, block_name=names, **fields)
 
 
 def concatenate(parts) -> Blocks:

@@ -97,16 +97,17 @@ class LevelTable:
         return np.abs(np.concatenate(parts))
 
 
-def _ellipse(a, c, theta):
+def ellipse_point(a, c, theta):
+    """``(x, z)`` of the quarter ellipse at angle ``theta``."""
     return np.array([a * np.cos(theta), c * np.sin(theta)])
 
 
 def _next_theta(a, c, theta0, radius):
     """Ellipse angle of the point at chord distance ``radius`` above ``theta0``, or None."""
-    p0 = _ellipse(a, c, theta0)
+    p0 = ellipse_point(a, c, theta0)
 
     def gap(theta):
-        return np.hypot(*(_ellipse(a, c, theta) - p0)) - radius
+        return np.hypot(*(ellipse_point(a, c, theta) - p0)) - radius
 
     if gap(np.pi / 2) < 0:
         return None
@@ -117,8 +118,38 @@ def _inclination(p0, p1):
     return np.arctan2(p0[0] - p1[0], p1[1] - p0[1])
 
 
+def contact_angles(a, c, z_max, unit, fits=None) -> np.ndarray:
+    """Ellipse angles of the contact points ``(a cos theta, c sin theta)`` one chord of
+    ``unit`` apart, from the ground up to ``z_max`` (docs/model.md 4.2).
+
+    Parameters
+    ----------
+    a, c : float, metres
+        The quarter ellipse's horizontal and vertical half axes.
+    z_max : float, metres
+        No contact point above it (``(1 + LEVEL_TOP_REL) z_max`` still counts).
+    unit : float, metres
+        The chord between consecutive contact points.
+    fits : callable, optional
+        ``fits(x) -> bool`` of a contact point's horizontal distance ``x``: the walk
+        stops before the first point where it is False (a course too narrow for a
+        brick).
+    """
+    thetas = [0.0]
+    z_limit = z_max * (1 + LEVEL_TOP_REL)
+    while True:
+        theta1 = _next_theta(a, c, thetas[-1], unit)
+        if theta1 is None:
+            break
+        x1, z1 = ellipse_point(a, c, theta1)
+        if z1 > z_limit or (fits is not None and not fits(x1)):
+            break
+        thetas.append(theta1)
+    return np.array(thetas)
+
+
 def level_table(params, dims: Dimensions | None = None) -> LevelTable:
-    """Contact points of every course up to ``z_max`` (SPEC 4.2).
+    """Contact points of every course up to ``z_max`` (docs/model.md 4.2).
 
     Levels stop where the next contact point would pass ``(1 - cut) c`` or the web gets
     narrower than ``min_fill`` across (no brick fits).
@@ -126,19 +157,9 @@ def level_table(params, dims: Dimensions | None = None) -> LevelTable:
     dims = Dimensions.of(params) if dims is None else dims
     a, c, h = dims.a, dims.c, params.unit
     tan = np.tan(np.pi / params.n)
-    thetas = [0.0]
-    z_limit = dims.z_max * (1 + LEVEL_TOP_REL)
-    while True:
-        theta0 = thetas[-1]
-        theta1 = _next_theta(a, c, theta0, h)
-        if theta1 is None:
-            break
-        p1 = _ellipse(a, c, theta1)
-        if p1[1] > z_limit or 2 * p1[0] * tan < params.min_fill * h:
-            break
-        thetas.append(theta1)
-    theta = np.array(thetas)
-    x, z = _ellipse(a, c, theta)
+    theta = contact_angles(a, c, dims.z_max, h,
+                           fits=lambda x: 2 * x * tan >= params.min_fill * h)
+    x, z = ellipse_point(a, c, theta)
     x[0], z[0] = a, 0.0  # exact ground point
     points = np.stack([x, z])
     gamma_reg = _inclination(points[:, :-1], points[:, 1:])

@@ -40,12 +40,13 @@ from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
-from masonry.blocks import BLOCK, BLOCK_CLASSES, Blocks, concatenate, tangent_basis
+from masonry.blocks import (BLOCK, BLOCK_CLASSES, Blocks, blocks_from_hulls, concatenate,
+                            hull_faces)
 from masonry.meshing import merge_vertices
 from masonry.parameters import declare
 from masonry.scenes.base import Scene, SceneKind
 from masonry.scenes.mesh_files import AssemblyError, TriangleSoup, read_mesh
-from masonry.tolerances import (COINCIDENT_ANGLE, COLLINEAR_SIN, CONVEXITY_REL,
+from masonry.tolerances import (COINCIDENT_ANGLE, CONVEXITY_REL,
                                 GROUND_MARGIN_REL, INTERPENETRATION_REL, PARALLEL_SIN,
                                 Tolerances)
 
@@ -403,9 +404,12 @@ def _convex_blocks(soup: TriangleSoup, path: Path, tol: Tolerances) -> Blocks:
                                  soup.triangles[soup.triangle_block == b] - vstart[b])
         if why is not None:
             raise AssemblyError(f"{path}: block {soup.block_name[b]!r} {why}")
-        hulls.append((points, _hull_faces(points, hull, tol.contact), hull.volume))
-    blocks = _blocks_from_hulls(soup.block_name, [h[0] for h in hulls], [h[1] for h in hulls],
-                                path)
+        hulls.append((points, hull_faces(points, hull, tol.contact), hull.volume))
+    try:
+        blocks = blocks_from_hulls([h[0] for h in hulls], [h[1] for h in hulls],
+                                   block_class="block", block_name=list(soup.block_name))
+    except ValueError as error:  # a degenerate face, named by its block
+        raise AssemblyError(f"{path}: {error}") from None
     # the merged polygons must enclose the hull: faces that overlap or leave holes (a
     # surface too curved for tol.contact to tell its facets apart) change the volume
     mismatch = np.abs(blocks.block_volume / np.array([h[2] for h in hulls]) - 1.0)
@@ -502,83 +506,6 @@ def _convex_hull(points, volume, triangles):
         return None, f"holds {bodies} separate bodies"
     return None, (f"is not convex: its volume is {100 * deficit:.3g}% below its convex "
                   f"hull's (tolerance {100 * CONVEXITY_REL:g}%)")
-
-
-def _hull_faces(points, hull, distance):
-    """Planar faces of a convex hull: ``(face_of_entry, point_of_entry, normal)``.
-
-    The points within ``distance`` of a hull triangle's plane form that triangle's face;
-    triangles with the same point set are one face (qhull's own merged facets, and
-    facets that rounding split). Returns, per (face, point) entry, the face index and the
-    point index ((e,) int each, by face), and (F, 3) outward unit normals.
-    """
-    normal, offset = hull.equations[:, :3], hull.equations[:, 3]
-    # only the hull's vertices: a point inside a face (a T-junction) is no corner
-    corner = hull.vertices
-    on = np.abs(normal @ points[corner].T + offset[:, None]) <= distance  # (T, n)
-    if on.shape[1] <= 62:
-        key = on @ (np.int64(1) << np.arange(on.shape[1], dtype=np.int64))
-    else:
-        key = np.packbits(on, axis=1).view(f"V{(on.shape[1] + 7) // 8}").reshape(-1)
-    _, first = np.unique(key, return_index=True)
-    entry_face, entry_corner = np.nonzero(on[first])
-    return entry_face, corner[entry_corner], normal[first]
-
-
-def _blocks_from_hulls(names, hull_points, hull_faces, path) -> Blocks:
-    """Assemble :class:`Blocks` from per-block hull faces: every face's points ordered
-    counter-clockwise about its outward normal, collinear points dropped (vectorized
-    over all faces of all blocks)."""
-    point_base = np.cumsum([0] + [len(p) for p in hull_points])
-    face_base = np.cumsum([0] + [len(f[2]) for f in hull_faces])
-    points = np.concatenate(hull_points)
-    entry_face = np.concatenate([f[0] + face_base[b] for b, f in enumerate(hull_faces)])
-    entry_point = np.concatenate([f[1] + point_base[b] for b, f in enumerate(hull_faces)])
-    normal = np.concatenate([f[2] for f in hull_faces])
-    face_block = np.repeat(np.arange(len(names)), np.diff(face_base))
-
-    # counter-clockwise about the outward normal: angle in the face's (t1, t2) basis
-    t1, t2 = tangent_basis(normal)
-    n_faces = len(normal)
-    centre = np.zeros((n_faces, 3))
-    np.add.at(centre, entry_face, points[entry_point])
-    centre /= np.bincount(entry_face, minlength=n_faces)[:, None]
-    arm = points[entry_point] - centre[entry_face]
-    angle = np.arctan2(np.einsum("ij,ij->i", arm, t2[entry_face]),
-                       np.einsum("ij,ij->i", arm, t1[entry_face]))
-    order = np.lexsort((angle, entry_face))
-    entry_face, entry_point = entry_face[order], entry_point[order]
-    # drop points where the ring goes straight on (they lie inside an edge of the block
-    # and are dropped from both faces of that edge alike) or turns back (a point inside
-    # the face); repeat, as a point inside the face can hide a straight neighbour
-    while True:
-        count = np.bincount(entry_face, minlength=n_faces)
-        start = np.cumsum(count) - count
-        k = np.arange(len(entry_face)) - start[entry_face]
-        prev = start[entry_face] + (k - 1) % count[entry_face]
-        nxt = start[entry_face] + (k + 1) % count[entry_face]
-        p = points[entry_point]
-        a, b = p - p[prev], p[nxt] - p
-        turn = np.einsum("ij,ij->i", np.cross(a, b), normal[entry_face])
-        scale = np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1)
-        straight = turn <= COLLINEAR_SIN * scale
-        if not straight.any():
-            break
-        entry_face, entry_point = entry_face[~straight], entry_point[~straight]
-    count = np.bincount(entry_face, minlength=n_faces)
-    if (count < 3).any():
-        bad = int(face_block[np.flatnonzero(count < 3)[0]])
-        raise AssemblyError(f"{path}: block {names[bad]!r}: a face of its convex hull "
-                            "collapses to a line; the block is degenerate")
-    # keep only points used by a face, block after block
-    used, face_vertices = np.unique(entry_point, return_inverse=True)
-    point_block = np.repeat(np.arange(len(names)), np.diff(point_base))
-    vertex_offsets = np.searchsorted(point_block[used], np.arange(len(names) + 1))
-    return Blocks.from_arrays(
-        vertices=points[used], vertex_offsets=vertex_offsets,
-        face_vertices=face_vertices.reshape(-1),
-        face_offsets=np.concatenate([[0], np.cumsum(count)]), face_block=face_block,
-        block_class="block", block_name=list(names))
 
 
 def _unique_names(names):
