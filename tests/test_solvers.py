@@ -26,7 +26,7 @@ from masonry.params import Params, from_preset, structure_id
 from masonry.rbe import solve as solve_module
 from masonry.rbe.solve import ACCURACY, LOAD_PATH, RBEProblem, _lp_feasible, solve_rbe
 from masonry.rbe.solvers import BACKENDS
-from masonry.rbe.solvers import cholesky
+from masonry.rbe.solvers import cholesky, ordering
 from masonry.rbe.solvers.cholesky import BlockCholesky
 from masonry.rbe.solvers.highs import highs_lp
 from masonry.rbe.solvers.interior import _scaling, vertex_cones, vertex_inverse
@@ -192,7 +192,7 @@ def test_block_cholesky_orders_large_graphs_by_metis_when_it_is_installed(monkey
     for nodes, metis, expected in ((144, True, "metis"), (145, True, "amd"), (144, False, "amd")):
         monkeypatch.setattr(cholesky, "METIS_NODES", nodes)
         if not metis:
-            monkeypatch.setattr(cholesky, "pymetis", None)
+            monkeypatch.setattr(ordering, "pymetis", None)
         sym = BlockCholesky(144, edges, block_size=1)
         assert sym.ordering == expected
         orders[expected] = sym.order

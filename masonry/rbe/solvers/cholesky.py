@@ -53,15 +53,12 @@ from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.linalg import blas, cython_blas, cython_lapack
+from scipy.linalg import cython_blas, cython_lapack
 
 from masonry import forking
-
-try:  # wheels for Linux and macOS only (pyproject.toml); elsewhere AMD orders every graph
-    import pymetis
-except ImportError:
-    pymetis = None
-
+from masonry.rbe.solvers.block_factor import BlockFactor, stacked_forward
+from masonry.rbe.solvers.ordering import (amd_order, elimination_tree, has_metis, metis_order,
+                                          postorder)
 log = logging.getLogger(__name__)
 
 RELAX_ZEROS = 0.2
@@ -130,65 +127,6 @@ _DTRSM = _cython_function(cython_blas, "dtrsm", _CHAR, _CHAR, _CHAR, _CHAR, _INT
                           _DOUBLE, _ARRAY, _INT, _ARRAY, _INT)
 _DSYRK = _cython_function(cython_blas, "dsyrk", _CHAR, _CHAR, _INT, _INT, _DOUBLE, _ARRAY,
                           _INT, _DOUBLE, _ARRAY, _INT)
-
-
-def _amd_order(graph: sp.csr_array) -> np.ndarray:
-    """AMD ordering of a symmetric block graph, from qdldl (SuiteSparse AMD)."""
-    import qdldl
-
-    degree = np.diff(graph.indptr)
-    # diagonally dominant, hence positive definite: the LDL^T exists in any order
-    spd = sp.csc_array(graph + sp.diags_array(degree + 1.0))
-    return np.asarray(qdldl.Solver(spd).factors()[2], dtype=np.int64)
-
-
-def _metis_order(graph: sp.csr_array) -> np.ndarray:
-    """Nested dissection ordering of a symmetric block graph, from METIS (pymetis)."""
-    if pymetis is None:
-        raise ModuleNotFoundError("the METIS ordering needs pymetis (pip install pymetis)")
-    graph = sp.csr_array(graph - sp.diags_array(graph.diagonal()))
-    graph.eliminate_zeros()
-    adjacency = pymetis.CSRAdjacency(graph.indptr, graph.indices)
-    return np.asarray(pymetis.nested_dissection(adjacency)[0], dtype=np.int64)
-
-
-def _etree(indptr, indices) -> np.ndarray:
-    """Elimination tree of a symmetric pattern (Liu's algorithm, path compression)."""
-    n = len(indptr) - 1
-    parent = np.full(n, -1, dtype=np.int64)
-    ancestor = np.full(n, -1, dtype=np.int64)
-    parent_l, ancestor_l = parent.tolist(), ancestor.tolist()
-    indices_l = indices.tolist()
-    for k in range(n):
-        for i in indices_l[indptr[k]:indptr[k + 1]]:
-            if i >= k:
-                continue
-            while ancestor_l[i] != -1 and ancestor_l[i] != k:
-                following = ancestor_l[i]
-                ancestor_l[i] = k
-                i = following
-            if ancestor_l[i] == -1:
-                ancestor_l[i] = k
-                parent_l[i] = k
-    return np.array(parent_l, dtype=np.int64)
-
-
-def _postorder(parent) -> np.ndarray:
-    n = len(parent)
-    children = [[] for _ in range(n)]
-    roots = []
-    for j, p in enumerate(parent.tolist()):
-        (children[p] if p >= 0 else roots).append(j)
-    order = []
-    stack = [(r, False) for r in reversed(roots)]
-    while stack:
-        j, done = stack.pop()
-        if done:
-            order.append(j)
-            continue
-        stack.append((j, True))
-        stack.extend((c, False) for c in reversed(children[j]))
-    return np.array(order, dtype=np.int64)
 
 
 def _runs(positions):
@@ -291,15 +229,15 @@ class BlockCholesky:
         graph.data[:] = 1.0
 
         if ordering == "auto":
-            large = self.n_nodes >= METIS_NODES and pymetis is not None
+            large = self.n_nodes >= METIS_NODES and has_metis()
             ordering = "metis" if large else "amd"
         self.ordering = ordering
-        orderings = {"amd": _amd_order, "metis": _metis_order}
+        orderings = {"amd": amd_order, "metis": metis_order}
         order = orderings[ordering](graph) if self.n_nodes > 1 else np.arange(self.n_nodes)
         permuted = sp.csr_array(graph[order][:, order])
-        parent = _etree(permuted.indptr, permuted.indices)
+        parent = elimination_tree(permuted.indptr, permuted.indices)
         # a postorder is an equivalent order: same fill, the tree relabelled
-        post = _postorder(parent)
+        post = postorder(parent)
         label = np.empty_like(post)
         label[post] = np.arange(len(post))
         parent = np.where(parent[post] >= 0, label[np.maximum(parent[post], 0)], -1)
@@ -535,7 +473,7 @@ class BlockCholesky:
         e.g. one while another process works on the second core."""
         self._threads = threads
 
-    def factor(self, values) -> "BlockFactor":
+    def factor(self, values) -> BlockFactor:
         """Numeric Cholesky factorization.
 
         The stacks of leaves (:data:`BATCH_LEAVES`) come first. Then independent
@@ -632,7 +570,7 @@ class BlockCholesky:
                 f"matrix not positive definite (a leaf among supernodes "
                 f"{group.supernodes.tolist()})") from None
         l21t = panel[:, :, k:]  # F21^T, then L21^T = L11^-1 F21^T
-        _stacked_forward(l11, l21t)
+        stacked_forward(l11, l21t)
         # the update F22 - L21 L21^T (F22 is zero in a leaf), its lower triangle; numpy
         # multiplies stacks by BLAS when the first factor is contiguous
         l21 = np.ascontiguousarray(l21t.transpose(0, 2, 1))
@@ -701,79 +639,3 @@ class BlockCholesky:
                        address + itemsize * (k * size + k), size_)
                 updates[s] = (flat[extend.front] if isinstance(extend, _AddAt)
                               else front[k:, k:].copy(order="F"))
-
-
-class BlockFactor:
-    """A numeric factorization ``P M P^T = L L^T``; :meth:`solve` applies ``M^-1``."""
-
-    def __init__(self, symbolic: BlockCholesky, pivots, below, leaves):
-        self.symbolic = symbolic
-        self._pivots = pivots    # per supernode: L11 (Fortran order), None if batched
-        self._below = below      # per supernode: L21, None if batched or a root
-        self._leaves = leaves    # per leaf group: stacked (L11, L21)
-
-    def solve(self, rhs) -> np.ndarray:
-        """``M^-1 rhs`` for ``rhs`` of shape (n,) or (n, k), n = nodes x block size."""
-        sym = self.symbolic
-        order = sym._scalar_order
-        x = np.asarray(rhs, dtype=float)[order]
-        # a vector by dtrsv: fewer checks and copies per supernode than a one-column
-        # dtrsm, and most solves are of one vector (docs/bench.md)
-        if x.ndim == 1:
-            forward = functools.partial(blas.dtrsv, lower=1)
-            backward = functools.partial(blas.dtrsv, lower=1, trans=1)
-        else:
-            forward = functools.partial(blas.dtrsm, 1.0, lower=1)
-            backward = functools.partial(blas.dtrsm, 1.0, lower=1, trans_a=1)
-        # one tuple per supernode outside the stacks: (its columns, the rows below
-        # them), L11, L21
-        plan = [(sym._solve_slices[s], self._pivots[s], self._below[s])
-                for s in sym._one_by_one]
-        stacked = x.reshape(len(x), -1)  # a view: columns of the right-hand sides
-        for group, (l11, l21) in zip(sym._leaf_groups, self._leaves):
-            _forward_leaves(stacked, group, l11, l21)
-        for (columns, rows), pivot, below in plan:
-            xs = forward(pivot, x[columns])
-            x[columns] = xs
-            if below is not None:
-                x[rows] -= below @ xs
-        for (columns, rows), pivot, below in reversed(plan):
-            v = x[columns]
-            if below is not None:
-                v = v - below.T @ x[rows]
-            x[columns] = backward(pivot, v)
-        for group, (l11, l21) in zip(sym._leaf_groups, self._leaves):
-            _backward_leaves(stacked, group, l11, l21)
-        out = np.empty_like(x)
-        out[order] = x
-        return out
-
-
-def _forward_leaves(x, group, l11, l21):
-    """Forward substitution of a group of leaves (:class:`_LeafGroup`) on ``x`` (n, m),
-    in place: their columns by ``L11 xs = x``, then the rows below them less ``L21 xs``
-    (rows of different leaves overlap: summed by ``np.subtract.at``)."""
-    xs = x[group.columns]  # (G, k, m)
-    _stacked_forward(l11, xs)
-    x[group.columns] = xs
-    np.subtract.at(x, group.rows, l21 @ xs)
-
-
-def _stacked_forward(l11, b):
-    """``b <- L11^-1 b`` in place for stacks of lower triangles ``l11`` (G, k, k) and
-    right-hand sides ``b`` (G, k, m): forward substitution, one row at a time."""
-    for j in range(l11.shape[1]):
-        if j:
-            b[:, j] -= (l11[:, j, None, :j] @ b[:, :j])[:, 0]
-        b[:, j] /= l11[:, j, j, None]
-
-
-def _backward_leaves(x, group, l11, l21):
-    """Backward substitution of a group of leaves on ``x`` (n, m), in place:
-    ``L11^T xs = x - L21^T x_below`` on their columns (the rows below are final)."""
-    xs = x[group.columns] - l21.transpose(0, 2, 1) @ x[group.rows]
-    for j in reversed(range(group.k)):
-        if j < group.k - 1:
-            xs[:, j] -= (l11[:, None, j + 1:, j] @ xs[:, j + 1:])[:, 0]
-        xs[:, j] /= l11[:, j, j, None]
-    x[group.columns] = xs
