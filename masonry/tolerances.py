@@ -36,6 +36,18 @@ of the structure's weight; below, it is the solver's tolerance (a feasible struc
 tensions are of the order of its residual, 1e-5 relative in the balanced preset, spread
 over thousands of interfaces)."""
 
+ACCEPT_RESIDUAL = 1e-5
+"""The acceptance tolerance of the analyses: a returned point counts as a solution when
+its relative equilibrium residual ``||A_eq x + f||_inf / ||f||_inf`` (and, for the rigid
+block equilibrium, its friction violation per reference weight) is at most this, recomputed
+from the matrices whatever the solver says. :attr:`Tolerances.residual` and the balanced
+accuracy preset (:data:`masonry.rbe.solve.ACCURACY`) take it for the rigid block
+equilibrium; the collapse load factor's interior point method stops when its primal rows
+meet it (:class:`masonry.rbe.solvers.interior_lp.LoadFactorOptions`), and Clarabel's
+"almost solved" collapse points are kept when they do
+(:mod:`masonry.rbe.solvers.direct_clarabel`). The fast and accurate presets trade it
+for 1e-4 and 1e-6."""
+
 
 @dataclass(frozen=True)
 class Tolerances:
@@ -60,7 +72,8 @@ class Tolerances:
         ``scale``.
     residual : float
         Largest accepted relative equilibrium residual ``||A x + f||_inf / ||f||_inf``
-        and relative friction violation for a result to count as solved.
+        and relative friction violation for a result to count as solved
+        (:data:`ACCEPT_RESIDUAL`).
     """
 
     scale: float = 1.0
@@ -68,7 +81,7 @@ class Tolerances:
     max_gap_angle: float = float(np.radians(10.0))
     min_area_rel: float = 1e-4
     length_rel: float = 1e-9
-    residual: float = 1e-5
+    residual: float = ACCEPT_RESIDUAL
 
     @property
     def contact(self) -> float:

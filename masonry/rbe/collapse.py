@@ -50,7 +50,7 @@ from masonry.rbe.solvers.base import OPTIMAL
 from masonry.rbe.solvers.highs import highs_lp
 from masonry.rbe.solvers.interior_lp import LoadFactorOptions, load_factor
 from masonry.rbe.solvers.newton import NewtonSystem
-from masonry.tolerances import FACTOR_TIE_REL, MECHANISM_MAIN, MOTION_TOL
+from masonry.tolerances import ACCEPT_RESIDUAL, FACTOR_TIE_REL, MECHANISM_MAIN, MOTION_TOL
 
 log = logging.getLogger(__name__)
 
@@ -71,10 +71,6 @@ default."""
 CLARABEL_SETTINGS = {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8}
 """Clarabel's tolerances for the collapse LP (its defaults; scaled rows of order one);
 tighter gaps end "almost solved" on the full domes (docs/collapse.md)."""
-
-ALMOST_RESIDUAL = 1e-6
-"""An interior point Clarabel calls "almost solved" is kept when its recomputed relative
-equilibrium residual is at most this (a warning says so)."""
 
 HIGHS_METHODS = {
     "ipm": {"solver": "ipm", "run_crossover": "off"},
@@ -747,7 +743,8 @@ class _ClarabelLP:
         if status == "AlmostSolved":
             x = np.array(solution.x)
             residual = np.abs(self.A[: self.n_eq] @ x - self.b[: self.n_eq]).max()
-            if residual > ALMOST_RESIDUAL * np.abs(self.b[: self.n_eq]).max():
+            # kept when it meets the acceptance tolerance (with a warning)
+            if residual > ACCEPT_RESIDUAL * np.abs(self.b[: self.n_eq]).max():
                 words = status
             else:
                 log.warning("Clarabel: almost solved, kept (relative residual %.1e)",

@@ -33,7 +33,7 @@ from masonry.rbe.solvers import BACKENDS, FAMILY, net_feasibility
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL
 from masonry.rbe.solvers.highs import highs_lp
 from masonry.rbe.solvers.newton import NewtonOptions, prepared_system
-from masonry.tolerances import Tolerances
+from masonry.tolerances import ACCEPT_RESIDUAL, Tolerances
 
 log = logging.getLogger(__name__)
 
@@ -50,7 +50,8 @@ class AccuracyPreset:
         explicit ``solver`` argument replaces both.
     residual : float
         Acceptance: a returned point counts when its relative equilibrium residual and
-        friction violation are at most this (``Tolerances.residual``).
+        friction violation are at most this (``Tolerances.residual``; the balanced
+        preset's is :data:`~masonry.tolerances.ACCEPT_RESIDUAL`).
     lp_check : bool or 'infeasible'
         Run the independent friction-net LP (HiGHS): always, never, or only to confirm
         an infeasible verdict. A feasible verdict needs no second opinion: it rests on
@@ -120,7 +121,8 @@ ACCURACY = {
     # (preset 1's full dome at mu 0.05: 6 iterations where Clarabel took 22 on its
     # KKT system); Clarabel takes over when either method fails.
     "balanced": AccuracyPreset(
-        "balanced", "newton", "interior", residual=1e-5, lp_check=False, load_path=True,
+        "balanced", "newton", "interior", residual=ACCEPT_RESIDUAL, lp_check=False,
+        load_path=True,
         polish=True,
         options={"newton": {"tol": 1e-9},
                  "interior": {"tol": 1e-10},

@@ -50,6 +50,7 @@ import numpy as np
 from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
 from masonry.rbe.solvers.cones import Lorentz, Orthant, centred_start
 from masonry.rbe.solvers.newton import NewtonSystem, one_blas_thread
+from masonry.tolerances import ACCEPT_RESIDUAL
 
 log = logging.getLogger(__name__)
 
@@ -66,7 +67,8 @@ class LoadFactorOptions:
         ``1 + |lambda|`` are at most ``tol`` ...
     primal_tol : float
         ... and the residual of the primal rows (``M g + lambda l = b``, relative to the
-        largest load entry) at most ``primal_tol``. The dual rows stay exact, so
+        largest load entry) at most ``primal_tol`` (the acceptance tolerance,
+        :data:`~masonry.tolerances.ACCEPT_RESIDUAL`). The dual rows stay exact, so
         ``-b^T y`` is an upper bound of the factor (:func:`load_factor` reports it),
         within the gap of the primal one while the primal rows hold. The residual is
         recomputed and reported with every collapse result.
@@ -90,7 +92,7 @@ class LoadFactorOptions:
     """
 
     tol: float = 1e-8
-    primal_tol: float = 1e-5
+    primal_tol: float = ACCEPT_RESIDUAL
     max_iter: int = 200
     step_fraction: float = 0.99
     regularization: float = 1e-16
