@@ -19,7 +19,7 @@ from pathlib import Path
 
 from masonry import __version__
 from masonry.errors import MasonryError
-from masonry.rbe.solvers.newton import use_one_blas_thread
+from masonry.forking import use_one_blas_thread
 
 from . import analyze, arch_thickness, bench, build, run, stages, structures, sweep
 from .options import Parser, describe_error, option_names, typed_values

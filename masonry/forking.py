@@ -1,4 +1,4 @@
-"""Work on the second core: calls made in a forked copy of this process.
+"""The process's cores: work on the second core, and BLAS's threads.
 
 A forked process shares this one's memory at the moment of the fork (copy on write), so
 it needs nothing pickled to start: the calls are closures over what this process
@@ -7,16 +7,24 @@ exporters use it (the 3DM file and the plots beside the other files) and so does
 rigid block equilibrium (friction+ beside friction-net, :mod:`masonry.rbe.solve`), and
 :func:`two_at_once` splits independent solves (a collapse search's azimuths, the
 construction stages) over two processes.
+
+The solvers (:mod:`masonry.rbe.solvers`) neither fork nor set threads: the analyses that
+call them decide, from :func:`cores` or the cores their caller gives them, and run them
+inside :func:`one_blas_thread`; the command line sets one BLAS thread for the whole
+process (:func:`use_one_blas_thread`).
 """
 
 import contextlib
 import ctypes
+import functools
 import logging
 import multiprocessing
 import os
 import signal
 import sys
 import traceback
+
+from threadpoolctl import ThreadpoolController
 
 HELD_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 """The signals that end a run (Ctrl-C, ``kill``): held while the process forks."""
@@ -52,6 +60,36 @@ def cores() -> int:
     if hasattr(os, "sched_getaffinity"):
         return len(os.sched_getaffinity(0))
     return os.cpu_count() or 1
+
+
+def usable_cores(limit=None) -> int:
+    """The cores a caller may use: :func:`cores`, at most ``limit`` (None: no limit)."""
+    return cores() if limit is None else max(1, min(int(limit), cores()))
+
+
+@functools.cache
+def _blas_controller() -> ThreadpoolController:
+    """The BLAS libraries loaded (numpy's and scipy's), found once."""
+    return ThreadpoolController()
+
+
+def use_one_blas_thread():
+    """Run BLAS on one thread for the rest of the process (the command line and sweep
+    workers call this first).
+
+    A factorization makes thousands of small BLAS calls; with a BLAS thread per core
+    every call waits for its threads, and idle BLAS threads spin on the other cores
+    (measured in ``docs/bench.md``). The cores are used by factoring independent
+    subtrees on threads instead (:meth:`masonry.rbe.solvers.cholesky.BlockCholesky.factor`).
+    Clarabel, OSQP and HiGHS have their own threads.
+    """
+    _blas_controller().limit(limits=1, user_api="blas")
+
+
+def one_blas_thread():
+    """A context in which BLAS runs on one thread (see :func:`use_one_blas_thread`): the
+    analyses solve inside it when the library is used without the command line."""
+    return _blas_controller().limit(limits=1, user_api="blas")
 
 
 @contextlib.contextmanager

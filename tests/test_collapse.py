@@ -350,6 +350,22 @@ def test_an_azimuth_search_on_two_cores_gives_every_azimuth_its_factor(two_proce
     check_mechanism(model, lateral(model, 0.0, DENSITY), worst)
 
 
+@pytest.mark.skipif(not forking.can_fork(), reason="the azimuths share the cores by fork")
+def test_an_azimuth_search_given_one_core_forks_nothing(two_processes):
+    """The caller decides: ``cores=1`` solves every azimuth here, to the factors the
+    two processes find."""
+    model = column(1, (0.2, 0.4, 0.5))
+    azimuths = [0.0, 90.0, 180.0, 270.0, 45.0]
+    alone = worst_lateral(model, azimuths, mu=0.7, density=DENSITY, dead_load_feasible=True,
+                          cores=1)
+    assert two_processes == []
+    shared = worst_lateral(model, azimuths, mu=0.7, density=DENSITY,
+                           dead_load_feasible=True)
+    assert len(two_processes) == 1
+    np.testing.assert_allclose([f for _, f in alone.azimuths],
+                               [f for _, f in shared.azimuths], rtol=1e-9)
+
+
 @pytest.mark.parametrize("azimuth", [0.0, 45.0])
 @pytest.mark.parametrize("cone", ["polygon:16", "square"])
 def test_interior_point_lp_finds_the_simplex_optimum_on_a_dome(azimuth, cone):

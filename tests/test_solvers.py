@@ -23,8 +23,10 @@ from masonry.rbe.equilibrium import assemble
 from masonry.pipeline import build_model
 from masonry.errors import ParameterError
 from masonry.params import Params, from_preset, structure_id
+from masonry.rbe import cores as cores_module
 from masonry.rbe import solve as solve_module
 from masonry.rbe.solve import ACCURACY, LOAD_PATH, RBEProblem, _lp_feasible, solve_rbe
+from masonry.rbe.cores import solver_threads
 from masonry.rbe.solvers import BACKENDS
 from masonry.rbe.solvers import cholesky, ordering
 from masonry.rbe.solvers.cholesky import BlockCholesky
@@ -268,8 +270,8 @@ def test_block_cholesky_factor_equals_the_dense_cholesky(monkeypatch, small_upda
 def test_a_factorization_starts_threads_only_where_the_process_has_two_cores(
         monkeypatch, two_processes):
     # the same symbolic analysis factored on two cores, inside forking.on_one_core
-    # (another process of the job on the other core), and on two again: the thread
-    # pool only on two, the factor the same
+    # (another process of the job on the other core: the caller's solver_threads
+    # allows one), and on two again: the thread pool only on two, the factor the same
     monkeypatch.setattr(cholesky, "PARALLEL_FLOPS", 0.0)
     pools = []
     executor = cholesky.ThreadPoolExecutor
@@ -281,7 +283,7 @@ def test_a_factorization_starts_threads_only_where_the_process_has_two_cores(
     values, dense = _random_spd_blocks(sym, np.random.default_rng(5))
     factors = [_dense_factor(sym.factor(values), bs * n)]
     assert len(pools) == 1
-    with forking.on_one_core():
+    with forking.on_one_core(), solver_threads():
         factors.append(_dense_factor(sym.factor(values), bs * n))
     assert len(pools) == 1
     factors.append(_dense_factor(sym.factor(values), bs * n))
@@ -646,7 +648,7 @@ def test_a_feasible_load_path_verdict_resumes_newton(monkeypatch, caplog):
     reference = problem(small("cyclic")).solve(mu=0.5, solver="clarabel",
                                                accuracy="accurate")
     prepared = problem(small("cyclic"))
-    with caplog.at_level(logging.INFO, logger="masonry.rbe.solve"):
+    with caplog.at_level(logging.INFO, logger="masonry.rbe"):
         result = prepared.solve(mu=0.5, accuracy="balanced")
     if forking.can_fork():
         assert "friction+ starts on the second core" in caplog.text
@@ -697,8 +699,9 @@ def test_a_feasible_dome_at_the_damping_ceiling_pays_no_load_path_lp():
 
 
 def _factor_threads(prepared):
-    """The thread limit of a solved problem's factorization (None: the default)."""
-    return prepared._workspaces["newton"]["systems"]["net"].symbolic._threads
+    """The thread limit of the factorizations once a problem is solved (None: the
+    default)."""
+    return cholesky.thread_limit()
 
 
 def _alongside(monkeypatch, on):
@@ -706,7 +709,7 @@ def _alongside(monkeypatch, on):
     or never."""
     monkeypatch.setattr(forking, "cores", lambda: 2)
     if not on:
-        monkeypatch.setattr(solve_module._Alongside, "wanted", staticmethod(lambda *a: False))
+        monkeypatch.setattr(cores_module.Alongside, "wanted", staticmethod(lambda *a: False))
 
 
 @pytest.mark.skipif(not forking.can_fork(), reason="friction+ alongside needs fork")
@@ -721,7 +724,7 @@ def test_friction_plus_alongside_is_the_one_solved_after(monkeypatch, caplog):
     monkeypatch.undo()
     _alongside(monkeypatch, True)
     prepared = problem(m)
-    with caplog.at_level(logging.INFO, logger="masonry.rbe.solve"):
+    with caplog.at_level(logging.INFO, logger="masonry.rbe"):
         alongside = prepared.solve(mu=0.05, accuracy="balanced")
     assert "friction+ was solved on the second core" in caplog.text
     assert _factor_threads(prepared) is None
@@ -751,9 +754,9 @@ def test_friction_plus_alongside_failing_is_solved_here(monkeypatch, caplog, whe
     if where == "at the fork":
         monkeypatch.setattr(forking.Forked, "start", no_fork)
     else:
-        monkeypatch.setattr(solve_module._Alongside, "_solve", broken)
+        monkeypatch.setattr(cores_module.Alongside, "_solve", broken)
     prepared = problem(m)
-    with caplog.at_level(logging.INFO, logger="masonry.rbe.solve"):
+    with caplog.at_level(logging.INFO, logger="masonry.rbe"):
         result = prepared.solve(mu=0.05, accuracy="balanced")
     assert ("cannot start on the second core" if where == "at the fork"
             else "friction+ on the second core failed (out of memory)") in caplog.text
@@ -772,6 +775,26 @@ def test_a_feasible_structure_solves_friction_net_alone(monkeypatch):
     monkeypatch.setattr(forking.Forked, "start", start)
     result = problem(small("cyclic")).solve(mu=0.7, accuracy="balanced")
     assert result.feasible and [a["solver"] for a in result.attempts] == ["newton"]
+
+
+def test_a_solve_given_one_core_solves_friction_plus_here(monkeypatch):
+    """The caller decides: on a machine where friction+ would start beside the load-path
+    LP (preset 2's dome with p = 3 at mu 0.05), ``cores=1`` starts no process and
+    factors on one thread."""
+    _alongside(monkeypatch, True)
+
+    def start(self):
+        raise AssertionError("friction+ started on a second core")
+
+    limits = []
+    factor = BlockCholesky.factor
+    monkeypatch.setattr(forking.Forked, "start", start)
+    monkeypatch.setattr(BlockCholesky, "factor", lambda self, values: limits.append(
+        cholesky.thread_limit()) or factor(self, values))
+    result = problem(model("2", scene="dome", p=3)).solve(mu=0.05, accuracy="balanced",
+                                                          cores=1)
+    assert result.verdict == "infeasible" and result.friction == "plus"
+    assert limits and set(limits) == {1}
 
 
 # ---------------------------------------------------------------------- reuse

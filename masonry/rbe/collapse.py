@@ -45,6 +45,7 @@ from masonry import forking
 from masonry.rbe.equilibrium import assemble, friction_edges
 from masonry.friction import FrictionCone
 from masonry.rbe.loads import LiveLoad, lateral
+from masonry.rbe.cores import solver_threads
 from masonry.rbe.solve import interface_forces
 from masonry.rbe.solvers.base import OPTIMAL
 from masonry.rbe.solvers.highs import highs_lp
@@ -370,6 +371,10 @@ class CollapseLP:
         HiGHS's and Clarabel's limit per solve.
     method : str, optional
         One of :data:`METHODS`; default :data:`METHOD`.
+    cores : int, optional
+        The cores a solve may use: its factorizations on up to two threads
+        (:func:`~masonry.rbe.solvers.cholesky.factor_threads`), BLAS on one. Default: the
+        process's (:func:`masonry.forking.cores`).
 
     Raises
     ------
@@ -378,7 +383,7 @@ class CollapseLP:
     """
 
     def __init__(self, model, *, mu=0.7, density=2000.0, cone="circle", time_limit=600.0,
-                 method=None):
+                 method=None, cores=None):
         self.model = model
         self.system = assemble(model.blocks, model.interfaces, mu=mu, density=density,
                                side_block=model.side_block,
@@ -394,6 +399,7 @@ class CollapseLP:
         self.columns = _cone_columns(self.system)
         self.matrix = sp.csc_array(self.system.A_eq @ self.columns.edges)
         self.mu, self.density, self.time_limit = float(mu), float(density), time_limit
+        self.cores = cores
         self._lateral = None
         self._newton_system = None  # the interior point method's, made on first use
 
@@ -423,32 +429,36 @@ class CollapseLP:
     def solve(self, live: LiveLoad, *, dead_load_feasible=None) -> CollapseResult:
         """The largest factor of ``live``; ``dead_load_feasible`` (e.g. the RBE's verdict)
         saves the check of ``lambda = 0`` when the optimum is positive."""
-        start = time.perf_counter()
-        load = self.scaled(live)
-        # the LP takes the load at the dead load's size (the same optimum, times the
-        # ratio): a point load of 1e12 N would leave the factor at the rows' rounding
-        if not np.any(load):
-            raise ValueError("the live load is zero on every free block")
-        ratio = float(np.abs(load).max() / np.abs(self.system.f_ext).max())
-        lp = self._backend(load[:, None] / ratio, np.ones(1))
-        return self._result(lp, live, None, start, dead_load_feasible, per_unit=1 / ratio)
+        with solver_threads(self.cores):
+            start = time.perf_counter()
+            load = self.scaled(live)
+            # the LP takes the load at the dead load's size (the same optimum, times the
+            # ratio): a point load of 1e12 N would leave the factor at the rows' rounding
+            if not np.any(load):
+                raise ValueError("the live load is zero on every free block")
+            ratio = float(np.abs(load).max() / np.abs(self.system.f_ext).max())
+            lp = self._backend(load[:, None] / ratio, np.ones(1))
+            return self._result(lp, live, None, start, dead_load_feasible,
+                                per_unit=1 / ratio)
 
     def solve_lateral(self, azimuth_deg: float, *, dead_load_feasible=None) -> CollapseResult:
         """The factor of :func:`masonry.rbe.loads.lateral` at ``azimuth_deg``, reusing the
-        previous azimuth's model (HiGHS: its basis; Clarabel and the interior point
+        previous azimuth's program (HiGHS: its basis; Clarabel and the interior point
         method: their symbolic factorization)."""
-        start = time.perf_counter()
-        angle = np.radians(azimuth_deg)
-        cos, sin = np.cos(angle), np.sin(angle)
-        if self._lateral is None:
-            loads = np.stack([self.scaled(lateral(self.model, 0.0, self.density)),
-                              self.scaled(lateral(self.model, 90.0, self.density))], axis=1)
-            self._lateral = self._backend(loads, np.array([cos, sin]), tie=(-sin, cos))
-        else:
-            self._lateral.direct(cos, sin)
-        live = lateral(self.model, azimuth_deg, self.density)
-        return self._result(self._lateral, live, float(azimuth_deg) % 360.0, start,
-                            dead_load_feasible)
+        with solver_threads(self.cores):
+            start = time.perf_counter()
+            angle = np.radians(azimuth_deg)
+            cos, sin = np.cos(angle), np.sin(angle)
+            if self._lateral is None:
+                loads = np.stack([self.scaled(lateral(self.model, 0.0, self.density)),
+                                  self.scaled(lateral(self.model, 90.0, self.density))],
+                                 axis=1)
+                self._lateral = self._backend(loads, np.array([cos, sin]), tie=(-sin, cos))
+            else:
+                self._lateral.direct(cos, sin)
+            live = lateral(self.model, azimuth_deg, self.density)
+            return self._result(self._lateral, live, float(azimuth_deg) % 360.0, start,
+                                dead_load_feasible)
 
     def _backend(self, loads, cost, tie=None):
         def clarabel_lp():
@@ -771,7 +781,8 @@ class _ClarabelLP:
 
 
 def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, cone="circle",
-                  friction=None, dead_load_feasible=None, time_limit=600.0) -> CollapseResult:
+                  friction=None, dead_load_feasible=None, time_limit=600.0,
+                  cores=None) -> CollapseResult:
     """The collapse load factor of ``live`` on ``model``, and its mechanism (SPEC 6.8-6.9).
 
     Parameters
@@ -793,6 +804,8 @@ def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, cone="circle
         Known verdict on the dead load alone (e.g. the RBE's); otherwise the LP decides it
         with ``lambda`` fixed at 0.
     time_limit : float, s
+    cores : int, optional
+        See :class:`CollapseLP`.
 
     Returns
     -------
@@ -801,7 +814,8 @@ def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, cone="circle
     if live.wrench.shape != (model.blocks.n_blocks, 6):
         raise ValueError(f"live load of shape {live.wrench.shape} for "
                          f"{model.blocks.n_blocks} blocks")
-    problem = CollapseLP(model, mu=mu, density=density, cone=cone, time_limit=time_limit)
+    problem = CollapseLP(model, mu=mu, density=density, cone=cone, time_limit=time_limit,
+                         cores=cores)
     if friction in (None, "associated"):
         return problem.solve(live, dead_load_feasible=dead_load_feasible)
     if friction == "non-associative":
@@ -879,13 +893,14 @@ def lateral_azimuths(n_webs=None, count=24) -> np.ndarray:
 
 def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle",
                   n_webs=None, period_deg=None, dead_load_feasible=None, time_limit=600.0,
-                  method=None) -> CollapseResult:
+                  method=None, cores=None) -> CollapseResult:
     """The smallest lateral load factor over ``azimuths`` (``--lateral all``).
 
     One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: the interior point
     method and Clarabel keep their symbolic factorization, HiGHS's simplex restarts from
     the last basis), ``method`` one of :data:`METHODS`, and the dead load is checked once
-    (unless ``dead_load_feasible`` is given); on large models two azimuths at once
+    (unless ``dead_load_feasible`` is given); on large models, when ``cores`` (default
+    the process's, :func:`masonry.forking.cores`) allow two, two azimuths at once
     (:func:`masonry.forking.two_at_once`). ``period_deg``: the model repeats under a
     rotation by this angle about the z axis (a full dome of ``n`` webs: ``360 / n``), so
     azimuths that differ by it have the same factor and each is solved once. Returns the
@@ -894,13 +909,14 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
     """
     azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
     problem = CollapseLP(model, mu=mu, density=density, cone=cone, time_limit=time_limit,
-                         method=method)
+                         method=method, cores=cores)
     start = time.perf_counter()
     keys = [round(float(a) % period_deg, 9) if period_deg else float(a) for a in azimuths]
     todo = {}
     for key, azimuth in zip(keys, azimuths):
         todo.setdefault(key, float(azimuth))
-    solved = _solve_azimuths(problem, list(todo.items()), dead_load_feasible)
+    solved = _solve_azimuths(problem, list(todo.items()), dead_load_feasible,
+                             two=forking.usable_cores(cores) >= 2)
     results = []
     for key in keys:
         if key not in solved:  # the dead load cannot stand: the search ended
@@ -920,16 +936,17 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
                                time_s=time.perf_counter() - start)
 
 
-def _solve_azimuths(problem, todo, known) -> dict:
+def _solve_azimuths(problem, todo, known, two) -> dict:
     """Solve the ``(key, azimuth)`` pairs of ``todo`` in order, each told what the earlier
-    ones found of the dead load; once it is known to stand, the rest two at once on a
-    large model (:func:`masonry.forking.two_at_once`). Returns key ->
-    :class:`CollapseResult`; ends at the first that finds the dead load cannot stand."""
+    ones found of the dead load; once it is known to stand, and when ``two`` cores may be
+    used, the rest two at once on a large model (:func:`masonry.forking.two_at_once`).
+    Returns key -> :class:`CollapseResult`; ends at the first that finds the dead load
+    cannot stand."""
     solved = {}
     for index, (key, azimuth) in enumerate(todo):
         # the interior point method factors on this process's cores; Clarabel and HiGHS
         # keep their own threads, and HiGHS's simplex gains from one model's warm starts
-        if known is True and problem.method == "interior":
+        if known is True and two and problem.method == "interior":
             keys, azimuths = zip(*todo[index:])
             standing = functools.partial(problem.solve_lateral, dead_load_feasible=True)
             solved.update(zip(keys, forking.two_at_once(

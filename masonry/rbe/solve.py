@@ -10,12 +10,19 @@ friction-net feasibility.
 
 :class:`RBEProblem` keeps one scene's matrices, symbolic factorizations and solver
 objects between solves, so a sweep over ``mu`` or ``density``, or friction+ after
-friction-net, does not start from scratch; :func:`solve_rbe` is one solve. On a machine
-with a second core, when Newton neither solves nor certifies friction-net, friction+
-is solved there while the load-path LP decides friction-net (:class:`_Alongside`).
+friction-net, does not start from scratch; :func:`solve_rbe` is one solve.
+
+The solvers neither fork nor set threads: this module decides (:mod:`masonry.rbe.cores`),
+from the cores its caller allows (``cores``, default the process's:
+:func:`masonry.forking.cores`). It solves inside
+:func:`~masonry.rbe.cores.solver_threads` (BLAS on one thread, factorizations on up to
+two), and with a second core, when Newton neither solves nor certifies friction-net, it
+solves friction+ there while the load-path LP decides friction-net
+(:class:`~masonry.rbe.cores.Alongside`).
 """
 
 import dataclasses
+import functools
 import logging
 import math
 import time
@@ -29,6 +36,7 @@ from masonry import forking
 from masonry.rbe.equilibrium import (FRICTION_METHODS, EquilibriumSystem, VariableLayout,
                                      assemble, friction_edges)
 from masonry.friction import FrictionCone
+from masonry.rbe.cores import Alongside, solver_threads
 from masonry.rbe.solvers import BACKENDS, FAMILY, net_feasibility
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL
 from masonry.rbe.solvers.highs import highs_lp
@@ -335,25 +343,42 @@ class RBEProblem:
         self._workspaces = {}
 
     def solve(self, mu=0.7, density=2000.0, friction="auto", solver=None, tol=None, *,
-              accuracy="balanced", cone=None, lp_check=None,
-              lp_time_limit=60.0) -> RBEResult:
+              accuracy="balanced", cone=None, lp_check=None, lp_time_limit=60.0,
+              cores=None) -> RBEResult:
         """Solve at ``mu`` and ``density``; see :func:`solve_rbe` for the parameters."""
         start = time.perf_counter()
         preset, tol, lp_check = _settings(friction, solver, tol, accuracy, lp_check)
         cone = friction_model(preset.name, cone)
         _check_solver(solver, cone)
         system = self.system.with_material(mu=mu, density=density, cone=cone)
+        cores = forking.usable_cores(cores)
+        with solver_threads(cores):
+            solved, attempts = self._flow(system, friction, solver, preset, tol, cores)
+            result = self._result(system, solved, tol, lp_check, lp_time_limit, accuracy,
+                                  attempts, friction)
+        log.info("%s: %s, MoI factor %.4g, residual %.1e, %.2f s", result.solver,
+                 result.verdict, result.moi_factor, result.residual_eq,
+                 time.perf_counter() - start)
+        return dataclasses.replace(result, time_s=time.perf_counter() - start)
+
+    def _flow(self, system, friction, solver, preset, tol, cores):
+        """The thesis's friction flow (friction-net, then friction+ unless friction-net
+        was solved; or the one model asked for), friction+ on a second core when
+        :class:`~masonry.rbe.cores.Alongside` may: ``(the last model's _Solved, attempts)``."""
         attempts = []
-        alongside = (_Alongside(self, system, _candidates("plus", solver, preset), preset, tol)
-                     if _Alongside.wanted(friction, solver, preset) else None)
+        alongside = None
+        if Alongside.wanted(friction, solver, preset, cores):
+            alongside = Alongside(functools.partial(
+                self._solve_model, system, "plus", _candidates("plus", solver, preset),
+                preset, tol))
         try:
             for method in ("net", "plus") if friction == "auto" else (friction,):
                 solved = None
                 if method == "plus" and alongside is not None and alongside.started:
                     solved = alongside.solved(attempts)
                 if solved is None:
-                    log.info("solving friction-%s (mu %.3g, %d unknowns)", method, mu,
-                             system.layout.n_columns)
+                    log.info("solving friction-%s (mu %.3g, %d unknowns)", method,
+                             system.mu, system.layout.n_columns)
                     solved = self._solve_model(
                         system, method, _candidates(method, solver, preset), preset, tol,
                         attempts, before_lp=alongside.start if alongside else None)
@@ -365,21 +390,16 @@ class RBEProblem:
         finally:
             if alongside is not None:
                 alongside.close()
-        result = self._result(system, solved, tol, lp_check, lp_time_limit, accuracy,
-                              attempts, friction)
-        log.info("%s: %s, MoI factor %.4g, residual %.1e, %.2f s", result.solver,
-                 result.verdict, result.moi_factor, result.residual_eq,
-                 time.perf_counter() - start)
-        return dataclasses.replace(result, time_s=time.perf_counter() - start)
+        return solved, attempts
 
-    def _solve_model(self, system, method, names, preset, tol, attempts,
+    def _solve_model(self, system, method, candidates, preset, tol, attempts,
                      before_lp=None) -> "_Solved":
         """One friction model: the candidate solvers in turn until one returns an
         accepted point (polished if the preset says so) or certifies infeasibility.
         Every QP solved is appended to ``attempts``; ``before_lp`` (a callable) is
         called when Newton hands friction-net over to the load-path LP."""
         outcome = None
-        for index, name in enumerate(names):
+        for index, name in enumerate(candidates):
             if name == LOAD_PATH:
                 if before_lp is not None:
                     before_lp()
@@ -387,7 +407,7 @@ class RBEProblem:
             else:
                 # Newton hands over sooner when the load-path LP follows it
                 hand_over = ({"stall": LOAD_PATH_STALL, "damped_out": LOAD_PATH_DAMPED_OUT}
-                             if LOAD_PATH in names[index:] else {})
+                             if LOAD_PATH in candidates[index:] else {})
                 outcome = self._run(system, method, name, preset, **hand_over)
             checks = _check(system, outcome.x, method)
             accepted = _accepted(checks, tol)
@@ -406,10 +426,10 @@ class RBEProblem:
                 if outcome.status == INFEASIBLE:
                     log.info("%s certified friction-%s infeasible", name, method)
                 return _Solved(method, name, outcome, checks, accepted)
-            if index + 1 < len(names):
+            if index + 1 < len(candidates):
                 # no silent fallback (STYLE): it warns and stays in ``attempts``
                 log.info("%s found no %s solution (%s); trying %s", name, method,
-                            outcome.status, names[index + 1])
+                         outcome.status, candidates[index + 1])
         return _Solved(method, name, outcome, checks, False)
 
     def _load_path(self, system, preset, tol, stalled, attempts):
@@ -507,79 +527,6 @@ class _Solved:
     accepted: bool
 
 
-class _Alongside:
-    """friction+ solved in a forked copy of this process, on the second core, while the
-    load-path LP decides friction-net in this one: started when Newton hands friction-net
-    over to the LP (it has neither solved nor certified it: most such structures are
-    infeasible), taken when friction-net has no solution, ended unused when it has one.
-    Both factor on one thread from the start, the forked one to its end (two threads
-    gain little at the sizes measured: docs/bench.md, "Batched leaves"). The forked
-    process solves friction+ as this one would after friction-net (the same candidates
-    from the same state), so the result does not depend on where it was solved; if it
-    cannot start or fails, this process solves friction+ (with a warning)."""
-
-    def __init__(self, problem, system, names, preset, tol):
-        self.problem, self.system = problem, system
-        self.args = (system, "plus", names, preset, tol)
-        self.forked = forking.Forked([self._solve])
-        self.symbolic = None
-
-    @staticmethod
-    def wanted(friction, solver, preset) -> bool:
-        """Whether a solve may work on the second core: the thesis's flow with friction+
-        on the Newton system (not Clarabel's), a process that may fork, two cores."""
-        return (friction == "auto" and solver is None and preset.plus_solver == "interior"
-                and forking.can_fork() and forking.cores() >= 2)
-
-    @property
-    def started(self) -> bool:
-        return self.forked.started
-
-    def start(self):
-        """Start friction+ on the second core (once)."""
-        if self.started:
-            return
-        log.info("friction+ starts on the second core while the load-path LP decides "
-                 "friction-net")
-        self.symbolic = prepared_system(self.system, "net",
-                                        self.problem._workspace("newton")).symbolic
-        self.symbolic.limit_threads(1)
-        try:
-            self.forked.start()
-        except OSError as error:  # no memory or processes left for a fork
-            log.warning("friction+ cannot start on the second core (%s); it is solved "
-                        "here after friction-net", error)
-            self.close()
-
-    def _solve(self):
-        """In the forked process: friction+ and its attempts."""
-        logging.disable(logging.INFO)  # its progress would mix with this process's
-        attempts = []
-        return self.problem._solve_model(*self.args, attempts), attempts
-
-    def solved(self, attempts):
-        """friction+ from the second core, its attempts appended to ``attempts``; None
-        if it failed (this process then solves it)."""
-        try:
-            solved, theirs = self.forked.result()
-        except Exception as error:
-            log.warning("friction+ on the second core failed (%s); solving it here", error)
-            self.close()
-            return None
-        log.info("friction+ was solved on the second core")
-        attempts.extend(theirs)
-        return solved
-
-    def close(self):
-        """End the forked process (if it still runs) and give the factorization its
-        threads back."""
-        try:
-            self.forked.close(cancel=True)
-        finally:
-            if self.symbolic is not None:
-                self.symbolic.limit_threads(None)
-
-
 WORKSPACE = {"interior": "newton"}
 """Backends that share another's workspace (see :meth:`RBEProblem._workspace`)."""
 
@@ -654,7 +601,7 @@ def _verdict(feasible, x, attempts, lp_feasible) -> str:
 
 def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solver=None,
               tol=None, *, accuracy="balanced", cone=None, lp_check=None,
-              lp_time_limit=60.0, side_block=None, side_rotation=None) -> RBEResult:
+              lp_time_limit=60.0, side_block=None, side_rotation=None, cores=None) -> RBEResult:
     """Rigid block equilibrium as a quadratic program (thesis 3.3.4).
 
     With ``x`` the vertex forces ``(c, t, f1, f2)`` of every interface vertex (thesis
@@ -684,26 +631,26 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
         ``'auto'`` (thesis 3.3.3): friction-net first; when it has no accepted solution,
         friction+ and report that.
     solver : str, optional
-        A :data:`masonry.rbe.solvers.BACKENDS` name (``newton``, ``clarabel``, ``osqp``,
-        ``clarabel-cvxpy``, ``osqp-cvxpy``) for both friction models, with the preset's
-        tolerances for its family. Default: the preset's solvers.
+        A :data:`masonry.rbe.solvers.BACKENDS` name (:data:`SOLVERS`) for both friction
+        models, with the preset's settings for it. Default: the preset's solvers.
     tol : Tolerances, optional
         ``tol.residual`` bounds the relative equilibrium residual and the friction
         violation of an accepted solution. Default: the preset's ``residual``.
     accuracy : {'fast', 'balanced', 'accurate'}
         The :data:`ACCURACY` preset.
     cone : FrictionCone or str, optional
-        The friction model: ``'circle'``, ``'polygon:K'`` or ``'square'``; default the
-        preset's (an isotropic one).
+        The friction model (``'circle'``, ``'polygon:K'``, ``'square'``); default the preset's.
     lp_check : bool or 'infeasible', optional
         Run the independent friction-net feasibility LP (HiGHS, zero objective): always,
-        never, or only when the verdict is infeasible. Default: the preset's
-        (``accurate``: when infeasible). Proving feasibility takes it far longer than
-        proving infeasibility (docs/bench.md).
+        never, or only when the verdict is infeasible. Default: the preset's (``accurate``:
+        when infeasible); proving feasibility takes it far longer (docs/bench.md).
     lp_time_limit : float, s
         HiGHS's time limit; when reached, ``lp_feasible`` is None and a warning is logged.
     side_block, side_rotation : optional
         Force routing for boundary modes, see :func:`masonry.rbe.equilibrium.assemble`.
+    cores : int, optional
+        The cores it may use: friction+ forked onto a second, factorizations on two threads
+        (:mod:`masonry.rbe.cores`). Default: the process's (:func:`masonry.forking.cores`).
 
     Returns
     -------
@@ -730,7 +677,7 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
                          side_rotation=side_rotation)
     result = problem.solve(mu=mu, density=density, friction=friction, solver=solver,
                            tol=tol, accuracy=accuracy, cone=cone, lp_check=lp_check,
-                           lp_time_limit=lp_time_limit)
+                           lp_time_limit=lp_time_limit, cores=cores)
     return dataclasses.replace(result, time_s=time.perf_counter() - start)
 
 

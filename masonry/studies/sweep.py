@@ -29,7 +29,7 @@ from masonry.errors import ParameterError
 from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run, versions
 from masonry.runfolder import Publication
-from masonry.rbe.solvers.newton import use_one_blas_thread
+from masonry.forking import use_one_blas_thread
 
 log = logging.getLogger(__name__)
 

@@ -44,6 +44,8 @@ Method (Liu, "The multifrontal method for sparse matrix solution", SIAM Review 1
    summed by ``np.subtract.at`` (leaves share rows, never columns).
 """
 
+import contextlib
+import contextvars
 import ctypes
 import functools
 import logging
@@ -55,7 +57,6 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.linalg import cython_blas, cython_lapack
 
-from masonry import forking
 from masonry.rbe.solvers.block_factor import BlockFactor, stacked_forward
 from masonry.rbe.solvers.ordering import (amd_order, elimination_tree, has_metis, metis_order,
                                           postorder)
@@ -92,7 +93,29 @@ pivot columns one by one; ``docs/bench.md``, "Batched leaves of the sparse Chole
 
 
 FACTOR_THREADS = 2
-"""Threads of a numeric factorization (at most the cores this process may use)."""
+"""Most threads of a numeric factorization; its caller may allow fewer
+(:func:`factor_threads`)."""
+
+_THREADS = contextvars.ContextVar("factor_threads", default=None)
+"""The thread count set by :func:`factor_threads`; None: :data:`FACTOR_THREADS`."""
+
+
+@contextlib.contextmanager
+def factor_threads(threads):
+    """Within it, numeric factorizations use at most ``threads`` threads (and at most
+    :data:`FACTOR_THREADS`; None: that many). The caller decides: the cores it may use,
+    one while another process of the job works on the other core. A context of the
+    calling thread, as :mod:`contextvars` keeps it (a forked process inherits it)."""
+    token = _THREADS.set(None if threads is None else max(1, int(threads)))
+    try:
+        yield
+    finally:
+        _THREADS.reset(token)
+
+
+def thread_limit():
+    """The limit :func:`factor_threads` set here, None outside it."""
+    return _THREADS.get()
 
 PARALLEL_FLOPS = 1e9
 """Factorizations of fewer flops run on one thread: below it the Python-level steps of
@@ -262,7 +285,6 @@ class BlockCholesky:
         self._scalar_order = (bs * order[:, None] + np.arange(bs)).ravel()
         self._front_buffers = []
         self._schedule = None
-        self._threads = None  # FACTOR_THREADS
         self._steps = self._numeric_plan()
         self._leaf_groups = self._leaf_plan()
         self._batched = np.zeros(len(self.supernodes), dtype=bool)
@@ -468,17 +490,13 @@ class BlockCholesky:
         return self.position[np.asarray(i)] < self.position[np.asarray(j)]
 
     # ------------------------------------------------------------------ numeric
-    def limit_threads(self, threads=None):
-        """Factor on at most ``threads`` threads from now on (None: :data:`FACTOR_THREADS`),
-        e.g. one while another process works on the second core."""
-        self._threads = threads
-
     def factor(self, values) -> BlockFactor:
         """Numeric Cholesky factorization.
 
         The stacks of leaves (:data:`BATCH_LEAVES`) come first. Then independent
         subtrees of the supernodal elimination tree are factored on
-        :data:`FACTOR_THREADS` threads when the factorization is large enough
+        :data:`FACTOR_THREADS` threads (fewer within :func:`factor_threads`, as the
+        caller decides) when the factorization is large enough
         (:data:`PARALLEL_FLOPS`): LAPACK and BLAS run without the GIL, and each thread
         works on its own fronts; the supernodes above the subtrees follow on one thread.
 
@@ -496,8 +514,8 @@ class BlockCholesky:
         values = np.asarray(values, dtype=float)[self._entry_order].reshape(-1)
         n = len(self._steps)
         state = ([None] * n, [None] * n, [None] * n)  # updates, pivots, below
-        threads = min(FACTOR_THREADS if self._threads is None else self._threads,
-                      forking.cores())
+        limit = _THREADS.get()
+        threads = FACTOR_THREADS if limit is None else min(limit, FACTOR_THREADS)
         if self._schedule is None or self._schedule[0] != threads:
             self._schedule = threads, self._parallel_schedule(threads)
         bins, top = self._schedule[1]

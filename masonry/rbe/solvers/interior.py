@@ -40,7 +40,7 @@ import numpy as np
 
 from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
 from masonry.rbe.solvers.cones import Lorentz, Orthant, centred_start
-from masonry.rbe.solvers.newton import NewtonSystem, one_blas_thread, prepared_system
+from masonry.rbe.solvers.newton import NewtonSystem, prepared_system
 
 log = logging.getLogger(__name__)
 
@@ -219,7 +219,6 @@ def _dot(a, b) -> float:
     return float(sum(x.ravel() @ y.ravel() for x, y in zip(a, b)))
 
 
-@one_blas_thread
 def solve(ns: NewtonSystem, options: InteriorOptions) -> QPOutcome:
     """Solve the scaled QP of ``ns`` (its friction model and ``mu``).
 

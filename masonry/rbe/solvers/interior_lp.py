@@ -49,7 +49,7 @@ import numpy as np
 
 from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
 from masonry.rbe.solvers.cones import Lorentz, Orthant, centred_start
-from masonry.rbe.solvers.newton import NewtonSystem, one_blas_thread
+from masonry.rbe.solvers.newton import NewtonSystem
 from masonry.tolerances import ACCEPT_RESIDUAL
 
 log = logging.getLogger(__name__)
@@ -287,7 +287,6 @@ def _start(variables, load, regularization):
     return g, y, s
 
 
-@one_blas_thread
 def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
                 stop=None) -> QPOutcome:
     """The largest ``lambda`` of the collapse LP (module docstring) on the friction-net

@@ -49,7 +49,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-from threadpoolctl import ThreadpoolController
 
 from masonry.rbe.equilibrium import VariableLayout, equilibrium_columns
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
@@ -347,37 +346,6 @@ def _vertex_groups(vertex_interface):
     return groups
 
 
-@functools.cache
-def _blas_controller() -> ThreadpoolController:
-    """The BLAS libraries loaded (numpy's and scipy's), found once."""
-    return ThreadpoolController()
-
-
-def use_one_blas_thread():
-    """Run BLAS on one thread for the rest of the process (the command line and sweep
-    workers call this first).
-
-    A factorization makes thousands of small BLAS calls; with a BLAS thread per core
-    every call waits for its threads (15 to 30 times slower while another process
-    keeps a core busy), and idle BLAS threads spin on the other cores (measured in
-    ``docs/bench.md``). The cores are used by factoring independent subtrees on
-    threads instead (:meth:`masonry.rbe.solvers.cholesky.BlockCholesky.factor`).
-    Clarabel, OSQP and HiGHS have their own threads.
-    """
-    _blas_controller().limit(limits=1, user_api="blas")
-
-
-def one_blas_thread(function):
-    """Run ``function`` with BLAS on one thread (see :func:`use_one_blas_thread`): the
-    Newton method's factorizations, when the library is used without the command line."""
-    @functools.wraps(function)
-    def limited(*args, **kwargs):
-        with _blas_controller().limit(limits=1, user_api="blas"):
-            return function(*args, **kwargs)
-    return limited
-
-
-@one_blas_thread
 def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOutcome:
     """Solve the scaled RBE QP of ``system`` for ``method`` (``'net'`` or ``'plus'``).
 
