@@ -9,7 +9,7 @@ from masonry.studies.bench import (FRICTION_MODELS, SCENES, bench, collapse_benc
 from masonry.errors import ParameterError
 from masonry.params import Params, from_preset, validate
 from masonry.rbe.solve import ACCURACY
-from masonry.rbe.solvers import BACKENDS
+from masonry.rbe.solvers import RBE, names as solver_names
 from masonry.studies.reader_bench import reader_bench, readers_markdown
 from masonry.runfolder import RunFolder, check_output_root
 
@@ -27,7 +27,7 @@ def register(subparsers):
                              "(default all)")
     parser.add_argument("--accuracy", nargs="+", default=list(ACCURACY),
                         choices=tuple(ACCURACY), help="accuracy presets (default all)")
-    parser.add_argument("--solvers", nargs="+", default=[], choices=tuple(BACKENDS),
+    parser.add_argument("--solvers", nargs="+", default=[], choices=solver_names(RBE),
                         help="extra rows: the balanced preset with another solver")
     parser.add_argument("--p", type=int, metavar="P",
                         help="override the presets' pattern bricks per rhombus side "

@@ -9,13 +9,13 @@ from masonry.outputs import Outputs
 from masonry.parameters import declarations, defaults
 from masonry.params import PRESETS, Params, applies, from_preset, load, names, validate
 from masonry.rbe.settings import BOUNDARIES, FRICTION_LAWS, FRICTIONS, Analysis
-from masonry.rbe.solve import ACCURACY
-from masonry.rbe.solvers import BACKENDS
+from masonry.rbe.accuracy import ACCURACY
+from masonry.rbe.solvers import RBE, names as solver_names
 from masonry.scenes import KINDS, kind_of
 from masonry.scenes.arch import ARCH_SHAPES
 from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS
 
-ACCURACIES, SOLVERS = tuple(ACCURACY), tuple(BACKENDS)
+ACCURACIES, SOLVERS = tuple(ACCURACY), solver_names(RBE)
 PARTS = (Analysis, Outputs, *(kind.geometry for kind in KINDS.values()))
 """The declared parts whose defaults and ranges the options' help quotes."""
 DEFAULTS = {name: value for part in PARTS for name, value in defaults(part).items()}

@@ -41,7 +41,7 @@ ACCEPT_RESIDUAL = 1e-5
 its relative equilibrium residual ``||A_eq x + f||_inf / ||f||_inf`` (and, for the rigid
 block equilibrium, its friction violation per reference weight) is at most this, recomputed
 from the matrices whatever the solver says. :attr:`Tolerances.residual` and the balanced
-accuracy preset (:data:`masonry.rbe.solve.ACCURACY`) take it for the rigid block
+accuracy preset (:data:`masonry.rbe.accuracy.ACCURACY`) take it for the rigid block
 equilibrium; the collapse load factor's interior point method stops when its primal rows
 meet it (:class:`masonry.rbe.solvers.interior_lp.LoadFactorOptions`), and Clarabel's
 "almost solved" collapse points are kept when they do

@@ -27,7 +27,7 @@ from masonry.rbe import cores as cores_module
 from masonry.rbe import solve as solve_module
 from masonry.rbe.solve import ACCURACY, LOAD_PATH, RBEProblem, _lp_feasible, solve_rbe
 from masonry.rbe.cores import solver_threads
-from masonry.rbe.solvers import BACKENDS
+from masonry.rbe.solvers import BACKENDS, COLLAPSE, RBE, backend, names
 from masonry.rbe.solvers import cholesky, ordering
 from masonry.rbe.solvers.cholesky import BlockCholesky
 from masonry.rbe.solvers.highs import highs_lp
@@ -59,6 +59,40 @@ def scale(result):
 
 
 # ---------------------------------------------------------------------- registries
+def test_the_registry_declares_problems_and_friction_models():
+    circle, pyramid = FrictionCone.parse("circle"), FrictionCone.parse("polygon:16")
+    assert names(COLLAPSE) == ("interior", "clarabel", "highs-ipm", "highs-crossover",
+                               "highs-simplex")
+    assert names(COLLAPSE, circle) == ("interior", "clarabel")
+    assert set(names(RBE, pyramid)) == set(names(RBE))
+    assert set(names(RBE)) - set(names(RBE, circle)) == {"osqp", "osqp-cvxpy"}
+    assert set(names()) == set(names(RBE)) | set(names(COLLAPSE))
+    with pytest.raises(ValueError, match="linear constraints only"):
+        backend("osqp", RBE, circle)
+    with pytest.raises(ValueError, match="unknown solver 'highs-simplex'"):
+        backend("highs-simplex", RBE)  # solves the collapse program, not the QP
+    with pytest.raises(ValueError, match="unknown collapse method 'newton'"):
+        backend("newton", COLLAPSE)
+
+
+@pytest.mark.parametrize("name, cone", [("newton", "circle"), ("osqp", "polygon:16"),
+                                        ("clarabel-cvxpy", "circle")])
+def test_every_outcome_carries_residuals_recomputed_from_the_matrices(name, cone):
+    system = problem(small("cyclic")).system.with_material(mu=0.7, density=2000.0,
+                                                           cone=cone)
+    outcome = BACKENDS[name].solve_rbe(system, "net", {}, {})
+    x = outcome.x
+    residual = (np.abs(system.A_eq @ x + system.f_ext).max()
+                / np.abs(system.f_ext).max())
+    # the same up to the rounding of the sums (a product in another order)
+    assert outcome.residuals.equilibrium == pytest.approx(residual, abs=1e-12)
+    c, t, f1, f2 = x.reshape(-1, 4).T
+    excess = max(float(system.cone.excess(c - t, f1, f2, system.mu).max()),
+                 float((system.lower - x).max()), 0.0)
+    assert outcome.residuals.net_friction == pytest.approx(excess, abs=1e-15)
+    assert outcome.residuals.equilibrium <= Tolerances().residual
+
+
 def test_params_accuracy_validation_and_structure_id():
     assert Params.of().analysis.accuracy == "balanced"
     assert Params.of(fast=True).analysis.accuracy == "fast"  # SPEC 3: fast mode, unless chosen
@@ -573,7 +607,7 @@ def test_the_load_path_lp_agrees_with_highs_and_clarabel(preset, boundary, mu, c
     system = problem(m).system.with_material(mu=mu, density=2000.0, cone=cone)
     tol = NewtonOptions().infeasibility_tol
     outcome = decide(NewtonSystem(system, "net"), tol, Tolerances().residual)
-    clarabel = BACKENDS["clarabel"](system, "net", {}, {})
+    clarabel = BACKENDS["clarabel"].solve_rbe(system, "net", {}, {})
     feasible = clarabel.status == "optimal"
     assert clarabel.status in ("optimal", "infeasible")
     if system.cone.is_polyhedral:  # HiGHS, a third opinion

@@ -6,8 +6,8 @@ from dataclasses import dataclass
 from masonry.friction import FrictionCone, FrictionModelError
 from masonry.parameters import check_fields, declare
 from masonry.errors import ParameterError
-from masonry.rbe.solve import ACCURACY, POLYHEDRAL_ONLY
-from masonry.rbe.solvers import BACKENDS
+from masonry.rbe.accuracy import ACCURACY
+from masonry.rbe.solvers import BACKENDS, RBE, names
 
 FRICTIONS = ("net", "plus", "auto")
 FRICTION_LAWS = ("associated", "non-associative")
@@ -41,7 +41,7 @@ class Analysis:
     accuracy: str = declare("balanced", "solver preset", kind="str",
                             choices=tuple(ACCURACY), tag="")
     solver: str | None = declare(None, "a solver in place of the preset's", kind="str",
-                                 choices=tuple(BACKENDS), optional=True, tag="")
+                                 choices=names(RBE), optional=True, tag="")
     boundary: str = declare("free", "what the section's end bricks bear on", kind="str",
                             choices=BOUNDARIES, tag="b", names_geometry=True)
     friction_law: str = declare("associated", "of the collapse load factor", kind="str",
@@ -51,21 +51,21 @@ class Analysis:
         """This analysis validated, the friction model in its canonical spelling; raises
         :class:`~masonry.errors.ParameterError`."""
         check_fields(self)
-        if self.friction_cone is None:
-            if self.solver in POLYHEDRAL_ONLY:
-                raise ParameterError("solver", self.solver, "a solver of Coulomb's cone (the "
-                                     "default friction model): newton, interior, clarabel "
-                                     "or clarabel-cvxpy; or a pyramid: --friction-cone "
-                                     "polygon:16")
-            return self
         try:
-            cone = FrictionCone.parse(self.friction_cone)
+            cone = self.cone
         except FrictionModelError as error:
             raise ParameterError("friction_cone", self.friction_cone, str(error)) from None
-        if self.solver in POLYHEDRAL_ONLY and not cone.is_polyhedral:
+        if self.solver is not None and not BACKENDS[self.solver].states(cone):
+            if self.friction_cone is None:
+                raise ParameterError("solver", self.solver, f"a solver of Coulomb's cone "
+                                     f"(the default friction model): "
+                                     f"{', '.join(names(RBE, cone))}; or a pyramid: "
+                                     f"--friction-cone polygon:16")
             raise ParameterError("friction_cone", self.friction_cone, f"a pyramid (polygon:K "
                                  f"or square) with --solver {self.solver}, which takes "
                                  f"linear constraints only", related=("solver",))
+        if self.friction_cone is None:
+            return self
         return Analysis(**{**self.__dict__, "friction_cone": cone.name})
 
     @property

@@ -1,12 +1,13 @@
 """Solve rigid block equilibrium (RBE) as a quadratic program (SPEC 6.5-6.7, thesis 3.3.4).
 
 The matrices come from :mod:`masonry.rbe.equilibrium`, the solvers from
-:mod:`masonry.rbe.solvers`; this module chooses them by accuracy preset (SPEC 6.6), runs the
-thesis's friction flow (friction-net, then friction+ when the structure is infeasible),
-checks what every solver returned and packs the result. A solver's status is never
+:mod:`masonry.rbe.solvers`; this module chooses them by accuracy preset
+(:mod:`masonry.rbe.accuracy`, SPEC 6.6), runs the thesis's friction flow (friction-net,
+then friction+ when the structure is infeasible), checks what every solver returned and
+packs the result. A solver's status is never
 trusted alone: the equilibrium residual and the friction violation are recomputed from
-the returned point, and an independent linear program (scipy's HiGHS) can check
-friction-net feasibility.
+the returned point (every backend's outcome carries them), and an independent linear
+program (HiGHS) can check friction-net feasibility.
 
 :class:`RBEProblem` keeps one scene's matrices, symbolic factorizations and solver
 objects between solves, so a sweep over ``mu`` or ``density``, or friction+ after
@@ -26,70 +27,28 @@ import functools
 import logging
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-import highspy
 import numpy as np
 import scipy.sparse as sp
 
 from masonry import forking
+from masonry.friction import FrictionCone
+from masonry.rbe.accuracy import ACCURACY, AccuracyPreset, friction_model
+from masonry.rbe.cores import Alongside, solver_threads
 from masonry.rbe.equilibrium import (FRICTION_METHODS, EquilibriumSystem, VariableLayout,
                                      assemble, friction_edges)
-from masonry.friction import FrictionCone
-from masonry.rbe.cores import Alongside, solver_threads
-from masonry.rbe.solvers import BACKENDS, FAMILY, net_feasibility
+from masonry.rbe.solvers import BACKENDS, RBE, backend, names, net_feasibility
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL
-from masonry.rbe.solvers.highs import highs_lp
+from masonry.rbe.solvers.highs import nonnegative_solution
 from masonry.rbe.solvers.newton import NewtonOptions, prepared_system
-from masonry.tolerances import ACCEPT_RESIDUAL, Tolerances
+from masonry.rbe.solvers.residuals import Residuals
+from masonry.tolerances import Tolerances
+
+__all__ = ["ACCURACY", "AccuracyPreset", "RBEProblem", "RBEResult", "friction_model",
+           "interface_forces", "solve_rbe"]
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class AccuracyPreset:
-    """A documented choice of solvers and tolerances (SPEC 6.6).
-
-    Parameters
-    ----------
-    name : str
-    net_solver, plus_solver : str
-        :data:`masonry.rbe.solvers.BACKENDS` names for friction-net and friction+. An
-        explicit ``solver`` argument replaces both.
-    residual : float
-        Acceptance: a returned point counts when its relative equilibrium residual and
-        friction violation are at most this (``Tolerances.residual``; the balanced
-        preset's is :data:`~masonry.tolerances.ACCEPT_RESIDUAL`).
-    lp_check : bool or 'infeasible'
-        Run the independent friction-net LP (HiGHS): always, never, or only to confirm
-        an infeasible verdict. A feasible verdict needs no second opinion: it rests on
-        a point whose equilibrium and friction residuals were recomputed here.
-    load_path : bool
-        When Newton neither solves nor certifies friction-net, decide feasibility by
-        the load-path LP on Newton's matrix (:mod:`masonry.rbe.solvers.net_feasibility`)
-        before Clarabel: its certificate ends friction-net; a feasible verdict resumes
-        Newton from where it stopped, then Clarabel.
-    cone : str
-        The friction model (:mod:`masonry.friction`) unless one is given.
-    polish : bool
-        Refine an accepted interior-point or ADMM point with Newton steps started from
-        its multipliers (:mod:`masonry.rbe.solvers.newton`): one or two steps find the exact
-        active set, which leaves residuals near rounding and no interior-point tension
-        (Clarabel at 1e-10 left 1e-6 of the weight as tension on a feasible section).
-        Kept only if it converges within :data:`POLISH_STEPS`.
-    options : dict
-        Solver settings per family (``newton``, ``interior``, ``clarabel``, ``osqp``).
-    """
-
-    name: str
-    net_solver: str
-    plus_solver: str
-    residual: float
-    lp_check: bool | str
-    cone: str = "circle"
-    load_path: bool = False
-    polish: bool = False
-    options: dict = field(default_factory=dict)
 
 
 POLISH_STEPS = 20
@@ -107,55 +66,6 @@ tiny steps (preset 1's free section at mu 1.0 under the square pyramid: 10 steps
 kept)."""
 
 
-ACCURACY = {
-    # Newton for friction-net, the interior point method on the Newton system for
-    # friction+ (both factor the 6-rows-per-block matrix): Newton converges fast once the
-    # active set of the friction cones is found, so a looser stop saves little; the savings are
-    # the interior point's last iterations and the acceptance of OSQP's ADMM points.
-    "fast": AccuracyPreset(
-        "fast", "newton", "interior", residual=1e-4, lp_check=False, load_path=True,
-        polish=False,
-        options={"newton": {"tol": 1e-6},
-                 "interior": {"tol": 1e-6},
-                 "clarabel": {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-6},
-                 "osqp": {"eps_abs": 1e-4, "eps_rel": 1e-4, "max_iter": 100_000,
-                          "polishing": False}}),
-    # the default: friction-net by Newton (preset 1's full dome: 10 factorizations
-    # of a 38,000-row system where Clarabel factors a 790,000-row one 16 times);
-    # friction+ by the interior point method on the same system, polished by Newton
-    # (Newton alone on friction+ is slowed by the 1,000:1 tension weight: more than 100
-    # steps on preset 1's free section). When Newton neither solves nor certifies
-    # friction-net (low-friction domes), the load-path LP on the same matrix decides
-    # (preset 1's full dome at mu 0.05: 6 iterations where Clarabel took 22 on its
-    # KKT system); Clarabel takes over when either method fails.
-    "balanced": AccuracyPreset(
-        "balanced", "newton", "interior", residual=ACCEPT_RESIDUAL, lp_check=False,
-        load_path=True,
-        polish=True,
-        options={"newton": {"tol": 1e-9},
-                 "interior": {"tol": 1e-10},
-                 "clarabel": {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8},
-                 # cvxpy's defaults (eps 1e-5, 10,000 iterations) leave residuals near
-                 # the acceptance tolerance; 1e-6 keeps a margin
-                 "osqp": {"eps_abs": 1e-7, "eps_rel": 1e-7, "max_iter": 100_000,
-                          "polishing": True}}),
-    # the reference: Clarabel (an independent implementation) with tight gaps for both
-    # models, polished, and the LP's second opinion on an infeasible verdict only (on
-    # feasible ones it is slow and adds nothing: docs/bench.md). Clarabel's default gaps
-    # (1e-8) leave 2.6e-6 of the weight as interior-point tension on the straight wall;
-    # 1e-10 leaves 2.4e-7.
-    "accurate": AccuracyPreset(
-        "accurate", "clarabel", "clarabel", residual=1e-6, lp_check="infeasible",
-        polish=True,
-        options={"newton": {"tol": 1e-12},
-                 "interior": {"tol": 1e-10},
-                 "clarabel": {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10,
-                              "tol_feas": 1e-10},
-                 "osqp": {"eps_abs": 1e-8, "eps_rel": 1e-8, "max_iter": 200_000,
-                          "polishing": True}}),
-}
-"""Accuracy preset name -> :class:`AccuracyPreset`."""
-
 LOAD_PATH = "load-path-lp"
 """The load-path LP's name among the candidates and in :attr:`RBEResult.attempts`."""
 
@@ -171,12 +81,12 @@ LOAD_PATH_DAMPED_OUT = 3
 otherwise): steps in a row ending at the damping ceiling before the LP decides. On the
 infeasible low-friction domes measured, Newton's steps ended there in long runs until
 its stall (preset 1's dome at mu 0.05: 20 in a row from its eighth step); no feasible
-structure measured ended two steps in a row there (docs/bench.md, issue 15d). A wrong
+structure measured ended two steps in a row there (docs/bench.md). A wrong
 hand-over costs one LP, never a wrong verdict: a feasible verdict resumes Newton without
 this rule."""
 
-SOLVERS = tuple(BACKENDS)
-"""Every solver name :func:`solve_rbe` accepts."""
+SOLVERS = names(RBE)
+"""Every solver name :func:`solve_rbe` accepts (the registry's RBE backends)."""
 
 RESULT_KEYS = ("verdict", "feasible", "friction", "mu", "friction_model",
                "friction_capacity_error", "objective", "moi", "moi_factor", "weight_N",
@@ -349,7 +259,8 @@ class RBEProblem:
         start = time.perf_counter()
         preset, tol, lp_check = _settings(friction, solver, tol, accuracy, lp_check)
         cone = friction_model(preset.name, cone)
-        _check_solver(solver, cone)
+        if solver is not None:
+            backend(solver, RBE, cone)  # refuses a friction model it cannot state
         system = self.system.with_material(mu=mu, density=density, cone=cone)
         cores = forking.usable_cores(cores)
         with solver_threads(cores):
@@ -409,19 +320,18 @@ class RBEProblem:
                 hand_over = ({"stall": LOAD_PATH_STALL, "damped_out": LOAD_PATH_DAMPED_OUT}
                              if LOAD_PATH in candidates[index:] else {})
                 outcome = self._run(system, method, name, preset, **hand_over)
-            checks = _check(system, outcome.x, method)
+            checks = outcome.residuals
             accepted = _accepted(checks, tol)
             attempts.append(_record(method, name, outcome))
             if outcome.x is not None and not accepted:
                 log.info("%s rejected the %s solution with status %r: equilibrium "
-                            "residual %.2e, friction violation %.2e (tolerance %.1e)",
-                            name, method, outcome.status, checks[0], checks[1],
-                            tol.residual)
+                         "residual %.2e, friction violation %.2e (tolerance %.1e)",
+                         name, method, outcome.status, checks.equilibrium,
+                         checks.friction, tol.residual)
             if accepted and preset.polish and name != "newton" and outcome.y is not None:
                 polished = self._polish(system, method, outcome, tol, attempts)
                 if polished is not None:
-                    outcome, checks, name = polished, _check(system, polished.x, method), \
-                        f"{name}+newton"
+                    outcome, checks, name = polished, polished.residuals, f"{name}+newton"
             if accepted or outcome.status == INFEASIBLE:
                 if outcome.status == INFEASIBLE:
                     log.info("%s certified friction-%s infeasible", name, method)
@@ -451,8 +361,8 @@ class RBEProblem:
         attempts.append(_record("net", LOAD_PATH, decided))
         log.info("the load-path LP found friction-net %s: Newton resumes",
                  decided.info["verdict"])
-        return "newton", BACKENDS["newton"](system, "net", dict(options), workspace,
-                                            y0=stalled.y)
+        return "newton", BACKENDS["newton"].solve_rbe(system, "net", dict(options),
+                                                      workspace, y0=stalled.y)
 
     def _polish(self, system, method, outcome, tol, attempts):
         """Newton steps from ``outcome``'s multipliers: the polished outcome, or None when
@@ -461,9 +371,10 @@ class RBEProblem:
         workspace = self._workspace("newton")
         options = {"tol": min(tol.residual, 1e-9), "max_iter": POLISH_STEPS,
                    "stall": POLISH_STALL}
-        polished = BACKENDS["newton"](system, method, options, workspace, y0=outcome.y)
+        polished = BACKENDS["newton"].solve_rbe(system, method, options, workspace,
+                                                y0=outcome.y)
         attempts.append(_record(method, "newton-polish", polished))
-        if polished.status == OPTIMAL and _accepted(_check(system, polished.x, method), tol):
+        if polished.status == OPTIMAL and _accepted(polished.residuals, tol):
             return polished
         log.info("Newton polish of the %s solution did not converge in %d steps (%s); "
                  "the unpolished point is kept", method, POLISH_STEPS, polished.status)
@@ -474,7 +385,8 @@ class RBEProblem:
         """Pack the last model's outcome: residuals, forces in newtons, the verdict and
         the LP's second opinion."""
         checks, accepted, outcome = solved.checks, solved.accepted, solved.outcome
-        residual_eq, violation, net_violation = (np.nan,) * 3 if checks is None else checks
+        residual_eq, violation, net_violation = ((np.nan,) * 3 if checks is None else (
+            checks.equilibrium, checks.friction, checks.net_friction))
         # a rejected point is no solution: its residuals are reported, its forces are not
         x = system.to_newtons(outcome.x) if accepted else None
         feasible = bool(accepted and net_violation <= tol.residual)
@@ -507,28 +419,26 @@ class RBEProblem:
 
     def _workspace(self, name):
         """The workspace of a backend; the Newton-system backends (semismooth Newton,
-        interior point) share one: the symbolic factorization and prepared matrices."""
-        return self._workspaces.setdefault(WORKSPACE.get(name, name), {})
+        interior point) share one: the symbolic factorization and prepared matrices
+        (:attr:`~masonry.rbe.solvers.base.Backend.workspace`)."""
+        return self._workspaces.setdefault(BACKENDS[name].workspace, {})
 
     def _run(self, system, method, name, preset, **overrides):
-        options = {**preset.options.get(FAMILY[name], {}), **overrides}
-        return BACKENDS[name](system, method, options, self._workspace(name))
+        chosen = BACKENDS[name]
+        options = {**preset.options.get(chosen.settings, {}), **overrides}
+        return chosen.solve_rbe(system, method, options, self._workspace(name))
 
 
 @dataclass(frozen=True)
 class _Solved:
     """The last outcome for one friction model: its solver's name (``+newton`` when
-    polished), the outcome, its residual checks, and whether the point was accepted."""
+    polished), the outcome, its residuals, and whether the point was accepted."""
 
     method: str
     name: str
     outcome: object
-    checks: tuple | None
+    checks: Residuals | None
     accepted: bool
-
-
-WORKSPACE = {"interior": "newton"}
-"""Backends that share another's workspace (see :meth:`RBEProblem._workspace`)."""
 
 
 def _settings(friction, solver, tol, accuracy, lp_check):
@@ -540,29 +450,11 @@ def _settings(friction, solver, tol, accuracy, lp_check):
         raise ValueError(f"unknown accuracy {accuracy!r}; choose from {list(ACCURACY)}")
     if isinstance(lp_check, str) and lp_check != "infeasible":
         raise ValueError(f"lp_check must be a bool or 'infeasible', not {lp_check!r}")
-    if solver is not None and solver not in BACKENDS:
-        raise ValueError(f"unknown solver {solver!r}; choose from {list(BACKENDS)}")
+    if solver is not None:
+        backend(solver, RBE)  # an unknown name, or one that does not solve the QP
     preset = ACCURACY[accuracy]
     tol = Tolerances(residual=preset.residual) if tol is None else tol
     return preset, tol, preset.lp_check if lp_check is None else lp_check
-
-
-def friction_model(accuracy="balanced", cone=None) -> FrictionCone:
-    """The friction model of a solve: ``cone`` (a name or a :class:`FrictionCone`) if
-    given, else the accuracy preset's."""
-    return FrictionCone.parse(ACCURACY[accuracy].cone if cone is None else cone)
-
-
-POLYHEDRAL_ONLY = ("osqp", "osqp-cvxpy")
-"""Solvers that take linear constraints only: the pyramids, not Coulomb's cone."""
-
-
-def _check_solver(solver, cone):
-    """Refuse a solver that cannot state the friction model (``ValueError``)."""
-    if solver in POLYHEDRAL_ONLY and not cone.is_polyhedral:
-        raise ValueError(f"{solver} takes linear constraints only: the friction model "
-                         f"{cone} needs newton, interior or clarabel, or a polygon:K model")
-
 
 def _candidates(method, solver, preset) -> list:
     """Solvers to try for ``method``, in order: the explicit ``solver`` alone, else the
@@ -580,7 +472,7 @@ def _candidates(method, solver, preset) -> list:
 
 
 def _accepted(checks, tol) -> bool:
-    return checks is not None and max(checks[0], checks[1]) <= tol.residual
+    return checks is not None and max(checks.equilibrium, checks.friction) <= tol.residual
 
 
 def _record(method, name, outcome) -> dict:
@@ -631,8 +523,8 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
         ``'auto'`` (thesis 3.3.3): friction-net first; when it has no accepted solution,
         friction+ and report that.
     solver : str, optional
-        A :data:`masonry.rbe.solvers.BACKENDS` name (:data:`SOLVERS`) for both friction
-        models, with the preset's settings for it. Default: the preset's solvers.
+        A backend of the RBE QP (:data:`SOLVERS`) for both friction models, with the
+        preset's settings for it. Default: the preset's solvers.
     tol : Tolerances, optional
         ``tol.residual`` bounds the relative equilibrium residual and the friction
         violation of an accepted solution. Default: the preset's ``residual``.
@@ -681,29 +573,6 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
     return dataclasses.replace(result, time_s=time.perf_counter() - start)
 
 
-def _check(system: EquilibriumSystem, x_scaled, method: str):
-    """Residuals of a returned point, recomputed from the matrices.
-
-    Returns ``(residual_eq, violation, net_violation)`` or None without a point.
-    ``residual_eq = ||A_eq x + f_ext||_inf / ||f_ext||_inf``; the violations are the
-    largest positive ``A_fr x`` (of ``method`` and of friction-net) or bound excess, in
-    units of the reference weight.
-    """
-    if x_scaled is None:
-        return None
-    residual_eq = (np.abs(system.times_A_eq(x_scaled) + system.f_ext).max()
-                   / np.abs(system.f_ext).max())
-    bound = max(0.0, float((system.lower - x_scaled).max()))
-    c, t, f1, f2 = np.asarray(x_scaled).reshape(-1, 4).T
-
-    def violation(name):
-        load = c - t if name == "net" else c
-        excess = system.cone.excess(load, f1, f2, system.mu)
-        return max(bound, float(excess.max(initial=0.0)))
-
-    return float(residual_eq), violation(method), violation("net")
-
-
 LP_CHECK_SIDES = 16
 """Coulomb's cone is checked by linear programming on a 16-sided pyramid: the inscribed
 one (1.9 % short of the cone) for a feasible verdict, the circumscribed one (1.9 % over)
@@ -746,17 +615,7 @@ def _edges_feasible(system, cone, mu, time_limit):
     True, False or None (no verdict)."""
     generators = friction_edges(system.layout.n_vertices, cone, mu)
     A = sp.csc_array(system.A_eq @ generators)
-    solver = highs_lp(A, np.zeros(A.shape[1]), np.zeros(A.shape[1]),
-                      np.full(A.shape[1], highspy.kHighsInf), -system.f_ext, -system.f_ext,
-                      (("solver", "ipm"), ("run_crossover", "off"),
-                       ("time_limit", float(time_limit))))
-    solver.run()
-    status = solver.getModelStatus()
-    if status == highspy.HighsModelStatus.kOptimal:
-        return True
-    # with a zero objective nothing is unbounded: either verdict means infeasible
-    if status in (highspy.HighsModelStatus.kInfeasible,
-                  highspy.HighsModelStatus.kUnboundedOrInfeasible):
-        return False
-    log.warning("friction-net LP inconclusive: %s", solver.modelStatusToString(status))
-    return None
+    verdict, words = nonnegative_solution(A, -system.f_ext, time_limit)
+    if verdict is None:
+        log.warning("friction-net LP inconclusive: %s", words)
+    return verdict

@@ -1,21 +1,34 @@
-"""Clarabel (interior point, homogeneous embedding) on the standard form, without cvxpy.
+"""Clarabel (interior point, homogeneous embedding): the RBE QP and the collapse program.
 
-Clarabel writes constraints as ``A x + s = b, s in K``: the equilibrium rows are a zero
-cone, a pyramid's friction rows a nonnegative cone and Coulomb's cone a second-order
-cone per vertex, the ``t >= 0`` rows a nonnegative cone (``t`` enters as ``-t + s =
-0``). One solver per scene and friction model; friction+ and other friction
-coefficients update the matrix values in place, which keeps Clarabel's KKT ordering
-(data updates need presolve off; presolve only drops rows with infinite bounds, and this
-problem has none).
+The RBE QP on the standard form, without cvxpy. Clarabel writes constraints as ``A x +
+s = b, s in K``: the equilibrium rows are a zero cone, a pyramid's friction rows a
+nonnegative cone and Coulomb's cone a second-order cone per vertex, the ``t >= 0`` rows
+a nonnegative cone (``t`` enters as ``-t + s = 0``). One solver per scene and friction
+model; friction+ and other friction coefficients update the matrix values in place,
+which keeps Clarabel's KKT ordering (data updates need presolve off; presolve only drops
+rows with infinite bounds, and this problem has none).
+
+The collapse program (:class:`ClarabelProgram`): the equilibrium (and tie) rows in the
+zero cone, the columns' cones after them (:mod:`masonry.rbe.solvers.program`). Clarabel
+tells a dead load that cannot stand from a live load carried at any factor, which the
+own interior point method does not (:mod:`masonry.rbe.collapse` asks it then).
 """
 
+import logging
 import time
 
+import clarabel
 import numpy as np
+import scipy.sparse as sp
 
-from masonry.rbe.solvers.base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL, OPTIMAL_INACCURATE,
-                   SOLVER_ERROR, USER_LIMIT, QPOutcome)
+from masonry.rbe.solvers.base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL,
+                                      OPTIMAL_INACCURATE, SOLVER_ERROR, UNBOUNDED, USER_LIMIT,
+                                      Backend, Outcome)
+from masonry.rbe.solvers.program import NONNEGATIVE, HeldProgram
 from masonry.rbe.solvers.standard_form import kept_form
+from masonry.tolerances import ACCEPT_RESIDUAL
+
+log = logging.getLogger(__name__)
 
 STATUS = {
     "Solved": OPTIMAL,
@@ -35,10 +48,8 @@ DEFAULTS = {
 }
 
 
-def solve(system, method, options, workspace) -> QPOutcome:
+def solve(system, method, options, workspace) -> Outcome:
     """One Clarabel solve; ``options`` are Clarabel settings (``DefaultSettings`` fields)."""
-    import clarabel
-
     start = time.perf_counter()
     form = kept_form(system, workspace)
     values = form.values(method, system.mu)
@@ -72,8 +83,8 @@ def solve(system, method, options, workspace) -> QPOutcome:
     # the equilibrium rows' multipliers in the Newton method's convention (L = 1/2 x^T P x
     # - y^T (A_eq x - b)); Clarabel's are those of A x + s = b, the opposite sign
     y = None if x is None else -np.array(result.z)[:form.n_eq]
-    return QPOutcome(status=status, x=x, iterations=int(result.iterations), y=y,
-                     setup_time=setup, solve_time=time.perf_counter() - start - setup)
+    return Outcome(status=status, x=x, iterations=int(result.iterations), y=y,
+                   setup_time=setup, solve_time=time.perf_counter() - start - setup)
 
 
 def _tension_rows(form):
@@ -81,3 +92,109 @@ def _tension_rows(form):
     rows = form.rows
     row_of_slot = rows.indices
     return np.flatnonzero(row_of_slot >= form.n_eq + form.n_friction)
+
+
+PROGRAM_SETTINGS = {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8}
+"""Clarabel's tolerances for the collapse program (its defaults; scaled rows of order
+one); tighter gaps end "almost solved" on the full domes (docs/collapse.md)."""
+
+PROGRAM_STATUS = {"Solved": OPTIMAL, "AlmostSolved": OPTIMAL,
+                  "PrimalInfeasible": INFEASIBLE, "DualInfeasible": UNBOUNDED}
+"""Clarabel's verdicts on a collapse program; other statuses keep Clarabel's words. An
+"almost solved" point is kept when its equilibrium rows meet
+:data:`~masonry.tolerances.ACCEPT_RESIDUAL` (with a warning)."""
+
+
+class ClarabelProgram(HeldProgram):
+    """A collapse program held by Clarabel (interior point, direct LDL): ``minimize -cost
+    . lambda`` over ``[g, lambda]`` with the equilibrium (and tie) rows in the zero cone
+    and the columns' cone constraints after them. A new lateral direction updates two
+    entries of ``A`` and the costs in place, which keeps the symbolic factorization."""
+
+    def __init__(self, program, workspace):
+        super().__init__(program, workspace)
+        matrix, loads, columns, tie = program.matrix, program.loads, program.columns, program.tie
+        n, m = matrix.shape[1], loads.shape[1]
+        rows = [sp.hstack([matrix, sp.csc_array(loads)])]
+        if tie is not None:
+            rows.append(sp.csc_array((np.asarray(tie, dtype=float), ([0, 0], [n, n + 1])),
+                                     shape=(1, n + m)))
+        self.n_eq = sum(r.shape[0] for r in rows)
+        rows.append(sp.hstack([columns.G, sp.csc_array((columns.G.shape[0], m))]))
+        self.cones = [clarabel.ZeroConeT(self.n_eq), *_cones(columns.cones)]
+        self.A = sp.csc_matrix(sp.vstack(rows, format="csc"))
+        self.A.sort_indices()
+        rhs = program.rhs
+        self.b = np.concatenate([rhs, np.zeros(self.n_eq - len(rhs)), columns.h])
+        self.q = np.concatenate([np.zeros(n), -np.asarray(program.cost, dtype=float)])
+        self.n, self.m = n, m
+        if tie is not None:  # where the tie row's two entries sit in A.data
+            self.tie_at = [self.A.indptr[c] + np.flatnonzero(
+                self.A.indices[self.A.indptr[c]:self.A.indptr[c + 1]] == self.n_eq - 1)[0]
+                for c in (n, n + 1)]
+        self.solver = None
+
+    def _settings(self):
+        settings = clarabel.DefaultSettings()
+        settings.verbose = False
+        settings.presolve_enable = False  # keep the rows: data updates need them
+        settings.time_limit = float(self.program.time_limit)
+        for name, value in PROGRAM_SETTINGS.items():
+            setattr(settings, name, value)
+        return settings
+
+    def solve(self) -> Outcome:
+        start = time.perf_counter()
+        if self.solver is None:
+            size = self.n + self.m
+            self.solver = clarabel.DefaultSolver(sp.csc_matrix((size, size)), self.q,
+                                                 self.A, self.b, self.cones, self._settings())
+        setup = time.perf_counter() - start
+        solution = self.solver.solve()
+        status = str(solution.status)
+        words = PROGRAM_STATUS.get(status, status)
+        iterations = int(solution.iterations)
+        if status == "AlmostSolved":
+            x = np.array(solution.x)
+            residual = np.abs(self.A[: self.n_eq] @ x - self.b[: self.n_eq]).max()
+            if residual > ACCEPT_RESIDUAL * np.abs(self.b[: self.n_eq]).max():
+                words = status
+            else:
+                log.warning("Clarabel: almost solved, kept (relative residual %.1e)",
+                            residual / np.abs(self.b[: self.n_eq]).max())
+        times = dict(setup_time=setup, solve_time=time.perf_counter() - start - setup)
+        if words != OPTIMAL:
+            return Outcome(words, None, iterations, **times)
+        x = np.array(solution.x)
+        rows = self.program.matrix.shape[0]
+        return Outcome(OPTIMAL, self.program.columns.edges @ x[:self.n], iterations,
+                       y=np.array(solution.z)[:rows],
+                       info={"load_factor": float(-self.q[self.n:] @ x[self.n:])}, **times)
+
+    def stands_unloaded(self) -> bool | None:
+        """The dead load alone: the load columns dropped, a zero objective."""
+        A = sp.csc_matrix(self.A[:, : self.n])
+        solver = clarabel.DefaultSolver(sp.csc_matrix((self.n, self.n)), np.zeros(self.n),
+                                        A, self.b, self.cones, self._settings())
+        status = str(solver.solve().status)
+        return {"Solved": True, "PrimalInfeasible": False}.get(status)
+
+    def direct(self, cos, sin):
+        self.A.data[self.tie_at[0]], self.A.data[self.tie_at[1]] = -sin, cos
+        self.q[self.n:] = (-cos, -sin)
+        if self.solver is not None:
+            self.solver.update(q=self.q, A=self.A)
+
+
+def _cones(cones) -> list:
+    """Clarabel's cones of :attr:`~masonry.rbe.solvers.program.Columns.cones`."""
+    out = []
+    for kind, dimension, count in cones:
+        cone = (clarabel.NonnegativeConeT(dimension) if kind == NONNEGATIVE
+                else clarabel.SecondOrderConeT(dimension))
+        out += [cone] * count
+    return out
+
+
+BACKEND = Backend("clarabel", settings="clarabel", rbe=solve, collapse=ClarabelProgram)
+"""Clarabel: the RBE QP (every friction model) and the collapse program."""

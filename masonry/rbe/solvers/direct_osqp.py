@@ -11,8 +11,9 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from masonry.rbe.solvers.base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL, OPTIMAL_INACCURATE,
-                   SOLVER_ERROR, USER_LIMIT, QPOutcome)
+from masonry.rbe.solvers.base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL,
+                                      OPTIMAL_INACCURATE, SOLVER_ERROR, USER_LIMIT, Backend,
+                                      Outcome)
 from masonry.rbe.solvers.standard_form import kept_form
 
 STATUS = {
@@ -32,13 +33,10 @@ def _csc32(matrix):
                           matrix.indptr.astype(np.int32)), shape=matrix.shape)
 
 
-def solve(system, method, options, workspace) -> QPOutcome:
+def solve(system, method, options, workspace) -> Outcome:
     """One OSQP solve; ``options`` are OSQP settings, ``workspace`` a dict kept per scene."""
     import osqp
 
-    if not system.cone.is_polyhedral:
-        raise ValueError(f"OSQP takes linear constraints only: the friction model "
-                         f"{system.cone} needs another solver, or a polygon:K model")
     start = time.perf_counter()
     form = kept_form(system, workspace)
     values = form.values(method, system.mu)
@@ -70,7 +68,11 @@ def solve(system, method, options, workspace) -> QPOutcome:
         x = None
     # OSQP's multipliers of the equilibrium rows (stationarity P x + A^T y = 0) are the
     # Newton method's with the opposite sign
-    return QPOutcome(status=status, x=x, iterations=int(result.info.iter),
-                     y=None if x is None else -result.y[:form.n_eq],
-                     setup_time=setup, solve_time=time.perf_counter() - start - setup,
-                     info={"polish": int(result.info.status_polish)})
+    return Outcome(status=status, x=x, iterations=int(result.info.iter),
+                   y=None if x is None else -result.y[:form.n_eq],
+                   setup_time=setup, solve_time=time.perf_counter() - start - setup,
+                   info={"polish": int(result.info.status_polish)})
+
+
+BACKEND = Backend("osqp", settings="osqp", rbe=solve, polyhedral_only=True)
+"""OSQP: the RBE QP of the pyramids."""

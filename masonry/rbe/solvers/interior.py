@@ -29,6 +29,9 @@ the exact active set.
 
 It assumes the problem is feasible (friction+ always is): there is no infeasibility
 detection, an infeasible problem ends at ``max_iter`` with status ``user_limit``.
+
+The backend ``interior`` (:data:`BACKEND`) is this method for the RBE QP and its
+counterpart for the collapse program (:mod:`masonry.rbe.solvers.interior_lp`).
 """
 
 import dataclasses
@@ -38,8 +41,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
+from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, Backend, Outcome
 from masonry.rbe.solvers.cones import Lorentz, Orthant, centred_start
+from masonry.rbe.solvers.interior_lp import InteriorProgram
 from masonry.rbe.solvers.newton import NewtonSystem, prepared_system
 
 log = logging.getLogger(__name__)
@@ -219,12 +223,12 @@ def _dot(a, b) -> float:
     return float(sum(x.ravel() @ y.ravel() for x, y in zip(a, b)))
 
 
-def solve(ns: NewtonSystem, options: InteriorOptions) -> QPOutcome:
+def solve(ns: NewtonSystem, options: InteriorOptions) -> Outcome:
     """Solve the scaled QP of ``ns`` (its friction model and ``mu``).
 
     Returns
     -------
-    QPOutcome
+    Outcome
         ``x`` as (IV, width) forces in the columns of ``ns`` (the caller spreads them to
         the full layout), ``y`` the equilibrium multipliers in the Newton method's
         convention (``H x = A^T y - G^T z``); status ``optimal``, ``user_limit`` (the
@@ -296,12 +300,12 @@ def solve(ns: NewtonSystem, options: InteriorOptions) -> QPOutcome:
                   "%.2e), step %.3f, sigma %.2e", iterations, np.abs(r_primal).max() / b_inf,
                   np.abs(r_dual).max() / max(1.0, np.abs(h * x).max()), gap, objective,
                   step, sigma)
-    return QPOutcome(status=status, x=x, iterations=iterations, y=y,
-                     solve_time=time.perf_counter() - start,
-                     info={"factorizations": iterations + 1})
+    return Outcome(status=status, x=x, iterations=iterations, y=y,
+                   solve_time=time.perf_counter() - start,
+                   info={"factorizations": iterations + 1})
 
 
-def backend(system, method, options, workspace) -> QPOutcome:
+def backend(system, method, options, workspace) -> Outcome:
     """The :mod:`masonry.rbe.solvers` interface: ``options`` are :class:`InteriorOptions`
     fields; the workspace is shared with the Newton backend (its prepared systems and
     their symbolic factorization)."""
@@ -311,3 +315,9 @@ def backend(system, method, options, workspace) -> QPOutcome:
     outcome = solve(ns, InteriorOptions(**options))
     return dataclasses.replace(outcome, x=ns.full_vector(outcome.x, system.layout),
                                setup_time=preparation)
+
+
+BACKEND = Backend("interior", settings="interior", rbe=backend, collapse=InteriorProgram,
+                  workspace="newton")
+"""The interior point methods on the Newton method's matrix: the RBE QP and the collapse
+program (every friction model); they share the Newton backend's prepared systems."""

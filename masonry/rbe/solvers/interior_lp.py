@@ -39,17 +39,23 @@ variable and constraint.
 It assumes the LP has an optimum: when the dead load cannot stand at any factor, or the
 live load is carried at every factor, it ends without one (status ``user_limit``) and
 :mod:`masonry.rbe.collapse` asks Clarabel, which detects both.
+
+:class:`InteriorProgram` holds a collapse program (:mod:`masonry.rbe.solvers.program`)
+for it: the friction-net Newton system is prepared once per model (its symbolic
+factorization serves every load case).
 """
 
+import dataclasses
 import logging
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
+from masonry.rbe.solvers.base import OPTIMAL, SOLVER_ERROR, USER_LIMIT, Outcome
 from masonry.rbe.solvers.cones import Lorentz, Orthant, centred_start
-from masonry.rbe.solvers.newton import NewtonSystem
+from masonry.rbe.solvers.newton import NewtonSystem, prepared_system
+from masonry.rbe.solvers.program import HeldProgram
 from masonry.tolerances import ACCEPT_RESIDUAL
 
 log = logging.getLogger(__name__)
@@ -288,7 +294,7 @@ def _start(variables, load, regularization):
 
 
 def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
-                stop=None) -> QPOutcome:
+                stop=None) -> Outcome:
     """The largest ``lambda`` of the collapse LP (module docstring) on the friction-net
     system ``ns`` (its friction model and ``mu``), for the live load ``load`` ((6 F,)
     float, scaled rows).
@@ -304,7 +310,7 @@ def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
 
     Returns
     -------
-    QPOutcome
+    Outcome
         ``x`` the vertex forces ``T g`` ((IV, 3): ``c, f1, f2``, scaled), ``y`` the
         mechanism (the equilibrium rows' multipliers), ``info["load_factor"]`` and
         ``info["dual_bound"]`` (``-b^T y``: with exact dual rows, an upper bound of the
@@ -349,11 +355,11 @@ def load_factor(ns: NewtonSystem, load, options: LoadFactorOptions, *, rhs=None,
                   np.abs(residuals[0]).max() / scale,
                   np.abs(residuals[1]).max() / max(residuals[3], 1.0), abs(residuals[2]),
                   float(g.ravel() @ s.ravel()), primal, dual)
-    return QPOutcome(status=status, x=g @ variables.T.T, iterations=iterations, y=y,
-                     solve_time=time.perf_counter() - start,
-                     info={"factorizations": iterations + 1, "load_factor": factor,
-                           "dual_bound": -float(ns.b @ y), "stopped": stopped,
-                           "cone_variables": g})
+    return Outcome(status=status, x=g @ variables.T.T, iterations=iterations, y=y,
+                   solve_time=time.perf_counter() - start,
+                   info={"factorizations": iterations + 1, "load_factor": factor,
+                         "dual_bound": -float(ns.b @ y), "stopped": stopped,
+                         "cone_variables": g})
 
 
 def _residuals(variables, load, g, y, s, factor):
@@ -422,3 +428,43 @@ def _centrality_correctors(normal, residuals, g, s, r_comp, target, direction, s
 def _steps(cone, g, s, dg, ds):
     """The largest steps ``<= 1`` that keep ``g`` and ``s`` in the cone."""
     return cone.max_step(g, dg), cone.max_step(s, ds)
+
+
+class InteriorProgram(HeldProgram):
+    """A collapse program solved by :func:`load_factor`: the load columns combined by the
+    costs (a lateral direction: ``cos, sin``) into one live load, on the friction-net
+    Newton system of the program's model (prepared once in the workspace). It assumes an
+    optimum: without one the outcome's status is not ``optimal`` and
+    :meth:`stands_unloaded` says None; the caller then asks a backend that tells which
+    (:mod:`masonry.rbe.collapse`).
+
+    Raises
+    ------
+    ValueError
+        Columns at a fixed friction capacity: it states the friction model at ``mu c``.
+    """
+
+    def __init__(self, program, workspace):
+        super().__init__(program, workspace)
+        if not program.columns.is_friction_model:
+            raise ValueError("the interior point method states the friction model at mu c "
+                             "only: a fixed friction capacity needs clarabel")
+        self.ns = prepared_system(program.system, "net", workspace)
+        self.cost = np.asarray(program.cost, dtype=float)
+
+    def solve(self) -> Outcome:
+        outcome = load_factor(self.ns, self.program.loads @ self.cost, LoadFactorOptions())
+        return dataclasses.replace(
+            outcome, x=self.ns.full_vector(outcome.x, self.program.system.layout))
+
+    def stands_unloaded(self) -> bool | None:
+        """The feasible factors are an interval: ``lambda = 0`` lies in it when the
+        largest factor of the reversed load is also at least 0."""
+        reversed_load = load_factor(self.ns, -(self.program.loads @ self.cost),
+                                    LoadFactorOptions())
+        if reversed_load.status == OPTIMAL:
+            return reversed_load.info["load_factor"] >= 0
+        return None
+
+    def direct(self, cos, sin):
+        self.cost = np.array([cos, sin])

@@ -51,7 +51,7 @@ import time
 
 import numpy as np
 
-from masonry.rbe.solvers.base import INFEASIBLE, USER_LIMIT, QPOutcome
+from masonry.rbe.solvers.base import INFEASIBLE, USER_LIMIT, Outcome
 from masonry.rbe.solvers.interior_lp import ConeVariables, LoadFactorOptions, load_factor
 from masonry.rbe.solvers.newton import NewtonSystem
 
@@ -112,12 +112,11 @@ class _LoadPath:
 
 OPTIONS = LoadFactorOptions(correctors=1)
 """The LP's settings: one centrality corrector, not the collapse LP's two. The verdict
-comes within 4 to 8 iterations, too few for a second corrector to pay for its solve:
-preset 1's full dome at mu 0.05 certified in 5 iterations, 1.8 s CPU, against 6
-iterations, 2.7 to 3.6 s with two (``docs/bench.md``, issue 15f)."""
+comes within 4 to 8 iterations, too few for a second corrector to pay for its solve
+(``docs/bench.md``, the load-path LP's correctors)."""
 
 
-def decide(ns: NewtonSystem, infeasibility_tol, residual, options=OPTIONS) -> QPOutcome:
+def decide(ns: NewtonSystem, infeasibility_tol, residual, options=OPTIONS) -> Outcome:
     """Decide friction-net feasibility of ``ns`` (the friction-net
     :class:`~masonry.rbe.solvers.newton.NewtonSystem`) by the load-path LP.
 
@@ -131,7 +130,7 @@ def decide(ns: NewtonSystem, infeasibility_tol, residual, options=OPTIONS) -> QP
 
     Returns
     -------
-    QPOutcome
+    Outcome
         ``x`` None (the LP's point is not the QP's optimum). Status ``infeasible`` with
         ``y`` the certificate, else ``user_limit``. ``info``: ``verdict`` (``feasible``,
         ``likely feasible``, ``infeasible`` or ``undecided``), ``forces`` (the vertex
@@ -147,7 +146,7 @@ def decide(ns: NewtonSystem, infeasibility_tol, residual, options=OPTIONS) -> QP
     log.info("load-path LP: friction-net %s after %d iterations (lambda %.6g, "
              "certificate quality %.2e)", path.verdict, outcome.iterations,
              outcome.info["load_factor"], path.quality)
-    return QPOutcome(
+    return Outcome(
         status=INFEASIBLE if path.verdict == INFEASIBLE else USER_LIMIT, x=None,
         iterations=outcome.iterations,
         y=outcome.y if path.verdict == INFEASIBLE else None,

@@ -51,7 +51,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from masonry.rbe.equilibrium import VariableLayout, equilibrium_columns
-from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL, SOLVER_ERROR, USER_LIMIT, QPOutcome
+from masonry.rbe.solvers.base import (INFEASIBLE, OPTIMAL, SOLVER_ERROR, USER_LIMIT, Backend,
+                                      Outcome)
 from masonry.rbe.solvers.cholesky import BlockCholesky
 
 log = logging.getLogger(__name__)
@@ -346,7 +347,7 @@ def _vertex_groups(vertex_interface):
     return groups
 
 
-def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOutcome:
+def solve(system, method, options=None, *, y0=None, newton_system=None) -> Outcome:
     """Solve the scaled RBE QP of ``system`` for ``method`` (``'net'`` or ``'plus'``).
 
     Parameters
@@ -362,7 +363,7 @@ def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOut
 
     Returns
     -------
-    QPOutcome
+    Outcome
         ``x`` in the layout of ``system`` (solver units; ``t = 0`` for friction-net),
         ``y`` the last dual point. Status ``optimal`` when the residual reached
         ``options.tol``, ``infeasible`` with a certificate (friction-net), else
@@ -379,11 +380,11 @@ def solve(system, method, options=None, *, y0=None, newton_system=None) -> QPOut
         y = np.asarray(y0, dtype=float).copy()
     run = _Run(ns, y, options, scale)
     status = run.iterate(certify=method == "net")
-    return QPOutcome(status=status,
-                     x=None if status == INFEASIBLE else ns.full_vector(run.x, system.layout),
-                     iterations=run.steps, y=run.y, setup_time=setup,
-                     solve_time=time.perf_counter() - start - setup,
-                     info={"factorizations": run.factorizations + (y0 is None)})
+    return Outcome(status=status,
+                   x=None if status == INFEASIBLE else ns.full_vector(run.x, system.layout),
+                   iterations=run.steps, y=run.y, setup_time=setup,
+                   solve_time=time.perf_counter() - start - setup,
+                   info={"factorizations": run.factorizations + (y0 is None)})
 
 
 def _unconstrained_dual(ns, shift):
@@ -529,7 +530,7 @@ def prepared_system(system, method, workspace) -> NewtonSystem:
     return ns
 
 
-def backend(system, method, options, workspace, y0=None) -> QPOutcome:
+def backend(system, method, options, workspace, y0=None) -> Outcome:
     """The :mod:`masonry.rbe.solvers` interface: ``options`` are :class:`NewtonOptions`
     fields. The workspace keeps the prepared systems (their symbolic factorization is
     shared by both friction models) and the last dual point per model, which starts the
@@ -543,3 +544,8 @@ def backend(system, method, options, workspace, y0=None) -> QPOutcome:
     if outcome.status == "optimal":
         workspace["warm"][method] = outcome.y
     return dataclasses.replace(outcome, setup_time=outcome.setup_time + preparation)
+
+
+BACKEND = Backend("newton", settings="newton", rbe=backend)
+"""The semismooth Newton method: the RBE QP (every friction model); the polish of the
+other backends' points."""

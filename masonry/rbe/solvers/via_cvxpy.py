@@ -12,7 +12,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from masonry.rbe.solvers.base import SOLVER_ERROR, QPOutcome
+from masonry.rbe.solvers.base import SOLVER_ERROR, Backend, Outcome
 
 log = logging.getLogger(__name__)
 
@@ -20,13 +20,13 @@ log = logging.getLogger(__name__)
 def solver_for(name):
     """A backend function for cvxpy's solver ``name`` (``'OSQP'`` or ``'CLARABEL'``)."""
 
-    def solve(system, method, options, workspace) -> QPOutcome:
+    def solve(system, method, options, workspace) -> Outcome:
         return _solve(system, method, name, options)
 
     return solve
 
 
-def _solve(system, method, name, options) -> QPOutcome:
+def _solve(system, method, name, options) -> Outcome:
     import cvxpy as cp
 
     start = time.perf_counter()
@@ -47,8 +47,8 @@ def _solve(system, method, name, options) -> QPOutcome:
     except cp.error.SolverError as error:
         # cvxpy raises when the solver ends without a usable status (numerical error)
         log.warning("%s (via cvxpy) failed on the %s problem: %s", name, method, error)
-        return QPOutcome(status=SOLVER_ERROR, x=None, iterations=-1,
-                         solve_time=time.perf_counter() - start)
+        return Outcome(status=SOLVER_ERROR, x=None, iterations=-1,
+                       solve_time=time.perf_counter() - start)
     stats = problem.solver_stats
     iterations = stats.num_iters
     if iterations is None:
@@ -57,6 +57,12 @@ def _solve(system, method, name, options) -> QPOutcome:
     x_value = x.value if problem.status in cp.settings.SOLUTION_PRESENT else None
     total = time.perf_counter() - start
     solver_time = stats.solve_time if stats.solve_time is not None else total
-    return QPOutcome(status=problem.status, x=x_value,
-                     iterations=-1 if iterations is None else int(iterations),
-                     setup_time=max(total - solver_time, 0.0), solve_time=solver_time)
+    return Outcome(status=problem.status, x=x_value,
+                   iterations=-1 if iterations is None else int(iterations),
+                   setup_time=max(total - solver_time, 0.0), solve_time=solver_time)
+
+
+BACKENDS = (Backend("clarabel-cvxpy", settings="clarabel", rbe=solver_for("CLARABEL")),
+            Backend("osqp-cvxpy", settings="osqp", rbe=solver_for("OSQP"),
+                    polyhedral_only=True))
+"""Clarabel and OSQP through cvxpy: the RBE QP, with the direct paths' settings."""
