@@ -74,7 +74,8 @@ def _interface_columns(blocks: Blocks, interfaces) -> list:
 def interfaces_csv(blocks: Blocks, interfaces) -> bytes:
     """``interfaces.csv``: one row per interface (SPEC 5), in id order: blocks (main
     first), their names and courses, kind, area, centre, the frame (unit normal from the
-    main block into the other, t1, t2), vertex count. README "Columns" names each one."""
+    main block into the other, t1, t2), vertex count. docs/outputs.md, "Columns", names
+    each one."""
     return _table(_interface_columns(blocks, interfaces)
                   + [("vertices", interfaces.vertex_count)])
 
@@ -109,7 +110,7 @@ def forces_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict) -> by
     Notes
     -----
     Forces act on the other block ``block_b``; ``block_a`` receives their opposite.
-    README "Columns" names each column with its unit and sign.
+    docs/outputs.md, "Columns", names each column with its unit and sign.
     """
     return _table(forces_columns(blocks, interfaces, forces, resultants))
 
