@@ -58,7 +58,7 @@ def register(subparsers):
 
 
 SMALL_DOME = dict(scene="dome", stretch=1.0, n=6, r=0, p=3, cut=0.5)
-"""78 bricks: the azimuth search's row (a full search on a thesis dome takes hours)."""
+"""72 bricks: the azimuth search's row (a full search on a thesis dome takes hours)."""
 
 
 def handle(args, report):

@@ -4,7 +4,8 @@ block equilibrium (RBE), collapse load and construction stages.
 The Python interface (:mod:`masonry.api`)::
 
     import masonry
-    dome = masonry.build(preset="3", boundary="cyclic")
+    dome = masonry.build(preset="3", scene="dome")  # all 4 webs: a cyclic section refuses
+                                                    # a lateral load
     dome.solve().verdict, dome.forces(), dome.collapse(lateral=0), dome.export()
 
 The package reads as the pipeline, one stage per module or folder::

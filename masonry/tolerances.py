@@ -104,9 +104,10 @@ class Tolerances:
 # ---------------------------------------------------------------------- inputs
 STRETCH_USUAL_RANGE = (0.2, 5.0)
 """Dome height over circumradius outside this range is accepted with a warning, logged
-once when such a dome is built (:func:`masonry.scenes.section.build_section`): the
+once when such a dome is built (:func:`masonry.scenes.polygonal.build_web`): the
 thesis's structures have 0.8 to 2.0, and beyond the range the dome is unusually flat or
-tall. (:data:`masonry.params.RANGES` holds the range refused outright.)"""
+tall. (The range refused outright is declared with ``stretch`` in
+:mod:`masonry.scenes.polygonal`.)"""
 
 MIN_LIVE_LOAD_N = 1e-9
 """Newtons. A point or crown load smaller than this is refused: its collapse load factor

@@ -34,7 +34,7 @@ LP_RESIDUAL = LoadFactorOptions().primal_tol
 rows hold to this fraction of the largest load entry (the factor itself is checked
 against statics to 1e-6); below it the residual depends on the BLAS kernels' rounding
 (OpenBLAS's Haswell kernels leave 4.6e-9 where others leave 1e-12)."""
-SMALL_DOME = dict(stretch=1.0, n=6, r=0, p=3, cut=0.5)  # 78 bricks in 6 webs
+SMALL_DOME = dict(stretch=1.0, n=6, r=0, p=3, cut=0.5)  # 72 bricks in 6 webs, on 6 slabs
 
 
 def column(count, size):
@@ -378,7 +378,7 @@ def test_highs_refuses_coulombs_cone():
 @pytest.mark.parametrize("cone", ["polygon:16", "square"])
 def test_interior_point_lp_finds_the_simplex_optimum_on_a_dome(azimuth, cone):
     """The own interior point method against HiGHS's dual simplex (an exact vertex
-    solution) on the 78-brick dome, without falling back to Clarabel."""
+    solution) on the 72-brick dome, without falling back to Clarabel."""
     dome = build_model(validate(Params.of(scene="dome", **SMALL_DOME)))[1]
     live = lateral(dome, azimuth, DENSITY)
     ours = CollapseLP(dome, method="interior", cone=cone).solve(live, dead_load_feasible=True)

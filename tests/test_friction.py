@@ -23,7 +23,7 @@ from masonry.tolerances import G, Tolerances
 DENSITY = 2000.0
 TILT_MU = float(np.tan(np.radians(20.0)))  # 3DEC's tilting block: friction angle 20 deg
 MODELS = ("circle", "polygon:16", "polygon:8", "square")
-SMALL_DOME = dict(stretch=1.0, n=6, r=0, p=3, cut=0.5)  # 78 bricks in 6 webs
+SMALL_DOME = dict(stretch=1.0, n=6, r=0, p=3, cut=0.5)  # 72 bricks in 6 webs, on 6 slabs
 
 
 def turned_block(size, turn_deg):
@@ -279,7 +279,7 @@ def test_the_own_solvers_of_the_cone_find_clarabels_optimum(boundary):
 def test_the_collapse_lp_of_the_cone_finds_clarabels_optimum(azimuth):
     """The collapse load factor with Coulomb's cone: the own interior point method
     (Nesterov-Todd scaling on the Newton system) against Clarabel's second-order cone
-    program on the 78-brick dome, between the inscribed and circumscribed 16-sided
+    program on the 72-brick dome, between the inscribed and circumscribed 16-sided
     pyramids' factors (HiGHS's dual simplex)."""
     dome = build_model(validate(Params.of(scene="dome", **SMALL_DOME)))[1]
     live = lateral(dome, azimuth, DENSITY)
