@@ -10,7 +10,7 @@ import trimesh
 from masonry.scenes.imported import AssemblyError, load_assembly, read_blocks, select_supports
 from masonry.export.obj import blocks_obj
 from masonry.interfaces import detect
-from masonry.params import Params, from_preset, validate
+from masonry.params import from_preset
 from masonry.scenes import build
 from masonry_cli.main import main
 
