@@ -9,7 +9,7 @@ from masonry.studies.thickness import folder_name, minimum_thickness, steps_csv
 from masonry.studies.thrust_line import thrust_line_minimum_thickness
 from masonry.tolerances import THICKNESS_RTOL
 
-from .options import add_arch_options, add_material_options, add_verbosity
+from .options import add_material_options, add_scene_options, add_verbosity
 
 ANALYSIS = ("arch_blocks", "arch_span", "arch_shape", "arch_rise", "arch_depth", "mu",
             "density", "friction_cone", "solver")
@@ -19,7 +19,7 @@ def register(subparsers):
     parser = subparsers.add_parser(
         "arch-thickness", help="minimum thickness t/R of an arch under self weight, by "
                                "bisection on rigid block equilibrium")
-    add_arch_options(parser, thickness=False)
+    add_scene_options(parser, kinds=("arch",), skip=("arch_thickness",))
     g = parser.add_argument_group("analysis")
     add_material_options(g)
     g.add_argument("--solver", choices=tuple(BACKENDS),

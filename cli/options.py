@@ -12,7 +12,6 @@ from masonry.rbe.settings import BOUNDARIES, FRICTION_LAWS, FRICTIONS, Analysis
 from masonry.rbe.accuracy import ACCURACY
 from masonry.rbe.solvers import RBE, names as solver_names
 from masonry.scenes import KINDS, kind_of
-from masonry.scenes.arch import ARCH_SHAPES
 from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS
 
 ACCURACIES, SOLVERS = tuple(ACCURACY), solver_names(RBE)
@@ -26,12 +25,6 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message):
         self.exit(2, f"masonry: error: {' '.join(message.split())}\n")
-
-
-def _preset_values(name) -> str:
-    """``default X; presets 1 / 2 / 3: a / b / c`` for a dome parameter."""
-    values = " / ".join(f"{PRESETS[k][name]:g}" for k in ("1", "2", "3"))
-    return f"default {DEFAULTS[name]:g} (preset 1); presets 1 / 2 / 3: {values}"
 
 
 def _range(name) -> str:
@@ -135,60 +128,68 @@ def add_model_options(parser):
                    help="parameters from a TOML file (inputs named as these options, "
                         "as in fixtures/presets); "
                         "options given next to it override it")
-    g.add_argument("--scene", choices=[name for name, kind in KINDS.items()
-                                       if kind.from_parameters],
-                   help="section (one web, default), dome (all n webs), wall (validation), "
-                        "arch (voussoirs, see the arch options)")
-    g.add_argument("--stretch", type=float,
-                   help=f"dome height / circumradius ({_range('stretch')}; "
-                        f"{_preset_values('stretch')})")
-    g.add_argument("--n", type=int,
-                   help=f"walls of the polygonal dome (>= 3; {_preset_values('n')})")
-    g.add_argument("--r", type=int,
-                   help=f"full rhombi across the section (>= 0; {_preset_values('r')})")
-    g.add_argument("--p", type=int,
-                   help=f"pattern bricks per rhombus side (>= 1; {_preset_values('p')})")
-    g.add_argument("--cut", type=float,
-                   help=f"fraction of the height cut off, 0 <= cut < 1 "
-                        f"({_preset_values('cut')})")
-    g.add_argument("--unit", type=float,
-                   help=f"brick unit in metres ({_range('unit')}; default {DEFAULTS['unit']:g})")
-    g.add_argument("--min-fill", dest="min_fill", type=float, metavar="F",
-                   help=f"shortest fill-in brick in units (0 < F <= 4; default "
-                        f"{DEFAULTS['min_fill']:g})")
-    g.add_argument("--wall-length", dest="wall_length", type=float, metavar="L",
-                   help=f"wall scene: length in units (>= 4; default {DEFAULTS['wall_length']:g})")
-    g.add_argument("--wall-courses", dest="wall_courses", type=int, metavar="K",
-                   help=f"wall scene: number of courses (>= 1; default "
-                        f"{DEFAULTS['wall_courses']})")
+    built = {name: kind for name, kind in KINDS.items() if kind.from_parameters}
+    g.add_argument("--scene", choices=list(built),
+                   help="; ".join(f"{name}: {kind.summary}" for name, kind in built.items()))
     g.add_argument("--fast", action="store_true", default=None,
-                   help="reduced output: one view, lower resolution")
+                   help="the fast accuracy preset and quick figures (one view, lower "
+                        "resolution)")
     g.add_argument("--max-bricks", dest="max_bricks", type=int, default=MAX_BRICKS,
                    metavar="N", help=f"refuse a model estimated above N blocks before "
                                      f"building it (default {MAX_BRICKS}, about "
                                      f"{MAX_BRICKS * BYTES_PER_BRICK / 1e9:.0f} GB to solve)")
-    add_arch_options(parser)
+    add_scene_options(parser)
 
 
-def add_arch_options(parser, thickness=True):
-    g = parser.add_argument_group("arch scene (metres; the span and rise of the centre line)")
-    g.add_argument("--blocks", dest="arch_blocks", type=int, metavar="N",
-                   help=f"number of voussoirs (>= 2; default {DEFAULTS['arch_blocks']}; even "
-                        "for a pointed arch)")
-    if thickness:
-        g.add_argument("--thickness", dest="arch_thickness", type=float, metavar="T",
-                       help=f"thickness t along the joints (at least 0.001 span; default "
-                            f"{DEFAULTS['arch_thickness']:g})")
-    g.add_argument("--span", dest="arch_span", type=float, metavar="S",
-                   help=f"span ({_range('arch_span')}; default {DEFAULTS['arch_span']:g})")
-    g.add_argument("--shape", dest="arch_shape", choices=ARCH_SHAPES,
-                   help="semicircular (default), pointed or segmental")
-    g.add_argument("--rise", dest="arch_rise", type=float, metavar="H",
-                   help="rise of a pointed (> span/2, default equilateral) or segmental "
-                        "(< span/2 and at least 0.01 span, default span/4) arch")
-    g.add_argument("--depth", dest="arch_depth", type=float, metavar="D",
-                   help=f"depth along y (0.001 to 1000 spans; default "
-                        f"{DEFAULTS['arch_depth']:g})")
+def add_scene_options(parser, kinds=None, skip=()):
+    """One option per declared geometry input of the scene kinds (``kinds``: names; all
+    built from parameters by default), grouped by geometry, from the declarations
+    (:mod:`masonry.parameters`): a new scene's inputs are options without a line here."""
+    groups = {}
+    for name, kind in KINDS.items():
+        if kind.from_parameters and (kinds is None or name in kinds):
+            groups.setdefault(kind.geometry, []).append(name)
+    added = set(skip)
+    for geometry, scenes in groups.items():
+        g = parser.add_argument_group(f"{' and '.join(scenes)} scene"
+                                      f"{'s' if len(scenes) > 1 else ''}")
+        for name, declaration in declarations(geometry).items():
+            if name in added:
+                continue
+            added.add(name)
+            option = declaration.option or f"--{name.replace('_', '-')}"
+            g.add_argument(option, dest=name, choices=declaration.choices,
+                           type={"int": int, "float": float}.get(declaration.kind, str),
+                           metavar=None if declaration.choices else
+                           option[2:].replace("-", "_").upper(),
+                           help=_scene_help(name, declaration, geometry, groups))
+
+
+def _scene_help(name, declaration, geometry, groups) -> str:
+    """An option's help from its declaration: what it is, the values it takes, its
+    default (and the values of the presets of its scenes), and the other scenes that
+    take it."""
+    if declaration.help:
+        text = declaration.help
+    else:
+        values = "" if declaration.choices else \
+            (declaration.expected or declaration._expected()).split(" (")[0] + "; "
+        text = f"{declaration.doc} ({values}default {_text(defaults(geometry)[name])}"
+        presets = [key for key, inputs in PRESETS.items() if name in inputs
+                   and kind_of(inputs.get("scene", "section")).geometry is geometry]
+        if len(presets) > 1:
+            text += (f"; presets {' / '.join(presets)}: "
+                     f"{' / '.join(_text(PRESETS[k][name]) for k in presets)}")
+        text += ")"
+    others = [scene for part, scenes in groups.items() if part is not geometry
+              and name in declarations(part) for scene in scenes]
+    if others:
+        text += f"; also the {', '.join(others)} scenes"
+    return text.replace("%", "%%")
+
+
+def _text(value) -> str:
+    return "none" if value is None else f"{value:g}" if isinstance(value, float) else str(value)
 
 
 def add_analysis_options(parser, boundary=True):

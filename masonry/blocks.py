@@ -422,13 +422,14 @@ def blocks_from_hulls(hull_points, faces, block_class, block_name, **fields) -> 
     """
     names = block_name
     hull_faces = faces
+    count_blocks = len(hull_points)
     point_base = np.cumsum([0] + [len(p) for p in hull_points])
     face_base = np.cumsum([0] + [len(f[2]) for f in hull_faces])
     points = np.concatenate(hull_points)
     entry_face = np.concatenate([f[0] + face_base[b] for b, f in enumerate(hull_faces)])
     entry_point = np.concatenate([f[1] + point_base[b] for b, f in enumerate(hull_faces)])
     normal = np.concatenate([f[2] for f in hull_faces])
-    face_block = np.repeat(np.arange(len(names)), np.diff(face_base))
+    face_block = np.repeat(np.arange(count_blocks), np.diff(face_base))
 
     # counter-clockwise about the outward normal: angle in the face's (t1, t2) basis
     t1, t2 = tangent_basis(normal)
@@ -461,12 +462,13 @@ def blocks_from_hulls(hull_points, faces, block_class, block_name, **fields) -> 
     count = np.bincount(entry_face, minlength=n_faces)
     if (count < 3).any():
         bad = int(face_block[np.flatnonzero(count < 3)[0]])
-        raise ValueError(f"block {names[bad]!r}: a face of its convex hull collapses to "
+        raise ValueError(f"block {bad if names is None else names[bad]!r}: a face of its "
+                         "convex hull collapses to "
                          "a line; the block is degenerate")
     # keep only points used by a face, block after block
     used, face_vertices = np.unique(entry_point, return_inverse=True)
-    point_block = np.repeat(np.arange(len(names)), np.diff(point_base))
-    vertex_offsets = np.searchsorted(point_block[used], np.arange(len(names) + 1))
+    point_block = np.repeat(np.arange(count_blocks), np.diff(point_base))
+    vertex_offsets = np.searchsorted(point_block[used], np.arange(count_blocks + 1))
     return Blocks.from_arrays(
         vertices=points[used], vertex_offsets=vertex_offsets,
         face_vertices=face_vertices.reshape(-1),

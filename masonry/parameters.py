@@ -50,6 +50,12 @@ class Declaration:
         differs from its default.
     names_geometry : bool
         Decides the geometry and interfaces: part of the geometry cache's key.
+    option : str, optional
+        The command line's option when it is not ``--`` and the name with dashes
+        (``--blocks`` for ``arch_blocks``).
+    help : str
+        The command line's help when it says more than ``doc``, the range and the
+        default.
     """
 
     doc: str
@@ -63,6 +69,8 @@ class Declaration:
     tag: str | None = None
     head: bool = False
     names_geometry: bool = False
+    option: str | None = None
+    help: str = ""
 
     def refusal(self, name, value) -> ParameterError | None:
         """The error for ``value`` of parameter ``name``, or None when it is valid."""

@@ -205,6 +205,14 @@ def _pieces(candidates, start, length, below, min_fill):
     return _choose(candidates(length, min_fill), start, below), False
 
 
+def fill_gap(start, length, below, min_fill):
+    """The pieces (lengths, units, from ``start``) of regular and fill-in bricks that fill
+    one gap of a course: of the fills the gap admits, the one whose joints keep farthest
+    from the joints ``below`` (units, in ``start``'s coordinate); and True when the gap
+    is shorter than ``min_fill`` (one short piece)."""
+    return _pieces(_side_candidates, start, length, below, min_fill)
+
+
 def _fill_course(rows, course, sequences, below, min_fill, miter):
     """Append the regular and fill-in bricks of one course's ``sequences`` to ``rows``,
     mirror-symmetric about ``s = 0``; return its sorted joints and the number of fill-ins

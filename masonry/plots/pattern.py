@@ -31,7 +31,7 @@ def pattern_png(scene, fast=False, title="") -> bytes:
         ax.add_patch(Rectangle((0, 0), 0, 0, facecolor=CLASS_COLOURS[name],
                                label=name.replace("_", "-")))
     ax.legend(loc="upper right", fontsize=7)
-    ax.set_xlabel("position along the wall s [units]")
+    ax.set_xlabel(scene.kind.pattern_axis)
     ax.set_ylabel("course")
     ax.set_xlim(-w.max() - 1, w.max() + 1)
     ax.set_ylim(-0.5, len(w) + 0.5)

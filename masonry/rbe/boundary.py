@@ -98,14 +98,6 @@ def check_supported(model: "Model") -> None:
         f"along an edge or at a point, or with a gap wider than the contact tolerance")
 
 
-def _end_masks(scene):
-    """Bricks mitered at the left (-pi/n) and right (+pi/n) corner planes."""
-    layout = scene.layout
-    ground = np.zeros(1, bool)  # the ground slab is a support: it bears on no image
-    return (np.concatenate([ground, layout.miter_left]),
-            np.concatenate([ground, layout.miter_right]))
-
-
 def _mark_web_boundaries(interfaces: Interfaces, blocks: Blocks) -> Interfaces:
     web = blocks.block_web[interfaces.pair]
     kind = np.where(web[:, 0] != web[:, 1], BOUNDARY, interfaces.kind).astype(np.int8)
@@ -142,7 +134,7 @@ def _model(scene, mode) -> Model:
         return Model(scene.blocks, _mark_web_boundaries(interfaces, scene.blocks))
 
     n = scene.symmetry.order
-    left, right = _end_masks(scene)
+    left, right = scene.kind.edge_blocks(scene)
     # images of the next web's left end, and (rigid) of the previous web's right end
     images = [(1, left)] + ([(-1, right)] if mode == "rigid" else [])
     parts, sources, ups = [scene.blocks], [], [scene.block_up]

@@ -288,11 +288,11 @@ def live_load(lateral=None, point_loads=(), crown_load=None):
     given = []
     if lateral is not None:
         given.append(("lateral", lateral, Lateral(_azimuth(lateral))))
+    if not isinstance(point_loads, (tuple, list, str)):
+        raise ParameterError("point_loads", point_loads, "NAME_OR_PATTERN:FX,FY,FZ strings")
     if point_loads:
         case = PointLoads.parse(point_loads)
         given.append(("point_loads", case.specs[0], case))
-    elif not isinstance(point_loads, (tuple, list, str)):
-        raise ParameterError("point_loads", point_loads, "NAME_OR_PATTERN:FX,FY,FZ strings")
     if crown_load is not None:
         if isinstance(crown_load, bool) or not isinstance(crown_load, (int, float)):
             raise ParameterError("crown_load", crown_load, "a number")

@@ -47,23 +47,35 @@ class ArchGeometry:
     module docstring): the span and rise of its centre line, its thickness along the
     joints and its depth along y."""
 
-    arch_shape: str = declare("semicircular", "", kind="str", choices=ARCH_SHAPES, tag="",
-                              head=True, names_geometry=True)
+    arch_shape: str = declare("semicircular", "the arch's shape", kind="str",
+                              choices=ARCH_SHAPES, tag="", head=True, names_geometry=True,
+                              option="--shape")
     arch_blocks: int = declare(
         16, "voussoirs", kind="int", check=lambda v: v >= 2, tag="N", head=True,
-        names_geometry=True,
+        names_geometry=True, option="--blocks",
+        help="number of voussoirs (>= 2; default 16; even for a pointed arch)",
         expected="an integer >= 2 (one voussoir is no arch, and a semicircular one is not "
                  "convex)")
     arch_span: float = declare(10.0, "m, of the centre line", low=0.01, high=1e4, tag="s",
-                               head=True, names_geometry=True,
+                               head=True, names_geometry=True, option="--span",
                                expected="0.01 to 10000 (metres)")
     arch_thickness: float = declare(0.6, "m", check=lambda v: v > 0, tag="t", head=True,
-                                    names_geometry=True, expected="> 0 (metres)")
+                                    names_geometry=True, expected="> 0 (metres)",
+                                    option="--thickness",
+                                    help="thickness t along the joints, metres (at least "
+                                         "0.001 span; default 0.6)")
     arch_depth: float = declare(1.0, "m, along y", check=lambda v: v > 0, tag="d",
-                                head=True, names_geometry=True, expected="> 0 (metres)")
+                                head=True, names_geometry=True, expected="> 0 (metres)",
+                                option="--depth",
+                                help="depth along y, metres (0.001 to 1000 spans; default 1)")
     arch_rise: float | None = declare(None, "m, of the centre line", optional=True,
                                       check=lambda v: v > 0, tag="h", head=True,
-                                      names_geometry=True, expected="> 0 (metres) or none")
+                                      names_geometry=True, expected="> 0 (metres) or none",
+                                      option="--rise",
+                                      help="rise of the centre line, metres: a pointed arch's "
+                                           "> span/2 (default equilateral), a segmental "
+                                           "one's < span/2 and at least 0.01 span (default "
+                                           "span/4)")
 
 
 def arch_radius(shape: str, span: float, rise=None) -> tuple:
@@ -272,6 +284,7 @@ class Arch(SceneKind):
     has_courses = False
     moved_for_cad = False
     id_prefix_name = "arch"
+    summary = "voussoirs on two supports (the arch options)"
 
     @classmethod
     def build(cls, geometry) -> Scene:

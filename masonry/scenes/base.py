@@ -90,6 +90,8 @@ class SceneKind:
         CAD offset (an arch's voussoirs and imported blocks stay where they are).
     id_prefix_name : str
         The first word of its structure ids.
+    summary : str
+        One line on what it is (the command line's help).
     """
 
     name = ""
@@ -101,6 +103,7 @@ class SceneKind:
     from_parameters = True
     moved_for_cad = True
     id_prefix_name = ""
+    summary = ""
 
     @classmethod
     def build(cls, geometry) -> "Scene":
@@ -137,9 +140,20 @@ class SceneKind:
         return cls.name
 
     @classmethod
+    def edge_blocks(cls, scene) -> tuple:
+        """``(left, right)`` (B,) bool: the blocks of a unit of a symmetric scene (a
+        section) that bear on the previous and the next unit (docs/model.md 6.4); their
+        images stand for the neighbours. Only kinds with boundaries besides ``free``
+        have them."""
+        raise NotImplementedError(f"a {cls.name} scene has no neighbours")
+
+    @classmethod
     def pattern_caption(cls, geometry) -> str:
         """What the flattened pattern figure shows of the scene."""
         return cls.name
+
+    pattern_axis = "position along the wall s [units]"
+    """The flattened pattern figure's horizontal axis."""
 
     @classmethod
     def shown(cls, geometry) -> dict:

@@ -201,6 +201,7 @@ class Assembly(SceneKind):
     (:func:`load_assembly`; not built from parameters alone)."""
 
     name = "assembly"
+    summary = "blocks read from mesh files (masonry analyze)"
     geometry = AssemblyGeometry
     block_word = "blocks"
     has_courses = False

@@ -119,6 +119,7 @@ class Section(SceneKind):
     boundary (docs/model.md 6.4)."""
 
     name = "section"
+    summary = "one web of the polygonal dome (default; see --boundary)"
     geometry = PolygonalDome
     boundaries = ("free", "rigid", "cyclic")
     crown = True
@@ -149,6 +150,14 @@ class Section(SceneKind):
         return f"section, boundary {boundary}"
 
     @classmethod
+    def edge_blocks(cls, scene) -> tuple:
+        """The bricks mitered at the left (-pi/n) and right (+pi/n) corner planes (the
+        ground slab bears on no neighbour)."""
+        layout, ground = scene.layout, np.zeros(1, bool)
+        return (np.concatenate([ground, layout.miter_left]),
+                np.concatenate([ground, layout.miter_right]))
+
+    @classmethod
     def pattern_caption(cls, geometry) -> str:
         return f"one web of {geometry.n}, flattened"
 
@@ -160,6 +169,7 @@ class Dome(Section):
     as a support."""
 
     name = "dome"
+    summary = "all n webs of the polygonal dome"
     boundaries = ("free",)
     id_prefix_name = "fulldome"
 

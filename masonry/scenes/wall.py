@@ -58,6 +58,7 @@ class Wall(SceneKind):
     name = "wall"
     geometry = WallGeometry
     id_prefix_name = "wall"
+    summary = "a straight running-bond wall, for validation"
 
     @classmethod
     def build(cls, geometry) -> Scene:

@@ -194,6 +194,25 @@ def geometry_group(inputs: dict) -> str:
         return json.dumps(inputs, sort_keys=True, default=str)
 
 
+def check_scheduler_address(address: str) -> None:
+    """Refuse a Dask scheduler address that names no scheme Dask speaks or, for TCP and
+    TLS, no host and port (:class:`~masonry.errors.ParameterError` named ``scheduler``),
+    before any client starts."""
+    from distributed.comm.addressing import parse_address, parse_host_port
+    from distributed.comm.registry import backends
+
+    expected = "the address of a running Dask scheduler, e.g. tcp://127.0.0.1:8786"
+    try:
+        scheme, location = parse_address(str(address))
+        if scheme in ("tcp", "tls"):
+            parse_host_port(location)
+    except (ValueError, TypeError) as error:
+        raise ParameterError("scheduler", address, f"{expected} ({error})") from None
+    if scheme not in backends:
+        raise ParameterError("scheduler", address, f"{expected} (no protocol {scheme!r}: "
+                             f"one of {', '.join(backends)})")
+
+
 def execute(study: Study, out_root, workers=1, scheduler=None):
     """Run every variant; yield ``(index, inputs, row)`` as each finishes.
 
@@ -227,6 +246,8 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
         answers at that address.
     """
     variants = study.variants()
+    if scheduler is not None:
+        check_scheduler_address(scheduler)
     options = dict(analyse=study.analyse, plots=study.plots, printable=study.printable)
     if workers == 1 and scheduler is None:
         for i, inputs in enumerate(variants):
