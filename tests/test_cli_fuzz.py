@@ -149,7 +149,7 @@ def test_a_bad_scheduler_address(tmp_path, address):
     out = tmp_path / "out"
     argv = ["sweep", str(study), "--scheduler", address, "--out", str(out)]
     code, _, err = call(argv)
-    assert code == 2 and "running Dask scheduler" in err
+    assert code == 2 and "running Dask scheduler" in err, err
     assert_clean(argv, out, code, err)
 
 
@@ -354,13 +354,21 @@ PLAUSIBLE = {
     "--crown-load": ["500", "20000", "0", "-100"],
     "--friction-law": ["associated", "non-associative", "coulomb"],
     "--friction-cone": ["circle", "polygon:16", "square", "polygon:4", "disc"],
+    "--radius": ["12", "20", "50", "8"], "--spirals": ["2", "4", "7", "12", "40"],
+    "--helix-angle": ["45", "50", "60", "30", "85"],
+    "--helix": ["loxodrome", "clelia", "spiral"],
+    "--pattern": ["herringbone", "none", "stripes"],
 }
-INTEGER_OPTIONS = {"--n", "--r", "--p", "--wall-courses", "--blocks"}
+INTEGER_OPTIONS = {"--n", "--r", "--p", "--wall-courses", "--blocks", "--spirals"}
+REVOLUTION = ["--radius", "--stretch", "--cut", "--unit", "--min-fill", "--p", "--spirals",
+              "--helix-angle", "--helix", "--pattern"]
 SCENE_OPTIONS = {
     None: ["--stretch", "--cut", "--unit", "--min-fill", "--n", "--r", "--p", "--boundary"],
     "dome": ["--stretch", "--cut", "--unit", "--min-fill", "--n", "--r", "--p"],
     "wall": ["--wall-length", "--wall-courses", "--unit"],
     "arch": ["--span", "--thickness", "--rise", "--depth", "--blocks", "--shape"],
+    "sector": REVOLUTION + ["--boundary"],
+    "revolution": REVOLUTION,
 }
 EVERY_SCENE = ["--mu", "--density", "--friction", "--accuracy", "--print-size", "--lateral",
                "--point-load", "--crown-load", "--friction-law", "--friction-cone"]
@@ -378,7 +386,7 @@ def test_the_tables_cover_every_option_of_run():
 def value_of(option):
     plausible = st.sampled_from(PLAUSIBLE[option])
     if option in ("--shape", "--boundary", "--friction", "--accuracy", "--point-load",
-                  "--friction-law", "--friction-cone"):
+                  "--friction-law", "--friction-cone", "--helix", "--pattern"):
         return plausible
     wild = WILD_INTEGERS if option in INTEGER_OPTIONS else WILD_FLOATS
     return st.one_of(plausible, plausible, plausible, wild)
@@ -388,7 +396,7 @@ def value_of(option):
 def command_lines(draw):
     """A scene, then up to four options: mostly the scene's own and plausible values,
     sometimes another scene's option or a wild value."""
-    scene = draw(st.sampled_from([None, "dome", "wall", "arch"]))
+    scene = draw(st.sampled_from([None, "dome", "wall", "arch", "sector", "revolution"]))
     every = sorted(PLAUSIBLE)
     mostly = SCENE_OPTIONS[scene] + EVERY_SCENE
     names = draw(st.lists(st.one_of(*[st.sampled_from(mostly)] * 6, st.sampled_from(every)),
@@ -432,7 +440,7 @@ def toml_value(value) -> str:
 @settings(max_examples=200, deadline=None, derandomize=True, database=None,
           suppress_health_check=list(HealthCheck))
 @given(st.one_of(
-    st.dictionaries(st.sampled_from(sorted(Params.__dataclass_fields__) + ["colour"]),
+    st.dictionaries(st.sampled_from(sorted(names()) + ["colour"]),
                     TOML_VALUES, max_size=4).map(
         lambda d: "".join(f"{k} = {toml_value(v)}\n" for k, v in d.items()).encode()),
     st.binary(max_size=40)))

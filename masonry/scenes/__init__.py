@@ -7,6 +7,8 @@ listed once in :data:`KINDS`:
   (:mod:`.polygonal`); ``dome``: all ``n`` webs explicitly (:mod:`.polygonal`).
 - ``wall``: a straight running-bond wall on a ground slab, for validation (:mod:`.wall`).
 - ``arch``: voussoirs on two supports (:mod:`.arch`).
+- ``revolution``: the dome of revolution, courses as rings and the pattern as
+  loxodromes; ``sector``: one of its sectors (:mod:`.revolution`).
 - ``assembly``: blocks read from mesh files (:mod:`.mesh_files` reads them,
   :mod:`.imported` checks them; built by :func:`~masonry.scenes.imported.load_assembly`,
   not from parameters alone).
@@ -21,10 +23,11 @@ from masonry.scenes.arch import Arch
 from masonry.scenes.base import Scene, SceneKind
 from masonry.scenes.imported import Assembly
 from masonry.scenes.polygonal import Dome, Section
+from masonry.scenes.revolution import Revolution, Sector
 from masonry.scenes.wall import Wall
 from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS
 
-KINDS = {kind.name: kind for kind in (Section, Wall, Dome, Assembly, Arch)}
+KINDS = {kind.name: kind for kind in (Section, Wall, Dome, Assembly, Arch, Revolution, Sector)}
 """Scene name -> its :class:`~masonry.scenes.base.SceneKind`."""
 
 __all__ = ["KINDS", "Scene", "SceneKind", "build", "check_size", "kind_of"]

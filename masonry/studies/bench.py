@@ -27,7 +27,8 @@ from masonry.rbe.boundary import analysis_model
 from masonry.export import force_tables
 from masonry.export.csv import interfaces_csv, locations_csv
 from masonry.export.obj import blocks_obj
-from masonry.params import from_preset
+from masonry.dome.levels import Dimensions
+from masonry.params import Params, from_preset, validate
 from masonry.pipeline import build_model
 from masonry.scenes import build
 from masonry.rbe.collapse import CollapseLP, lateral_azimuths, worst_lateral
@@ -41,10 +42,15 @@ SCENES = {
     "cyclic": dict(scene="section", boundary="cyclic"),
     "dome": dict(scene="dome"),
     "dome-mu0.05": dict(scene="dome", mu=0.05),
+    "revolution": dict(scene="revolution"),
+    "sector": dict(scene="sector", boundary="cyclic"),
 }
 """Bench scene name -> :class:`~masonry.params.Params` fields (over the bench's ``mu``
 and ``density``). ``section`` (free-standing, the thesis's x.1) and ``dome-mu0.05`` are
-infeasible; ``cyclic`` and ``dome`` are their feasible counterparts of the same size."""
+infeasible; ``cyclic`` and ``dome`` are their feasible counterparts of the same size.
+``revolution`` and ``sector`` are the dome of revolution of the preset's profile (its
+circumradius, stretch, cut, p and unit: :func:`revolution_inputs`) and its cyclic
+sector."""
 
 PAIRS = (("section", "cyclic"), ("dome-mu0.05", "dome"))
 """(infeasible, feasible) scenes of the same size, compared by :func:`ratios`."""
@@ -101,8 +107,8 @@ def bench(presets=("1", "2", "3"), scenes=tuple(SCENES), accuracies=tuple(ACCURA
     runs += [("balanced", solver) for solver in solvers]
     for preset in presets:
         for scene_name in scenes:
-            params = from_preset(preset, **{"mu": mu, "density": density,
-                                            **SCENES[scene_name], **(overrides or {})})
+            params = preset_params(preset, scene_name, mu=mu, density=density,
+                                   **(overrides or {}))
             reference = None
             if "accurate" not in accuracies:
                 reference = _run(params, "accurate", None, exports=False)[1]
@@ -122,6 +128,23 @@ def bench(presets=("1", "2", "3"), scenes=tuple(SCENES), accuracies=tuple(ACCURA
                 rows.append(_row(preset, scene_name, accuracy, solver, times, result,
                                  counts, reference))
     return rows
+
+
+def revolution_inputs(preset) -> dict:
+    """The dome of revolution of a preset's profile: its circumradius as the radius (in
+    units), its stretch, cut, pattern spacing p and unit."""
+    polygonal = from_preset(preset).geometry
+    dims = Dimensions.of(polygonal)
+    return dict(radius=round(float(dims.radius / polygonal.unit), 6), stretch=polygonal.stretch,
+                cut=polygonal.cut, p=polygonal.p, unit=polygonal.unit)
+
+
+def preset_params(preset, scene_name, **inputs):
+    """The inputs of a bench structure: a preset in one of the :data:`SCENES`."""
+    scene = SCENES[scene_name]
+    if scene["scene"] in ("revolution", "sector"):
+        return validate(Params.of(**{**revolution_inputs(preset), **scene, **inputs}))
+    return from_preset(preset, **{**scene, **inputs})
 
 
 def _run(params, accuracy, solver, exports=True):
