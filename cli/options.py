@@ -377,7 +377,21 @@ def summary(record, report):
             f"pattern, {counts['fill_in']} fill-in) in {counts['courses']} courses")
     report(f"{record['structure_id']}: {what}, {interfaces} interfaces, "
            f"weight {record['weight_N']:.4g} N")
+    pattern_note(record, report)
     report(f"{state}: {record['path']}")
+
+
+def pattern_note(record, report):
+    """The line about pattern lines that end far below the top (docs/model.md 4.3), when
+    a dome's did."""
+    pattern = record.get("pattern") or {}
+    ended = pattern.get("ended_far_below_top") or []
+    if ended:
+        courses = sorted({course for course, _ in ended})
+        report(f"note: {len(ended)} of {pattern['lines']} pattern lines end far below the "
+               f"top course {record['counts']['courses']}, on course"
+               f"{'s' if len(courses) > 1 else ''} {', '.join(map(str, courses))}: "
+               f"{pattern['ended_why']} (run.json: pattern.ended)")
 
 
 def _verdict(rbe) -> str:

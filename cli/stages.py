@@ -5,7 +5,7 @@ from masonry.scenes.imported import load_assembly
 from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS, run_stages
 
 from .options import (add_analysis_options, add_model_options, add_verbosity, given_inputs,
-                      params_from_args)
+                      params_from_args, pattern_note)
 
 
 def register(subparsers):
@@ -75,6 +75,7 @@ def handle(args, report):
     stages = record["stages"]
     state = "up to date, reused" if record.get("reused") else "written"
     report(f"{record['structure_id']}: {record['plan']['described']}")
+    pattern_note(record, report)
     report(f"{stages['standing']} of {stages['count']} stages stand without support "
            f"(mu {params.analysis.mu:g}, friction {params.analysis.friction}); stage solves "
            f"{stages['solve_s']:.3g} s")

@@ -110,8 +110,10 @@ def model_record(scene, density: float) -> dict:
     dict
         ``counts`` (free bricks, by class, courses; ints), ``volume_m3`` (m^3) and
         ``weight_N`` (N) of the free blocks (supports left out), and where the scene has
-        them ``layout`` (repeated joints, short fill-ins) and ``pattern`` (nodes, near
-        nodes, boundary bounces, ended lines).
+        them ``layout`` (repeated joints, short fill-ins) and ``pattern`` (lines, nodes,
+        near nodes, boundary bounces, ended lines; ``ended`` and
+        ``ended_far_below_top``: ``[course, s]`` of the last brick of every line that
+        ended, and of those that ended far below the top, docs/model.md 4.3).
     """
     blocks = scene.blocks
     free = ~blocks.block_is_support
@@ -135,11 +137,16 @@ def model_record(scene, density: float) -> dict:
             "short_fill_ins": int(scene.layout.short_fill_ins),
         }
     if scene.pattern is not None:
+        pattern = scene.pattern
         record["pattern"] = {
-            "nodes": len(scene.pattern.nodes),
-            "near_nodes": len(scene.pattern.near_nodes),
-            "boundary_bounces": len(scene.pattern.boundary_bounces),
-            "lines_ended": len(scene.pattern.ended),
+            "lines": pattern.n_lines,
+            "nodes": len(pattern.nodes),
+            "near_nodes": len(pattern.near_nodes),
+            "boundary_bounces": len(pattern.boundary_bounces),
+            "lines_ended": len(pattern.ended),
+            "ended": pattern.ended.tolist(),
+            "ended_far_below_top": pattern.ended_far_below_top(
+                scene.levels.n_courses).tolist(),
         }
     return record
 

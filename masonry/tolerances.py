@@ -30,6 +30,10 @@ UNITS_PER_BRICK = 2.7
 made before building (:func:`masonry.scenes.estimate_bricks`): 2.0 to 3.3 on the presets
 and their extremes (pattern and fill-in bricks are smaller than regular ones)."""
 
+UNITS_PER_PLAIN_BRICK = 3.8
+"""The same for a plain dome (docs/model.md 4.9), whose courses are regular bricks but for
+their ends: 3.76 to 3.89 on the presets."""
+
 TENSION_REPORTED_REL = 1e-6
 """An interface's tension counts as tension in ``RBE/tension_top.csv`` above this fraction
 of the structure's weight; below, it is the solver's tolerance (a feasible structure's
@@ -123,6 +127,15 @@ compared with this slack: a pattern brick fits a course, a piece is a regular br
 below (:mod:`masonry.dome.pattern`, :mod:`masonry.dome.courses`). Rounding of sums of a
 few dozen units is about 1e-14, and real differences are whole or half units or
 ``min_fill``, so any value between those works."""
+
+PATTERN_END_REPORTED = 0.9
+"""A pattern line that ends on a course below this fraction of the highest course a
+pattern brick starts on (one below the top) ends far below the top: ``run.json`` lists it
+(``pattern.ended_far_below_top``) and the command line says so
+(:meth:`masonry.dome.pattern.Pattern.ended_far_below_top`). Lines end near the top where
+the web has narrowed (preset 3's two, on course 39 of 42; two of an 11-course dome on
+course 9); lower, a part of the dome has fewer pattern lines than the rest (preset 1 with
+``p = 2``: two of four end on course 8 of 17)."""
 
 LEVEL_TOP_REL = 1e-12
 """A contact point up to ``(1 + LEVEL_TOP_REL) z_max`` still counts as below the cut

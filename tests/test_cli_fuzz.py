@@ -106,6 +106,9 @@ LISTED = [
     ["--friction-law", "non-associative"], ["--friction-law", "coulomb", "--lateral", "0"],
     ["--preset", "wall", "--scene", "dome"], ["--preset", "1", "--scene", "arch"],
     ["--scene", "dome", "--lateral", "all", "--friction-law", "non-associative"],
+    ["--pattern", "plain"], ["--pattern", ""], ["--scene", "wall", "--pattern", "none"],
+    ["--scene", "arch", "--pattern", "herringbone"], ["--p", "1"],
+    ["--pattern", "none", "--p", "0"],
 ]
 RUN_ONLY = [["--scene", "arch", "--boundary", "cyclic"], ["--scene", "wall", "--dome"],
             ["--friction", "none"], ["--solver", "gurobi"]]
@@ -177,6 +180,8 @@ PARAM_FILES = {
     "unknown": b"colour = 3\n", "huge_n": b"n = 100000000\n", "bad_n": b"n = 2\n",
     "list": b"stretch = [1, 2]\n", "params_not_table": b"params = 3\n",
     "big_int": b"p = 99999999999999999999\n", "nan": b"unit = nan\n",
+    "pattern": b'pattern = "plain"\n', "pattern_type": b"pattern = 0\n",
+    "wall_pattern": b'scene = "wall"\npattern = "none"\n',
 }
 
 
@@ -218,6 +223,8 @@ STUDIES = {
     "misspelled": "[grids]\nmu = [0.5]\n", "plots_string": '[outputs]\nplots = "no"\n',
     "dome_not_bool": "[grid]\ndome = [true, 3]\n", "unknown_option": "[grid]\ncolour = [1]\n",
     "empty_list": "[grid]\nmu = []\n", "preset": "[base]\npreset = 7\n",
+    "pattern": '[grid]\npattern = ["herringbone", "plain"]\n',
+    "pattern_p1": '[base]\np = 1\n[grid]\npattern = ["none", "herringbone"]\n',
     "latin1": None,
 }
 
@@ -363,8 +370,9 @@ INTEGER_OPTIONS = {"--n", "--r", "--p", "--wall-courses", "--blocks", "--spirals
 REVOLUTION = ["--radius", "--stretch", "--cut", "--unit", "--min-fill", "--p", "--spirals",
               "--helix-angle", "--helix", "--pattern"]
 SCENE_OPTIONS = {
-    None: ["--stretch", "--cut", "--unit", "--min-fill", "--n", "--r", "--p", "--boundary"],
-    "dome": ["--stretch", "--cut", "--unit", "--min-fill", "--n", "--r", "--p"],
+    None: ["--stretch", "--cut", "--unit", "--min-fill", "--n", "--r", "--p", "--boundary",
+           "--pattern"],
+    "dome": ["--stretch", "--cut", "--unit", "--min-fill", "--n", "--r", "--p", "--pattern"],
     "wall": ["--wall-length", "--wall-courses", "--unit"],
     "arch": ["--span", "--thickness", "--rise", "--depth", "--blocks", "--shape"],
     "sector": REVOLUTION + ["--boundary"],

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from conftest import PRESETS, support_force
 
+from masonry.blocks import BLOCK_CLASSES
 from masonry.rbe.boundary import analysis_model
 from masonry.interfaces import INTERFACE_KINDS
 from masonry.params import from_preset
@@ -13,6 +14,7 @@ from masonry.scenes import build
 from masonry.rbe.solve import solve_rbe
 
 BOUNDARY, SUPPORT = INTERFACE_KINDS.index("boundary"), INTERFACE_KINDS.index("support")
+PATTERN = BLOCK_CLASSES.index("pattern")
 
 # small domes for the symmetry test: (n, p, r), unit 0.1, preset 1's stretch and cut;
 # the smallest whose course wedges stay under max_gap_angle (9.5, 9.5, 8.8 degrees)
@@ -30,11 +32,14 @@ def analysed(friction="auto", lp_check=False, **params):
     return scene, model, result
 
 
-@pytest.mark.parametrize("n", sorted(SMALL))
-def test_cyclic_section_equals_full_dome(n):
+@pytest.mark.parametrize("n, pattern", [(n, "herringbone") for n in sorted(SMALL)]
+                         + [(4, "none"), (8, "none")])
+def test_cyclic_section_equals_full_dome(n, pattern):
     n, p, r = SMALL[n]
-    section, cyclic, part = analysed(n=n, p=p, r=r, boundary="cyclic")
-    _, dome, whole = analysed(n=n, p=p, r=r, scene="dome")
+    plain = {} if pattern == "herringbone" else {"pattern": pattern}  # the cache's key
+    section, cyclic, part = analysed(n=n, p=p, r=r, boundary="cyclic", **plain)
+    _, dome, whole = analysed(n=n, p=p, r=r, scene="dome", **plain)
+    assert (section.layout.klass == PATTERN).any() == (pattern == "herringbone")
     assert whole.friction == part.friction and whole.feasible == part.feasible
     assert whole.objective == pytest.approx(n * part.objective, rel=1e-6)
     assert whole.moi == pytest.approx(n * part.moi, rel=1e-5, abs=1e-6 * whole.weight_N)

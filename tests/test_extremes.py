@@ -29,7 +29,8 @@ def analyse(accuracy="balanced", **changes):
     model = analysis_model(scene, params.analysis.boundary)
     problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
                          side_rotation=model.side_rotation)
-    result = problem.solve(mu=params.analysis.mu, density=params.analysis.density, accuracy=accuracy)
+    result = problem.solve(mu=params.analysis.mu, density=params.analysis.density,
+                           accuracy=accuracy)
     check_valid(params, scene, model, result)
     return params, model, result
 
@@ -90,8 +91,8 @@ def test_unit_scales_forces_by_its_cube():
 @pytest.mark.parametrize("changes", [
     dict(stretch=0.5), dict(stretch=4.0), dict(stretch=0.3, n=32),
     dict(n=3, p=10), dict(n=32, p=3, r=0), dict(n=4, p=6),
-    dict(p=1, r=4), dict(p=20, r=0),
-    dict(r=0), dict(r=4, p=1),
+    dict(p=2, r=4), dict(p=20, r=0),
+    dict(r=0), dict(r=4, p=1, pattern="none"),
     dict(cut=0.0), dict(cut=0.9, p=20, r=2),
 ])
 def test_geometric_extremes_build_and_solve(changes):
@@ -102,6 +103,7 @@ def test_geometric_extremes_build_and_solve(changes):
     (dict(stretch=0.3), "p"),   # courses meet in wedges too steep to close
     (dict(n=3, p=3, r=0), "p"),
     (dict(p=1, r=0), "p"),
+    (dict(p=1, r=4), "p"),  # the lines from the corners end on the first course
     (dict(cut=0.9, p=3, r=0), "cut"),  # fewer than two courses
     (dict(stretch=0.0), "stretch"),
     (dict(n=2), "n"),

@@ -155,9 +155,10 @@ def _line_cover(blocks, ids, point):
     return sorted(out)
 
 
+@pytest.mark.parametrize("pattern", ("herringbone", "none"))
 @pytest.mark.parametrize("preset", PRESETS)
-def test_every_course_is_covered_boundary_to_boundary(preset):
-    scene = scene_of(preset)
+def test_every_course_is_covered_boundary_to_boundary(preset, pattern):
+    scene = scene_of(preset, pattern=pattern)
     blocks, levels, u = scene.blocks, scene.levels, 0.1
     tan = np.tan(np.pi / scene.geometry.n)
     for k in range(1, levels.n_courses + 1):
@@ -174,11 +175,13 @@ def test_every_course_is_covered_boundary_to_boundary(preset):
         assert cover[0][0] <= -edge + 1e-6 and cover[-1][1] >= edge - 1e-6, k
         holes = [b[0] - a[1] for a, b in zip(cover[:-1], cover[1:])]
         assert max(holes, default=0) <= 1e-6, (k, max(holes))
+        assert min(holes, default=0) >= -1e-6, (k, min(holes))  # and no overlap
 
 
+@pytest.mark.parametrize("pattern", ("herringbone", "none"))
 @pytest.mark.parametrize("preset", PRESETS)
-def test_section_is_mirror_symmetric(preset):
-    blocks = scene_of(preset).blocks
+def test_section_is_mirror_symmetric(preset, pattern):
+    blocks = scene_of(preset, pattern=pattern).blocks
     from scipy.spatial import cKDTree
 
     centroid = blocks.block_centroid
@@ -196,9 +199,10 @@ def _manifold(block_vertices, faces):
     return m3d.Manifold(mesh)
 
 
-@pytest.mark.parametrize("preset", ("1", "3", "wall"))
-def test_no_two_bricks_overlap(preset):
-    blocks = scene_of(preset).blocks
+@pytest.mark.parametrize("preset, overrides", [("1", {}), ("3", {}), ("wall", {}),
+                                               ("1", {"pattern": "none"})])
+def test_no_two_bricks_overlap(preset, overrides):
+    blocks = scene_of(preset, **overrides).blocks
     solids = [_manifold(m.vertices, m.faces) for m in blocks.meshes()]
     lo, hi = blocks.block_bounds[:, 0], blocks.block_bounds[:, 1]
     from scipy.spatial import cKDTree

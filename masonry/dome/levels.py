@@ -96,6 +96,13 @@ class LevelTable:
         parts = [reg - below, pat - below[: len(pat)], above - pat[: len(above)]]
         return np.abs(np.concatenate(parts))
 
+    @property
+    def course_wedge_angles(self) -> np.ndarray:
+        """Angles (radians) of the wedges of a dome without pattern bricks
+        (docs/model.md 4.9): course 1 on the ground and course k on course k - 1, the
+        first :attr:`n_courses` of :attr:`wedge_angles`."""
+        return self.wedge_angles[: self.n_courses]
+
 
 def ellipse_point(a, c, theta):
     """``(x, z)`` of the quarter ellipse at angle ``theta``."""

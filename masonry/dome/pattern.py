@@ -1,4 +1,4 @@
-"""The double-helix pattern in the flattened section (SPEC 4.3, thesis 3.2.2).
+"""The double-helix pattern in the flattened section (docs/model.md 4.3, thesis 3.2.2).
 
 Coordinates: ``s`` is the position along the wall in units (``s = 0`` on the mid-plane),
 courses are numbered ``k = 1..L``. A pattern brick started on course ``k`` at ``s``
@@ -13,13 +13,20 @@ bounces (reverses) where its next brick would leave the section (the rhombi clos
 the boundary) or would run into another line (the rhombi meet in a node: two pattern
 bricks side by side on one course). A line that can go neither on nor back (the section
 has become too narrow) ends.
+
+With one pattern brick per rhombus side (``p = 1``) no line from a corner node lays a
+brick above the first course, whatever the dome: course 2 is narrower than the ground,
+so a corner line starts one cell in, beside or one cell from the line coming toward it;
+the two go on only into one cell or across each other, and back only out of the web or
+onto a cell another line holds. The polygonal dome refuses it
+(:meth:`masonry.scenes.polygonal.Section.check`).
 """
 
 from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.tolerances import UNIT_SLACK
+from masonry.tolerances import PATTERN_END_REPORTED, UNIT_SLACK
 
 
 @dataclass(frozen=True)
@@ -58,6 +65,24 @@ class Pattern:
 
     def __len__(self) -> int:
         return len(self.course)
+
+    @classmethod
+    def none(cls) -> "Pattern":
+        """No pattern bricks: a plain dome's or a wall's courses (docs/model.md 4.9)."""
+        empty, pairs = np.zeros(0, int), np.zeros((0, 2), int)
+        return cls(empty, empty, empty, pairs, pairs, pairs, pairs)
+
+    @property
+    def n_lines(self) -> int:
+        """The number of pattern lines (every line lays a brick on course 1)."""
+        return len(np.unique(self.line))
+
+    def ended_far_below_top(self, n_courses: int) -> np.ndarray:
+        """``(course, s)`` rows of :attr:`ended` for lines that end on a course below
+        :data:`~masonry.tolerances.PATTERN_END_REPORTED` of the highest course a pattern
+        brick starts on, ``n_courses - 1`` (lines that end near the top, where the web
+        has narrowed, are not counted)."""
+        return self.ended[self.ended[:, 0] < PATTERN_END_REPORTED * (n_courses - 1)]
 
     def cells(self, n_courses: int) -> list:
         """Per course ``k = 1..n_courses`` (list index ``k - 1``), the sorted left edges of
@@ -134,10 +159,8 @@ def build_pattern(half_width, p: int, r: int) -> Pattern:
     """
     half_width = np.asarray(half_width, dtype=float)
     n_courses = len(half_width)
-    empty = np.zeros((0, 2), int)
     if n_courses < 2:
-        return Pattern(np.zeros(0, int), np.zeros(0, int), np.zeros(0, int),
-                       empty, empty, empty, empty)
+        return Pattern.none()
     pos, step = _ground_lines(p, r, half_width[1])
     alive = np.ones(len(pos), bool)
 

@@ -11,8 +11,9 @@ from masonry.plots.common import CLASS_COLOURS, png_bytes
 
 def pattern_png(scene, fast=False, title="") -> bytes:
     """The flattened section (thesis figures 3.8-3.9): position along the wall (units)
-    against course, pattern, regular and fill-in bricks in distinct colours, the web's
-    half width at every course in blue; ``title`` is the line under the figure's own."""
+    against course, pattern, regular and fill-in bricks in distinct colours (the legend
+    names the classes present), the web's half width at every course in blue; ``title`` is
+    the line under the figure's own."""
     layout, levels, unit = scene.layout, scene.levels, scene.unit
     height = np.where(layout.klass == PATTERN, 2, 1)
     # mitered ends reach the web's boundary (at the course's lower, wider edge)
@@ -28,8 +29,9 @@ def pattern_png(scene, fast=False, title="") -> bytes:
     z = np.arange(len(w))
     ax.plot(w, z, "b-", -w, z, "b-", linewidth=1.2)
     for name in ("pattern", "regular", "fill_in"):
-        ax.add_patch(Rectangle((0, 0), 0, 0, facecolor=CLASS_COLOURS[name],
-                               label=name.replace("_", "-")))
+        if np.any(layout.klass == BLOCK_CLASSES.index(name)):
+            ax.add_patch(Rectangle((0, 0), 0, 0, facecolor=CLASS_COLOURS[name],
+                                   label=name.replace("_", "-")))
     ax.legend(loc="upper right", fontsize=7)
     ax.set_xlabel(scene.kind.pattern_axis)
     ax.set_ylabel("course")
@@ -37,5 +39,6 @@ def pattern_png(scene, fast=False, title="") -> bytes:
     ax.set_ylim(-0.5, len(w) + 0.5)
     pattern = int((layout.klass == PATTERN).sum())
     what = scene.kind.pattern_caption(scene.geometry)
-    ax.set_title(f"{what}: {len(layout)} bricks ({pattern} pattern)\n{title}", fontsize=9)
+    counts = f"{pattern} pattern" if pattern else "no pattern bricks"
+    ax.set_title(f"{what}: {len(layout)} bricks ({counts})\n{title}", fontsize=9)
     return png_bytes(fig, 80 if fast else 130)

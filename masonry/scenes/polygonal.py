@@ -4,7 +4,9 @@
 One web faces +x on its ground slab (docs/model.md 4.2 to 4.5): level table, pattern,
 courses, then posed bricks (:mod:`masonry.scenes.bricks`). End bricks are mitered: their
 end face lies in the corner plane ``y = +-x tan(pi/n)`` where this web meets the next, so
-``n`` rotated copies close into the whole dome face to face (docs/model.md 4.6).
+``n`` rotated copies close into the whole dome face to face (docs/model.md 4.6). The
+plain dome (``pattern = "none"``, docs/model.md 4.9) lays the same courses with no
+pattern bricks: running bond, filled and staggered by the same rules.
 """
 
 import dataclasses
@@ -16,19 +18,29 @@ import numpy as np
 from masonry.blocks import concatenate, rotated_web, rotation_z
 from masonry.dome.courses import fill_courses
 from masonry.dome.levels import Dimensions, level_table
-from masonry.dome.pattern import build_pattern
+from masonry.dome.pattern import Pattern, build_pattern
 from masonry.errors import ParameterError
 from masonry.parameters import declare
 from masonry.scenes.base import Scene, SceneKind, Symmetry, ThrustSection, hexahedra_frames
 from masonry.scenes.bricks import blocks_from_layout, posed_corners
-from masonry.tolerances import STRETCH_USUAL_RANGE, UNITS_PER_BRICK, Tolerances
+from masonry.tolerances import (STRETCH_USUAL_RANGE, UNITS_PER_BRICK, UNITS_PER_PLAIN_BRICK,
+                                Tolerances)
 
 log = logging.getLogger(__name__)
 
 
+PATTERNS = ("herringbone", "none")
+"""The dome's patterns: the double helix (docs/model.md 4.3) or none, the plain dome of
+running bond (docs/model.md 4.9)."""
+
+MIN_PATTERN_P = 2
+"""The fewest pattern bricks per rhombus side that make a pattern: with one, every line
+from a corner node ends on the first course (:mod:`masonry.dome.pattern`)."""
+
+
 @dataclass(frozen=True)
 class PolygonalDome:
-    """A polygonal cloister vault of ``n`` webs with the double-helix pattern
+    """A polygonal cloister vault of ``n`` webs with the double-helix pattern, or none
     (docs/model.md 3, 4); lengths in units of ``unit`` metres unless stated."""
 
     stretch: float = declare(1.0, "dome height / circumradius", low=0.05, high=20.0,
@@ -52,6 +64,9 @@ class PolygonalDome:
                               check=lambda v: 0 < v <= 4,
                               expected="0 < min_fill <= 4 (units)", tag="mf",
                               names_geometry=True)
+    pattern: str = declare("herringbone", "pattern bricks: herringbone (the double helix) "
+                           "or none (running bond, the same courses)", kind="str",
+                           choices=PATTERNS, tag="pat", names_geometry=True)
 
 
 def build_web(geometry: PolygonalDome) -> Scene:
@@ -69,7 +84,8 @@ def build_web(geometry: PolygonalDome) -> Scene:
         log.warning("stretch=%g is outside %g..%g: the dome is unusually flat or tall",
                     geometry.stretch, low, high)
     half_width = levels.y[1:] / geometry.unit
-    pattern = build_pattern(half_width, geometry.p, geometry.r)
+    pattern = (build_pattern(half_width, geometry.p, geometry.r)
+               if geometry.pattern == "herringbone" else Pattern.none())
     layout = fill_courses(half_width, pattern, geometry.min_fill, miter=True)
     tan = np.tan(np.pi / geometry.n)
     u = geometry.unit
@@ -89,7 +105,9 @@ def _check_levels(geometry, levels):
         raise ParameterError("cut", geometry.cut, "a dome at least two courses high "
                              f"(this one holds {levels.n_courses}); lower cut or unit",
                              related=("unit", "stretch", "p", "r"))
-    widest = float(levels.wedge_angles.max())
+    wedges = (levels.wedge_angles if geometry.pattern == "herringbone"
+              else levels.course_wedge_angles)
+    widest = float(wedges.max())
     limit = Tolerances().max_gap_angle
     if widest > limit:
         raise ParameterError(
@@ -103,7 +121,8 @@ def _check_levels(geometry, levels):
 def web_bricks(geometry: PolygonalDome) -> float:
     """The number of blocks of one web, from its dimensions alone: its intrados area (the
     web's width integrated along the quarter ellipse) over
-    :data:`~masonry.tolerances.UNITS_PER_BRICK`, within a factor 1.4."""
+    :data:`~masonry.tolerances.UNITS_PER_BRICK` (a plain dome's:
+    :data:`~masonry.tolerances.UNITS_PER_PLAIN_BRICK`), within a factor 1.4."""
     with np.errstate(all="ignore"):  # absurd inputs give inf, which is refused
         d = Dimensions.of(geometry)
         theta = np.linspace(0.0, np.arcsin(min(d.z_max / d.c, 1.0)), 257)
@@ -111,7 +130,8 @@ def web_bricks(geometry: PolygonalDome) -> float:
         speed = np.hypot(d.a * np.sin(theta), d.c * np.cos(theta))
         f = width * speed
         area = np.sum((f[1:] + f[:-1]) / 2 * np.diff(theta)) / geometry.unit**2
-    return float(area) / UNITS_PER_BRICK
+    per_brick = UNITS_PER_BRICK if geometry.pattern == "herringbone" else UNITS_PER_PLAIN_BRICK
+    return float(area) / per_brick
 
 
 class Section(SceneKind):
@@ -127,6 +147,19 @@ class Section(SceneKind):
     @classmethod
     def build(cls, geometry) -> Scene:
         return build_web(geometry)
+
+    @classmethod
+    def check(cls, geometry):
+        """Refuse a herringbone dome of one pattern brick per rhombus side: its lines from
+        the corners end on the first course (:mod:`masonry.dome.pattern`), and with
+        ``r = 1`` no pattern is left above it."""
+        if geometry.pattern == "herringbone" and geometry.p < MIN_PATTERN_P:
+            raise ParameterError(
+                "p", geometry.p,
+                f"an integer >= {MIN_PATTERN_P} for the herringbone pattern: with "
+                f"{geometry.p} pattern brick per rhombus side the lines from the corners "
+                f"end on the first course; --pattern none lays the same courses without "
+                f"a pattern")
 
     @classmethod
     def estimate_blocks(cls, geometry) -> float:
@@ -159,7 +192,7 @@ class Section(SceneKind):
 
     @classmethod
     def pattern_caption(cls, geometry) -> str:
-        return f"one web of {geometry.n}, flattened"
+        return f"one web of {geometry.n}, flattened{_no_pattern(geometry)}"
 
 
 class Dome(Section):
@@ -202,4 +235,9 @@ class Dome(Section):
 
     @classmethod
     def pattern_caption(cls, geometry) -> str:
-        return f"web 0 of {geometry.n}, flattened"
+        return f"web 0 of {geometry.n}, flattened{_no_pattern(geometry)}"
+
+
+def _no_pattern(geometry) -> str:
+    """What a pattern figure's caption adds for a plain dome."""
+    return ", no pattern (running bond)" if geometry.pattern == "none" else ""

@@ -38,9 +38,7 @@ def build_wall(params: WallGeometry) -> Scene:
     count = params.wall_courses
     half = params.wall_length / 2
     half_width = np.full(count, half)
-    empty = np.zeros(0, int)
-    no_pattern = Pattern(empty, empty, empty, *[np.zeros((0, 2), int)] * 4)
-    layout = fill_courses(half_width, no_pattern, MIN_FILL, miter=False)
+    layout = fill_courses(half_width, Pattern.none(), MIN_FILL, miter=False)
     levels = LevelTable(
         theta=np.zeros(count + 1), x=np.zeros(count + 1), y=np.full(count + 1, half * u),
         z=np.arange(count + 1) * u, gamma_reg=np.zeros(count), gamma_pat=np.zeros(count),
