@@ -147,6 +147,7 @@ def model_record(scene, density: float) -> dict:
             "ended": pattern.ended.tolist(),
             "ended_far_below_top": pattern.ended_far_below_top(
                 scene.levels.n_courses).tolist(),
+            "ended_why": scene.kind.pattern_ends,
         }
     return record
 

@@ -155,6 +155,9 @@ class SceneKind:
     pattern_axis = "position along the wall s [units]"
     """The flattened pattern figure's horizontal axis."""
 
+    pattern_ends = "the web grew too narrow for them"
+    """Why its pattern lines end below the top (``run.json``'s pattern record)."""
+
     @classmethod
     def shown(cls, geometry) -> dict:
         """The geometry's values as a run used them (defaults resolved), for

@@ -139,7 +139,8 @@ class RingPattern:
 
     ``course``, ``phi0``, ``phi1`` (P,) the pattern bricks (started on ``course``,
     spanning it and the next), ``node_step`` (P,) bool whether the brick closed a node
-    (its step is longer than ``tan(beta)`` units, to stand beside its partner);
+    (its step is longer than ``tan(beta)`` units, to stand beside its partner), ``line``
+    (P,) its line (the start node's right-handed lines, then the left-handed ones);
     ``nodes`` and ``ended`` (M, 2) ``(course, phi)`` of every node and of the nodes where
     lines ended; ``order`` (L + 1,) the rotational symmetry of the bricks started on
     each course (index ``k``).
@@ -149,6 +150,7 @@ class RingPattern:
     phi0: np.ndarray
     phi1: np.ndarray
     node_step: np.ndarray
+    line: np.ndarray
     nodes: np.ndarray
     ended: np.ndarray
     order: np.ndarray
@@ -217,9 +219,9 @@ def ring_pattern(g: RevolutionDome) -> RingPattern:
     if g.pattern == "none" or prof.n_courses < 3:
         order = np.full(prof.n_courses + 1, spirals)
         return RingPattern(np.zeros(0, int), np.zeros(0), np.zeros(0), np.zeros(0, bool),
-                           nothing, nothing, order)
+                           np.zeros(0, int), nothing, nothing, order)
     line, nodes, ended, order = _zigzag(g, prof, spirals)
-    course, phi0, width, node_step = [], [], [], []
+    course, phi0, width, node_step, which = [], [], [], [], []
     for k, lo, hi, node, n, mirror in line:  # the line's brick's orbit on its course
         turns = 2 * np.pi * np.arange(n) / n
         starts = np.concatenate([lo + turns, 2 * mirror - hi + turns])
@@ -227,11 +229,12 @@ def ring_pattern(g: RevolutionDome) -> RingPattern:
         phi0.append(starts)
         width.append(np.full(2 * n, hi - lo))
         node_step.append(np.full(2 * n, node))
+        which.append(np.arange(2 * n))  # its rotations, then their mirror images
     course, phi0 = np.concatenate(course), np.mod(np.concatenate(phi0), 2 * np.pi)
     order_ = np.lexsort((phi0, course))
     phi0 = phi0[order_]
     return RingPattern(course[order_], phi0, phi0 + np.concatenate(width)[order_],
-                       np.concatenate(node_step)[order_],
+                       np.concatenate(node_step)[order_], np.concatenate(which)[order_],
                        np.array(nodes, float).reshape(-1, 2),
                        np.array(ended, float).reshape(-1, 2), order)
 
@@ -486,21 +489,21 @@ def _layout(rings: Rings, mine, prof: Profile, unit) -> Layout:
 
 
 def _pattern_record(g: RevolutionDome, prof: Profile) -> Pattern:
-    """The pattern's report (docs/model.md 4.8): the sector's pattern bricks, and the
-    nodes and line ends of the whole dome, ``s`` in units on their course's ring."""
+    """The whole dome's pattern report (docs/model.md 4.8): its pattern bricks, nodes and
+    line ends, ``s`` in units on their course's ring from longitude 0; two lines end at
+    every node where lines ended (one row each)."""
     pattern = ring_pattern(g)
-    count = pattern.symmetry
-    mine = np.mod(pattern.phi0 + np.pi / count, 2 * np.pi) < 2 * np.pi / count
 
-    def at(rows):
-        k = rows[:, 0].astype(int)
-        return np.column_stack([k, rows[:, 1] * prof.x[k] / g.unit])
+    def at(course, phi):
+        course = np.asarray(course, int)
+        return np.column_stack([course, np.asarray(phi) * prof.x[course] / g.unit])
 
-    empty = np.zeros((0, 2))
-    return Pattern(course=pattern.course[mine],
-                   s=pattern.phi0[mine] * prof.x[pattern.course[mine]] / g.unit,
-                   line=np.zeros(int(mine.sum()), int), nodes=at(pattern.nodes),
-                   near_nodes=empty, boundary_bounces=empty, ended=at(pattern.ended))
+    ended = np.repeat(pattern.ended, 2, axis=0)
+    return Pattern(course=pattern.course, s=at(pattern.course, pattern.phi0)[:, 1],
+                   line=pattern.line,
+                   nodes=at(pattern.nodes[:, 0], pattern.nodes[:, 1]),
+                   near_nodes=np.zeros((0, 2)), boundary_bounces=np.zeros((0, 2)),
+                   ended=at(ended[:, 0], ended[:, 1]))
 
 
 def whole_dome(section: Scene, kind) -> Scene:
@@ -568,6 +571,7 @@ class Sector(SceneKind):
     moved_for_cad = False  # the bricks share their beds: the printed body needs no offset
     pattern_axis = ("arc length s along the ring (its top inner edge) from the sector's "
                     "middle [units]")
+    pattern_ends = "their nodes came closer than 2(p + 1) units"
     summary = "one sector of the dome of revolution (see --boundary)"
 
     @classmethod
