@@ -387,7 +387,7 @@ def pattern_note(record, report):
     pattern = record.get("pattern") or {}
     ended = pattern.get("ended_far_below_top") or []
     if ended:
-        courses = sorted({course for course, _ in ended})
+        courses = sorted({int(course) for course, _ in ended})
         report(f"note: {len(ended)} of {pattern['lines']} pattern lines end far below the "
                f"top course {record['counts']['courses']}, on course"
                f"{'s' if len(courses) > 1 else ''} {', '.join(map(str, courses))}: "
