@@ -287,6 +287,8 @@ def add_output_options(parser):
     g.add_argument("--no-plots", dest="plots", action="store_false", help="skip all plots")
     g.add_argument("--no-printable", dest="printable", action="store_false",
                    help="skip the printable body (dome.stl, dome.obj)")
+    g.add_argument("--no-html", dest="html", action="store_false",
+                   help="skip dome.html (the bricks in 3D, for a browser)")
     g.add_argument("--print-size", dest="print_size", type=float, metavar="MM",
                    help=f"also write dome.3mf for a slicer, in millimetres, its largest "
                         f"dimension MM ({_range('print_size')}; default: no 3MF)")

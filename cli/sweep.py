@@ -89,8 +89,8 @@ def load_study(path) -> Study:
         if not ok:
             refuse(key, value, expected)
     for key, value in outputs.items():
-        if key not in ("plots", "printable") or not isinstance(value, bool):
-            refuse(f"outputs.{key}", value, "plots or printable = true or false")
+        if key not in ("plots", "printable", "html") or not isinstance(value, bool):
+            refuse(f"outputs.{key}", value, "plots, printable or html = true or false")
     for key, values in grid.items():
         if not isinstance(values, list) or not values:
             refuse(f"grid.{key}", values, "a non-empty list of values")
@@ -110,7 +110,8 @@ def load_study(path) -> Study:
               **_fields(base, "base", names, where)},
         grid=_fields(grid, "grid", names, where, lists=True),
         sample=_fields(sample, "sample", names, where), count=count, seed=seed,
-        plots=outputs.get("plots", False), printable=outputs.get("printable", False))
+        plots=outputs.get("plots", False), printable=outputs.get("printable", False),
+        html=outputs.get("html", False))
     _check_variants(study, where)
     return study
 

@@ -184,7 +184,7 @@ class Structure:
             The output root.
         **outputs
             What to write (docs/model.md 7): ``plots``, ``quick``, ``printable``,
-            ``print_size``, ``cad_offset``.
+            ``print_size``, ``html``, ``cad_offset``.
 
         Returns
         -------
@@ -195,7 +195,7 @@ class Structure:
         if unknown:
             name = sorted(unknown)[0]
             raise ParameterError(name, outputs[name], "an output option: plots, quick, "
-                                 "printable, print_size or cad_offset")
+                                 "printable, print_size, html or cad_offset")
         params = validate(self.params.replace(**outputs))
         return run(params, out, scene=self.scene, source=self.source)
 

@@ -22,6 +22,15 @@ from masonry.tolerances import COLLINEAR_SIN, HORIZONTAL_SIN, TIE_REL
 BLOCK_CLASSES = ("ground", "regular", "pattern", "fill_in", "block")
 """Names of the ``block_class`` codes. ``block`` is an imported or scene block (arch)."""
 
+CLASS_COLOURS = {
+    "ground": "#9e9e9e",
+    "regular": "#e8d5b0",
+    "pattern": "#d62728",
+    "fill_in": "#f2a541",
+    "block": "#c9b79c",
+}
+"""The colour of each block class in the figures and ``dome.html``."""
+
 GROUND = BLOCK_CLASSES.index("ground")
 """``block_class`` code of a ground slab or support block."""
 

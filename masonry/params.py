@@ -33,10 +33,14 @@ PRESETS = {
 }
 
 RECORDED_OUTPUTS = ("quick", "print_size", "cad_offset")
-"""The outputs' inputs a run records among its parameters (``plots`` and ``printable``
-are recorded as what the run wrote)."""
+"""The outputs' inputs a run records among its parameters (those of
+:data:`WRITTEN_OUTPUTS` are recorded as what the run wrote)."""
 
-FILE_OUTPUTS = ("plots", "quick", "printable", "print_size")
+WRITTEN_OUTPUTS = ("plots", "printable", "html")
+"""The outputs a run writes or not, recorded in ``run.json``'s ``outputs`` (what the run
+wrote), not among its parameters."""
+
+FILE_OUTPUTS = (*WRITTEN_OUTPUTS, "quick", "print_size")
 """Inputs that choose files, not results: a folder whose run differs only in them holds
 the same input (not in the structure id)."""
 
@@ -104,9 +108,9 @@ class Params:
 
     def record(self) -> dict:
         """The inputs ``run.json`` records (:func:`inputs` but the outputs that are
-        recorded as what the run wrote)."""
+        recorded as what the run wrote, :data:`WRITTEN_OUTPUTS`)."""
         return {name: value for name, value in self.inputs().items()
-                if name not in ("plots", "printable")}
+                if name not in WRITTEN_OUTPUTS}
 
     def replace(self, **changes) -> "Params":
         """The same inputs with ``changes`` (flat names), not yet validated."""

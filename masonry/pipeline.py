@@ -22,7 +22,8 @@ import masonry
 from masonry import __version__, forking
 from masonry.blocks import BLOCK_CLASSES
 from masonry.export import EXPORTERS, RunOutputs
-from masonry.params import FILE_OUTPUTS, Params, geometry_key, structure_id, validate
+from masonry.params import (FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, geometry_key, structure_id,
+                            validate)
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.collapse import CollapseResult, collapse_load, worst_lateral
 from masonry.rbe.loads import Lateral
@@ -35,7 +36,7 @@ from masonry.tolerances import MAX_BRICKS, G
 log = logging.getLogger(__name__)
 
 PACKAGES = ("numpy", "scipy", "trimesh", "manifold3d", "cvxpy", "osqp", "highspy",
-            "clarabel", "meshio", "matplotlib")
+            "clarabel", "meshio", "matplotlib", "plotly")
 
 
 def versions() -> dict:
@@ -306,7 +307,7 @@ def _identify(record) -> dict:
 
 def with_outputs(params: Params, outputs: dict) -> Params:
     """``params`` writing ``outputs`` (:meth:`masonry.runfolder.Publication.outputs`)."""
-    chosen = {name: outputs[name] for name in ("plots", "printable", "quick", "print_size")}
+    chosen = {name: outputs[name] for name in FILE_OUTPUTS}
     return dataclasses.replace(params, outputs=dataclasses.replace(params.outputs, **chosen))
 
 
@@ -352,9 +353,8 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     if scene is None:
         check_size(params, max_bricks)
     out = params.outputs
-    job = Publication(out_root, structure_id(params), {"params": identity(params)},
-                      {"analyse": analyse, "plots": out.plots, "printable": out.printable,
-                       "quick": out.quick, "print_size": out.print_size},
+    wanted = {"analyse": analyse, **{name: getattr(out, name) for name in FILE_OUTPUTS}}
+    job = Publication(out_root, structure_id(params), {"params": identity(params)}, wanted,
                       force=force, identify=_identify)
     reused = job.reusable()
     if reused is not None:
@@ -416,7 +416,8 @@ def run_record(params: Params, scene: Scene, model: Model, outputs: dict, cached
     model : masonry.rbe.boundary.Model
         Its analysis model; its interface counts by kind go into ``counts``.
     outputs : dict str -> bool
-        What the run writes (``analyse``, ``plots``, ``printable``, ``quick``).
+        What the run writes (``analyse``, :data:`~masonry.params.WRITTEN_OUTPUTS`,
+        ``quick``).
     cached : str
         ``'reused'``, ``'computed'`` or ``'given'``: where the geometry came from.
     source : dict, optional
@@ -432,8 +433,7 @@ def run_record(params: Params, scene: Scene, model: Model, outputs: dict, cached
         "structure_id": structure_id(params),
         "scene": params.scene,
         "params": params.record(),
-        "outputs": {name: outputs[name] for name in ("analyse", "plots", "printable",
-                                                     "quick")},
+        "outputs": {name: outputs[name] for name in ("analyse", *WRITTEN_OUTPUTS, "quick")},
         **model_record(scene, params.analysis.density),
         "coordinates": coordinates_record(scene, params.outputs.cad_offset),
         "cache": {"geometry": cached},

@@ -193,6 +193,11 @@ GROUND_MARGIN_REL = 0.05
 the lowest blocks by this fraction of the footprint's larger side on every side, and is
 as thick as that margin (:func:`masonry.scenes.imported.with_ground`)."""
 
+FACE_COVERED = 1 - 1e-3
+"""A face of a brick whose interfaces with other bricks cover this fraction of its area
+is inside the structure, never seen: ``dome.html`` does not draw it
+(:func:`masonry.export.html.outer_faces`)."""
+
 # ---------------------------------------------------------------------- interfaces
 BED_JOINT_ANGLE = float(np.pi / 4)
 """Radians. A face whose normal is within this angle of its block's course direction

@@ -58,7 +58,7 @@ def test_run_after_build_adds_the_forces_and_keeps_the_plots(tmp_path):
                  "-q"]) == 0
     record = json.loads((tmp_path / WALL_ID / "run.json").read_text())
     assert record["outputs"] == {"analyse": True, "plots": True, "printable": False,
-                                 "quick": True}
+                                 "html": True, "quick": True}
     assert (tmp_path / WALL_ID / "RBE" / "forces.csv").is_file()
     assert (tmp_path / WALL_ID / "00_pattern.png").is_file()
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from masonry.export import csv, obj, rhino, stl, summaries, threemf, vtu
+from masonry.export import csv, html, obj, rhino, stl, summaries, threemf, vtu
 from masonry.printable import printable_blocks, printable_body
 from masonry.rbe.equilibrium import VariableLayout
 from masonry.rbe.resultants import interface_resultants
@@ -95,7 +95,7 @@ class Exporter:
         Also the run.json key of its record, if it returns one.
     stage : str
         The timing stage it counts towards (``forces``, ``exports``, ``printable``,
-        ``plots``).
+        ``html``, ``plots``).
     make : callable RunOutputs -> Export
     wanted : callable RunOutputs -> bool
         Whether this run writes it.
@@ -225,6 +225,10 @@ def _printable_files(made: RunOutputs) -> Export:
     return Export(files, report)
 
 
+def _html_files(made: RunOutputs) -> Export:
+    return Export({"dome.html": html.dome_html(made)})
+
+
 def _mechanism_plots(made: RunOutputs) -> dict:
     from masonry import plots  # matplotlib: imported by the runs that draw (see _plot_files)
 
@@ -287,6 +291,7 @@ EXPORTERS = (
              wanted=lambda made: made.collapse is not None),
     Exporter("printable", "printable", _printable_files,
              wanted=lambda made: made.outputs.printable),
+    Exporter("html", "html", _html_files, wanted=lambda made: made.outputs.html),
     # the model's plots beside the 3DM file in the second process, the forces' here: the
     # two take about as long
     Exporter("plots", "plots", _plot_files, wanted=lambda made: made.outputs.plots,

@@ -59,13 +59,9 @@ def block_user_text(blocks: Blocks, model=None, forces=None) -> dict:
             "support": np.where(blocks.block_is_support, "yes", "no")}
     if model is None or forces is None:
         return text
-    sides = model.interfaces.pair if model.side_block is None else model.side_block
     for name in ("compression", "tension"):
-        largest = np.zeros(model.blocks.n_blocks)
-        value = np.asarray(forces[name], dtype=float)
-        for side in (0, 1):
-            np.maximum.at(largest, sides[:, side], value)
-        text[f"max_{name}_N"] = np.array([f"{v:.6g}" for v in largest[:blocks.n_blocks]])
+        largest = model.block_largest(forces[name])[:blocks.n_blocks]
+        text[f"max_{name}_N"] = np.array([f"{v:.6g}" for v in largest])
     return text
 
 

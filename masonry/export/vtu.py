@@ -24,6 +24,7 @@ import numpy as np
 
 from masonry import __version__
 from masonry.interfaces import INTERFACE_KINDS
+from masonry.rbe.collapse_result import vertex_displacements
 
 VTK_TRIANGLE, VTK_QUAD, VTK_POLYGON = 5, 9, 7
 """The VTK cell type codes of the interfaces' polygons."""
@@ -61,9 +62,7 @@ def mechanism_vtu(blocks, mechanism) -> bytes:
     import meshio
 
     mechanism = np.asarray(mechanism, dtype=float)
-    owner = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
-    arm = blocks.vertices - blocks.block_centroid[owner]
-    displacement = mechanism[owner, :3] + np.cross(mechanism[owner, 3:], arm)
+    displacement = vertex_displacements(blocks, mechanism)
     block = blocks.face_block[blocks.triangle_face]
     mesh = meshio.Mesh(np.asarray(blocks.vertices, dtype=float),
                        [("triangle", blocks.triangles)],

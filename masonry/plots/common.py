@@ -1,5 +1,6 @@
-"""What every figure shares: the block class colours, the four views and their axes,
-polygons, lines and markers drawn in any view, titles, and the PNG bytes a figure becomes.
+"""What every figure shares: the block class colours (:data:`masonry.blocks.CLASS_COLOURS`),
+the four views and their axes, polygons, lines and markers drawn in any view, titles, and
+the PNG bytes a figure becomes.
 
 A view is 3D (``01_angle``, from :data:`ANGLE`) or an elevation (:data:`ELEVATIONS`),
 drawn as a 2D projection at equal scale; the drawing helpers take the view's name and
@@ -14,15 +15,8 @@ import numpy as np
 from matplotlib.collections import PolyCollection
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+from masonry.blocks import CLASS_COLOURS  # noqa: F401 (the figures' name for it)
 from masonry.interfaces import INTERFACE_KINDS
-
-CLASS_COLOURS = {
-    "ground": "#9e9e9e",
-    "regular": "#e8d5b0",
-    "pattern": "#d62728",
-    "fill_in": "#f2a541",
-    "block": "#c9b79c",
-}
 
 # the thesis's four views (section 3.4): a 3D view from an angle (elevation, azimuth in
 # degrees) and three elevations, drawn as 2D projections at equal scale (3D axes seen

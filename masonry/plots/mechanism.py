@@ -10,6 +10,7 @@ from matplotlib.transforms import ScaledTranslation
 from masonry.plots.colours import colour_bar, colour_scale
 from masonry.plots.common import (ELEVATIONS, NO_FILL, VIEWS, add_points, add_polygons,
                                   interface_polygons, png_bytes, view_axes)
+from masonry.rbe.collapse_result import vertex_displacements
 from masonry.tolerances import MECHANISM_MAIN
 
 MECHANISM_SCALE = 0.08
@@ -21,8 +22,7 @@ def _mechanism_faces(blocks, mechanism):
     """The free blocks' faces undeformed and displaced by ``mechanism`` drawn at
     :data:`MECHANISM_SCALE`, and each face's block's largest vertex displacement."""
     owner = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
-    arm = blocks.vertices - blocks.block_centroid[owner]
-    displacement = mechanism[owner, :3] + np.cross(mechanism[owner, 3:], arm)
+    displacement = vertex_displacements(blocks, mechanism)
     size = float(np.linalg.norm(blocks.bounds[1] - blocks.bounds[0]))
     moved = blocks.vertices + MECHANISM_SCALE * size * displacement
     per_block = np.zeros(blocks.n_blocks)
@@ -38,26 +38,24 @@ def _mechanism_faces(blocks, mechanism):
 
 def _live_load_marks(ax, view, blocks, live, bounds) -> list:
     """Where the live load acts: the loaded blocks marked when not every block is loaded
-    (a point or crown load), and its resultant's direction as an arrow, into them, or
-    from the plot's edge the load comes from (none for forces that cancel). Returns the
+    (a point or crown load), and its resultant's direction as an arrow
+    (:meth:`~masonry.rbe.loads.LiveLoad.arrow`; none for forces that cancel). Returns the
     legend handles."""
     handles = []
-    loaded = np.flatnonzero(np.abs(live.wrench[:, :3]).max(axis=1) > 0)
-    some = len(loaded) < int((~np.asarray(blocks.block_is_support)).sum())
-    if some:
+    loaded = live.loaded_blocks(blocks)
+    if loaded is not None:
         add_points(ax, view, blocks.block_centroid[loaded], marker="v", color="k", s=18)
         handles.append(Line2D([], [], marker="v", color="k", linestyle="none",
                               label=f"loaded blocks ({len(loaded)})"))
-    total = live.total_force
-    if np.linalg.norm(total) <= 1e-9 * np.abs(live.wrench[:, :3]).sum():
-        return handles  # a couple, a push and a pull: no one direction
-    direction = total / float(np.linalg.norm(total))
-    start, end = _arrow(blocks.block_centroid[loaded].mean(axis=0) if some else None,
-                        direction, bounds)
+    arrow = live.arrow(blocks, bounds)
+    if arrow is None:
+        return handles
+    start, end = arrow
     if view not in ELEVATIONS:
         ax.quiver(*start, *(end - start), color="k", linewidth=1.5, arrow_length_ratio=0.3)
     else:
         h, v, _, _ = ELEVATIONS[view]
+        direction = (end - start) / float(np.linalg.norm(end - start))
         if np.hypot(*direction[[h, v]]) < 0.1:  # seen along the load
             return handles
         ax.annotate("", xy=end[[h, v]], xytext=start[[h, v]], zorder=11,
@@ -65,19 +63,6 @@ def _live_load_marks(ax, view, blocks, live, bounds) -> list:
     handles.append(Line2D([], [], marker=r"$\rightarrow$", color="k", linestyle="none",
                           markersize=12, label="live load's direction"))
     return handles
-
-
-def _arrow(target, direction, bounds):
-    """``(start, end)`` of an arrow along ``direction`` (a unit (3,)): into ``target``, as
-    long as the box ``bounds`` leaves room for behind it, or (None) from the box's edge."""
-    size = float(np.abs(direction) @ (bounds[1] - bounds[0]))  # the box along it
-    if target is None:
-        start = bounds.mean(axis=0) - 0.45 * size * direction
-        return start, start + 0.25 * size * direction
-    room = np.where(direction > 0, target - bounds[0], bounds[1] - target)
-    moving = np.abs(direction) > 1e-9  # not empty: a unit vector
-    length = min(0.25 * size, 0.9 * float((room[moving] / np.abs(direction[moving])).min()))
-    return target - length * direction, target
 
 
 def _joint_handles(collapse) -> list:

@@ -62,6 +62,16 @@ class Model:
     def boundary_count(self) -> int:
         return int((self.interfaces.kind == BOUNDARY).sum())
 
+    def block_largest(self, values) -> np.ndarray:
+        """(B,) float: the largest of per-interface ``values`` ((K,), >= 0) over the
+        interfaces each block bears on, 0 where none; an interface side routed elsewhere
+        (``side_block``, cyclic symmetry) counts for the block it acts on."""
+        sides = self.interfaces.pair if self.side_block is None else self.side_block
+        largest = np.zeros(self.blocks.n_blocks)
+        for side in (0, 1):
+            np.maximum.at(largest, sides[:, side], np.asarray(values, dtype=float))
+        return largest
+
 
 class UnsupportedError(MasonryError, ValueError):
     """Some blocks have no path of contacts to a support: nothing can carry them, and no

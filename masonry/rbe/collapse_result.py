@@ -180,6 +180,15 @@ class CollapseResult:
         return out
 
 
+def vertex_displacements(blocks, mechanism) -> np.ndarray:
+    """(V, 3) float: the virtual displacement of every vertex of ``blocks`` by
+    ``mechanism`` ((B, 6), per block ``(u, theta)`` about its centroid)."""
+    mechanism = np.asarray(mechanism, dtype=float)
+    owner = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
+    arm = blocks.vertices - blocks.block_centroid[owner]
+    return mechanism[owner, :3] + np.cross(mechanism[owner, 3:], arm)
+
+
 def _count(flags) -> int:
     """How many interfaces ``flags`` marks; -1 without a mechanism (None)."""
     return -1 if flags is None else int(flags.sum())

@@ -53,6 +53,37 @@ class LiveLoad:
         """(3,) float, N: the resultant force."""
         return self.wrench[:, :3].sum(axis=0)
 
+    def loaded_blocks(self, blocks) -> np.ndarray | None:
+        """(k,) int: the blocks of ``blocks`` (the model's) the load pushes, when it
+        pushes only some of the free ones (a point or crown load); None for a body force
+        on every free block."""
+        loaded = np.flatnonzero(np.abs(self.wrench[:, :3]).max(axis=1) > 0)
+        some = len(loaded) < int((~np.asarray(blocks.block_is_support)).sum())
+        return loaded if some else None
+
+    def arrow(self, blocks, bounds, outside=False) -> tuple | None:
+        """``(start, end)`` ((3,) float each, metres) of an arrow along the resultant
+        force: into the loaded blocks (:meth:`loaded_blocks`), as long as the box
+        ``bounds`` ((2, 3), the drawing's) leaves room for behind them, or for a body
+        force from the box's edge the load comes from (``outside``: ending just outside
+        it, for a view that hides what is inside the structure); None when the forces
+        cancel (a couple, a push and a pull: no one direction)."""
+        total = self.total_force
+        if np.linalg.norm(total) <= 1e-9 * np.abs(self.wrench[:, :3]).sum():
+            return None
+        direction = total / float(np.linalg.norm(total))
+        size = float(np.abs(direction) @ (bounds[1] - bounds[0]))  # the box along it
+        loaded = self.loaded_blocks(blocks)
+        if loaded is None:
+            start = bounds.mean(axis=0) - (0.8 if outside else 0.45) * size * direction
+            return start, start + 0.25 * size * direction
+        target = blocks.block_centroid[loaded].mean(axis=0)
+        room = np.where(direction > 0, target - bounds[0], bounds[1] - target)
+        moving = np.abs(direction) > 1e-9  # not empty: a unit vector
+        length = min(0.25 * size,
+                     0.9 * float((room[moving] / np.abs(direction[moving])).min()))
+        return target - length * direction, target
+
 
 def _blocks(model_or_blocks):
     return getattr(model_or_blocks, "blocks", model_or_blocks)

@@ -56,8 +56,9 @@ class Study:
         Inputs drawn uniformly at random, ``count`` draws (integers where both bounds are
         integers), seeded by ``seed``; combined with every grid point.
     count, seed : int
-    analyse, plots, printable : bool
-        What each run does and writes (defaults: solve, no plots, no printable body).
+    analyse, plots, printable, html : bool
+        What each run does and writes (defaults: solve, no plots, no printable body, no
+        ``dome.html``).
     """
 
     base: dict
@@ -68,6 +69,7 @@ class Study:
     analyse: bool = True
     plots: bool = False
     printable: bool = False
+    html: bool = False
 
     @property
     def swept(self) -> list:
@@ -116,7 +118,8 @@ class Study:
         return [{**self.base, **point, **draw} for point in points for draw in draws]
 
 
-def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=False) -> dict:
+def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=False,
+                html=False) -> dict:
     """Run one variant; never raises: a failure becomes a row with its error.
 
     Parameters
@@ -125,9 +128,9 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
         The variant's inputs (flat names).
     out_root : str or Path
         The study's output root; the variant's run folder is named by its structure id.
-    analyse, plots, printable : bool
-        What the run does and writes (:func:`masonry.pipeline.run`; ``plots`` and
-        ``printable`` unless the variant's inputs say otherwise).
+    analyse, plots, printable, html : bool
+        What the run does and writes (:func:`masonry.pipeline.run`; ``plots``,
+        ``printable`` and ``html`` unless the variant's inputs say otherwise).
 
     Returns
     -------
@@ -141,7 +144,8 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     start = time.perf_counter()
     row = {"status": "failed", "error": ""}
     try:
-        params = Params.of(**{"plots": plots, "printable": printable, **inputs})
+        params = Params.of(**{"plots": plots, "printable": printable, "html": html,
+                              **inputs})
         record = run(validate(params), out_root, analyse=analyse)
     except Exception as error:  # a variant's failure is data, not the study's end
         row["error"] = f"{type(error).__name__}: {error}"
@@ -248,7 +252,8 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
     variants = study.variants()
     if scheduler is not None:
         check_scheduler_address(scheduler)
-    options = dict(analyse=study.analyse, plots=study.plots, printable=study.printable)
+    options = dict(analyse=study.analyse, plots=study.plots, printable=study.printable,
+                   html=study.html)
     if workers == 1 and scheduler is None:
         for i, inputs in enumerate(variants):
             yield i, inputs, run_variant(inputs, str(out_root), **options)
