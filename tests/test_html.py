@@ -26,7 +26,7 @@ ARTEFACTS = Path(os.environ.get("MASONRY_TEST_ARTEFACTS",
                                Path(__file__).resolve().parent.parent / "exports"
                                / "test_artefacts"))
 """Where the browser test leaves its screenshot of preset 1's full dome (under the
-output root, not committed; CI collects it)."""
+output root, not committed), for a reader or a CI job to keep."""
 CHROMIUM = next(filter(None, map(shutil.which, ("chromium", "chromium-browser",
                                                 "google-chrome"))), None)
 # as root, and with no network: no sandbox, no background connections (docs/outputs.md)
