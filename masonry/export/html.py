@@ -59,7 +59,9 @@ _SCRIPT = """
 const gd = document.getElementById('{plot_id}');
 const page = JSON.parse(document.getElementById('bricks').textContent);
 const owner = new Int32Array(page.first[page.first.length - 1]);
-for (let b = 0; b + 1 < page.first.length; b++) owner.fill(b, page.first[b], page.first[b + 1]);
+for (let b = 0; b + 1 < page.first.length; b++) {
+  owner.fill(b, page.first[b], page.first[b + 1]);
+}
 const select = document.getElementById('colouring');
 page.colourings.forEach((c, i) => {
   const option = new Option(c.empty ? c.label + ': none' : c.label, i);
@@ -73,10 +75,13 @@ select.onchange = () => {
     colorscale: [s.colorscale], cmin: s.cmin, cmax: s.cmax, colorbar: [s.colorbar]}, [0]);
 };
 function pick(brick) {
-  const rows = [page.name[brick], 'course ' + page.course[brick] + ', web ' + page.web[brick]];
+  const rows = [page.name[brick],
+                'course ' + page.course[brick] + ', web ' + page.web[brick]];
   for (const c of page.colourings) {
     const v = c.values[brick];
-    rows.push(c.label + ': ' + (c.names ? c.names[v] : (+v.toPrecision(4)).toLocaleString('en') + ' ' + c.unit));
+    const shown = c.names ? c.names[v]
+                          : ((+v.toPrecision(4)).toLocaleString('en') + ' ' + c.unit).trim();
+    rows.push(c.label + ': ' + shown);
   }
   document.getElementById('pick').textContent = rows.join('\\n');
 }
@@ -89,8 +94,9 @@ gd.on('plotly_click', e => {
 
 def outer_faces(blocks, interfaces) -> np.ndarray:
     """(F,) bool: the faces of ``blocks`` not covered
-    (:data:`~masonry.tolerances.FACE_COVERED`) by their interfaces with other blocks of ``blocks`` (those with images or other blocks of a
-    model, indices ``>= blocks.n_blocks``, stay: nothing of them is drawn).
+    (:data:`~masonry.tolerances.FACE_COVERED`) by their interfaces with other blocks of
+    ``blocks`` (those with images or other blocks of a model, indices
+    ``>= blocks.n_blocks``, stay: nothing of them is drawn).
 
     Each side of an interface lies on the face of its block whose outward normal is the
     interface's normal (the main block) or its opposite (the other block): of a convex
@@ -246,7 +252,8 @@ def camera(points) -> dict:
         seen = p - centre
         distance = (seen @ eye + (np.abs(seen @ screen.T) / reach).max(axis=1)).max()
         picture = (seen @ screen.T) / (distance - seen @ eye)[:, None]
-        centre = centre + distance * (picture.max(axis=0) + picture.min(axis=0)) / 2 @ screen
+        middle = (picture.max(axis=0) + picture.min(axis=0)) / 2
+        centre = centre + distance * middle @ screen
     return {"center": dict(zip("xyz", centre.tolist())),
             "eye": dict(zip("xyz", (centre + distance * eye).tolist()))}
 
@@ -283,5 +290,6 @@ def dome_html(made) -> str:
     bricks = {"first": first.tolist(), "name": blocks.block_name.tolist(),
               "course": blocks.block_course.tolist(), "web": blocks.block_web.tolist(),
               "colourings": shown}
+    data = json.dumps(bricks, separators=(",", ":"), allow_nan=False)
     return _PAGE.format(title=html.escape(made.figure_title), plot=plot,
-                        bricks=json.dumps(bricks, separators=(",", ":")).replace("</", "<\\/"))
+                        bricks=data.replace("</", "<\\/"))
