@@ -218,7 +218,7 @@ def add_analysis_options(parser, boundary=True):
 
 
 def add_live_load_options(parser):
-    """The live loads of a collapse load factor (SPEC 6.8); at most one per run."""
+    """The live loads of a collapse load factor (docs/model.md 6.8); at most one per run."""
     g = parser.add_argument_group(
         "live load: compute the collapse load factor lambda and its mechanism")
     g.add_argument("--lateral", metavar="AZIMUTH|all",

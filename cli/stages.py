@@ -1,4 +1,4 @@
-"""``masonry stages``: does the structure stand at every stage of its laying (SPEC 4.7)?"""
+"""``masonry stages``: does the structure stand at every stage of its laying (docs/model.md 4.7)?"""
 
 from masonry.params import Params, validate
 from masonry.scenes.imported import load_assembly

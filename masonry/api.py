@@ -146,7 +146,7 @@ class Structure:
 
     def stages(self, by="course", order=None, course=None):
         """Whether it stands at every stage of its construction without centering
-        (docs/model.md 6.6): one row per stage.
+        (docs/model.md 4.7): one row per stage.
 
         Parameters
         ----------

@@ -1,4 +1,4 @@
-"""Blocks as arrays: convex polyhedra with planar faces (SPEC 4.5).
+"""Blocks as arrays: convex polyhedra with planar faces (docs/model.md 4.5).
 
 A :class:`Blocks` is a struct of arrays. Vertices and faces of all blocks are stored flat,
 with offsets (as meshio stores cells), so a scene of 10,000 bricks is a handful of numpy
@@ -534,5 +534,6 @@ def _newell(polygons):
 
 def _sum_by(index, values, n) -> np.ndarray:
     """(n, C) float: ``out[i]`` is the sum of the rows of ``values`` (N, C) whose ``index``
-    is ``i``; ``np.add.at`` in the same order, one bincount per column (faster: docs/bench.md)."""
+    is ``i``; ``np.add.at`` in the same order, one bincount per column (faster: docs/bench.md,
+    "Measurements behind design choices")."""
     return np.stack([np.bincount(index, column, minlength=n) for column in values.T], axis=1)

@@ -79,7 +79,7 @@ def use_one_blas_thread():
 
     A factorization makes thousands of small BLAS calls; with a BLAS thread per core
     every call waits for its threads, and idle BLAS threads spin on the other cores
-    (measured in ``docs/bench.md``). The cores are used by factoring independent
+    (measured in ``docs/bench.md``, "In brief"). The cores are used by factoring independent
     subtrees on threads instead (:meth:`masonry.rbe.solvers.cholesky.BlockCholesky.factor`).
     Clarabel, OSQP and HiGHS have their own threads.
     """

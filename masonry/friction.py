@@ -1,5 +1,5 @@
-"""Friction models: the set of forces one interface vertex can carry (docs/model.md,
-"Friction").
+"""Friction models: the set of forces one interface vertex can carry (docs/model.md
+6.3).
 
 At a vertex with compression ``c`` and friction ``(f1, f2)`` along the joint's axes
 ``t1, t2``, Coulomb's law is isotropic: ``||(f1, f2)|| <= mu c``, a circular cone. The

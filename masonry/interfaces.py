@@ -1,4 +1,4 @@
-"""Contact interfaces between blocks (SPEC 5, thesis 3.2.4).
+"""Contact interfaces between blocks (docs/model.md 5, thesis 3.2.4).
 
 One generic detector for every scene; nothing here knows about domes.
 
@@ -7,14 +7,15 @@ the plane of the *main* face (the lower block's face for bed joints), with that 
 outward normal ``n`` (pointing from the main block ``pair[:, 0]`` into the other block
 ``pair[:, 1]``) and in-plane basis ``t1, t2``.
 
-Why the polygons are clipped here and not by shapely (GEOS), unlike SPEC 5 step 4:
+Why the polygons are clipped here and not by shapely (GEOS) (docs/model.md 5.4):
 every pair is a pair of convex polygons, and in masonry they share edges and corners as
 a rule. GEOS's overlay has no tolerance: it returned two points for two coincident
 quadrilaterals 3e-17 m apart, and a polygon plus a 1e-12 m line elsewhere, so it needed
-a snap-rounding retry wherever the result was not one polygon, and was several times
-slower (docs/bench.md). Convex clipping of all pairs at once (:func:`_clip_convex`,
-Sutherland-Hodgman with a point-on-line tolerance) has no degenerate cases. Shapely
-stays its reference in the tests (``test_convex_clipping_matches_shapely``).
+a snap-rounding retry wherever the result was not one polygon, and was slower
+(docs/bench.md, "Measurements behind design choices"). Convex clipping of all pairs
+at once (:func:`_clip_convex`, Sutherland-Hodgman with a point-on-line tolerance) has
+no degenerate cases. Shapely stays its reference in the tests
+(``test_convex_clipping_matches_shapely``).
 """
 
 from dataclasses import dataclass
@@ -109,7 +110,7 @@ class Interfaces:
 
 # ---------------------------------------------------------------------- detection
 def detect(blocks: Blocks, tol: Tolerances | None = None, up=None) -> Interfaces:
-    """Contact interfaces between convex blocks (SPEC 5, thesis 3.2.4).
+    """Contact interfaces between convex blocks (docs/model.md 5, thesis 3.2.4).
 
     1. Candidate block pairs from a spatial index (:func:`candidate_pairs`).
     2. Face pairs of a candidate pair whose outward normals are anti-parallel within
@@ -366,7 +367,7 @@ def _intersect(blocks, main, comp, faces, tol, up):
     t1, t2 = blocks.face_basis
     n_m, n_c = normal[main], normal[comp]
 
-    # gap closing (SPEC 5.3); faces whose wedge rotation would move no vertex farther
+    # gap closing (docs/model.md 5.3); faces whose wedge rotation would move no vertex farther
     # than tol.length count as parallel and are only projected (below)
     sin = np.linalg.norm(np.cross(n_m, n_c), axis=1)
     is_wedge = sin * faces.radius[comp] > tol.length

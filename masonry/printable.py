@@ -1,9 +1,9 @@
-"""The printable body: all bricks united into one watertight solid (SPEC 7, thesis 3.4.1).
+"""The printable body: all bricks united into one watertight solid (docs/model.md 7, thesis 3.4.1).
 
 The thesis joins its bricks in a CAD tool after offsetting them inward by one unit, so
 that consecutive courses overlap (3.4.1), and prints the joined body (3.4.2). Here the
 union is computed with manifold3d. Three facts measured with manifold3d 3.5.4 shape the
-method (SPEC 7):
+method (docs/model.md 7):
 
 1. Faces that touch exactly merge, but bricks that touch only up to floating-point
    rounding, or only along an edge, stay separate bodies. So every brick is first grown
@@ -19,8 +19,8 @@ method (SPEC 7):
    ``simplify(tol.contact)`` swaps away degenerate triangles and drops redundant
    coplanar vertices (a quarter of the triangles), repeated until no short edge is left.
 3. ``Manifold.decompose()`` is far too slow and memory-hungry for a body count
-   (docs/bench.md); bodies are counted on the mesh's connectivity (trimesh's
-   ``body_count``) instead.
+   (docs/bench.md, "Measurements behind design choices"); bodies are counted on the
+   mesh's connectivity (trimesh's ``body_count``) instead.
 
 The result is verified, not assumed: watertight, consistently wound, one body, no
 zero-area triangle and no two vertices closer than ``tol.contact`` (so float32 rounding
@@ -169,7 +169,7 @@ def _halfspace_corners(blocks: Blocks, i: int, overlap: float) -> np.ndarray:
 
 
 def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
-    """One watertight body from all blocks, for 3D printing (SPEC 7, thesis 3.4.1).
+    """One watertight body from all blocks, for 3D printing (docs/model.md 7, thesis 3.4.1).
 
     Every block is grown by ``overlap`` (:func:`grown_blocks`), all are united in one
     ``Manifold.batch_boolean`` call, and the union is cleaned of edges shorter than

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 G = 9.81
-"""Gravitational acceleration, m/s^2 (SPEC 2)."""
+"""Gravitational acceleration, m/s^2 (docs/model.md 2)."""
 
 MAX_BRICKS = 50_000
 """Largest model built without being asked (``--max-bricks``): solving takes about
@@ -23,7 +23,7 @@ MAX_BRICKS = 50_000
 
 BYTES_PER_BRICK = 200e3
 """Peak memory of a run per brick, accurate preset: 4.2 GiB for the 21,648 bricks of
-preset 1's full dome with ``--p 21`` (docs/bench.md; balanced takes half)."""
+preset 1's full dome with ``--p 21`` (docs/bench.md, "In brief"; balanced takes less than half)."""
 
 UNITS_PER_BRICK = 2.7
 """Intrados area of a dome section per brick, in square units, for the size estimate
@@ -63,14 +63,14 @@ class Tolerances:
         Scene size in metres (bounding box diagonal). Length tolerances scale with it.
     contact_rel : float
         Two faces touch when their polygons are within ``contact_rel * scale`` of each
-        other (SPEC 5, default 1e-6).
+        other (docs/model.md 5, default 1e-6).
     max_gap_angle : float
         Largest wedge angle (radians) between two faces that gap closing rotates shut;
         faces whose outward normals are farther from anti-parallel are not in contact
-        (SPEC 5, default 10 degrees).
+        (docs/model.md 5, default 10 degrees).
     min_area_rel : float
         An interface is kept when its area exceeds ``min_area_rel`` times the smaller of
-        the two faces' areas (SPEC 5, default 1e-4).
+        the two faces' areas (docs/model.md 5, default 1e-4).
     length_rel : float
         Generic geometric tolerance (point coincidence, coplanarity), relative to
         ``scale``.

@@ -1,4 +1,5 @@
-"""The arch scene and its minimum thickness (SPEC 8): RBE bisection against the thrust line."""
+"""The arch scene and its minimum thickness (docs/model.md 8): RBE bisection against the
+thrust line."""
 
 import csv
 import json

@@ -1,4 +1,4 @@
-"""Fuzz of the command line and its input files (issue 18).
+"""Fuzz of the command line and its input files.
 
 Every input either succeeds or is refused with exit code 2 and one line on stderr that
 names the option as typed (or the file and key), with no traceback and nothing written.

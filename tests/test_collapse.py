@@ -1,4 +1,4 @@
-"""Collapse load factors and mechanisms (SPEC 6.8-6.9) against analytic limit states and
+"""Collapse load factors and mechanisms (docs/model.md 6.8, 6.9) against analytic limit states and
 an independent 2D linear program on the arch's voussoirs."""
 
 import csv

@@ -1,4 +1,4 @@
-"""Dome mode: boundary conditions of a section against the full dome (SPEC 6.4)."""
+"""Dome mode: boundary conditions of a section against the full dome (docs/model.md 6.4)."""
 
 import functools
 

@@ -1,4 +1,4 @@
-"""Interfaces of the dome section (SPEC 5 on the model of SPEC 4)."""
+"""Interfaces of the dome section (docs/model.md 5 on the model of docs/model.md 4)."""
 
 import functools
 

@@ -1,4 +1,4 @@
-"""Round trips of the VTU and 3DM exporters (SPEC 7)."""
+"""Round trips of the VTU and 3DM exporters (docs/model.md 7)."""
 
 import functools
 import sys
@@ -16,7 +16,7 @@ from masonry.rbe.boundary import Model
 
 # binary VTU stores float64 as is
 VTU_RTOL = 1e-12
-# the per-interface resultants of RBE/forces.csv (SPEC 7)
+# the per-interface resultants of RBE/forces.csv (docs/model.md 6.7)
 FORCE_NAMES = ("compression", "tension", "normal", "t1", "t2", "friction")
 
 

@@ -1,4 +1,4 @@
-"""The CSV tables: column types, units, order (SPEC 7)."""
+"""The CSV tables: column types, units, order (docs/model.md 7)."""
 
 import numpy as np
 

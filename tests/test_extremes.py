@@ -1,10 +1,10 @@
-"""Numerical stability at the extremes of every parameter (issue 8, SPEC 3).
+"""Numerical stability at the extremes of every parameter (docs/model.md 3).
 
 Every extreme either builds a valid model whose equilibrium is solved with residuals
 below tolerance, or is refused before any work with one :class:`ParameterError` that
 names the parameter and says why; never a traceback, never a silently wrong answer.
 Domes are kept small (few pattern bricks, one rhombus) so the whole file runs in
-seconds; the ranges are those of the issue.
+seconds; the ranges are the valid ones of docs/model.md 3.
 """
 
 import numpy as np
@@ -129,7 +129,7 @@ def test_the_command_line_reports_a_refused_input_in_one_line(capsys, tmp_path):
     assert not any(tmp_path.iterdir())
 
 
-@pytest.mark.parametrize("mu", [0.01, 0.05, 0.3, 5.0, 10.0])  # the ends of RANGES["mu"]
+@pytest.mark.parametrize("mu", [0.01, 0.05, 0.3, 5.0, 10.0])  # the ends of mu's valid range
 @pytest.mark.parametrize("boundary", ["free", "cyclic"])
 def test_friction_coefficient_extremes(mu, boundary):
     _, _, result = analyse(mu=mu, boundary=boundary)
@@ -148,7 +148,7 @@ def test_friction_lowers_the_measure_of_infeasibility_strictly():
 
 
 def test_density_over_six_decades_only_scales_the_forces():
-    # the ends of RANGES["density"]
+    # the ends of density's valid range
     results = {rho: analyse(density=rho, boundary=b)[2]
                for rho in (1.0, 2.0e3, 1.0e7) for b in ("free",)}
     reference = results[2.0e3]

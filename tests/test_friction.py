@@ -1,4 +1,4 @@
-"""Coulomb's isotropic friction (SPEC 6.3): analytic sliding, tipping and torsion of single
+"""Coulomb's isotropic friction (docs/model.md 6.3): analytic sliding, tipping and torsion of single
 blocks under each friction model, results that do not depend on how the joints' axes are
 chosen, and the own solvers of the cone against Clarabel's second-order cone program."""
 

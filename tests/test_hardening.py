@@ -1,4 +1,4 @@
-"""Nothing lost, nothing cryptic (issue 18): no command degrades another's results, killed
+"""Nothing lost, nothing cryptic: no command degrades another's results, killed
 runs leave nothing behind, a corrupt cache is rebuilt, internal failures are one line."""
 
 import json

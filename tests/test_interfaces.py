@@ -1,4 +1,4 @@
-"""Contact interface detection (SPEC 5, thesis 3.2.4) on boxes built by hand."""
+"""Contact interface detection (docs/model.md 5, thesis 3.2.4) on boxes built by hand."""
 
 import dataclasses
 import itertools

@@ -1,4 +1,5 @@
-"""The package's layout: no import cycle, and no stage importing a later one (STYLE).
+"""The package's layout: no import cycle, and no stage importing a later one, so that the
+folder tree reads as the pipeline (README.md, "Layout").
 
 Imports are read from the source with ``ast`` (lazy imports inside functions count: a lazy
 import still makes a cycle, it only hides it)."""

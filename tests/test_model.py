@@ -1,4 +1,4 @@
-"""The dome model: level table, pattern, courses, bricks (SPEC 4)."""
+"""The dome model: level table, pattern, courses, bricks (docs/model.md 4)."""
 
 import json
 import tomllib
@@ -93,7 +93,7 @@ def test_pattern_of_preset_1_against_the_sketch():
     # identical up to course 33
     assert {b for b in model if b[0] <= 33} == {b for b in sketch if b[0] <= 33}
     # where they part, the sketch's brick leaves the web on the course above its start
-    # (the sketch checks only the start course; SPEC 4.3 says a brick may not leave)
+    # (the sketch checks only the start course; docs/model.md 4.3 says a brick may not leave)
     first = min(k for k, s in model ^ sketch)
     half_width = scene.levels.y[1:] / 0.1
     for k, s in sketch - model:

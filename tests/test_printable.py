@@ -1,4 +1,4 @@
-"""The printable body (SPEC 7, thesis 3.4.1): grown bricks, one watertight union, and the
+"""The printable body (docs/model.md 7, thesis 3.4.1): grown bricks, one watertight union, and the
 STL as a slicer reads it back."""
 
 import functools

@@ -1,4 +1,4 @@
-"""Property-based test over the parameter space (issue 8): whatever the inputs in the
+"""Property-based test over the parameter space: whatever the inputs in the
 ranges users may choose, the library either refuses them with one ParameterError, or
 builds bricks that do not overlap and weigh what their volumes say, and solves an
 equilibrium that holds.

@@ -1,4 +1,4 @@
-"""Rigid block equilibrium on the thesis's structures (SPEC 8, thesis 3.3.6)."""
+"""Rigid block equilibrium on the thesis's structures (docs/model.md 8, thesis 3.3.6)."""
 
 import functools
 import json

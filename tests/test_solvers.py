@@ -1,4 +1,4 @@
-"""QP backends and accuracy presets (SPEC 6.5, 6.6): every path gives the same answer.
+"""QP backends and accuracy presets (docs/model.md 6.5, 6.6): every path gives the same answer.
 
 The direct paths (OSQP, Clarabel on sparse matrices), the cvxpy reference path and the
 semismooth Newton method must agree; the presets must meet their residuals; reuse
@@ -95,7 +95,7 @@ def test_every_outcome_carries_residuals_recomputed_from_the_matrices(name, cone
 
 def test_params_accuracy_validation_and_structure_id():
     assert Params.of().analysis.accuracy == "balanced"
-    assert Params.of(fast=True).analysis.accuracy == "fast"  # SPEC 3: fast mode, unless chosen
+    assert Params.of(fast=True).analysis.accuracy == "fast"  # docs/model.md 3, fast mode
     assert Params.of(fast=True, accuracy="accurate").analysis.accuracy == "accurate"
     assert structure_id(from_preset("1")) == "dome0_fast0_fricauto_s1_n8_r1_p10_c0.1_u0.1"
     assert structure_id(from_preset("1", accuracy="accurate")).endswith("_accurate")

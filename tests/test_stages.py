@@ -1,4 +1,4 @@
-"""Construction stages (SPEC 4.7): stage models filtered from the whole structure's, and
+"""Construction stages (docs/model.md 4.7): stage models filtered from the whole structure's, and
 their verdicts against book stacking, an arch laid without centering and the full dome."""
 
 import csv
@@ -173,7 +173,7 @@ def test_cyclic_section_stage_equals_full_dome_stage(plan_of, stage):
         n * part.interfaces.counts()["horizontal"]
     assert whole["feasible"] == ours["feasible"]
     # one web's share of the whole dome's solution: the objective is strictly convex, the
-    # stage symmetric, so the unique solution is symmetric (SPEC 6.4)
+    # stage symmetric, so the unique solution is symmetric (docs/model.md 6.4)
     params = from_preset("1", **SMALL_DOME)
     results = []
     for model in (part, whole_part):

@@ -1,4 +1,4 @@
-"""Courses: regular and fill-in bricks between the pattern bricks (SPEC 4.4, thesis 3.2.3).
+"""Courses: regular and fill-in bricks between the pattern bricks (docs/model.md 4.4, thesis 3.2.3).
 
 Works in the flattened section (``s`` along the wall in units, course ``k = 1..L``).
 Each course's pattern cells split ``[-W_k, W_k]`` into sequences; each sequence gets
@@ -40,7 +40,7 @@ class Layout:
         End bricks, clipped by the corner plane at ``-pi/n`` / ``+pi/n``.
     repeated_joints : (L,) int
         Per course, joints within one unit of a joint of the course below (pattern
-        bricks excepted), SPEC 4.4's measure of staggering.
+        bricks excepted), docs/model.md 4.4's measure of staggering.
     short_fill_ins : int
         Fill-ins shorter than ``min_fill`` that could not be avoided (an end gap beside a
         pattern brick that is not the course's end brick).
@@ -243,7 +243,7 @@ def fill_courses(half_width, pattern: Pattern, min_fill: float = 1.0,
         ``W_k`` (index ``k - 1``), units.
     pattern : Pattern
     min_fill : float
-        Shortest fill-in, units (SPEC 4.4).
+        Shortest fill-in, units (docs/model.md 4.4).
     miter : bool
         End bricks are clipped by the corner planes (a dome web); False for a straight wall.
 

@@ -1,4 +1,4 @@
-"""The level table: where each course meets the intrados (SPEC 4.1, 4.2; thesis 3.2.1).
+"""The level table: where each course meets the intrados (docs/model.md 4.1, 4.2; thesis 3.2.1).
 
 The intrados of one web, in its mid-plane, is the quarter ellipse
 ``x = a cos(theta), z = c sin(theta)``. Course ``l`` starts at the contact point
@@ -19,7 +19,7 @@ from masonry.tolerances import LEVEL_ANGLE_XTOL, LEVEL_TOP_REL
 
 @dataclass(frozen=True)
 class Dimensions:
-    """Dome dimensions in metres (SPEC 4.1).
+    """Dome dimensions in metres (docs/model.md 4.1).
 
     ``width`` side of the polygon at ground level, ``radius`` its circumradius, ``a`` the
     apothem (intrados of the web at the ground), ``b`` half the side, ``c`` dome height,
@@ -65,12 +65,12 @@ class LevelTable:
 
     Notes
     -----
-    SPEC 4.2 takes ``gamma_pat`` from a circle of radius two units. A two-unit brick posed
+    Thesis 3.2.1 takes ``gamma_pat`` from a circle of radius two units. A two-unit brick posed
     that way ends slightly above ``(x_{k+1}, z_{k+1})`` (two chords of one unit are shorter
     than one chord of two) and bites up to 3e-7 of its volume into the course above, and
     the intrados gets a step there. The two-course chord keeps the intrados continuous and
     the bricks disjoint; it is shorter than two units by less than 4e-4 of a unit on the
-    thesis structures (``tests/test_model.py`` measures it).
+    thesis structures (``tests/test_model.py`` measures it; docs/model.md 4.2).
     """
 
     theta: np.ndarray

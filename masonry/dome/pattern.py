@@ -47,8 +47,8 @@ class Pattern:
     near_nodes : (M, 2) int
         ``(course, s)`` where two lines met one unit apart and bounced without forming a
         node (the narrowing section or the corner clamp shifted their parity); ``s`` is
-        the middle of the one-unit gap. This is the rhombus deviation SPEC 4.3 asks to
-        report.
+        the middle of the one-unit gap. This is the rhombus deviation of docs/model.md 4.3,
+        counted in run.json.
     boundary_bounces : (Q, 2) int
         ``(course, s)`` of the brick at which a line turned back at the boundary.
     ended : (E, 2) int

@@ -1,4 +1,4 @@
-"""CSV tables: brick vertex locations, interfaces and their forces (SPEC 5, 7)."""
+"""CSV tables: brick vertex locations, interfaces and their forces (docs/model.md 5, 7)."""
 
 import numpy as np
 
@@ -21,7 +21,8 @@ def _table(columns) -> bytes:
 
     Notes
     -----
-    Columns are printed whole and joined once, not row by row in Python (docs/bench.md).
+    Columns are printed whole and joined once, not row by row in Python (docs/bench.md,
+    "Measurements behind design choices").
     """
     names, texts = [], []
     for name, value in columns:
@@ -39,7 +40,7 @@ def locations_csv(blocks: Blocks, vertices=None) -> bytes:
     Parameters
     ----------
     vertices : (V, 3) float, optional
-        Positions to write instead of ``blocks.vertices`` (the CAD-offset ones, SPEC 7).
+        Positions to write instead of ``blocks.vertices`` (the CAD-offset ones, docs/model.md 7).
     """
     vertices = blocks.vertices if vertices is None else vertices
     counts = np.diff(blocks.vertex_offsets)
@@ -72,7 +73,7 @@ def _interface_columns(blocks: Blocks, interfaces) -> list:
 
 
 def interfaces_csv(blocks: Blocks, interfaces) -> bytes:
-    """``interfaces.csv``: one row per interface (SPEC 5), in id order: blocks (main
+    """``interfaces.csv``: one row per interface (docs/model.md 5.5), in id order: blocks (main
     first), their names and courses, kind, area, centre, the frame (unit normal from the
     main block into the other, t1, t2), vertex count. docs/outputs.md, "Columns", names
     each one."""
@@ -95,7 +96,7 @@ def forces_columns(blocks: Blocks, interfaces, forces: dict, resultants: dict) -
 
 
 def forces_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict) -> bytes:
-    """``RBE/forces.csv``: one row per interface (SPEC 7), in id order (the rows of
+    """``RBE/forces.csv``: one row per interface (docs/model.md 6.7), in id order (the rows of
     ``interfaces.csv`` and the cells of ``RBE/interfaces.vtu``).
 
     Parameters
@@ -150,7 +151,7 @@ def tension_top_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict,
 
 
 def mechanism_csv(blocks: Blocks, mechanism) -> bytes:
-    """``collapse/mechanism.csv``: one row per block (SPEC 6.9): block, name, virtual
+    """``collapse/mechanism.csv``: one row per block (docs/model.md 6.9): block, name, virtual
     translation of the centroid ``ux, uy, uz`` and rotation ``rx, ry, rz`` (radians per
     unit), normalised so the largest block displacement is 1.
 

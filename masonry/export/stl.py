@@ -1,5 +1,5 @@
 """The printable body as binary STL and OBJ, and the read-back check a slicer would make
-(SPEC 7: ``dome.stl``, ``dome.obj``).
+(docs/model.md 7: ``dome.stl``, ``dome.obj``).
 
 Binary STL stores float32 coordinates and no connectivity: a loader rebuilds the mesh by
 merging equal vertices. :func:`readback_check` loads the bytes the same way (trimesh,

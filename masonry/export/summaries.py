@@ -97,7 +97,7 @@ def objective_text(result) -> str:
 
 def collapse_text(result) -> str:
     """``collapse/00_collapse.txt``: the collapse load factor and its mechanism, readable
-    (SPEC 6.8-6.9), with the friction-law note when sliding takes part."""
+    (docs/model.md 6.8, 6.9), with the friction-law note when sliding takes part."""
     d = result.to_dict()
     factor = "none" if d["load_factor"] is None else f"{d['load_factor']:.6g}"
     live = d["live_load"]

@@ -1,5 +1,5 @@
-"""Interfaces with their forces as VTK XML unstructured grid (SPEC 7: ``RBE/interfaces.vtu``,
-for ParaView), written here; the collapse mechanism's blocks with meshio.
+"""Interfaces with their forces as VTK XML unstructured grid (``RBE/interfaces.vtu``, for
+ParaView; docs/model.md 7), written here; the collapse mechanism's blocks with meshio.
 
 Interface polygons have 3 to 8 vertices, each a ``triangle``, ``quad`` or ``polygon``
 cell: the file's cells are the interfaces in id order, the rows of ``interfaces.csv`` and
@@ -37,7 +37,7 @@ _RESERVED = ("interface", "kind", "area_m2", "frame_normal", "frame_t1", "frame_
 def _vtu_bytes(mesh, name) -> bytes:
     """meshio writes to paths only (and drops field data in VTU): write into a temporary
     folder and read back. Not compressed: zlib would take most of the export's time
-    (docs/bench.md)."""
+    (docs/bench.md, "Measurements behind design choices")."""
     import meshio
 
     with tempfile.TemporaryDirectory() as folder:
@@ -50,7 +50,7 @@ def _vtu_bytes(mesh, name) -> bytes:
 def mechanism_vtu(blocks, mechanism) -> bytes:
     """VTU bytes of the blocks (triangulated faces) with the collapse mechanism as point
     data ``displacement`` ((V, 3), the virtual displacement of every block vertex,
-    largest 1): ParaView's "Warp By Vector" draws the mechanism (SPEC 6.9). Cell data:
+    largest 1): ParaView's "Warp By Vector" draws the mechanism (docs/model.md 6.9). Cell data:
     ``block`` (int64) and ``displacement_norm`` of the block's centroid.
 
     Parameters

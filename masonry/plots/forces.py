@@ -94,7 +94,7 @@ def force_pngs(blocks, interfaces, forces: dict, fast=False, title="", webs=None
 def _whole_dome_pngs(blocks, interfaces, forces, fast, title, n) -> dict:
     """Normal force and tension on the whole dome: the section's interfaces (its boundary
     interfaces with the next web included) rotated ``n`` times, each copy with the
-    section's forces (exact under the cyclic symmetry of SPEC 6.4)."""
+    section's forces (exact under the cyclic symmetry of docs/model.md 6.4)."""
     polygons = [interfaces.polygon(k) @ rotation_z(2 * np.pi * w / n).T
                 for w in range(n) for k in range(len(interfaces))]
     whole = concatenate([rotated_web(blocks, w, n) for w in range(n)])

@@ -93,7 +93,7 @@ def _legend(fig, ax, view, handles):
 
 
 def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="") -> dict:
-    """The collapse mechanism (SPEC 6.9) drawn exaggerated over the undeformed structure,
+    """The collapse mechanism (docs/model.md 6.9) drawn exaggerated over the undeformed structure,
     in the four views (``collapse/<view>_mechanism.png``; one view when ``fast``):
     displaced blocks coloured by their largest vertex displacement, the undeformed ones as
     grey outlines, the hinges and sliding joints that carry the mechanism

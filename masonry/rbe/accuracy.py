@@ -1,4 +1,4 @@
-"""The accuracy presets of the rigid block equilibrium (SPEC 6.6): which backends solve
+"""The accuracy presets of the rigid block equilibrium (docs/model.md 6.6): which backends solve
 friction-net and friction+ (:mod:`masonry.rbe.solvers`), with which settings, and when a
 point is accepted. :mod:`masonry.rbe.solve` runs them."""
 
@@ -10,7 +10,7 @@ from masonry.tolerances import ACCEPT_RESIDUAL
 
 @dataclass(frozen=True)
 class AccuracyPreset:
-    """A documented choice of solvers and tolerances (SPEC 6.6).
+    """A documented choice of solvers and tolerances (docs/model.md 6.6).
 
     Parameters
     ----------
@@ -69,14 +69,13 @@ ACCURACY = {
                  "clarabel": {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-6},
                  "osqp": {"eps_abs": 1e-4, "eps_rel": 1e-4, "max_iter": 100_000,
                           "polishing": False}}),
-    # the default: friction-net by Newton (preset 1's full dome: 10 factorizations
-    # of a 38,000-row system where Clarabel factors a 790,000-row one 16 times);
+    # the default: friction-net by Newton (a few factorizations of the six-rows-per-block
+    # system where Clarabel factors a KKT system twenty times larger more often);
     # friction+ by the interior point method on the same system, polished by Newton
-    # (Newton alone on friction+ is slowed by the 1,000:1 tension weight: more than 100
-    # steps on preset 1's free section). When Newton neither solves nor certifies
-    # friction-net (low-friction domes), the load-path LP on the same matrix decides
-    # (preset 1's full dome at mu 0.05: 6 iterations where Clarabel took 22 on its
-    # KKT system); Clarabel takes over when either method fails.
+    # (Newton alone on friction+ is slowed by the 1,000:1 tension weight). When Newton
+    # neither solves nor certifies friction-net (low-friction domes), the load-path LP
+    # on the same matrix decides, in fewer iterations than Clarabel on its KKT system;
+    # Clarabel takes over when either method fails. Measured: docs/bench.md.
     "balanced": AccuracyPreset(
         "balanced", "newton", "interior", residual=ACCEPT_RESIDUAL, lp_check=False,
         load_path=True,
@@ -90,7 +89,8 @@ ACCURACY = {
                           "polishing": True}}),
     # the reference: Clarabel (an independent implementation) with tight gaps for both
     # models, polished, and the LP's second opinion on an infeasible verdict only (on
-    # feasible ones it is slow and adds nothing: docs/bench.md). Clarabel's default gaps
+    # feasible ones it is slow and adds nothing: docs/bench.md, "Measurements behind
+    # design choices"). Clarabel's default gaps
     # (1e-8) leave 2.6e-6 of the weight as interior-point tension on the straight wall;
     # 1e-10 leaves 2.4e-7.
     "accurate": AccuracyPreset(

@@ -1,4 +1,4 @@
-"""Dome boundary conditions of a section, and the full dome (SPEC 4.6, 6.4).
+"""Dome boundary conditions of a section, and the full dome (docs/model.md 4.6, 6.4).
 
 A section's boundary mode decides what its end bricks bear on in the corner planes:
 
@@ -170,7 +170,7 @@ def _model(scene, mode) -> Model:
 
 def restrict(model: Model, is_present) -> Model:
     """The model of a part of the scene: the blocks present, the images of those present,
-    and the interfaces of ``model`` whose two blocks are both kept (SPEC 4.7: a stage of
+    and the interfaces of ``model`` whose two blocks are both kept (docs/model.md 4.7: a stage of
     construction; interfaces are filtered, never detected again).
 
     Parameters

@@ -1,4 +1,4 @@
-"""The collapse load factor and mechanism: one linear program (SPEC 6.8, 6.9).
+"""The collapse load factor and mechanism: one linear program (docs/model.md 6.8, 6.9).
 
 With the scaled matrices of :mod:`masonry.rbe.equilibrium` (``A_eq``, the dead load
 ``f_dead`` = the RBE's ``f_ext``) and a live load ``l`` (:mod:`masonry.rbe.loads`, in the
@@ -9,7 +9,7 @@ same row scaling)::
                 g in K                                 every vertex's friction model
 
 ``x = E g`` are the vertex forces ``(c, 0, f1, f2)`` with no tension and the friction
-within the model (:class:`~masonry.friction.FrictionCone`, SPEC 6.3 with ``t = 0``):
+within the model (:class:`~masonry.friction.FrictionCone`, docs/model.md 6.3 with ``t = 0``):
 for Coulomb's cone ``g = (c, f1, f2)`` with ``||(f1, f2)|| <= mu c`` (a second-order cone
 program), for a pyramid ``g >= 0`` the weights of its edge rays
 (:func:`~masonry.rbe.equilibrium.friction_edges`; a linear program). This module states
@@ -20,9 +20,9 @@ interior point method (``interior``, :mod:`masonry.rbe.solvers.interior_lp`, the
 default) and Clarabel both models, HiGHS the pyramids (``highs-simplex``: the dual
 simplex, whose basis warm-starts the next load case). One held program serves every
 load case (:class:`CollapseLP`: a lateral load at another azimuth changes two
-coefficients and two costs, SPEC 6.8's "reuse work").
+coefficients and two costs; docs/model.md 6.8: every azimuth on one LP).
 
-The dual of the equilibrium rows is the collapse mechanism (SPEC 6.9): per free block a
+The dual of the equilibrium rows is the collapse mechanism (docs/model.md 6.9): per free block a
 virtual translation ``u`` and rotation ``theta`` about the centroid. The dual constraints
 ``E^T A_eq^T y in K*`` say that the relative motion at every vertex lies in the normal
 cone of its friction model: it opens the joint at least ``mu`` times its slip, with the
@@ -68,7 +68,8 @@ method on the Newton method's matrix (:mod:`masonry.rbe.solvers.interior_lp`). C
 interior point (direct LDL factorization of the whole KKT system) stopped 0.3 % short of
 the optimum on preset 1's cyclic section; HiGHS (the pyramids only) decides the small
 scenes of the tests at once, and its dual simplex warm-starts across azimuths, but gave
-no verdict on preset 1's sections and dome within minutes (docs/collapse.md)."""
+no verdict on preset 1's sections and dome in the time it was given (docs/collapse.md,
+"The cone program")."""
 
 FALLBACK = {"interior": "clarabel"}
 """Backends that assume the program has an optimum -> the backend that decides when
@@ -374,7 +375,7 @@ class _Held:
 def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, cone="circle",
                   friction=None, dead_load_feasible=None, time_limit=600.0,
                   cores=None) -> CollapseResult:
-    """The collapse load factor of ``live`` on ``model``, and its mechanism (SPEC 6.8-6.9).
+    """The collapse load factor of ``live`` on ``model`` and its mechanism (docs/model.md 6.8, 6.9).
 
     Parameters
     ----------
@@ -421,7 +422,7 @@ NON_ASSOCIATIVE_ROUNDS = 30
 
 def fixed_capacity_factor(problem: CollapseLP, live: LiveLoad, *, dead_load_feasible=None,
                           rounds=NON_ASSOCIATIVE_ROUNDS, rtol=1e-3) -> CollapseResult:
-    """A non-associative estimate of the load factor (SPEC 6.8's friction-law note).
+    """A non-associative estimate of the load factor (docs/model.md 6.8, the friction law).
 
     Start from the associated LP; then fix every vertex's friction capacity at ``mu``
     times its compression at the last collapse (:meth:`CollapseLP.with_friction_capacity`:
@@ -434,9 +435,8 @@ def fixed_capacity_factor(problem: CollapseLP, live: LiveLoad, *, dead_load_feas
     so only a settled factor is reported: after ``rounds`` (at least 2) re-solves
     without one, or a round whose capacities admit no equilibrium, the factor and the
     mechanism are None (the status says which). The LP's optimum is degenerate, so the
-    factor wanders by a few 1e-3 as it settles (the small dome of docs/collapse.md: 0.586
-    to 0.590 from the 14th round). ``friction_law`` of the result says
-    ``non-associative``; ``associated_factor`` keeps the starting factor.
+    factor wanders as it settles (docs/collapse.md, "The friction law"). ``friction_law``
+    of the result says ``non-associative``; ``associated_factor`` keeps the starting factor.
     """
     if rounds < 2:
         raise ValueError(f"rounds must be at least 2 (a factor settles over two), not "

@@ -1,4 +1,4 @@
-"""The outcome of a collapse load factor LP (SPEC 6.8, 6.9): the factor, its mechanism,
+"""The outcome of a collapse load factor LP (docs/model.md 6.8, 6.9): the factor, its mechanism,
 and what they mean (:mod:`masonry.rbe.collapse` computes it)."""
 
 from dataclasses import dataclass, field
@@ -12,7 +12,7 @@ from masonry.tolerances import MECHANISM_MAIN
 ASSOCIATED_NOTE = (
     "sliding interfaces take part in this mechanism: the load factor assumes associated "
     "friction (the friction cone's normal as flow rule, joints that dilate as they slide) "
-    "and can overestimate the collapse load of real, non-dilatant joints (SPEC 6.8)")
+    "and can overestimate the collapse load of real, non-dilatant joints (docs/model.md 6.8)")
 
 ANISOTROPIC_NOTE = (
     "the friction model is the thesis's square pyramid: it carries up to 41 % more "
@@ -80,7 +80,7 @@ class CollapseResult:
     azimuths : tuple of (float, float or None)
         After :func:`worst_lateral`: every azimuth searched and its factor.
     friction_law : str
-        ``associated`` (the LP of SPEC 6.8) or ``non-associative`` (see
+        ``associated`` (the LP of docs/model.md 6.8) or ``non-associative`` (see
         :func:`fixed_capacity_factor`).
     associated_factor : float or None
         With ``non-associative``: the associated factor it started from.

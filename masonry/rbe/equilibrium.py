@@ -1,4 +1,4 @@
-"""Rigid block equilibrium (RBE) matrices, without a solver (SPEC 6.1-6.3, thesis 3.3).
+"""Rigid block equilibrium (RBE) matrices, without a solver (docs/model.md 6.1 to 6.3, thesis 3.3).
 
 This module only assembles; :mod:`masonry.rbe.solve` calls a solver. Keeping the two apart
 makes the matrices testable on their own (the peers compas_cra keep ``cra_helper.py``
@@ -12,7 +12,7 @@ Glossary (thesis 3.3 symbol -> name here)
 - ``A_eq`` (eq. 3.14-3.17), force and moment coefficients -> ``A_eq``, 6 rows per free
   block: force x, y, z, then moment x, y, z about the block's centroid.
 - ``f_ext`` / ``f_weight`` (eq. 3.14, 3.20), external loads -> ``f_ext``: self weight only.
-  The thesis's hoop term (eq. 3.19-3.20) is not reproduced (SPEC 6.4); the cyclic and
+  The thesis's hoop term (eq. 3.19-3.20) is not reproduced (docs/model.md 6.4); the cyclic and
   rigid boundary modes route interface forces instead (``side_block``, ``side_rotation``).
 - ``A_fr`` (eq. 3.24-3.26), the thesis's friction pyramid -> the friction model
   :class:`~masonry.friction.FrictionCone` (``cone``): Coulomb's isotropic cone by
@@ -26,10 +26,10 @@ Glossary (thesis 3.3 symbol -> name here)
 Sign convention: at a vertex of interface ``k`` with frame ``(t1, t2, n)``, the force on
 the *other* block ``pair[k, 1]`` is ``F = (c - t) n + f1 t1 + f2 t2`` and the main block
 ``pair[k, 0]`` receives ``-F``; ``n`` points from the main block into the other, so
-compression ``c`` pushes the two apart (SPEC 6.1).
+compression ``c`` pushes the two apart (docs/model.md 6.1).
 
-Scaling (SPEC 6.2, STYLE "Tolerances and numerics")
----------------------------------------------------
+Scaling (docs/model.md 6.2)
+---------------------------
 The matrices are stored scaled, and all scaling lives in :class:`EquilibriumSystem`:
 variables are in units of a reference weight ``W_ref`` (newtons) and moment rows are
 divided by a reference length ``L_ref`` (metres), so every coefficient and right-hand
@@ -317,7 +317,7 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     side_rotation : (K, 2, 3, 3) float, optional
         Rotation ``Q`` (about the origin) applied to each side before its force reaches
         ``side_block``: that side's force ``Q (+-F)`` acts at the point ``Q v``. Default
-        identity. Cyclic symmetry (SPEC 6.4) routes the side on the rotated copy of a
+        identity. Cyclic symmetry (docs/model.md 6.4) routes the side on the rotated copy of a
         section block back onto that block with the inverse rotation.
     cone : FrictionCone or str
         The friction model (:mod:`masonry.friction`).
@@ -461,7 +461,7 @@ def friction_rows(n_vertices: int, cone: FrictionCone, mu: float) -> dict:
 
 
 def friction_edges(n_vertices: int, cone: FrictionCone, mu: float) -> sp.csr_array:
-    """A polyhedral model with ``t = 0`` by its edge rays (SPEC 6.3, 6.8).
+    """A polyhedral model with ``t = 0`` by its edge rays (docs/model.md 6.3, 6.8).
 
     A vertex force with no tension inside the model is a nonnegative combination of its
     ``K`` edge rays (:meth:`~masonry.friction.FrictionCone.rays`), so ``x = E g`` with

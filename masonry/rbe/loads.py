@@ -1,8 +1,8 @@
-"""Live loads as arrays: the load cases of the collapse load factor (SPEC 6.8).
+"""Live loads as arrays: the load cases of the collapse load factor (docs/model.md 6.8).
 
 A :class:`LiveLoad` is one wrench per block: the applied force (N) and its moment about the
 block's centroid (N m), the same reduction as the equilibrium rows of
-:mod:`masonry.rbe.equilibrium` (moments about centroids, SPEC 6.2). Support blocks carry no
+:mod:`masonry.rbe.equilibrium` (moments about centroids, docs/model.md 6.2). Support blocks carry no
 load (they have no rows). The builders are the three load cases of the command line:
 
 - :func:`lateral`: a horizontal body force of each block's weight, at its centroid (the
@@ -107,7 +107,7 @@ def lateral(model_or_blocks, azimuth_deg: float, density: float = 2000.0) -> Liv
     Returns
     -------
     LiveLoad
-        Forces at the centroids, so no moments (SPEC 6.8).
+        Forces at the centroids, so no moments (docs/model.md 6.8).
     """
     blocks = _blocks(model_or_blocks)
     weight = density * G * blocks.block_volume * ~np.asarray(blocks.block_is_support)
@@ -177,7 +177,7 @@ def point_loads(blocks, specs) -> LiveLoad:
 
 def top_course(blocks) -> np.ndarray:
     """(m,) int: the free blocks whose top lies in the highest course (a pattern brick
-    spans its course and the next, SPEC 2)."""
+    spans its course and the next, docs/model.md 2)."""
     free = ~np.asarray(blocks.block_is_support)
     reach = blocks.block_course + (blocks.block_class == PATTERN)
     if not (free & (blocks.block_course > 0)).any():

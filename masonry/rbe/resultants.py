@@ -17,7 +17,7 @@ polygon's area centroid) are reduced to
   polygon's boundary in the direction of ``P``: 0 at the centroid, 1 on the edge (a
   hinge), above 1 outside the polygon (only possible with tension).
 
-Forces are those on the interface's other block ``pair[:, 1]`` (SPEC 6.1); the main block
+Forces are those on the interface's other block ``pair[:, 1]`` (docs/model.md 6.1); the main block
 receives their opposite.
 """
 

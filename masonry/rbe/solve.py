@@ -1,8 +1,8 @@
-"""Solve rigid block equilibrium (RBE) as a quadratic program (SPEC 6.5-6.7, thesis 3.3.4).
+"""Solve rigid block equilibrium (RBE) as a quadratic program (docs/model.md 6.5 to 6.7).
 
 The matrices come from :mod:`masonry.rbe.equilibrium`, the solvers from
 :mod:`masonry.rbe.solvers`; this module chooses them by accuracy preset
-(:mod:`masonry.rbe.accuracy`, SPEC 6.6), runs the thesis's friction flow (friction-net,
+(:mod:`masonry.rbe.accuracy`, docs/model.md 6.6), runs the thesis's friction flow (friction-net,
 then friction+ when the structure is infeasible), checks what every solver returned and
 packs the result. A solver's status is never
 trusted alone: the equilibrium residual and the friction violation are recomputed from
@@ -52,18 +52,16 @@ log = logging.getLogger(__name__)
 
 
 POLISH_STEPS = 20
-"""Newton steps a polish may take. From a pyramid's interior point 1 or 2 steps find the
-exact active set (Clarabel at 1e-8 on the thesis's sections, friction+ included;
-preset 2's full dome took 6 from Clarabel at 1e-10). Coulomb's cone has no active set to
-find: its interior point stops at a gap of about 1e-7 of the objective (the cone's
-scaling spans more decades than double precision holds), and Newton's first steps from
-there are damped before it converges quadratically (preset 1's free section: 8 steps)."""
+"""Newton steps a polish may take. From a pyramid's interior point one or two steps
+usually find the exact active set. Coulomb's cone has no active set to find: its interior
+point stops at a gap of about 1e-7 of the objective (the cone's scaling spans more
+decades than double precision holds), and Newton's first steps from there are damped
+before it converges quadratically. The bound leaves room for both."""
 
 POLISH_STALL = 8
 """... and it ends after this many steps without halving the residual: a polish that
 converges halves it within a few damped steps, one that does not creeps at 1e-9 with
-tiny steps (preset 1's free section at mu 1.0 under the square pyramid: 10 steps, none
-kept)."""
+tiny steps and is not kept."""
 
 
 LOAD_PATH = "load-path-lp"
@@ -72,16 +70,16 @@ LOAD_PATH = "load-path-lp"
 LOAD_PATH_STALL = 20
 """Newton's ``stall`` on friction-net when the load-path LP follows it (Newton's own,
 25, otherwise): steps without halving the residual before the LP decides. Large
-feasible domes wander that long before converging (preset 1 with ``--p 21``: 16 steps,
-``--p 19``: 19); with 10 the 21,648-block dome paid an LP and took twice as long
-(docs/bench.md)."""
+feasible domes wander nearly that long before converging (preset 1 with ``--p 19`` and
+``--p 21``); a shorter stall makes them pay an LP and Newton's second run for nothing
+(docs/bench.md, "Newton's hand-over to the load-path LP")."""
 
 LOAD_PATH_DAMPED_OUT = 3
 """Newton's ``damped_out`` on friction-net when the load-path LP follows it (off
 otherwise): steps in a row ending at the damping ceiling before the LP decides. On the
 infeasible low-friction domes measured, Newton's steps ended there in long runs until
-its stall (preset 1's dome at mu 0.05: 20 in a row from its eighth step); no feasible
-structure measured ended two steps in a row there (docs/bench.md). A wrong
+its stall; no feasible structure measured ended two steps in a row there (docs/bench.md,
+"Newton's hand-over to the load-path LP"). A wrong
 hand-over costs one LP, never a wrong verdict: a feasible verdict resumes Newton without
 this rule."""
 
@@ -208,7 +206,7 @@ class RBEResult:
 
 
 def interface_forces(layout, x) -> dict:
-    """Sum the vertex forces of every interface (SPEC 6.7, thesis eq. 3.29-3.34).
+    """Sum the vertex forces of every interface (docs/model.md 6.7, thesis eq. 3.29-3.34).
 
     Parameters
     ----------
@@ -220,8 +218,8 @@ def interface_forces(layout, x) -> dict:
     dict str -> (K,) float, N
         ``compression`` (sum c), ``tension`` (sum t), ``normal`` (sum of t - c, tension
         positive), ``t1`` (sum f1), ``t2`` (sum f2), ``friction``
-        ``sqrt((sum f1)^2 + (sum f2)^2)`` (the thesis's eq. 3.34 is garbled; this is SPEC
-        6.7's reading).
+        ``sqrt((sum f1)^2 + (sum f2)^2)`` (the thesis's eq. 3.34 is garbled; this is the
+        reading of docs/model.md 6.7).
     """
     c, t, f1, f2 = (layout.interface_sum(layout.component(x, name))
                     for name in layout.COMPONENTS)
@@ -337,7 +335,7 @@ class RBEProblem:
                     log.info("%s certified friction-%s infeasible", name, method)
                 return _Solved(method, name, outcome, checks, accepted)
             if index + 1 < len(candidates):
-                # no silent fallback (STYLE): it warns and stays in ``attempts``
+                # no silent fallback: a fallback warns and stays in ``attempts``
                 log.info("%s found no %s solution (%s); trying %s", name, method,
                          outcome.status, candidates[index + 1])
         return _Solved(method, name, outcome, checks, False)
@@ -535,7 +533,8 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
     lp_check : bool or 'infeasible', optional
         Run the independent friction-net feasibility LP (HiGHS, zero objective): always,
         never, or only when the verdict is infeasible. Default: the preset's (``accurate``:
-        when infeasible); proving feasibility takes it far longer (docs/bench.md).
+        when infeasible); proving feasibility takes it far longer (docs/bench.md,
+        "Measurements behind design choices").
     lp_time_limit : float, s
         HiGHS's time limit; when reached, ``lp_feasible`` is None and a warning is logged.
     side_block, side_rotation : optional
@@ -595,7 +594,8 @@ def _lp_feasible(system: EquilibriumSystem, time_limit: float, verdict: bool):
     circumscribed one (infeasible there proves it); a structure within 2 % of its friction
     limit gets no second opinion (None). HiGHS's interior point method decides, without
     crossover (a vertex solution is not needed, only the verdict; crossover and the dual
-    simplex were measured slower, docs/bench.md). Proving feasibility takes far longer
+    simplex were measured slower: docs/bench.md, "Measurements behind design choices").
+    Proving feasibility takes far longer
     than proving infeasibility and grows faster than linearly, hence ``time_limit``.
 
     Returns True, False, or None when HiGHS ends without a verdict (time limit) or the

@@ -1,6 +1,6 @@
 """The ``arch`` scene: an arch of voussoirs on two supports.
 
-Geometry (SPEC 8, Heyman's conventions). The arch lies in the xz-plane, its span along x,
+Geometry (docs/model.md 4.6, Heyman's conventions). The arch lies in the xz-plane, its span along x,
 symmetric about x = 0, springing at z = 0; it is extruded along y by its depth. ``R`` is
 the radius of the centre line and ``t`` the thickness, so the intrados has radius
 ``R - t/2`` and the extrados ``R + t/2``; the span and rise are the centre line's. Joints

@@ -1,4 +1,4 @@
-"""Any assembly of convex blocks, read from mesh files (SPEC 4.6, scene ``assembly``).
+"""Any assembly of convex blocks, read from mesh files (docs/model.md 4.6, scene ``assembly``).
 
 The interface detector and the rigid block equilibrium serve blocks that did not come
 from our dome: an arch drawn in Rhino, a tower, a scan, a peer tool's model. This module

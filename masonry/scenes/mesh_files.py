@@ -1,4 +1,4 @@
-"""Mesh files read as triangle soups: the first step of an imported assembly (SPEC 4.6).
+"""Mesh files read as triangle soups: the first step of an imported assembly (docs/model.md 4.6).
 
 This module only reads: it turns one OBJ, STL or PLY file into a :class:`TriangleSoup`,
 the file's triangles with the block each belongs to, coordinates exactly as written.
@@ -133,11 +133,11 @@ def _read_obj(data: bytes) -> TriangleSoup:
 
     Our own parser, not a library's (docs/bench.md, "Reading meshes": ``OMP_NUM_THREADS=1
     masonry bench --readers bricks.obj`` on the 6,328 objects of preset 1's full dome).
-    trimesh's ``load_obj`` took 2.6 times its time, joins the objects that share a name,
-    returns them last first, and resolves negative (relative) indices against all of the
-    file's vertices instead of those before the face. meshio's ``meshio.read`` took 0.8
-    times its time but keeps no object or group names, and refuses a file with fewer
-    normals than vertices (Rhino's style: ``fixtures/assembly/arch_rhino.obj``).
+    trimesh's ``load_obj`` takes longer than the rule allows, joins the objects that share
+    a name, returns them last first, and resolves negative (relative) indices against all
+    of the file's vertices instead of those before the face. meshio's ``meshio.read`` is as
+    fast but keeps no object or group names, and refuses a file with fewer normals than
+    vertices (Rhino's style: ``fixtures/assembly/arch_rhino.obj``).
     """
     vertices, faces, face_object, face_group = [], [], [], []
     objects, groups = [], {}
@@ -228,10 +228,9 @@ def _read_stl(data: bytes) -> TriangleSoup:
 
     Read by trimesh's ``load_stl_binary`` and ``load_stl_ascii``, after our own checks of
     the size, ``solid`` and ``endsolid`` (for their messages). On preset 1's full dome
-    written as one STL, they took 0.2 to 1.5 times (binary: a few milliseconds, within
-    the machine's noise) and 1.1 to 1.2 times (ASCII) the time of the parser they
-    replaced; meshio's took 21 to 45 times (binary) and could not read trimesh's ASCII
-    STL (``OMP_NUM_THREADS=1 masonry bench --readers bricks.stl bricks_ascii.stl``;
+    written as one STL they meet the rule above against the parser they replaced; meshio's is
+    far slower on the binary file and could not read trimesh's ASCII STL
+    (``OMP_NUM_THREADS=1 masonry bench --readers bricks.stl bricks_ascii.stl``;
     docs/bench.md, "Reading meshes").
     """
     from trimesh.exchange.stl import load_stl_ascii, load_stl_binary
@@ -263,9 +262,9 @@ def _read_stl(data: bytes) -> TriangleSoup:
 def _read_ply(data: bytes) -> TriangleSoup:
     """PLY (ASCII or binary) by trimesh's reader: one soup of its faces.
 
-    meshio's took 10 to 14 times as long on the binary PLY of preset 1's full dome and
-    1.1 to 1.2 times on the ASCII one (``OMP_NUM_THREADS=1 masonry bench --readers
-    bricks.ply bricks_ascii.ply``; docs/bench.md, "Reading meshes").
+    meshio's is far slower on the binary PLY of preset 1's full dome and no faster on the
+    ASCII one (``OMP_NUM_THREADS=1 masonry bench --readers bricks.ply bricks_ascii.ply``;
+    docs/bench.md, "Reading meshes").
     """
     import trimesh
 

@@ -1,4 +1,4 @@
-"""Speed against accuracy, measured (SPEC 6.6): the table users choose a preset from.
+"""Speed against accuracy, measured (docs/model.md 6.6): the table users choose a preset from.
 
 For every structure (a thesis preset as a free-standing section, a cyclic section and the
 full dome) and every accuracy preset, :func:`bench` runs the whole process from
@@ -349,7 +349,7 @@ instead, `collapse_s` the search reusing one LP, `ratio` their quotient."""
 
 def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None,
                    progress=None) -> list:
-    """Time the lateral collapse load factor (SPEC 6.8) against the balanced RBE solve.
+    """Time the lateral collapse load factor (docs/model.md 6.8) against the balanced RBE solve.
 
     Parameters
     ----------

@@ -1,4 +1,4 @@
-"""Construction stages: does the structure stand at every stage of its laying (SPEC 4.7)?
+"""Construction stages: does the structure stand at every stage of its laying (docs/model.md 4.7)?
 
 Brunelleschi's dome was built without centering; the herringbone pattern bricks are
 believed to hold each course while it is laid. A finished dome standing says nothing
@@ -24,7 +24,7 @@ A :class:`StagePlan` says when each block is laid:
   symmetric arch rises from both springings at once).
 
 A stage laid the same in every web is rotationally symmetric, so the cyclic section
-(SPEC 6.4) models it exactly.
+(docs/model.md 6.4) models it exactly.
 """
 
 import csv
@@ -65,7 +65,7 @@ BRICK_ORDERS = {
     "along": "every brick of the course by its position along the course, from the "
              "corner at -pi/n to the corner at +pi/n",
 }
-"""Laying orders of :func:`brick_plan` (SPEC 4.7)."""
+"""Laying orders of :func:`brick_plan` (docs/model.md 4.7)."""
 
 BLOCK_ORDERS = {
     "names": "one block at a time, by name (digits compared as numbers)",
@@ -170,7 +170,7 @@ def brick_plan(scene, course: int, order: str = "pattern-first") -> StagePlan:
     if not isinstance(course, (int, np.integer)) or not 1 <= course <= courses:
         raise ParameterError("course", course, f"a course of this model, 1..{courses}")
     rank = _laying_rank(layout, course, order)
-    per_web = np.concatenate([[0], rank])  # the web's ground slab first (SPEC 4.4)
+    per_web = np.concatenate([[0], rank])  # the web's ground slab first (docs/model.md 4.6)
     webs, rest = divmod(scene.blocks.n_blocks, len(per_web))
     if rest:
         raise ValueError("the scene's blocks are not whole webs of its layout")
@@ -310,7 +310,7 @@ def loose_blocks(part: Model) -> np.ndarray:
 
 
 def stage_load_factor(part: Model, params) -> float | None:
-    """The collapse load factor of a stage (SPEC 6.8) under the lateral load at
+    """The collapse load factor of a stage (docs/model.md 6.8) under the lateral load at
     ``params.lateral`` degrees, built on the stage's own blocks; None without a lateral
     load or without a factor (unbounded: the stage carries any lateral load).
 

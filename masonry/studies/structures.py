@@ -1,5 +1,5 @@
 """The thesis's structures (table 4.1) and friction test (table 4.3), with every boundary
-model side by side (SPEC 3, 6.4).
+model side by side (docs/model.md 3, 6.4).
 
 Structure ``k.1`` is preset ``k`` as a free-standing section, ``k.2`` in dome mode. The
 thesis's dome mode added a hoop term it doubted itself (5.5); here ``k.2`` is the
@@ -41,7 +41,7 @@ ROWS = (
 )
 
 # what the thesis printed (tables 4.3 to 4.9; 3.1's and 3.2's tables are missing from
-# its text, their verdicts are from 5.2 and SPEC 8): (feasible, MoI factor)
+# its text, their verdicts are from 5.2 and docs/model.md 8): (feasible, MoI factor)
 THESIS = {
     "1.1": ("no", 2.11), "1.1 mu 0.3": ("no", 7.86), "1.1 mu 1.5": ("no", 0.07),
     "2.1": ("yes?", 1.795), "3.1": ("no", None),
@@ -57,7 +57,7 @@ COLUMNS = ("structure", "preset", "scene", "boundary", "friction", "mu", "fricti
 LATERAL_COLUMNS = ("lateral_factor", "lateral_azimuth", "hinge_webs", "hinge_courses",
                    "sliding", "lateral_s")
 """Columns added to the full-dome rows by ``lateral=True``: the worst lateral load factor
-(SPEC 6.8), its azimuth, the webs and courses of its hinges, the number of sliding
+(docs/model.md 6.8), its azimuth, the webs and courses of its hinges, the number of sliding
 interfaces (those that carry the mechanism:
 :data:`~masonry.tolerances.MECHANISM_MAIN`), and the search's seconds."""
 
@@ -66,7 +66,7 @@ def symmetric_azimuths(n_webs: int, count: int = 3):
     """Azimuths that cover every lateral direction of a dome with ``n_webs`` webs:
     ``count`` from the mid-plane of web 0 (0 degrees) to its corner (180/n). The dome is
     symmetric under rotation by 360/n and under the mirror in a web's mid-plane (the
-    pattern is mirror-symmetric, SPEC 4.3), so every other direction repeats one of
+    pattern is mirror-symmetric, docs/model.md 4.3), so every other direction repeats one of
     these."""
     return np.linspace(0.0, 180.0 / n_webs, count)
 

@@ -39,7 +39,7 @@ SUMMARY_COLUMNS = ("variant", "status", "error", "feasible", "friction_used",
                    "load_factor", "load_azimuth_deg", "time_s", "structure_id")
 """Result columns of the summary; the swept inputs come first. ``load_factor`` (and the
 lateral load's azimuth, the worst one for ``lateral = "all"``) when the study gives a live
-load (``lateral``, ``point-load`` or ``crown-load``, SPEC 6.8)."""
+load (``lateral``, ``point-load`` or ``crown-load``, docs/model.md 6.8)."""
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-"""Minimum thickness of an arch by bisection on rigid block equilibrium (SPEC 8).
+"""Minimum thickness of an arch by bisection on rigid block equilibrium (docs/model.md 8).
 
 An arch of rigid, no-tension voussoirs stands above a minimum thickness and falls below
 it (Heyman; Milankovitch's t/R = 0.1075 for a semicircle under self weight). Here the

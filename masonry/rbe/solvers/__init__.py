@@ -1,4 +1,5 @@
-"""Solver backends of the rigid block equilibrium and the collapse load factor (SPEC 6.5-6.8).
+"""Solver backends of the rigid block equilibrium and the collapse load factor
+(docs/model.md 6.5 to 6.8).
 
 One registry, :data:`BACKENDS`: every backend is a module of this package that declares
 a :class:`~masonry.rbe.solvers.base.Backend`: its name, the problems it solves (the RBE

@@ -2,9 +2,9 @@
 
 Two problems, in the scaled rows of :mod:`masonry.rbe.equilibrium`:
 
-- :data:`RBE`: the rigid block equilibrium QP (thesis eq. 3.27, SPEC 6.5) for friction-net
+- :data:`RBE`: the rigid block equilibrium QP (thesis eq. 3.27, docs/model.md 6.5) for friction-net
   or friction+, ``solve(system, method, options, workspace) -> Outcome``;
-- :data:`COLLAPSE`: the collapse load factor's cone program (SPEC 6.8,
+- :data:`COLLAPSE`: the collapse load factor's cone program (docs/model.md 6.8,
   :class:`~masonry.rbe.solvers.program.ConeProgram`), held between load cases by a
   :class:`~masonry.rbe.solvers.program.HeldProgram`.
 

@@ -25,7 +25,8 @@ class BlockFactor:
         order = sym._scalar_order
         x = np.asarray(rhs, dtype=float)[order]
         # a vector by dtrsv: fewer checks and copies per supernode than a one-column
-        # dtrsm, and most solves are of one vector (docs/bench.md)
+        # dtrsm, and most solves are of one vector (docs/bench.md,
+        # "Measurements behind design choices")
         if x.ndim == 1:
             forward = functools.partial(blas.dtrsv, lower=1)
             backward = functools.partial(blas.dtrsv, lower=1, trans=1)

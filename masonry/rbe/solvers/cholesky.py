@@ -68,21 +68,23 @@ the merged supernode's stored entries are explicit zeros ..."""
 
 RELAX_COLUMNS = 8
 """... or if the merged supernode has at most this many block columns (fewer, larger
-fronts: more flops, far fewer Python-level steps; measured in ``docs/bench.md``)."""
+fronts: more flops, far fewer Python-level steps; measured in ``docs/bench.md``, "The
+sparse Cholesky against libraries")."""
 
 
 METIS_NODES = 2000
 """Block graphs of at least this many nodes are ordered by METIS nested dissection,
 smaller ones by AMD: on the Newton matrices of the full domes (2,264 to 21,648 blocks)
-nested dissection needs 12 to 46% fewer flops than AMD and factors faster; on a
-section of 790 blocks it needs more flops and is slower (``docs/bench.md``,
+nested dissection needs fewer flops than AMD and factors faster; on a section of 790
+blocks it needs more flops and is slower (``docs/bench.md``,
 "Ordering and two threads")."""
 
 
 SMALL_UPDATE = 120
 """Update matrices up to this size are added to their parent's front by one add at
 precomputed flat positions, larger ones by runs of consecutive columns (the fastest
-of 60, 120, 240 and 480 on preset 1's full dome; ``docs/bench.md``)."""
+of 60, 120, 240 and 480 on preset 1's full dome; ``docs/bench.md``, "The sparse
+Cholesky against libraries")."""
 
 
 BATCH_LEAVES = 2
@@ -619,8 +621,8 @@ class BlockCholesky:
         and the update for the parent are copied out of it."""
         updates, pivots, below = state
         steps = self._steps
-        # one buffer per thread for every front: fresh fronts cost 10% of a
-        # factorization in page faults
+        # one buffer per thread for every front: fresh fronts would fault their pages in
+        # at every factorization
         while len(self._front_buffers) <= worker:
             self._front_buffers.append(np.empty(max(step[0] for step in steps) ** 2))
         buffer = self._front_buffers[worker]

@@ -20,8 +20,8 @@ system instead, one row per variable and constraint (26 times larger on the full
 
 Why it exists: friction+ weighs tension 1,000 times more than compression and friction
 (thesis eq. 3.27). The semismooth Newton method's dual is piecewise quadratic with
-curvatures 1,000 apart, and its active set settles slowly (more than 100 steps on
-preset 1's free section); the interior point path crosses the pieces smoothly, in a
+curvatures 1,000 apart, and its active set settles slowly (``docs/bench.md``, "friction+
+by the interior point method"); the interior point path crosses the pieces smoothly, in a
 number of iterations that barely depends on the weights (Mehrotra's predictor-corrector,
 S. Mehrotra, SIAM J. Optim. 2, 1992; the form is CVXOPT's ``coneqp``, L. Vandenberghe,
 2010). Its last point is polished by Newton steps (:mod:`masonry.rbe.solve`), which find
@@ -202,9 +202,9 @@ START_MU = 0.7
 START_SCALE = (0.1, 1000.0)
 """The starting slacks and multipliers are scaled by ``(START_MU / mu)^2``, bounded by
 these: a start of the wrong scale makes the first iterations take short steps. The
-rule is fitted to the thesis's sections and domes, mu 0.05 to 1.5 (``docs/bench.md``,
-"friction+ by the interior point method"): at mu 0.05 a scale of 100 to 1,000 took 25 or
-26 iterations where 1 took 44 or 45; at mu 1.5 a scale of 0.3 saved 2 and 100 cost 5."""
+rule is fitted to the thesis's sections and domes, mu 0.05 to 1.5: a larger start at low
+friction, a smaller one at high friction (the iterations per scale: ``docs/bench.md``,
+"friction+ by the interior point method")."""
 
 
 def start_scale(mu) -> float:

@@ -80,8 +80,8 @@ class LoadFactorOptions:
         recomputed and reported with every collapse result.
     max_iter : int
         Iterations before the method gives up (Clarabel then decides). The pyramids'
-        many edge rays make the LP degenerate: a 16-sided pyramid took 111 iterations
-        on preset 1's full dome, the cone and the square about 50.
+        many edge rays make the LP degenerate and the iterations many (``docs/bench.md``,
+        "Friction models").
     step_fraction : float
         Fraction of the largest step to the boundary of the cone that is taken.
     regularization : float
@@ -171,7 +171,8 @@ class _RayProducts:
     per vertex and ray, the columns of every interface side by side, and the interfaces
     with the same vertex count in one product (the Newton system's
     :attr:`~masonry.rbe.solvers.newton.NewtonSystem.groups`), into buffers kept from call
-    to call (fresh ones fault their pages in every time; docs/bench.md)."""
+    to call (fresh ones fault their pages in every time; docs/bench.md, "Measurements
+    behind design choices")."""
 
     def __init__(self, ns: NewtonSystem, rays):
         self.out = np.zeros((ns.n_interfaces, 12, 12))

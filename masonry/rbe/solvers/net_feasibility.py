@@ -112,8 +112,9 @@ class _LoadPath:
 
 OPTIONS = LoadFactorOptions(correctors=1)
 """The LP's settings: one centrality corrector, not the collapse LP's two. The verdict
-comes within 4 to 8 iterations, too few for a second corrector to pay for its solve
-(``docs/bench.md``, the load-path LP's correctors)."""
+comes within a few iterations, too few for a second corrector to pay for its solve
+(``docs/bench.md``, "friction+ by the interior point method", the load-path LP's
+correctors)."""
 
 
 def decide(ns: NewtonSystem, infeasibility_tol, residual, options=OPTIONS) -> Outcome:

@@ -1,6 +1,6 @@
 """Semismooth Newton method on the dual of the RBE quadratic program.
 
-The thesis's QP (eq. 3.27, SPEC 6.5), scaled as in :mod:`masonry.rbe.equilibrium`::
+The thesis's QP (eq. 3.27, docs/model.md 6.5), scaled as in :mod:`masonry.rbe.equilibrium`::
 
     minimize 1/2 x^T H x   subject to   A x = b,   x in K
 
@@ -29,9 +29,10 @@ steps converge quadratically instead; both end with residuals near rounding.
 
 Why: an interior point solver (Clarabel) factors the whole KKT system, one row per
 unknown and constraint (790,000 rows on preset 1's full dome), at every iteration, and
-ADMM (OSQP) needs hundreds of iterations for a loose friction tolerance; this method
-factors a system of six rows per block (38,000 rows), about ten times on a feasible
-full dome (``docs/bench.md``).
+ADMM (OSQP) needs many iterations for a loose friction tolerance; this method factors a
+system of six rows per block (38,000 rows), once per step, and a feasible full dome
+takes few steps (the measured times and steps: ``docs/bench.md``, the bench table and
+"Newton against the general solvers").
 
 When friction-net is infeasible the dual is unbounded: the iterates run off along a
 Farkas direction ``d`` with ``b^T d > 0`` and ``A^T d`` in the polar cone of ``K``. The
@@ -87,9 +88,9 @@ class NewtonOptions:
         Newton steps (each one factorization) before giving up.
     stall : int
         Give up when the residual has not halved in this many steps; an interior-point
-        method takes over. The residual wanders before the active set settles: preset
-        1's full dome went 4 steps without halving it, with p = 19 (18,000 blocks) 19
-        steps (then converged at step 25).
+        method takes over. The residual wanders before the active set settles, the
+        longer the larger the dome (``docs/bench.md``, "Newton's hand-over to the
+        load-path LP").
     divergence : float
         Give up when the dual point has grown this many times larger than the first one:
         the iterates run off along a direction of infeasibility without certifying it
@@ -157,12 +158,12 @@ class NewtonSystem:
         # CSC, and its transpose CSR: no conversion, and products as fast as CSR's
         self.A = equilibrium_columns(self.coefficients, system.vertex_side_row, len(self.b))
         self.AT = self.A.T
-        # contiguous transposes make the stacked matmuls 3x faster
+        # contiguous transposes make the stacked matmuls faster
         self._coefficients_t = np.ascontiguousarray(self.coefficients.transpose(0, 2, 1))
         self.vertex_interface = np.asarray(layout.vertex_interface)
         """(IV,) int: the interface of every vertex."""
         self.n_interfaces = layout.n_interfaces
-        # sums vertices into interfaces: a sparse product is 14x faster than reduceat
+        # sums vertices into interfaces: a sparse product is faster than reduceat
         self._vertex_sum = sp.csc_array(
             (np.ones(layout.n_vertices), (self.vertex_interface, np.arange(layout.n_vertices))),
             shape=(self.n_interfaces, layout.n_vertices))
@@ -181,7 +182,7 @@ class NewtonSystem:
         """The sparse 0/1 matrix that sums the four 6 x 6 blocks ``(a, b)`` of every
         interface's 12 x 12 block (side ``a``'s rows, side ``b``'s columns) into the
         stored blocks of the Newton matrix: one product per Newton step, with one
-        nonzero per interface block rather than per entry (36 times cheaper to build)."""
+        nonzero per interface block rather than per entry (36 times fewer nonzeros to build)."""
         sym = self.symbolic
         k = np.arange(len(rows))
         targets, sources = [], []
