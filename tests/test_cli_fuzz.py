@@ -23,7 +23,7 @@ import trimesh
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from masonry.params import Params, names, validate
+from masonry.params import names, validate
 from masonry.pipeline import model_record
 from masonry.runfolder import check_output_root
 from masonry.scenes import build, check_size

@@ -20,8 +20,9 @@ from masonry.rbe.solvers.program import HeldProgram
 _HIGHS = getattr(highspy.highs, "_Highs", highspy.Highs)
 """The HiGHS class without highspy's Python layer: from highspy 1.16, ``highspy.Highs()``
 prints HiGHS's banner to standard output as it sets up its callbacks, before
-``output_flag`` can be switched off (HiGHS issues 1702, 2749); the class under it prints
-nothing until run, and has every method used here (no callbacks are used)."""
+``output_flag`` can be switched off (github.com/ERGO-Code/HiGHS issues 1702, 2749); the
+class under it prints nothing until run, and has every method used here (no callbacks are
+used)."""
 
 
 def highs_lp(A, cost, col_lower, col_upper, row_lower, row_upper, options,
