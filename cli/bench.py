@@ -23,8 +23,9 @@ def register(subparsers):
     parser.add_argument("--presets", nargs="+", default=["1", "2", "3"],
                         choices=["1", "2", "3"], help="thesis presets (default 1 2 3)")
     parser.add_argument("--scenes", nargs="+", default=list(SCENES), choices=list(SCENES),
-                        help="free section, cyclic section, full dome, full dome at mu 0.05 "
-                             "(default all)")
+                        help="free section, cyclic section, full dome, full dome at mu 0.05, "
+                             "the dome of revolution of the preset's profile and its "
+                             "sector (default all)")
     parser.add_argument("--accuracy", nargs="+", default=list(ACCURACY),
                         choices=tuple(ACCURACY), help="accuracy presets (default all)")
     parser.add_argument("--solvers", nargs="+", default=[], choices=solver_names(RBE),
