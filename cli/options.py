@@ -414,6 +414,18 @@ def _missing(value) -> bool:
     return value is None or (isinstance(value, float) and not math.isfinite(value))
 
 
+def centering_line(total_N, fraction, held, count, where) -> str:
+    """The line about a centering force (docs/model.md 6.10): its total, its fraction of
+    the weight, how many blocks need a support and the largest of them (``held``: dicts
+    with ``name`` and ``support_N``, largest first), and the file that lists them."""
+    if total_N is None:
+        return "centering force: not solved (the support program found no optimum)"
+    largest = ", ".join(f"{h['name']} ({h['support_N']:.3g} N)" for h in held[:3])
+    return (f"centering force: supports must give {total_N:.4g} N ({fraction:.3g} of the "
+            f"weight) to {count} block{'' if count == 1 else 's'} at their centroids; the "
+            f"largest {largest} ({where})")
+
+
 def rbe_summary(record, report) -> int:
     """The lines about the rigid block equilibrium of a run record; returns the exit code:
     3 when the equilibrium was not solved (no verdict), else 0."""
@@ -439,6 +451,10 @@ def rbe_summary(record, report) -> int:
         report("note: the square friction model is the thesis's pyramid: up to 41 % more "
                "friction than Coulomb's cone where joints slide diagonally to their axes, "
                "so this verdict depends on how the model is turned")
+    centering = record.get("centering")
+    if centering is not None:
+        report(centering_line(centering["total_N"], centering["fraction"], centering["held"],
+                              centering["held_count"], "RBE/centering.csv"))
     if verdict == "infeasible" and record["params"].get("friction") == "net":
         report("friction-net has no equilibrium for this structure, so it has no measure "
                "of infeasibility: --friction auto (or plus) gives its MoI and forces")

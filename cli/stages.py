@@ -4,8 +4,8 @@ from masonry.params import Params, validate
 from masonry.scenes.imported import load_assembly
 from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS, run_stages
 
-from .options import (add_analysis_options, add_model_options, add_verbosity, given_inputs,
-                      params_from_args, pattern_note)
+from .options import (add_analysis_options, add_model_options, add_verbosity,
+                      centering_line, given_inputs, params_from_args, pattern_note)
 
 
 def register(subparsers):
@@ -86,18 +86,29 @@ def handle(args, report):
         report(f"lateral load factor at {params.load.azimuth_deg:g} deg: smallest {low:.4g} "
                f"(stage {at}), {factors[-1][0]:.4g} at stage {factors[-1][1]} (stages.csv)")
     first = stages["first_unsupported"]
-    if first is not None and first.get("loose"):
+    if first is not None:
         report(f"first stage that needs support: {first['stage']} ({first['bricks']} "
-               f"bricks): {', '.join(first['loose'][:3])} touch nothing that joins them to "
-               f"a support")
-    elif first is not None:
-        largest = ", ".join(f"{h['name']} ({h['tension_N']:.3g} N)" for h in first["held"][:3])
-        report(f"first stage that needs support: {first['stage']} ({first['bricks']} "
-               f"bricks, MoI factor {first['moi_factor']:.3g}); most tension in {largest}; "
-               f"{len(first['held'])} bricks carry some (first_unsupported/held.csv)")
+               f"bricks{_moi(first)}){_loose(first)}")
+        report(centering_line(first["centering_N"], first["centering_fraction"],
+                              first["held"], len(first["held"]),
+                              "first_unsupported/held.csv"))
     loose = [str(r["stage"]) for r in record.get("rows", ()) if r.get("loose")]
     if loose:
         report(f"stages with blocks joined to no support, so no MoI: {', '.join(loose[:10])}"
                f"{', ...' if len(loose) > 10 else ''} (stages.csv, column loose)")
     report(f"{state}: {record['path']}")
     return 0
+
+
+def _moi(first) -> str:
+    """The MoI factor of the first stage that needs support, where it has one."""
+    if first["moi_factor"] is None:
+        return ""
+    return f", MoI factor {first['moi_factor']:.3g}: the QP's optimality measure"
+
+
+def _loose(first) -> str:
+    """The loose blocks of that stage, where it has some."""
+    if not first.get("loose"):
+        return ""
+    return f": {', '.join(first['loose'][:3])} touch nothing that joins them to a support"

@@ -1,5 +1,6 @@
 """The Python interface: build a structure or read one from mesh files, solve its
-equilibrium, its collapse load and its construction stages, read the forces, export.
+equilibrium, its centering force, its collapse load and its construction stages, read the
+forces, export.
 
 A :class:`Structure` is what ``masonry run`` analyses, held in memory: its inputs
 (:class:`~masonry.params.Params`), the built scene and the analysed model (the scene's
@@ -20,7 +21,7 @@ import functools
 from masonry.errors import ParameterError
 from masonry.export.csv import forces_columns
 from masonry.params import Params, from_preset, names, structure_id, validate
-from masonry.pipeline import build_model, collapse_of, run
+from masonry.pipeline import build_model, centering_of, collapse_of, run
 from masonry.rbe.boundary import analysis_model
 from masonry.rbe.loads import LOAD_OPTIONS
 from masonry.rbe.resultants import interface_resultants
@@ -115,6 +116,20 @@ class Structure:
         columns = forces_columns(self.blocks, self.interfaces, forces, resultants)
         return pandas.DataFrame(dict(columns)).set_index("id")
 
+    def centering(self):
+        """The centering force (docs/model.md 6.10): the least total force that supports
+        at the blocks' centroids must give so that the structure stands, and the blocks
+        that need one (0 and none when it stands).
+
+        Returns
+        -------
+        masonry.rbe.centering.CenteringResult
+            ``total_N``, ``fraction`` (of the weight), per free block its ``force``
+            (newtons) and the blocks that need one, largest first
+            (:meth:`~masonry.rbe.centering.CenteringResult.held_forces`).
+        """
+        return centering_of(self.model, self.params)
+
     def collapse(self, **load):
         """The collapse load factor of a live load and its mechanism (docs/model.md 6.8).
 
@@ -162,8 +177,8 @@ class Structure:
         -------
         pandas.DataFrame
             The columns of ``stages.csv``, one row per stage (docs/stages.md): blocks
-            laid, verdict, MoI factor, the load factor of the live load if the
-            structure has one.
+            laid, verdict, MoI factor, centering force, the load factor of the live load
+            if the structure has one.
         """
         import pandas
 

@@ -25,6 +25,7 @@ from masonry.export import EXPORTERS, RunOutputs
 from masonry.params import (FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, geometry_key, structure_id,
                             validate)
 from masonry.rbe.boundary import Model, analysis_model
+from masonry.rbe.centering import CenteringResult, centering_force
 from masonry.rbe.collapse import CollapseResult, collapse_load, worst_lateral
 from masonry.rbe.loads import Lateral
 from masonry.rbe.solve import RBEProblem, RBEResult
@@ -365,12 +366,15 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     scene, model, cached = run_model(params, out_root, timer, scene)
     record = run_record(params, scene, model, outputs, cached, source)
     result = solve(model, params, timer) if outputs["analyse"] else None
-    collapse = None
+    centering = collapse = None
+    if result is not None and not result.feasible:
+        with timer.stage("centering"):
+            centering = centering_of(model, params)
     if result is not None and params.load is not None:
         with timer.stage("collapse"):
             collapse = collapse_of(model, params, result)
-    record.update(results_record(result, collapse))
-    made = RunOutputs(params, scene, model, result, collapse=collapse,
+    record.update(results_record(result, collapse, centering, scene.blocks.block_name))
+    made = RunOutputs(params, scene, model, result, collapse=collapse, centering=centering,
                       title=structure_id(params))
     folder = job.publish(lambda folder: write_run(folder, made, record, timer))
     if cached == "computed":  # only a model whose run completed is cached
@@ -378,11 +382,15 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     return {**record, "path": str(folder.target)}
 
 
-def results_record(result: RBEResult | None, collapse: CollapseResult | None) -> dict:
-    """run.json's ``rbe`` and ``collapse``, where the run has them."""
+def results_record(result: RBEResult | None, collapse: CollapseResult | None,
+                   centering: CenteringResult | None = None, names=None) -> dict:
+    """run.json's ``rbe``, ``collapse`` and ``centering`` (the blocks named by ``names``,
+    per block of the model), where the run has them."""
     out = {}
     if result is not None:
         out["rbe"] = {**result.to_dict(), "attempts": list(result.attempts)}
+    if centering is not None:
+        out["centering"] = centering.to_dict(names)
     if collapse is not None:
         out["collapse"] = collapse.to_dict()
     return out
@@ -472,6 +480,15 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
         return problem.solve(mu=analysis.mu, density=analysis.density,
                              friction=analysis.friction, solver=analysis.solver,
                              accuracy=analysis.accuracy, cone=analysis.friction_cone)
+
+
+def centering_of(model: Model, params: Params) -> CenteringResult:
+    """The centering force of a run's model (docs/model.md 6.10): the least force that
+    supports at the blocks' centroids must give for it to stand, under the run's friction
+    model. A run computes it when the structure cannot stand."""
+    analysis = params.analysis
+    return centering_force(model, mu=analysis.mu, density=analysis.density,
+                           cone=analysis.cone)
 
 
 def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> CollapseResult:

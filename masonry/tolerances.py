@@ -286,3 +286,12 @@ FACTOR_TIE_REL = 1e-6
 """Load factors of two azimuths this close (relative) are the same worst case: the search
 reports the first azimuth (a symmetric structure's 0 and 180 degrees differ by the LP's
 rounding only)."""
+
+CENTERING_REPORTED_REL = 1e-3
+"""A block needs a temporary support when the centering force on it (docs/model.md 6.10,
+:mod:`masonry.rbe.centering`) exceeds this fraction of its own weight. Clarabel solves
+to gaps of 1e-8 of the mean block weight, but where the optimum is not unique (a brick
+held directly or through the one it rests on) its interior point spreads forces of
+1e-9 to 1e-5 of the structure's weight over many bricks (preset 1's free section: 169
+bricks above 1e-9 of the weight, 83 above 1e-3 of their own, carrying all but 4e-5 of the
+total); a thousandth of a brick's weight is no support anyone gives."""

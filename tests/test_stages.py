@@ -88,7 +88,8 @@ def test_overhanging_stack_fails_at_the_stage_statics_says(offsets, first_failin
     assert [r["bricks"] for r in rows] == list(range(1, n + 1))
     failing = rows[first_failing - 1]
     assert failing["moi"] > 1e-3 * 9.81 * 2000 * 0.2  # tension of a real mechanism, N
-    assert failing["tension"]  # somebody must hold a block
+    assert failing["held"] and failing["centering_N"] > 0  # somebody must hold a block
+    assert all(r["centering_N"] == 0 for r in rows[:first_failing - 1])
 
 
 @pytest.mark.skipif(not forking.can_fork(), reason="the stages share the cores by fork")
@@ -104,6 +105,27 @@ def test_stages_on_two_cores_fail_where_statics_says(two_processes):
 
 
 # ---------------------------------------------------------------------- arch
+def voussoirs(radius, thickness, count, k):
+    """Areas (k,) and centroids (k, 2) of the lowest ``k`` voussoirs of the right half of
+    a semicircular arch centred at the origin (straight joints and faces, as built), the
+    springing at ``(radius, 0)``."""
+    inner, outer = radius - thickness / 2, radius + thickness / 2
+    step = np.pi / count
+    area, centroid = [], []
+    for i in range(k):
+        a, b = i * step, (i + 1) * step
+        x, y = np.array([[inner * np.cos(a), inner * np.sin(a)],
+                         [outer * np.cos(a), outer * np.sin(a)],
+                         [outer * np.cos(b), outer * np.sin(b)],
+                         [inner * np.cos(b), inner * np.sin(b)]]).T
+        x1, y1 = np.roll(x, -1), np.roll(y, -1)
+        cross = x * y1 - x1 * y
+        area.append(cross.sum() / 2)
+        centroid.append([((x + x1) * cross).sum(), ((y + y1) * cross).sum()]
+                        / (3 * cross.sum()))
+    return np.array(area), np.array(centroid)
+
+
 def half_arch_stands(radius, thickness, count, mu):
     """Per stage k = 1..count/2 - 1 (k voussoirs on each springing, not yet closed):
     whether a half arch stands. Each part above a joint carries only its own weight, so
@@ -111,42 +133,83 @@ def half_arch_stands(radius, thickness, count, mu):
     not exceed the friction angle."""
     inner, outer = radius - thickness / 2, radius + thickness / 2
     step = np.pi / count
-    area, cx = [], []
-    for i in range(count // 2):
-        a, b = i * step, (i + 1) * step
-        poly = np.array([[inner * np.cos(a), inner * np.sin(a)],
-                         [outer * np.cos(a), outer * np.sin(a)],
-                         [outer * np.cos(b), outer * np.sin(b)],
-                         [inner * np.cos(b), inner * np.sin(b)]])
-        x, y = poly.T
-        x1, y1 = np.roll(x, -1), np.roll(y, -1)
-        cross = x * y1 - x1 * y
-        area.append(cross.sum() / 2)
-        cx.append(((x + x1) * cross).sum() / (3 * cross.sum()))
-    area, cx = np.array(area), np.array(cx)
+    area, centroid = voussoirs(radius, thickness, count, count // 2)
     verdicts = []
     for k in range(1, count // 2):
         ok = True
         for j in range(k):  # joint j at angle j step above the springing
-            x = (area[j:k] * cx[j:k]).sum() / area[j:k].sum()
+            x = (area[j:k] * centroid[j:k, 0]).sum() / area[j:k].sum()
             phi = j * step
             ok &= inner * np.cos(phi) <= x <= outer * np.cos(phi) and np.tan(phi) <= mu
         verdicts.append(bool(ok))
     return verdicts
 
 
+def half_arch_held(radius, thickness, count, k, hinge, mu):
+    """The least force at the voussoirs' centroids that holds a half arch of ``k``
+    voussoirs whose part above joint ``hinge`` tips inwards about the joint's intrados
+    edge P, as a fraction of the half arch's weight, and that force ((2,), the arch's
+    plane, per unit weight of the half arch).
+
+    Virtual work: the part turning about P by d theta, its weight does ``W_part e d
+    theta`` (``e`` the horizontal distance of its centroid inside P), a force ``s_i`` at
+    a centroid ``c_i`` at most ``||s_i|| |c_i - P| d theta``, and the opening joint
+    none: ``sum ||s_i|| >= W_part e / max |c_i - P|``, reached by a force on the top
+    voussoir (the farthest from P) perpendicular to ``c_k - P``. The force is
+    admissible: with it, the load on the part above every joint crosses the joint
+    within its thickness and within the friction angle (asserted here), so it is the
+    least."""
+    inner, outer = radius - thickness / 2, radius + thickness / 2
+    step = np.pi / count
+    area, centroid = voussoirs(radius, thickness, count, k)
+    hinge_point = inner * np.array([np.cos(hinge * step), np.sin(hinge * step)])
+    part = slice(hinge, k)
+    x = (area[part] * centroid[part, 0]).sum() / area[part].sum()
+    moment = area[part].sum() * (hinge_point[0] - x)
+    arm = centroid[k - 1] - hinge_point
+    lever = np.linalg.norm(arm)
+    force = moment / lever * np.array([arm[1], -arm[0]]) / lever  # turns it back out
+    for j in range(k):  # statics of every joint with the force on the top voussoir
+        load = np.array([force[0], force[1] - area[j:].sum()])
+        moment_o = (-(area[j:] * centroid[j:, 0]).sum()
+                    + centroid[k - 1, 0] * force[1] - centroid[k - 1, 1] * force[0])
+        along = np.array([np.cos(j * step), np.sin(j * step)])  # the joint, outwards
+        crossing = moment_o / (along[0] * load[1] - along[1] * load[0])
+        assert inner - 1e-9 <= crossing <= outer + 1e-9
+        normal = np.array([-along[1], along[0]])                 # up the arch
+        assert abs(load @ along) <= mu * -(load @ normal)
+    return moment / lever / area.sum(), force / area.sum()
+
+
 def test_arch_laid_without_centering_fails_before_closure_and_stands_closed():
-    # the default arch: semicircular, 16 voussoirs, span 10 m, t = 0.6 m: t/R = 0.12,
-    # above Milankovitch's 0.1075, so the closed arch stands
+    """The default arch: semicircular, 16 voussoirs, span 10 m, t = 0.6 m: t/R = 0.12,
+    above Milankovitch's 0.1075, so the closed arch stands. Laid in pairs from the
+    springings, stage 3 is the first that fails: the two upper voussoirs of each half
+    tip inwards about joint 1's intrados edge; the centering force holds them by the top
+    voussoir of each half (:func:`half_arch_held`)."""
     params = validate(Params.of(scene="arch"))
     scene = build(params)
     plan = make_plan(scene, "block", "z")
     assert plan.n_stages == 8  # one voussoir on each side per stage
     rows = analyse_stages(analysis_model(scene, "free"), params, plan)
-    expected = half_arch_stands(5.0, 0.6, 16, params.analysis.mu)
+    mu = params.analysis.mu
+    expected = half_arch_stands(5.0, 0.6, 16, mu)
     assert expected[:2] == [True, True] and not expected[2]  # statics: third pair tips
     assert [r["feasible"] for r in rows[:-1]] == expected
     assert rows[-1]["feasible"] and rows[-1]["bricks"] == 16
+    assert [r["centering_N"] for r in rows[:2] + rows[-1:]] == [0.0] * 3
+    fraction, force = half_arch_held(5.0, 0.6, 16, 3, 1, mu)
+    third = rows[2]
+    assert third["centering_fraction"] == pytest.approx(fraction, abs=1e-6 / 6)
+    names = scene.blocks.block_name
+    held = {str(names[block]): vector for block, vector, _ in third["held"]}
+    assert set(held) == {"v002", "v013"}  # the top voussoir of each half
+    half_weight = third["centering_N"] / fraction / 2
+    # the right half in the xz-plane; the left one its mirror image
+    assert held["v002"][[0, 2]] == pytest.approx(force * half_weight,
+                                                 abs=1e-3 * half_weight / 3)
+    assert held["v013"][[0, 2]] == pytest.approx(force * [-1, 1] * half_weight,
+                                                 abs=1e-3 * half_weight / 3)
 
 
 # ---------------------------------------------------------------------- domes
@@ -310,7 +373,19 @@ def test_imported_stack_laid_by_names_or_height(tmp_path, capsys, order):
     first = record["stages"]["first_unsupported"]
     assert first["stage"] == 4 and len(first["laid"]) == 1
     assert first["laid"][0] == str(blocks.block_name[4])  # the fourth above the slab
-    assert "first stage that needs support: 4" in capsys.readouterr().out
+    # the top block is held (tests/test_centering.py): 0.3 / sqrt(0.41) of its weight
+    brick = 2000.0 * 9.81 * blocks.block_volume[4]
+    assert first["centering_N"] == pytest.approx(0.3 / np.sqrt(0.41) * brick, rel=1e-6)
+    assert [h["name"] for h in first["held"]] == [str(blocks.block_name[4])]
+    with open(folder / "first_unsupported" / "held.csv") as f:
+        (held,) = list(csv.DictReader(f))
+    assert held["name"] == first["held"][0]["name"] and held["course"] == ""
+    assert float(held["support_N"]) == pytest.approx(first["centering_N"], rel=1e-6)
+    assert np.hypot(float(held["force_x_N"]), float(held["force_z_N"])) == pytest.approx(
+        float(held["support_N"]), rel=1e-6)
+    printed = capsys.readouterr().out
+    assert "first stage that needs support: 4" in printed
+    assert "centering force: supports must give" in printed
 
 
 def test_first_unsupported_stage_is_drawn_with_its_new_block_outlined(tmp_path):
@@ -372,6 +447,11 @@ def test_a_block_laid_before_the_one_under_it_is_loose_and_has_no_moi():
     first, second = (analyse_stage(model, params, plan, k) for k in (1, 2))
     assert first["loose"] == 2 and first["loose_blocks"] == [2, 3]
     assert not first["feasible"] and first["moi"] is None
+    # nothing holds them but a support: their whole weight (shared between them as the
+    # solver likes: the one below may carry both)
+    weight = 2000.0 * 9.81 * model.blocks.block_volume[[2, 3]].sum()
+    assert first["centering_N"] == pytest.approx(weight, rel=1e-6)
+    assert {block for block, _, _ in first["held"]} <= {2, 3}
     assert second["loose"] == 0 and second["feasible"]
 
 

@@ -38,6 +38,8 @@ class RunOutputs:
     collapse : masonry.rbe.collapse.CollapseResult or None
         The collapse load factor of the run's live load (docs/model.md 6.8), if it has
         one.
+    centering : masonry.rbe.centering.CenteringResult or None
+        The centering force (docs/model.md 6.10) of a structure that cannot stand.
     title : str
         The run's name in figures (its structure id).
     """
@@ -47,6 +49,7 @@ class RunOutputs:
     model: object
     result: object = None
     collapse: object = None
+    centering: object = None
     title: str = ""
 
     @property
@@ -187,7 +190,10 @@ def force_tables(blocks, interfaces, result, forces: dict, resultants=None,
 
 
 def _rbe_files(made: RunOutputs) -> Export:
-    files = {"RBE/00_objective.txt": summaries.objective_text(made.result)}
+    files = {"RBE/00_objective.txt": summaries.objective_text(made.result, made.centering)}
+    centering = made.centering
+    if centering is not None and centering.total_N is not None:
+        files["RBE/centering.csv"] = csv.held_csv(made.scene.blocks, centering.held_forces())
     if made.forces is not None:
         files.update(force_tables(made.model.blocks, made.model.interfaces, made.result,
                                   made.forces, _resultants(made)))

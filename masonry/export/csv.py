@@ -1,4 +1,5 @@
-"""CSV tables: brick vertex locations, interfaces and their forces (docs/model.md 5, 7)."""
+"""CSV tables: brick vertex locations, interfaces and their forces, the blocks a temporary
+support must hold (docs/model.md 5, 6.10, 7)."""
 
 import numpy as np
 
@@ -171,3 +172,29 @@ def azimuths_csv(azimuths) -> bytes:
     lines = ["azimuth_deg,load_factor"]
     lines += [f"{a:.10g}," + ("" if f is None else f"{f:.10g}") for a, f in azimuths]
     return ("\n".join(lines) + "\n").encode()
+
+
+def held_csv(blocks: Blocks, held) -> bytes:
+    """The blocks a temporary support must hold and with what force (docs/model.md 6.10): a run's
+    ``RBE/centering.csv``, a stage study's ``first_unsupported/held.csv``. One row per
+    block, the largest force first: ``block``, ``name``, ``class``, ``course`` (empty for
+    a block without one: an arch's voussoir, an imported block), ``support_N`` (the
+    force's size) and ``force_x_N``, ``force_y_N``, ``force_z_N``, the force the support
+    gives the block at its centroid (model axes).
+
+    Parameters
+    ----------
+    blocks : Blocks
+        The blocks ``held`` indexes (a scene's).
+    held : list of (int, (3,) float, float)
+        Block, force and its size in newtons
+        (:meth:`~masonry.rbe.centering.CenteringResult.held_forces`).
+    """
+    block = np.array([b for b, _, _ in held], dtype=np.int64)
+    force = np.array([f for _, f, _ in held], dtype=float).reshape(-1, 3)
+    size = np.array([m for _, _, m in held], dtype=float)
+    course = blocks.block_course[block]
+    classes = np.array(BLOCK_CLASSES, dtype=object)[blocks.block_class[block]]
+    return _table([("block", block), ("name", blocks.block_name[block]), ("class", classes),
+                   ("course", np.where(course > 0, course.astype(str), "")),
+                   ("support_N", size), *_xyz("force", force, "N")])

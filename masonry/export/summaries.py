@@ -65,9 +65,10 @@ def lp_check_text(result) -> str:
             + (f"confirms {verdict}" if agrees else f"CONTRADICTS the QP's {verdict}"))
 
 
-def objective_text(result) -> str:
+def objective_text(result, centering=None) -> str:
     """``RBE/00_objective.txt``: the thesis's summary of a solve, each value with what it
-    means."""
+    means, and the centering force (:class:`~masonry.rbe.centering.CenteringResult`)
+    where the structure cannot stand."""
     d = result.to_dict()
     verdict = "feasible" if d["feasible"] else "infeasible"
     meaning = ("stands without tension: the friction-net QP was solved to tolerance"
@@ -80,7 +81,8 @@ def objective_text(result) -> str:
         f"friction model:     {result.cone.describe()}",
         f"objective:          {d['objective']:.6g} N^2 (1/2 x^T H x, weights: tension 1, "
         "compression and friction 1e-3)",
-        f"MoI:                {d['moi']:.6g} N (sum of all vertex tensions)",
+        f"MoI:                {d['moi']:.6g} N (sum of all vertex tensions: the QP's "
+        "optimality measure, not a force anyone supplies)",
         f"MoI factor:         {d['moi_factor']:.6g} (MoI / weight)",
         f"weight:             {d['weight_N']:.6g} N",
         f"solver:             {d['solver']} ({d['status']}, {d['iterations']} iterations; "
@@ -92,7 +94,20 @@ def objective_text(result) -> str:
         f"LP check (HiGHS):   {lp_check_text(result)}",
         f"time:               {d['time_s']:.3g} s",
     ]
+    if centering is not None:
+        lines.append(_centering_text(centering))
     return "\n".join(lines) + "\n"
+
+
+def _centering_text(centering) -> str:
+    """The centering force's line of ``RBE/00_objective.txt`` (docs/model.md 6.10)."""
+    if centering.total_N is None:
+        return (f"centering force:    not solved ({centering.solver}: {centering.status})")
+    return (f"centering force:    {centering.total_N:.6g} N ({centering.fraction:.6g} of the "
+            f"weight): the least total force that supports at the blocks' centroids must "
+            f"give, with no tension and the friction model above; {centering.held_count} "
+            f"blocks need one (RBE/centering.csv; {centering.solver}, residual "
+            f"{centering.residual_eq:.3g}, {centering.time_s:.3g} s)")
 
 
 def collapse_text(result) -> str:

@@ -1,6 +1,6 @@
-"""Construction stages: the chart of every stage's MoI factor (and collapse load factor),
-which stand and which need support, and the structure views of one stage, its bricks
-coloured by the tension they carry and the bricks just laid outlined."""
+"""Construction stages: the chart of every stage's centering force (and collapse load
+factor), which stand and which need support, and the structure views of one stage, its
+bricks coloured by the support force they need and the bricks just laid outlined."""
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -27,7 +27,7 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
                           subtitle="") -> dict:
     """The structure views of a part of ``scene`` (e.g. a construction stage): the blocks
     of ``is_present`` ((B,) bool), coloured by ``value`` ((B,) float >= 0, e.g. the
-    tension a brick carries, newtons) on a logarithmic scale over
+    support force a brick needs, newtons) on a logarithmic scale over
     :data:`MARK_DECADES` decades, in their class colours below it; the blocks of
     ``is_outlined`` ((B,) bool, e.g. the ones just laid) with thick :data:`OUTLINE_COLOUR`
     edges and a ring (legend ``outline_label``); the rest of the scene's blocks as faint
@@ -81,42 +81,46 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
     return out
 
 
-def stage_chart_png(stage, moi_factor, feasible, load_factor=None, title="",
+def stage_chart_png(stage, centering, feasible, load_factor=None, title="",
                     xlabel="stage", loose=None) -> bytes:
-    """MoI factor (and the collapse load factor, where given) against the construction
-    stage: stages that stand in green, those that need support in red, the first of
-    them marked by a dashed line; stages with loose blocks (no MoI) as red crosses at 0.
+    """The centering force as a fraction of the weight (and the collapse load factor,
+    where given) against the construction stage: stages that stand in green (at 0),
+    those that need support in red, the first of them marked by a dashed line; stages
+    with loose blocks as red crosses.
 
     Parameters
     ----------
     stage : (N,) int
-    moi_factor : (N,) float (NaN: not solved)
+    centering : (N,) float
+        Centering force / weight (NaN: not solved).
     feasible : (N,) bool
     load_factor : (N,) float or None (NaN: not computed)
     loose : (N,) int or None
         Blocks per stage that touch nothing joining them to a support.
     """
     stage = np.asarray(stage)
-    moi = np.asarray(moi_factor, dtype=float)
+    centering = np.asarray(centering, dtype=float)
     feasible = np.asarray(feasible, dtype=bool)
     loose = np.zeros(len(stage), int) if loose is None else np.asarray(loose)
     fig, ax = plt.subplots(figsize=(7, 4))
-    ax.plot(stage, moi, color="0.6", linewidth=0.8, zorder=1)
-    ax.scatter(stage[feasible], moi[feasible], s=14, color="#2ca02c",
+    ax.plot(stage, centering, color="0.6", linewidth=0.8, zorder=1)
+    ax.scatter(stage[feasible], centering[feasible], s=14, color="#2ca02c",
                label=f"stands ({int(feasible.sum())})", zorder=2)
-    ax.scatter(stage[~feasible], moi[~feasible], s=14, color="#d62728",
-               label=f"needs support ({int((~feasible).sum())})", zorder=2)
+    held = ~feasible & (loose == 0)
+    ax.scatter(stage[held], centering[held], s=14, color="#d62728",
+               label=f"needs support ({int(held.sum())})", zorder=2)
     if loose.any():
-        ax.scatter(stage[loose > 0], np.zeros(int((loose > 0).sum())), marker="x", s=24,
+        ax.scatter(stage[loose > 0], centering[loose > 0], marker="x", s=24,
                    color="#d62728", zorder=2, label=f"a block touches nothing that holds "
-                   f"it, no MoI ({int((loose > 0).sum())})")
+                   f"it ({int((loose > 0).sum())})")
     if not feasible.all():
         first = stage[np.argmin(feasible)]
         ax.axvline(first, color="#d62728", linestyle="--", linewidth=0.8,
                    label=f"first needs support: {first}")
     ax.set_xlabel(xlabel)
-    ax.set_ylabel("MoI factor (tension / weight)")
-    ax.set_ylim(bottom=min(-0.02 * max(np.nanmax(moi, initial=0), 0.05), 0))
+    ax.set_ylabel("centering force / weight (least support force)")
+    top = float(np.nanmax(centering, initial=0.0))
+    ax.set_ylim(bottom=-0.02 * (top if top > 0 else 1.0))
     handles, labels = ax.get_legend_handles_labels()
     if load_factor is not None and np.isfinite(np.asarray(load_factor, float)).any():
         right = ax.twinx()

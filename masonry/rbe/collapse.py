@@ -93,7 +93,7 @@ def _selection(layout) -> sp.csr_array:
                         shape=(layout.n_columns, count))
 
 
-def _cone_columns(system) -> Columns:
+def friction_columns(system) -> Columns:
     """The friction model's columns: a pyramid's edge ray weights ``g >= 0``, or the
     forces ``(c, f1, f2)`` with ``(mu c, f1, f2)`` in the second-order cone."""
     n_vertices, cone, mu = system.layout.n_vertices, system.cone, system.mu
@@ -187,7 +187,7 @@ class CollapseLP:
                                side_rotation=model.side_rotation, cone=cone)
         self.method = METHOD if method is None else method
         backend(self.method, COLLAPSE, self.system.cone)  # refuses what it cannot solve
-        self.columns = _cone_columns(self.system)
+        self.columns = friction_columns(self.system)
         self.matrix = sp.csc_array(self.system.A_eq @ self.columns.edges)
         self.mu, self.density, self.time_limit = float(mu), float(density), time_limit
         self.cores = cores

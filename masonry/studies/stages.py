@@ -8,9 +8,10 @@ A stage is the set of blocks laid so far. Its model (:func:`masonry.rbe.boundary
 holds those blocks, the supports, the images of the laid bricks (cyclic and rigid
 boundaries) and the interfaces of the whole structure whose two blocks are both present:
 interfaces are detected once, never per stage. Each stage is solved as an ordinary run
-(friction auto: friction-net, then friction+ where the stage cannot stand). The first
-stage that cannot stand, and the bricks that carry tension there, are what a mason would
-have to hold.
+(friction auto: friction-net, then friction+ where the stage cannot stand); a stage that
+cannot stand gets its centering force (docs/model.md 6.10, :mod:`masonry.rbe.centering`): the least
+total force that temporary supports must give its laid blocks, and the blocks that need
+one, which is what a mason or a robot would have to hold.
 
 A :class:`StagePlan` says when each block is laid:
 
@@ -44,14 +45,16 @@ from masonry import forking
 from masonry.blocks import BLOCK_CLASSES
 from masonry.errors import ParameterError
 from masonry.export._text import format_float
+from masonry.export.csv import held_csv
 from masonry.export.summaries import parameters_text
 from masonry.params import FILE_OUTPUTS, structure_id, validate
 from masonry.pipeline import (Timer, identity, model_record, run_model, versions,
                               write_cache)
 from masonry.rbe.boundary import Model, restrict
+from masonry.rbe.centering import centering_force
 from masonry.rbe.collapse import collapse_load
 from masonry.rbe.loads import Lateral
-from masonry.rbe.solve import ACCURACY, RBEProblem
+from masonry.rbe.solve import RBEProblem
 from masonry.runfolder import Publication, check_output_root
 from masonry.scenes import check_size
 from masonry.tolerances import MAX_BRICKS, Tolerances
@@ -74,11 +77,13 @@ BLOCK_ORDERS = {
 """Laying orders of :func:`block_plan`."""
 
 STAGE_COLUMNS = ("stage", "course", "laid", "bricks", "feasible", "loose", "moi",
-                 "moi_factor", "load_factor", "solve_s")
+                 "moi_factor", "centering_N", "centering_fraction", "load_factor", "solve_s")
 """Columns of ``stages.csv``, one row per stage. ``laid``: the names of the blocks the
 stage lays, in a brick or block plan (a course plan's stage is its course). ``loose``: the
 laid blocks that touch nothing joining them to a support (:func:`loose_blocks`: the stage
-has no equilibrium at all, and no MoI). ``load_factor``: the collapse load factor of the
+has no equilibrium at all, and no MoI). ``centering_N``, ``centering_fraction``: the
+centering force and its fraction of the stage's weight (:func:`stage_centering`; 0 for a
+stage that stands). ``load_factor``: the collapse load factor of the
 stage under the lateral load of ``params.lateral`` (:func:`stage_load_factor`); empty
 without one, or where the stage does not stand under its own weight."""
 
@@ -243,14 +248,16 @@ def _natural_key(name):
 
 # ---------------------------------------------------------------------- one stage
 def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
-    """The rigid block equilibrium of one stage, as a row of ``stages.csv``.
+    """The rigid block equilibrium of one stage, and its centering force, as a row of
+    ``stages.csv``.
 
     Parameters
     ----------
     model : Model
         The whole structure's analysis model (:func:`masonry.rbe.boundary.analysis_model`).
     params : masonry.params.Params
-        ``mu``, ``density``, ``friction``, ``solver`` and the accuracy preset.
+        ``mu``, ``density``, ``friction``, the friction model, ``solver`` and the
+        accuracy preset.
     plan : StagePlan
     stage : int
         1..``plan.n_stages``.
@@ -258,10 +265,10 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
     Returns
     -------
     dict
-        :data:`STAGE_COLUMNS` (``moi`` in newtons; ``solve_s`` the stage's wall time:
-        model, assembly and solves; ``load_factor`` None: no lateral load, or the stage
-        does not stand), and ``tension``:
-        scene block -> newtons of tension it carries (see :func:`tension_by_block`).
+        :data:`STAGE_COLUMNS` (``moi`` and ``centering_N`` in newtons; ``solve_s`` the
+        stage's wall time: model, assembly and solves; ``load_factor`` None: no lateral
+        load, or the stage does not stand), ``loose_blocks`` and ``held``: the scene
+        blocks a support must hold, largest first (see :func:`stage_centering`).
     """
     start = time.perf_counter()
     part = restrict(model, plan.is_present(stage))
@@ -273,7 +280,7 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
            "bricks": int((~part.blocks.block_is_support).sum()), "loose": len(loose),
            "loose_blocks": loose.tolist(), "load_factor": None}
     if len(loose) or len(part.interfaces) == 0:  # no equilibrium: nothing to solve
-        row.update(feasible=False, moi=None, moi_factor=None, tension={})
+        row.update(feasible=False, moi=None, moi_factor=None)
     else:
         problem = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
                              side_rotation=part.side_rotation)
@@ -281,14 +288,44 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
         result = problem.solve(mu=analysis.mu, density=analysis.density,
                                friction=analysis.friction, solver=analysis.solver,
                                accuracy=analysis.accuracy, cone=analysis.friction_cone)
-        floor = ACCURACY[analysis.accuracy].residual * result.weight_N / row["bricks"]
         row.update(feasible=result.feasible, moi=_number(result.moi),
-                   moi_factor=_number(result.moi_factor),
-                   tension=tension_by_block(part, result, plan, floor))
+                   moi_factor=_number(result.moi_factor))
         if result.feasible:
             row["load_factor"] = stage_load_factor(part, params)
+    row.update(stage_centering(part, params, row["feasible"]))
     row["solve_s"] = round(time.perf_counter() - start, 4)
     return row
+
+
+def stage_centering(part: Model, params, stands: bool) -> dict:
+    """The centering force of a stage (docs/model.md 6.10, :mod:`masonry.rbe.centering`): 0 for a
+    stage that stands (its equilibrium needs none), else the least total force that
+    supports at the laid blocks' centroids must give, loose blocks included (they must
+    be held whole).
+
+    Parameters
+    ----------
+    part : Model
+        A stage's model (:func:`masonry.rbe.boundary.restrict`).
+    params : masonry.params.Params
+        ``mu``, ``density`` and the friction model.
+    stands : bool
+        The stage's verdict.
+
+    Returns
+    -------
+    dict
+        ``centering_N`` (N) and ``centering_fraction`` (of the stage's weight), None when
+        the program was not solved; ``held``: ``(scene block, force (3,) N, size N)`` of
+        every block that needs a support, largest first.
+    """
+    if stands:
+        return {"centering_N": 0.0, "centering_fraction": 0.0, "held": []}
+    analysis = params.analysis
+    result = centering_force(part, mu=analysis.mu, density=analysis.density,
+                             cone=analysis.cone)
+    return {"centering_N": result.total_N, "centering_fraction": result.fraction,
+            "held": result.held_forces(part.block_source)}
 
 
 def loose_blocks(part: Model) -> np.ndarray:
@@ -330,39 +367,6 @@ def stage_load_factor(part: Model, params) -> float | None:
                            cone=analysis.cone, friction=analysis.friction_law,
                            dead_load_feasible=True)
     return result.load_factor
-
-
-def tension_by_block(part: Model, result, plan: StagePlan, floor: float) -> dict:
-    """Tension per brick: each interface's tension is charged to the later laid of its two
-    blocks (both when laid at one stage), the brick a mason would have to hold.
-
-    Parameters
-    ----------
-    part : Model
-        A stage's model (:func:`masonry.rbe.boundary.restrict`).
-    result : masonry.rbe.solve.RBEResult
-    plan : StagePlan
-    floor : float, newtons
-        Interface tension at or below this is solver noise, not tension.
-
-    Returns
-    -------
-    dict int -> float
-        Scene block index -> newtons, largest first; empty without a solution.
-    """
-    if result.x is None:
-        return {}
-    tension = result.per_interface()["tension"]
-    carried = np.flatnonzero(tension > floor)
-    side = part.interfaces.pair if part.side_block is None else part.side_block
-    block = part.block_source[side[carried]]                   # (k, 2) scene blocks
-    when = np.where(part.blocks.block_is_support[side[carried]], -1,
-                    plan.block_stage[block])
-    held = when == when.max(axis=1, keepdims=True)
-    total = np.zeros(len(plan.block_stage))
-    np.add.at(total, block[held], np.broadcast_to(tension[carried, None], held.shape)[held])
-    order = np.argsort(-total, kind="stable")
-    return {int(b): float(total[b]) for b in order if total[b] > 0}
 
 
 def _number(value):
@@ -439,22 +443,6 @@ def stages_csv(rows) -> bytes:
     return buf.getvalue().encode()
 
 
-def held_csv(scene, row) -> bytes:
-    """``first_unsupported/held.csv``: the bricks that carry tension at the first stage
-    that needs support (block, name, class, course (empty for a block without one: an
-    arch's voussoir, an imported block), tension in newtons), largest first."""
-    blocks = scene.blocks
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(("block", "name", "class", "course", "tension_N"))
-    for block, newtons in row["tension"].items():
-        course = int(blocks.block_course[block])
-        writer.writerow((block, blocks.block_name[block],
-                         BLOCK_CLASSES[blocks.block_class[block]],
-                         course or "", format_float(newtons)))
-    return buf.getvalue().encode()
-
-
 # ---------------------------------------------------------------------- the run
 def stages_folder_name(params, plan: StagePlan) -> str:
     """The run folder of a stage study: the structure id and the plan, so it never
@@ -484,9 +472,10 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
 
     The folder is published by the run-folder protocol
     (:class:`masonry.runfolder.Publication`), as a run's is: a folder holding this
-    input's complete study with at least the plots asked for (``params.outputs``) is
-    reused; one without plots gets them (the study is computed again), also with
-    ``force``: a run folder only grows.
+    input's complete study with at least the plots asked for (``params.outputs``) and
+    the centering forces is reused; one without plots gets them (the study is computed
+    again; so is one written before the centering force), also with ``force``: a run
+    folder only grows.
 
     Parameters
     ----------
@@ -510,7 +499,7 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
     -------
     dict
         The record written as ``run.json``, its ``path``, and ``rows`` (one dict per
-        stage, :data:`STAGE_COLUMNS` and ``tension``).
+        stage, :data:`STAGE_COLUMNS`, ``loose_blocks`` and ``held``).
     """
     params = validate(params)
     check_live_load(params)
@@ -528,7 +517,8 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
     out = params.outputs
     job = Publication(out_root, stages_folder_name(params, plan),
                       {"params": identity(params), "plan": _plan_identity(plan)},
-                      {"plots": out.plots, "quick": out.quick}, force=force,
+                      {"plots": out.plots, "quick": out.quick, "centering": True},
+                      force=force,
                       identify=_identify)
     reused = job.reusable()
     if reused is not None:
@@ -563,7 +553,7 @@ def _write(folder, params, scene, plan, rows, record, timer):
     folder.write("stages.csv", stages_csv(rows))
     first = first_unsupported(rows)
     if first is not None:
-        folder.write("first_unsupported/held.csv", held_csv(scene, first))
+        folder.write("first_unsupported/held.csv", held_csv(scene.blocks, first["held"]))
     if params.outputs.plots:
         with timer.stage("plots"):
             for name, png in stage_pngs(params, scene, plan, rows).items():
@@ -578,13 +568,14 @@ def _record(params, scene, model, plan, rows, cached, source) -> dict:
     """run.json of a stage study, before timings."""
     first = first_unsupported(rows)
     held = [] if first is None else [
-        {"block": block, "name": str(scene.blocks.block_name[block]), "tension_N": newtons}
-        for block, newtons in first["tension"].items()]
+        {"block": block, "name": str(scene.blocks.block_name[block]), "support_N": size,
+         "force_N": [float(v) for v in force]} for block, force, size in first["held"]]
     record = {
         "structure_id": structure_id(params),
         "scene": params.scene,
         "params": params.record(),
-        "outputs": {"plots": params.outputs.plots, "quick": params.outputs.quick},
+        "outputs": {"plots": params.outputs.plots, "quick": params.outputs.quick,
+                    "centering": True},
         "plan": {**plan.record(), "described": _described(plan)},
         **model_record(scene, params.analysis.density),
         "cache": {"geometry": cached},
@@ -595,6 +586,8 @@ def _record(params, scene, model, plan, rows, cached, source) -> dict:
             "first_unsupported": None if first is None else {
                 "stage": first["stage"], "course": first["course"],
                 "bricks": first["bricks"], "moi_factor": first["moi_factor"],
+                "centering_N": first["centering_N"],
+                "centering_fraction": first["centering_fraction"],
                 "laid": [str(name) for name in scene.blocks.block_name[
                     plan.block_stage == first["stage"]]],
                 "loose": [str(scene.blocks.block_name[b]) for b in first["loose_blocks"]],
@@ -618,8 +611,9 @@ def _described(plan: StagePlan) -> str:
 
 
 def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
-    """``stages.png`` (MoI factor of every stage, which stand) and, when a stage needs
-    support, ``first_unsupported/<view>.png``: that stage with its held bricks marked."""
+    """``stages.png`` (the centering force of every stage as a fraction of its weight,
+    which stages stand) and, when a stage needs support, ``first_unsupported/<view>.png``:
+    that stage, its bricks coloured by the support force they need."""
     from masonry import plots  # matplotlib, imported only by the runs that draw
 
     what = {"course": "course stages", "brick": f"course {plan.course} brick by brick "
@@ -628,7 +622,8 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
             f"{len(rows)} stages stand (mu {params.analysis.mu:g})"
     out = {"stages.png": plots.stage_chart_png(
         [r["stage"] for r in rows],
-        [np.nan if r["moi_factor"] is None else r["moi_factor"] for r in rows],
+        [np.nan if r["centering_fraction"] is None else r["centering_fraction"]
+         for r in rows],
         [bool(r["feasible"]) for r in rows],
         [np.nan if r["load_factor"] is None else r["load_factor"] for r in rows],
         loose=[r["loose"] for r in rows], title=title,
@@ -637,13 +632,20 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
     first = first_unsupported(rows)
     if first is None:
         return out
-    tension = np.zeros(scene.blocks.n_blocks)
-    tension[list(first["tension"])] = list(first["tension"].values())
+    support = np.zeros(scene.blocks.n_blocks)
+    for block, _, size in first["held"]:
+        support[block] = size
+    per_web = " per web" if scene.symmetry.unit and params.analysis.boundary == "cyclic" \
+        else ""
+    total = ("not solved" if first["centering_N"] is None else
+             f"{first['centering_N']:.3g} N{per_web} ({first['centering_fraction']:.3g} of "
+             f"the weight)")
     views = plots.marked_structure_pngs(
-        scene, plan.is_present(first["stage"]), tension,
-        f"stage {first['stage']} of {plan.n_stages}: {first['bricks']} bricks, "
-        f"{len(first['tension'])} carry tension", value_label="tension the brick carries "
-        "[N] (hold it)", is_outlined=plan.block_stage == first["stage"],
+        scene, plan.is_present(first["stage"]), support,
+        f"stage {first['stage']} of {plan.n_stages}: supports must give {total} to "
+        f"{len(first['held'])} of {first['bricks']} bricks",
+        value_label="support force on the brick, at its centroid [N] (centering force)",
+        is_outlined=plan.block_stage == first["stage"],
         outline_label=f"laid at stage {first['stage']}", fast=params.outputs.quick,
         subtitle=f"{scene.kind.describe(params.analysis.boundary)} | {structure_id(params)}")
     out.update({f"first_unsupported/{name}": png for name, png in views.items()})

@@ -122,7 +122,7 @@ class ClarabelProgram(HeldProgram):
                                      shape=(1, n + m)))
         self.n_eq = sum(r.shape[0] for r in rows)
         rows.append(sp.hstack([columns.G, sp.csc_array((columns.G.shape[0], m))]))
-        self.cones = [clarabel.ZeroConeT(self.n_eq), *_cones(columns.cones)]
+        self.cones = [clarabel.ZeroConeT(self.n_eq), *clarabel_cones(columns.cones)]
         self.A = sp.csc_matrix(sp.vstack(rows, format="csc"))
         self.A.sort_indices()
         rhs = program.rhs
@@ -187,7 +187,37 @@ class ClarabelProgram(HeldProgram):
             self.solver.update(q=self.q, A=self.A)
 
 
-def _cones(cones) -> list:
+def solve_cone_program(q, A, b, G, h, cones, time_limit) -> tuple:
+    """``minimize q . z`` subject to ``A z = b`` and ``h - G z`` in ``cones`` (the
+    ``(kind, dimension, count)`` of :attr:`~masonry.rbe.solvers.program.Columns.cones`),
+    with the collapse program's settings (:data:`PROGRAM_SETTINGS`): a program stated
+    once and solved once (the centering force, :mod:`masonry.rbe.centering`).
+
+    Returns
+    -------
+    status : str
+        Clarabel's words (``Solved``, ``AlmostSolved``, ...).
+    z : (n,) float or None
+        Clarabel's point, unless it has none (neither solved nor almost).
+    iterations : int
+    """
+    settings = clarabel.DefaultSettings()
+    settings.verbose = False
+    settings.time_limit = float(time_limit)
+    for name, value in PROGRAM_SETTINGS.items():
+        setattr(settings, name, value)
+    n = len(q)
+    solver = clarabel.DefaultSolver(
+        sp.csc_matrix((n, n)), np.asarray(q, dtype=float),
+        sp.csc_matrix(sp.vstack([A, G], format="csc")), np.concatenate([b, h]),
+        [clarabel.ZeroConeT(A.shape[0]), *clarabel_cones(cones)], settings)
+    solution = solver.solve()
+    status = str(solution.status)
+    z = np.array(solution.x) if status in ("Solved", "AlmostSolved") else None
+    return status, z, int(solution.iterations)
+
+
+def clarabel_cones(cones) -> list:
     """Clarabel's cones of :attr:`~masonry.rbe.solvers.program.Columns.cones`."""
     out = []
     for kind, dimension, count in cones:
