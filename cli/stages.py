@@ -2,7 +2,7 @@
 
 from masonry.params import Params, validate
 from masonry.scenes.imported import load_assembly
-from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS, run_stages
+from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS, run_stages, stage_params
 
 from .options import (add_analysis_options, add_model_options, add_verbosity,
                       centering_line, given_inputs, params_from_args, pattern_note)
@@ -65,10 +65,7 @@ def handle(args, report):
         params, by = params_from_args(args), args.by or "course"
         if not params.kind.has_courses and args.by is None:
             by = "block"
-        # a stage of the dome, not of a free-standing web: a section is cyclic unless the
-        # user says otherwise
-        if "cyclic" in params.kind.boundaries and args.boundary is None and not args.dome:
-            params = validate(params.replace(boundary="cyclic"))
+        params = stage_params(params, args.boundary is not None or args.dome)
     record = run_stages(params, args.out, by=by, order=args.order, course=args.course,
                         force=args.force, scene=scene, source=source,
                         max_bricks=args.max_bricks)
@@ -92,6 +89,10 @@ def handle(args, report):
         report(centering_line(first["centering_N"], first["centering_fraction"],
                               first["held"], len(first["held"]),
                               "first_unsupported/held.csv"))
+    if stages["centering_max_stage"] is not None:
+        report(f"largest centering force: {stages['centering_max_N']:.4g} N "
+               f"({stages['centering_max_fraction']:.3g} of the stage's weight) at stage "
+               f"{stages['centering_max_stage']} (stages.csv, column centering_N)")
     loose = [str(r["stage"]) for r in record.get("rows", ()) if r.get("loose")]
     if loose:
         report(f"stages with blocks joined to no support, so no MoI: {', '.join(loose[:10])}"

@@ -10,6 +10,8 @@ from masonry.errors import ParameterError
 from masonry.parameters import read_toml
 from masonry.params import PRESETS, Params, validate
 from masonry.runfolder import check_output_root
+from masonry.studies.stages import (BLOCK_ORDERS, BRICK_ORDERS, check_live_load,
+                                    stage_params)
 from masonry.studies.sweep import Study, execute, publish_summary, summary_rows
 
 from . import run as run_command
@@ -88,9 +90,7 @@ def load_study(path) -> Study:
              "an integer")):
         if not ok:
             refuse(key, value, expected)
-    for key, value in outputs.items():
-        if key not in ("plots", "printable", "html") or not isinstance(value, bool):
-            refuse(f"outputs.{key}", value, "plots, printable or html = true or false")
+    stages = _stage_outputs(outputs, refuse)
     for key, values in grid.items():
         if not isinstance(values, list) or not values:
             refuse(f"grid.{key}", values, "a non-empty list of values")
@@ -111,18 +111,62 @@ def load_study(path) -> Study:
         grid=_fields(grid, "grid", names, where, lists=True),
         sample=_fields(sample, "sample", names, where), count=count, seed=seed,
         plots=outputs.get("plots", False), printable=outputs.get("printable", False),
-        html=outputs.get("html", False))
+        html=outputs.get("html", False), **stages)
     _check_variants(study, where)
     return study
 
 
+STAGE_PLANS = {"course": (), "brick": BRICK_ORDERS, "block": BLOCK_ORDERS}
+"""``[outputs] stages`` values (``masonry stages --by``) and their laying orders."""
+
+
+def _stage_outputs(outputs, refuse) -> dict:
+    """The ``[outputs]`` table checked: ``plots``, ``printable``, ``html`` (true or
+    false) and a stage study's ``stages`` (``course``, ``brick`` or ``block``),
+    ``stages_course`` (the course of ``brick``) and ``stages_order``; returns
+    :class:`Study`'s ``stages*``."""
+    for key, value in outputs.items():
+        if key in ("plots", "printable", "html"):
+            if not isinstance(value, bool):
+                refuse(f"outputs.{key}", value, "true or false")
+        elif key not in ("stages", "stages_course", "stages_order"):
+            refuse(f"outputs.{key}", value, "plots, printable, html, stages, "
+                                            "stages_course or stages_order")
+    by, course = outputs.get("stages"), outputs.get("stages_course")
+    order = outputs.get("stages_order")
+    if by is None:
+        if course is not None or order is not None:
+            key = "stages_course" if course is not None else "stages_order"
+            refuse(f"outputs.{key}", outputs[key], "with outputs.stages only")
+        return {}
+    if by not in STAGE_PLANS:
+        refuse("outputs.stages", by, '"course", "brick" or "block" (the stage plan of '
+                                     "'masonry stages --by')")
+    if by == "brick" and not (isinstance(course, int) and not isinstance(course, bool)
+                              and course >= 1):
+        refuse("outputs.stages_course", course, 'the course laid brick by brick with '
+                                                'stages = "brick", an integer >= 1')
+    if by != "brick" and course is not None:
+        refuse("outputs.stages_course", course, 'none: a course only with stages = "brick"')
+    if order is not None and order not in STAGE_PLANS[by]:
+        expected = (f"one of {', '.join(STAGE_PLANS[by])}" if STAGE_PLANS[by] else
+                    "none: a course plan has no laying order")
+        refuse("outputs.stages_order", order, expected)
+    return {"stages": by, "stages_course": course, "stages_order": order}
+
+
 def _check_variants(study: Study, where):
-    """Every variant's inputs checked as ``masonry run`` checks them, before any runs: a
-    value out of range names the table and key it came from (of the inputs the check
-    involves, a swept one first; one the study leaves at its default says so)."""
+    """Every variant's inputs checked as ``masonry run`` (and for a study of stages
+    ``masonry stages``) checks them, before any runs: a value out of range names the
+    table and key it came from (of the inputs the check involves, a swept one first; one
+    the study leaves at its default says so); a plan by course or brick of a scene not
+    laid in courses names ``outputs.stages``."""
     for inputs in study.variants():
         try:
-            validate(Params.of(**inputs))
+            params = validate(Params.of(**inputs))
+            if study.stages:  # what 'masonry stages' would refuse of the variant
+                check_live_load(params)
+                stage_params(params, "boundary" in inputs)
         except ParameterError as error:
             names = (error.name, *error.related)
             table, name = next(((t, n) for t in ("grid", "sample", "base") for n in names
@@ -131,6 +175,9 @@ def _check_variants(study: Study, where):
             raise ParameterError(f"{table}.{key}" if table else f"{key} (the default)",
                                  inputs.get(name, error.value), error.expected,
                                  where=where) from None
+        if study.stages in ("course", "brick") and not params.kind.has_courses:
+            raise ParameterError("outputs.stages", study.stages, f'"block": scene '
+                                 f"{params.scene} is not laid in courses", where=where)
 
 
 def _fields(table, name, names, where, lists=False) -> dict:

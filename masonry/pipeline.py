@@ -330,7 +330,9 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     out_root : str or Path
         The output root; the run folder is ``out_root/<structure id>``.
     analyse : bool
-        Solve the rigid block equilibrium (``masonry run``); False only builds the model
+        Solve the rigid block equilibrium and, where the structure cannot stand, its
+        centering force (``masonry run``; ``outputs.centering`` in run.json: a folder
+        written before the centering force is not reused); False only builds the model
         and its interfaces (``masonry build``).
     force : bool
         Recompute even when the folder holds a complete run of the same input.
@@ -354,7 +356,8 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     if scene is None:
         check_size(params, max_bricks)
     out = params.outputs
-    wanted = {"analyse": analyse, **{name: getattr(out, name) for name in FILE_OUTPUTS}}
+    wanted = {"analyse": analyse, "centering": analyse,
+              **{name: getattr(out, name) for name in FILE_OUTPUTS}}
     job = Publication(out_root, structure_id(params), {"params": identity(params)}, wanted,
                       force=force, identify=_identify)
     reused = job.reusable()
@@ -424,8 +427,8 @@ def run_record(params: Params, scene: Scene, model: Model, outputs: dict, cached
     model : masonry.rbe.boundary.Model
         Its analysis model; its interface counts by kind go into ``counts``.
     outputs : dict str -> bool
-        What the run writes (``analyse``, :data:`~masonry.params.WRITTEN_OUTPUTS`,
-        ``quick``).
+        What the run writes (``analyse``, ``centering``,
+        :data:`~masonry.params.WRITTEN_OUTPUTS`, ``quick``).
     cached : str
         ``'reused'``, ``'computed'`` or ``'given'``: where the geometry came from.
     source : dict, optional
@@ -441,7 +444,8 @@ def run_record(params: Params, scene: Scene, model: Model, outputs: dict, cached
         "structure_id": structure_id(params),
         "scene": params.scene,
         "params": params.record(),
-        "outputs": {name: outputs[name] for name in ("analyse", *WRITTEN_OUTPUTS, "quick")},
+        "outputs": {name: outputs[name] for name in ("analyse", "centering",
+                                                     *WRITTEN_OUTPUTS, "quick")},
         **model_record(scene, params.analysis.density),
         "coordinates": coordinates_record(scene, params.outputs.cad_offset),
         "cache": {"geometry": cached},

@@ -57,8 +57,8 @@ def test_run_after_build_adds_the_forces_and_keeps_the_plots(tmp_path):
     assert main(["run", *WALL, "--out", str(tmp_path), "--no-plots", "--no-printable",
                  "-q"]) == 0
     record = json.loads((tmp_path / WALL_ID / "run.json").read_text())
-    assert record["outputs"] == {"analyse": True, "plots": True, "printable": False,
-                                 "html": True, "quick": True}
+    assert record["outputs"] == {"analyse": True, "centering": True, "plots": True,
+                                 "printable": False, "html": True, "quick": True}
     assert (tmp_path / WALL_ID / "RBE" / "forces.csv").is_file()
     assert (tmp_path / WALL_ID / "00_pattern.png").is_file()
 
@@ -273,4 +273,5 @@ def test_a_stage_study_without_plots_keeps_the_plots_of_one_with(tmp_path, capsy
     assert snapshot(folder) == before
     assert main([*args, "--no-plots", "--force"]) == 0  # recomputed, the plots kept
     assert set(snapshot(folder)) == set(before)
-    assert json.loads((folder / "run.json").read_text())["outputs"] == {"plots": True, "quick": False}
+    assert json.loads((folder / "run.json").read_text())["outputs"] == {
+        "plots": True, "quick": False, "centering": True}

@@ -118,3 +118,129 @@ def test_samples_are_seeded_and_bad_names_refused(tmp_path, capsys):
     assert main(["sweep", str(path), "--out", str(tmp_path / "x")]) == 2
     assert "grid.frobnicate" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+# ---------------------------------------------------------------------- stages
+SMALL_DOME = {"preset": "1", "n": 4, "p": 3, "r": 1}  # tests/test_stages.py: a 73-brick web
+
+
+def _stage_study(tmp_path, grid, outputs, base=SMALL_DOME):
+    lines = ["[base]", *[f"{k} = {v!r}" for k, v in base.items()], "[grid]",
+             *[f"{k} = {v!r}" for k, v in grid.items()], "[outputs]",
+             *[f"{k} = {v!r}" for k, v in outputs.items()]]
+    path = tmp_path / "staged.toml"
+    path.write_text("\n".join(lines).replace("'", '"') + "\n")
+    assert main(["sweep", str(path), "--workers", "1", "--out", str(tmp_path / "sweep"),
+                 "-q"]) == 0
+    return _summary(tmp_path / "sweep", "staged")
+
+
+def _stages_alone(tmp_path, *args):
+    """``masonry stages`` of the same variant in a root of its own: its stages.csv rows
+    and its run.json."""
+    out = tmp_path / f"alone{len(list(tmp_path.glob('alone*')))}"
+    assert main(["stages", *args, "--no-plots", "--out", str(out), "-q"]) == 0
+    (folder,) = out.glob("*_stages_*")
+    with open(folder / "stages.csv") as f:
+        return list(csv.DictReader(f)), json.loads((folder / "run.json").read_text())
+
+
+def _expected(rows):
+    """The sweep's stage columns from a stage study's stages.csv, by hand."""
+    failing = [r for r in rows if r["feasible"] == "False"]
+    top = max(rows, key=lambda r: float(r["centering_N"]))
+    return {"stages": str(len(rows)), "stages_standing": str(len(rows) - len(failing)),
+            "first_unsupported_stage": failing[0]["stage"] if failing else "",
+            "first_unsupported_course": failing[0]["course"] if failing else "",
+            "centering_max_N": float(top["centering_N"]),
+            "centering_max_fraction": float(top["centering_fraction"])}
+
+
+def _stage_columns(row):
+    out = {k: row[k] for k in ("stages", "stages_standing", "first_unsupported_stage",
+                               "first_unsupported_course")}
+    return {**out, "centering_max_N": float(row["centering_max_N"]),
+            "centering_max_fraction": float(row["centering_max_fraction"])}
+
+
+def test_a_sweep_of_course_stages_gives_the_columns_of_masonry_stages(tmp_path):
+    """The small dome by course at mu 0.1 (stages 5-11 need support) and 0.7 (all
+    stand): the summary's stage columns equal those ``masonry stages`` writes for the
+    same variant (a section laid cyclic in both), to the printed digits."""
+    rows = _stage_study(tmp_path, {"mu": [0.1, 0.7]}, {"stages": "course"})
+    assert [r["status"] for r in rows] == ["computed", "computed"]
+    for row, mu in zip(rows, ("0.1", "0.7")):
+        alone, record = _stages_alone(tmp_path, "--preset", "1", "--n", "4", "--p", "3",
+                                      "--r", "1", "--mu", mu)
+        assert record["params"]["boundary"] == "cyclic"
+        expected = _expected(alone)
+        assert _stage_columns(row) == pytest.approx(expected, rel=1e-9)
+        assert row["first_unsupported_brick"] == row["stages_load_factor_min"] == ""
+    low, high = rows
+    assert low["first_unsupported_course"] == "5" and float(low["centering_max_N"]) > 0
+    assert high["stages_standing"] == "11" and high["first_unsupported_course"] == ""
+    assert float(high["centering_max_N"]) == 0.0
+    # the run of the variant itself: a free-standing web, its own centering force
+    assert float(low["centering_N"]) > 0 and low["feasible"] == "False"
+
+
+def test_a_sweep_of_brick_stages_names_the_first_brick_that_needs_support(tmp_path):
+    """Course 9 of the small dome brick by brick at mu 0.2 (its course stage 9 is the
+    first that needs support): the brick's rank on the course is the stage's number."""
+    (row,) = _stage_study(tmp_path, {"mu": [0.2]},
+                          {"stages": "brick", "stages_course": 9})
+    alone, record = _stages_alone(tmp_path, "--preset", "1", "--n", "4", "--p", "3", "--r",
+                                  "1", "--mu", "0.2", "--by", "brick", "--course", "9")
+    expected = _expected(alone)
+    assert _stage_columns(row) == pytest.approx(expected, rel=1e-9)
+    assert row["first_unsupported_course"] == "9"
+    assert row["first_unsupported_brick"] == expected["first_unsupported_stage"] != ""
+    assert record["stages"]["first_unsupported"]["brick"] == int(row["first_unsupported_brick"])
+
+
+def test_a_sweep_of_stages_under_a_lateral_load_gives_the_worst_stage(tmp_path):
+    """The 72-brick dome (tests/test_collapse.py) under a lateral load at 0 degrees: the
+    smallest load factor over its four course stages, as ``masonry stages`` finds it
+    (docs/stages.md: 0.7000, 0.6867, 0.6690, 0.6845)."""
+    dome = {"stretch": 1.0, "n": 6, "r": 0, "p": 3, "cut": 0.5}
+    (row,) = _stage_study(tmp_path, {"mu": [0.7]}, {"stages": "course"},
+                          base={"preset": "1", **dome, "scene": "dome", "lateral": "0"})
+    alone, _ = _stages_alone(tmp_path, "--preset", "1", *[f"--{k}={v}" for k, v in
+                                                          dome.items()],
+                             "--scene", "dome", "--lateral", "0")
+    factors = [float(r["load_factor"]) for r in alone if r["load_factor"]]
+    assert len(factors) == 4 and row["stages_standing"] == "4"
+    assert float(row["stages_load_factor_min"]) == pytest.approx(min(factors), rel=1e-9)
+    assert float(row["stages_load_factor_min"]) == pytest.approx(0.6690, abs=5e-5)
+
+
+@pytest.mark.parametrize("outputs, shown", [
+    ('stages = "height"', "outputs.stages = 'height'"),
+    ('stages = "brick"', "outputs.stages_course = None"),
+    ('stages = "course"\nstages_course = 3', "outputs.stages_course = 3"),
+    ('stages = "brick"\nstages_course = 3\nstages_order = "z"', "outputs.stages_order = 'z'"),
+    ('stages_course = 3', "outputs.stages_course = 3"),
+])
+def test_bad_stage_outputs_are_refused_before_any_run(tmp_path, capsys, outputs, shown):
+    path = tmp_path / "bad.toml"
+    path.write_text(STUDY + f"\n[outputs]\n{outputs}\n")
+    assert main(["sweep", str(path), "--workers", "1", "--out", str(tmp_path / "x")]) == 2
+    error = capsys.readouterr().err.strip().splitlines()
+    assert len(error) == 1 and f"bad.toml: {shown}: expected" in error[0]
+    assert not (tmp_path / "x").exists()
+
+
+def test_stages_that_masonry_stages_refuses_stop_the_study_first(tmp_path, capsys):
+    """A lateral load on the section, which its stages analyse cyclic, and an arch laid
+    by course are refused as ``masonry stages`` refuses them, naming where they came
+    from."""
+    path = tmp_path / "bad.toml"
+    path.write_text('[base]\npreset = "1"\nlateral = "0"\n[grid]\nmu = [0.7]\n'
+                    '[outputs]\nstages = "course"\n')
+    assert main(["sweep", str(path), "--workers", "1", "--out", str(tmp_path / "x")]) == 2
+    assert "bad.toml: base.lateral" in capsys.readouterr().err
+    path.write_text('[base]\nscene = "arch"\n[grid]\nmu = [0.7]\n[outputs]\n'
+                    'stages = "course"\n')
+    assert main(["sweep", str(path), "--workers", "1", "--out", str(tmp_path / "x")]) == 2
+    assert "bad.toml: outputs.stages = 'course'" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()

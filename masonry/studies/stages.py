@@ -137,6 +137,13 @@ class StagePlan:
         return {"by": self.by, "order": self.order, "course": self.course,
                 "stages": self.n_stages}
 
+    def brick_on_course(self, stage: int) -> int | None:
+        """A brick plan's stage ``stage`` (1..N) lays the ``k``-th brick of its course
+        (1-based, in laying order); None for the other plans."""
+        if self.by != "brick":
+            return None
+        return int((self.stage_course[:stage] == self.stage_course[stage - 1]).sum())
+
 
 def course_plan(blocks) -> StagePlan:
     """Stage ``k``: every brick starting on courses ``1..k`` (``block_course``).
@@ -430,6 +437,43 @@ def first_unsupported(rows) -> dict | None:
     return next((row for row in rows if not row["feasible"]), None)
 
 
+def stage_extremes(rows) -> dict:
+    """The largest centering force over the stages and the smallest collapse load factor.
+
+    Returns
+    -------
+    dict
+        ``centering_max_N`` (0 when every stage stands; None when no stage's centering
+        force was solved), ``centering_max_fraction`` (that stage's
+        ``centering_fraction``: of its own weight), ``centering_max_stage`` (None when
+        every stage stands); ``load_factor_min`` and ``load_factor_min_stage`` over the
+        stages with a load factor (None without a lateral load or where no stage stands).
+    """
+    solved = [row for row in rows if row["centering_N"] is not None]
+    out = {"centering_max_N": None, "centering_max_fraction": None,
+           "centering_max_stage": None, "load_factor_min": None,
+           "load_factor_min_stage": None}
+    if solved:
+        top = max(solved, key=lambda row: row["centering_N"])  # the first of equal ones
+        out.update(centering_max_N=top["centering_N"],
+                   centering_max_fraction=top["centering_fraction"],
+                   centering_max_stage=top["stage"] if top["centering_N"] > 0 else None)
+    factors = [row for row in rows if row["load_factor"] is not None]
+    if factors:
+        low = min(factors, key=lambda row: row["load_factor"])
+        out.update(load_factor_min=low["load_factor"], load_factor_min_stage=low["stage"])
+    return out
+
+
+def stage_params(params, boundary_given: bool):
+    """The inputs of a stage study of ``params``: a stage of the dome, not of a
+    free-standing web, so a section whose scene takes a cyclic boundary is analysed
+    cyclic unless the user gave a boundary (``boundary_given``)."""
+    if "cyclic" in params.kind.boundaries and not boundary_given:
+        return validate(params.replace(boundary="cyclic"))
+    return params
+
+
 def stages_csv(rows) -> bytes:
     """``stages.csv``: :data:`STAGE_COLUMNS`, one row per stage; empty cells for None,
     floats as every CSV of the project prints them."""
@@ -586,12 +630,14 @@ def _record(params, scene, model, plan, rows, cached, source) -> dict:
             "first_unsupported": None if first is None else {
                 "stage": first["stage"], "course": first["course"],
                 "bricks": first["bricks"], "moi_factor": first["moi_factor"],
+                "brick": plan.brick_on_course(first["stage"]),
                 "centering_N": first["centering_N"],
                 "centering_fraction": first["centering_fraction"],
                 "laid": [str(name) for name in scene.blocks.block_name[
                     plan.block_stage == first["stage"]]],
                 "loose": [str(scene.blocks.block_name[b]) for b in first["loose_blocks"]],
                 "held": held},
+            **stage_extremes(rows),
             "solve_s": round(sum(row["solve_s"] for row in rows), 4),
         },
     }

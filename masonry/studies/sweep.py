@@ -28,18 +28,47 @@ from masonry.export._text import format_floats
 from masonry.errors import ParameterError
 from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run, versions
+from masonry.studies.stages import run_stages, stage_params
 from masonry.runfolder import Publication
 from masonry.forking import use_one_blas_thread
 
 log = logging.getLogger(__name__)
 
 SUMMARY_COLUMNS = ("variant", "status", "error", "feasible", "friction_used",
-                   "friction_model", "moi", "moi_factor",
-                   "objective", "weight_N", "bricks", "interfaces", "residual_eq",
-                   "load_factor", "load_azimuth_deg", "time_s", "structure_id")
-"""Result columns of the summary; the swept inputs come first. ``load_factor`` (and the
-lateral load's azimuth, the worst one for ``lateral = "all"``) when the study gives a live
-load (``lateral``, ``point-load`` or ``crown-load``, docs/model.md 6.8)."""
+                   "friction_model", "moi", "moi_factor", "centering_N",
+                   "centering_fraction", "objective", "weight_N", "bricks", "interfaces",
+                   "residual_eq", "load_factor", "load_azimuth_deg", "time_s",
+                   "structure_id")
+"""Result columns of the summary; the swept inputs come first. ``centering_N``,
+``centering_fraction``: the run's centering force (docs/model.md 6.10), 0 where the
+structure stands. ``load_factor`` (and the lateral load's azimuth, the worst one for
+``lateral = "all"``) when the study gives a live load (``lateral``, ``point-load`` or
+``crown-load``, docs/model.md 6.8). A study of stages adds :data:`STAGE_SUMMARY_COLUMNS`."""
+
+STAGE_SUMMARY_COLUMNS = ("stages", "stages_standing", "first_unsupported_stage",
+                         "first_unsupported_course", "first_unsupported_brick",
+                         "centering_max_N", "centering_max_fraction",
+                         "stages_load_factor_min")
+"""A stage study's columns in a sweep's summary (:func:`stage_summary`), after
+:data:`SUMMARY_COLUMNS` when the study asks for stages (``Study.stages``)."""
+
+
+def stage_summary(record) -> dict:
+    """A stage study's :data:`STAGE_SUMMARY_COLUMNS` from its ``run.json`` record
+    (:func:`masonry.studies.stages.run_stages`): the number of stages and of those that
+    stand; the first that needs support (stage, course, and for a brick plan the brick's
+    rank on its course), None when every stage stands; the largest centering force (N,
+    and its fraction of that stage's weight) and the smallest lateral load factor over
+    the stages (:func:`masonry.studies.stages.stage_extremes`)."""
+    stages = record["stages"]
+    first = stages["first_unsupported"] or {}
+    return {"stages": stages["count"], "stages_standing": stages["standing"],
+            "first_unsupported_stage": first.get("stage"),
+            "first_unsupported_course": first.get("course"),
+            "first_unsupported_brick": first.get("brick"),
+            "centering_max_N": stages["centering_max_N"],
+            "centering_max_fraction": stages["centering_max_fraction"],
+            "stages_load_factor_min": stages["load_factor_min"]}
 
 
 @dataclass(frozen=True)
@@ -59,6 +88,14 @@ class Study:
     analyse, plots, printable, html : bool
         What each run does and writes (defaults: solve, no plots, no printable body, no
         ``dome.html``).
+    stages : str or None
+        Also a stage study of every variant (:func:`masonry.studies.stages.run_stages`),
+        laid by ``course``, ``brick`` or ``block``; its results add
+        :data:`STAGE_SUMMARY_COLUMNS` to the summary.
+    stages_course : int or None
+        The course a brick plan lays brick by brick.
+    stages_order : str or None
+        The laying order of a brick or block plan (its default when None).
     """
 
     base: dict
@@ -70,11 +107,28 @@ class Study:
     plots: bool = False
     printable: bool = False
     html: bool = False
+    stages: str | None = None
+    stages_course: int | None = None
+    stages_order: str | None = None
 
     @property
     def swept(self) -> list:
         """Names of the inputs that vary, grid first."""
         return list(self.grid) + [k for k in self.sample if k not in self.grid]
+
+    @property
+    def columns(self) -> list:
+        """The summary's columns: the swept inputs, :data:`SUMMARY_COLUMNS`, and
+        :data:`STAGE_SUMMARY_COLUMNS` for a study of stages."""
+        return self.swept + list(SUMMARY_COLUMNS) + list(
+            STAGE_SUMMARY_COLUMNS if self.stages else ())
+
+    def options(self) -> dict:
+        """:func:`run_variant`'s keyword arguments: what each variant does and writes."""
+        stages = None if self.stages is None else {
+            "by": self.stages, "course": self.stages_course, "order": self.stages_order}
+        return dict(analyse=self.analyse, plots=self.plots, printable=self.printable,
+                    html=self.html, stages=stages)
 
     def variants(self) -> list:
         """One dict of inputs per variant (base, then grid point, then sample).
@@ -119,8 +173,9 @@ class Study:
 
 
 def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=False,
-                html=False) -> dict:
-    """Run one variant; never raises: a failure becomes a row with its error.
+                html=False, stages=None) -> dict:
+    """Run one variant (and its stage study); never raises: a failure becomes a row with
+    its error.
 
     Parameters
     ----------
@@ -131,6 +186,10 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     analyse, plots, printable, html : bool
         What the run does and writes (:func:`masonry.pipeline.run`; ``plots``,
         ``printable`` and ``html`` unless the variant's inputs say otherwise).
+    stages : dict or None
+        ``by``, ``course`` and ``order`` of a stage study of the variant
+        (:func:`masonry.studies.stages.run_stages`, in its own run folder; a section
+        laid cyclic unless the inputs give a boundary, as ``masonry stages`` does).
 
     Returns
     -------
@@ -138,34 +197,49 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
         ``status`` (``'computed'``, ``'reused'`` or ``'failed'``), ``error`` (str, empty
         unless failed), ``time_s`` (wall clock, s) and, for a run that did not fail, the
         result columns of :data:`SUMMARY_COLUMNS` (``moi`` and ``weight_N`` in N,
-        ``objective`` in N^2, ``moi_factor`` and ``residual_eq`` dimensionless).
+        ``objective`` in N^2, ``moi_factor`` and ``residual_eq`` dimensionless) and with
+        ``stages`` those of :data:`STAGE_SUMMARY_COLUMNS` (``computed`` when the run or
+        the stage study was).
     """
     use_one_blas_thread()  # in a Dask worker process too
     start = time.perf_counter()
     row = {"status": "failed", "error": ""}
     try:
-        params = Params.of(**{"plots": plots, "printable": printable, "html": html,
-                              **inputs})
-        record = run(validate(params), out_root, analyse=analyse)
+        params = validate(Params.of(**{"plots": plots, "printable": printable,
+                                       "html": html, **inputs}))
+        record = run(params, out_root, analyse=analyse)
+        staged = None if stages is None else run_stages(
+            stage_params(params, "boundary" in inputs), out_root, **stages)
     except Exception as error:  # a variant's failure is data, not the study's end
         row["error"] = f"{type(error).__name__}: {error}"
         log.debug("variant failed: %s", traceback.format_exc())
     else:
-        rbe = record.get("rbe", {})
-        row.update(
-            status="reused" if record.get("reused") else "computed",
-            feasible=rbe.get("feasible"), friction_used=rbe.get("friction"),
-            friction_model=rbe.get("friction_model"),
-            moi=rbe.get("moi"), moi_factor=rbe.get("moi_factor"),
-            objective=rbe.get("objective"), weight_N=record.get("weight_N"),
-            bricks=record["counts"]["bricks"],
-            interfaces=sum(record["counts"].get("interfaces", {}).values()),
-            residual_eq=rbe.get("residual_eq"), structure_id=record["structure_id"])
-        collapse = record.get("collapse", {})
-        row.update(load_factor=collapse.get("load_factor"),
-                   load_azimuth_deg=collapse.get("azimuth_deg"))
+        reused = record.get("reused") and (staged is None or staged.get("reused"))
+        row.update(status="reused" if reused else "computed", **run_summary(record))
+        if staged is not None:
+            row.update(stage_summary(staged))
     row["time_s"] = round(time.perf_counter() - start, 3)
     return row
+
+
+def run_summary(record) -> dict:
+    """The result columns of :data:`SUMMARY_COLUMNS` from a run's ``run.json`` record
+    (see :func:`run_variant`)."""
+    rbe = record.get("rbe", {})
+    centering = record.get("centering") or {}
+    stands = rbe.get("feasible") is True
+    collapse = record.get("collapse", {})
+    return dict(
+        feasible=rbe.get("feasible"), friction_used=rbe.get("friction"),
+        friction_model=rbe.get("friction_model"),
+        moi=rbe.get("moi"), moi_factor=rbe.get("moi_factor"),
+        centering_N=0.0 if stands else centering.get("total_N"),
+        centering_fraction=0.0 if stands else centering.get("fraction"),
+        objective=rbe.get("objective"), weight_N=record.get("weight_N"),
+        bricks=record["counts"]["bricks"],
+        interfaces=sum(record["counts"].get("interfaces", {}).values()),
+        residual_eq=rbe.get("residual_eq"), structure_id=record["structure_id"],
+        load_factor=collapse.get("load_factor"), load_azimuth_deg=collapse.get("azimuth_deg"))
 
 
 def run_after(previous, inputs: dict, out_root, **options) -> dict:
@@ -252,8 +326,7 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
     variants = study.variants()
     if scheduler is not None:
         check_scheduler_address(scheduler)
-    options = dict(analyse=study.analyse, plots=study.plots, printable=study.printable,
-                   html=study.html)
+    options = study.options()
     if workers == 1 and scheduler is None:
         for i, inputs in enumerate(variants):
             yield i, inputs, run_variant(inputs, str(out_root), **options)
@@ -330,21 +403,21 @@ def summary_rows(study: Study, results) -> list:
     Returns
     -------
     list of dict
-        One dict per variant, keys ``study.swept`` then :data:`SUMMARY_COLUMNS`.
+        One dict per variant, keys ``study.columns``.
     """
     rows = []
     for i, inputs, row in sorted(results, key=lambda r: r[0]):
         rows.append({**{k: inputs.get(k) for k in study.swept}, "variant": i,
-                     **{k: row.get(k) for k in SUMMARY_COLUMNS if k != "variant"}})
+                     **{k: row.get(k) for k in study.columns[len(study.swept):]
+                        if k != "variant"}})
     return rows
 
 
 def summary_csv(study: Study, rows) -> bytes:
-    """CSV (UTF-8 bytes) of :func:`summary_rows`: swept inputs, then
-    :data:`SUMMARY_COLUMNS`; floats as every CSV of the project prints them
+    """CSV (UTF-8 bytes) of :func:`summary_rows`: its columns (``study.columns``); floats as every CSV of the project prints them
     (:func:`~masonry.export._text.format_floats`: 12 digits, every digit of a sampled
     input and of its run folder's name), None as an empty cell."""
-    columns = study.swept + list(SUMMARY_COLUMNS)
+    columns = study.columns
     texts = []
     for c in columns:
         values = [row.get(c) for row in rows]
@@ -369,7 +442,7 @@ def summary_parquet(study: Study, rows):
         import pyarrow.parquet as pq
     except ImportError:
         return None
-    columns = study.swept + list(SUMMARY_COLUMNS)
+    columns = study.columns
     table = pa.table({c: [None if r.get(c) is None else str(r.get(c))
                           if c in ("error", "status", "friction_used", "friction_model",
                                    "structure_id")
