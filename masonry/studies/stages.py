@@ -688,8 +688,8 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
              f"the weight)")
     views = plots.marked_structure_pngs(
         scene, plan.is_present(first["stage"]), support,
-        f"stage {first['stage']} of {plan.n_stages}: supports must give {total} to "
-        f"{len(first['held'])} of {first['bricks']} bricks",
+        f"stage {first['stage']} of {plan.n_stages}: {total} on {len(first['held'])} of "
+        f"{first['bricks']} bricks",
         value_label="support force on the brick, at its centroid [N] (centering force)",
         is_outlined=plan.block_stage == first["stage"],
         outline_label=f"laid at stage {first['stage']}", fast=params.outputs.quick,
