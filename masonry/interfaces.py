@@ -278,10 +278,13 @@ def _face_table(blocks) -> _FaceTable:
     count = blocks.face_polygon_count
     k = np.minimum(np.arange(count.max()), count[:, None] - 1)
     xyz = blocks.vertices[blocks.face_vertices[blocks.face_offsets[:-1, None] + k]]
-    x, y, z = np.moveaxis(xyz - blocks.face_centre[:, None], 2, 0)
-    n_x, n_y, n_z = blocks.face_normal[:, :, None].transpose(1, 0, 2)
-    return _FaceTable(xyz, np.sqrt((x * x + y * y + z * z).max(axis=1)),
-                      np.abs(x * n_x + y * n_y + z * n_z).max(axis=1))
+    # the radius and warp over each face's own vertices (the flat list, not the padding)
+    x, y, z = (blocks.vertices[blocks.face_vertices]
+               - np.repeat(blocks.face_centre, count, axis=0)).T
+    n_x, n_y, n_z = np.repeat(blocks.face_normal, count, axis=0).T
+    start = blocks.face_offsets[:-1]
+    return _FaceTable(xyz, np.sqrt(np.maximum.reduceat(x * x + y * y + z * z, start)),
+                      np.maximum.reduceat(np.abs(x * n_x + y * n_y + z * n_z), start))
 
 
 def _touching_face_pairs(blocks, pairs, faces, tol):
@@ -300,7 +303,9 @@ def _touching_face_pairs(blocks, pairs, faces, tol):
     if len(pairs) == 0:
         return np.zeros(0, int), np.zeros(0, int)
     # faces per block in a padded (B, width) table, so that the normals of all face pairs
-    # of all block pairs are one batched product; padding normals are NaN and never pass
+    # of the block pairs of one width class are one batched product (a block of many
+    # faces, a ground ring's, does not widen the others'); padding normals are NaN and
+    # never pass
     face_count = np.bincount(blocks.face_block, minlength=blocks.n_blocks)
     order = np.argsort(blocks.face_block, kind="stable")
     owner = blocks.face_block[order]
@@ -310,10 +315,16 @@ def _touching_face_pairs(blocks, pairs, faces, tol):
     block_normal = np.full(block_face.shape + (3,), np.nan)
     block_normal[owner, slot] = blocks.face_normal[order]
 
-    a, b = pairs[:, 0], pairs[:, 1]
-    cos_ab = block_normal[a] @ block_normal[b].transpose(0, 2, 1)
-    p, i, j = np.nonzero(cos_ab <= -np.cos(tol.max_gap_angle))
-    face_a, face_b = block_face[a[p], i], block_face[b[p], j]
+    face_a, face_b, cos = [], [], []
+    for group in _width_classes(np.maximum(face_count[pairs[:, 0]], face_count[pairs[:, 1]])):
+        a, b = pairs[group, 0], pairs[group, 1]
+        width = max(face_count[a].max(), face_count[b].max())
+        cos_ab = block_normal[a, :width] @ block_normal[b, :width].transpose(0, 2, 1)
+        p, i, j = np.nonzero(cos_ab <= -np.cos(tol.max_gap_angle))
+        face_a.append(block_face[a[p], i])
+        face_b.append(block_face[b[p], j])
+        cos.append(cos_ab[p, i, j])
+    face_a, face_b, cos = np.concatenate(face_a), np.concatenate(face_b), np.concatenate(cos)
 
     # a cheap screen first: b's face centre near a's face plane. For b's vertices v,
     # n_a . (v - centre_b) = (n_a + n_b) . (v - centre_b) - n_b . (v - centre_b), at most
@@ -321,7 +332,7 @@ def _touching_face_pairs(blocks, pairs, faces, tol):
     normal, centre = blocks.face_normal, blocks.face_centre
     gap = np.einsum("ij,ij->i", normal[face_a], centre[face_b] - centre[face_a])
     excess = np.maximum(np.abs(gap) - tol.contact - faces.warp[face_b], 0.0)
-    keep = excess**2 <= np.maximum(2.0 + 2.0 * cos_ab[p, i, j], 0.0) * faces.radius[face_b]**2
+    keep = excess**2 <= np.maximum(2.0 + 2.0 * cos, 0.0) * faces.radius[face_b]**2
     face_a, face_b = face_a[keep], face_b[keep]
 
     # the test itself, both ways
@@ -363,26 +374,19 @@ def _intersect(blocks, main, comp, faces, tol, up):
         Main and complementary face of every surviving face pair.
     faces : _FaceTable
     """
-    normal, centre, area = blocks.face_normal, blocks.face_centre, blocks.face_area
+    normal, centre = blocks.face_normal, blocks.face_centre
     t1, t2 = blocks.face_basis
-    n_m, n_c = normal[main], normal[comp]
-
-    # gap closing (docs/model.md 5.3); faces whose wedge rotation would move no vertex farther
-    # than tol.length count as parallel and are only projected (below)
-    sin = np.linalg.norm(np.cross(n_m, n_c), axis=1)
-    is_wedge = sin * faces.radius[comp] > tol.length
-    xyz = _close_wedge(faces.xyz[comp], is_wedge, n_m, centre[main], n_c, centre[comp])
-
-    # both polygons in the main face's (t1, t2) frame; the complementary face turns the
-    # other way round there (its normal is -n), so it is reversed
-    frame = np.stack([t1[main], t2[main]], axis=2)  # (S, 3, 2)
-    comp_xy = _planar(xyz[:, ::-1], centre[main], frame)
-    xy = _clip_convex(comp_xy, _planar(faces.xyz[main], centre[main], frame), tol.length)
-    keep = _area_centroid(xy)[0] > tol.min_area_rel * np.minimum(area[main], area[comp])
-    main, comp = main[keep], comp[keep]
-    xy, count = _clean(xy[..., keep], tol.length)
-    keep = count >= 3  # a sliver may collapse
-    main, comp, xy, count = main[keep], comp[keep], xy[..., keep], count[keep]
+    # face pairs in classes of polygon width, so that a few faces of many vertices (a
+    # ground ring's) do not widen the padded arrays of all the others
+    count = blocks.face_polygon_count
+    parts = [_overlaps(blocks, main[group], comp[group], faces, tol)
+             for group in _width_classes(np.maximum(count[main], count[comp]))]
+    main, comp = (np.concatenate([part[i] for part in parts]) for i in (0, 1))
+    count = np.concatenate([part[3] for part in parts])
+    width = max(part[2].shape[1] for part in parts)
+    xy = np.concatenate([_take(part[2], np.minimum(np.arange(width)[:, None],
+                                                   part[2].shape[1] - 1))
+                         for part in parts], axis=2)
     order = np.lexsort((comp, main, blocks.face_block[comp], blocks.face_block[main]))
     main, comp, xy, count = main[order], comp[order], xy[..., order], count[order]
     if len(main) == 0:
@@ -418,6 +422,40 @@ def _intersect(blocks, main, comp, faces, tol, up):
         t1=t1_k,
         t2=t2_k,
     )
+
+
+def _overlaps(blocks, main, comp, faces, tol):
+    """The overlaps of face pairs ``main``, ``comp`` ((S,) int) in the main faces'
+    ``(t1, t2)`` frames: the pairs kept, their polygons (2, W, S') and vertex counts."""
+    normal, centre, area = blocks.face_normal, blocks.face_centre, blocks.face_area
+    t1, t2 = blocks.face_basis
+    n_m, n_c = normal[main], normal[comp]
+    width = int(max(blocks.face_polygon_count[main].max(initial=1),
+                    blocks.face_polygon_count[comp].max(initial=1)))
+    xyz_m, xyz_c = faces.xyz[main, :width], faces.xyz[comp, :width]
+
+    # gap closing (docs/model.md 5.3); faces whose wedge rotation would move no vertex farther
+    # than tol.length count as parallel and are only projected (below)
+    sin = np.linalg.norm(np.cross(n_m, n_c), axis=1)
+    is_wedge = sin * faces.radius[comp] > tol.length
+    xyz = _close_wedge(xyz_c, is_wedge, n_m, centre[main], n_c, centre[comp])
+
+    # both polygons in the main face's (t1, t2) frame; the complementary face turns the
+    # other way round there (its normal is -n), so it is reversed
+    frame = np.stack([t1[main], t2[main]], axis=2)  # (S, 3, 2)
+    comp_xy = _planar(xyz[:, ::-1], centre[main], frame)
+    xy = _clip_convex(comp_xy, _planar(xyz_m, centre[main], frame), tol.length)
+    keep = _area_centroid(xy)[0] > tol.min_area_rel * np.minimum(area[main], area[comp])
+    main, comp = main[keep], comp[keep]
+    xy, count = _clean(xy[..., keep], tol.length)
+    keep = count >= 3  # a sliver may collapse
+    return main[keep], comp[keep], xy[..., keep], count[keep]
+
+
+def _width_classes(width):
+    """Index arrays of the entries of ``width`` ((n,) int) in classes 1-4, 5-8, 9-16, ..."""
+    level = np.ceil(np.log2(np.maximum(width, 4))).astype(int)
+    return [np.flatnonzero(level == k) for k in np.unique(level)]
 
 
 def _close_wedge(xyz, is_wedge, n_m, point_m, n_c, point_c):
