@@ -342,8 +342,8 @@ def params_from_args(args) -> Params:
         _refuse_inapplicable(given, params.kind)
     elif args.preset:
         params = from_preset(args.preset, **given)
-    elif scene == "wall":
-        params = from_preset("wall", **given)
+    elif scene in PRESETS:  # a scene whose inputs default to a preset of its name
+        params = from_preset(scene, **given)
     else:
         params = validate(Params.of(**given))
     check_print_size(args, params)

@@ -37,20 +37,31 @@ from masonry.rbe.solve import ACCURACY, RBEProblem
 
 log = logging.getLogger(__name__)
 
+
+def revolution_inputs(preset) -> dict:
+    """The dome of revolution of a preset's profile: its circumradius as the radius (in
+    units), its stretch, cut, pattern spacing p and unit."""
+    polygonal = from_preset(preset).geometry
+    dims = Dimensions.of(polygonal)
+    return dict(radius=round(float(dims.radius / polygonal.unit), 6), stretch=polygonal.stretch,
+                cut=polygonal.cut, p=polygonal.p, unit=polygonal.unit)
+
+
 SCENES = {
     "section": dict(scene="section", boundary="free"),
     "cyclic": dict(scene="section", boundary="cyclic"),
     "dome": dict(scene="dome"),
     "dome-mu0.05": dict(scene="dome", mu=0.05),
-    "revolution": dict(scene="revolution"),
-    "sector": dict(scene="sector", boundary="cyclic"),
+    "revolution": dict(scene="revolution", of_preset=revolution_inputs),
+    "sector": dict(scene="sector", boundary="cyclic", of_preset=revolution_inputs),
 }
 """Bench scene name -> :class:`~masonry.params.Params` fields (over the bench's ``mu``
 and ``density``). ``section`` (free-standing, the thesis's x.1) and ``dome-mu0.05`` are
 infeasible; ``cyclic`` and ``dome`` are their feasible counterparts of the same size.
 ``revolution`` and ``sector`` are the dome of revolution of the preset's profile (its
 circumradius, stretch, cut, p and unit: :func:`revolution_inputs`) and its cyclic
-sector."""
+sector. ``of_preset``: the scene's inputs from a preset's, where its geometry is not a
+preset's."""
 
 PAIRS = (("section", "cyclic"), ("dome-mu0.05", "dome"))
 """(infeasible, feasible) scenes of the same size, compared by :func:`ratios`."""
@@ -130,20 +141,12 @@ def bench(presets=("1", "2", "3"), scenes=tuple(SCENES), accuracies=tuple(ACCURA
     return rows
 
 
-def revolution_inputs(preset) -> dict:
-    """The dome of revolution of a preset's profile: its circumradius as the radius (in
-    units), its stretch, cut, pattern spacing p and unit."""
-    polygonal = from_preset(preset).geometry
-    dims = Dimensions.of(polygonal)
-    return dict(radius=round(float(dims.radius / polygonal.unit), 6), stretch=polygonal.stretch,
-                cut=polygonal.cut, p=polygonal.p, unit=polygonal.unit)
-
-
 def preset_params(preset, scene_name, **inputs):
     """The inputs of a bench structure: a preset in one of the :data:`SCENES`."""
-    scene = SCENES[scene_name]
-    if scene["scene"] in ("revolution", "sector"):
-        return validate(Params.of(**{**revolution_inputs(preset), **scene, **inputs}))
+    scene = dict(SCENES[scene_name])
+    of_preset = scene.pop("of_preset", None)
+    if of_preset is not None:
+        return validate(Params.of(**{**of_preset(preset), **scene, **inputs}))
     return from_preset(preset, **{**scene, **inputs})
 
 
