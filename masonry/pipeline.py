@@ -21,7 +21,7 @@ from pathlib import Path
 import masonry
 from masonry import __version__, forking
 from masonry.blocks import BLOCK_CLASSES
-from masonry.export import EXPORTERS, RunOutputs
+from masonry.export import EXPORTERS, RunOutputs, rhino
 from masonry.params import (FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, geometry_key, structure_id,
                             validate)
 from masonry.rbe.boundary import Model, analysis_model
@@ -356,7 +356,9 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     if scene is None:
         check_size(params, max_bricks)
     out = params.outputs
-    wanted = {"analyse": analyse, "centering": analyse,
+    # bricks.3dm whenever rhino3dm is there: a folder written without it is not up to
+    # date once it is
+    wanted = {"analyse": analyse, "centering": analyse, "3dm": rhino.available(),
               **{name: getattr(out, name) for name in FILE_OUTPUTS}}
     job = Publication(out_root, structure_id(params), {"params": identity(params)}, wanted,
                       force=force, identify=_identify)
@@ -402,6 +404,7 @@ def results_record(result: RBEResult | None, collapse: CollapseResult | None,
 def write_run(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer):
     """Every file of a run and, last, its ``run.json`` (``record``, completed)."""
     write_exports(folder, made, record, timer)
+    record["outputs"]["3dm"] = (folder.tmp / "bricks.3dm").exists()
     record["coordinates"] = _held(record["coordinates"], folder)
     record["timings_s"] = timer.seconds
     record["versions"] = versions()

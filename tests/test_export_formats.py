@@ -177,7 +177,8 @@ def test_3dm_user_text_carries_each_bricks_largest_forces():
         SUPPORT_LAYER, "block", "block"]
 
 
-def test_3dm_without_rhino3dm_names_the_extra(monkeypatch):
+def test_3dm_without_rhino3dm_says_why(monkeypatch):
     monkeypatch.setitem(sys.modules, "rhino3dm", None)  # import now raises ImportError
-    with pytest.raises(ImportError, match=r"masonry\[rhino\]"):
+    with pytest.raises(ImportError, match=r"rhino3dm, a dependency of masonry, is not "
+                                          r"installed \(pip install rhino3dm"):
         blocks_3dm(scene_of("wall").blocks)

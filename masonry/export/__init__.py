@@ -129,13 +129,19 @@ def _model_files(made: RunOutputs) -> Export:
 @cache
 def _say_rhino_missing():
     """Once per process (a sweep runs many variants in one)."""
-    log.info("bricks.3dm skipped: pip install 'masonry[rhino]' to write it")
+    log.warning(rhino.MISSING)
+
+
+def _rhino_wanted(made: RunOutputs) -> bool:
+    """Whether the run can write ``bricks.3dm`` (asked in the run's process, before the
+    exporters made aside fork); says once why not."""
+    if rhino.available():
+        return True
+    _say_rhino_missing()
+    return False
 
 
 def _rhino_files(made: RunOutputs) -> Export:
-    if not rhino.available():
-        _say_rhino_missing()
-        return Export({})
     blocks = made.scene.blocks
     text = rhino.block_user_text(blocks, made.model, made.forces)
     return Export({"bricks.3dm": rhino.blocks_3dm(blocks, user_text=text)})
@@ -292,7 +298,7 @@ EXPORTERS = (
     # user waits for results (the model's files do not need them)
     Exporter("rbe", "forces", _rbe_files, wanted=lambda made: made.result is not None),
     Exporter("model", "exports", _model_files),
-    Exporter("rhino", "exports", _rhino_files, aside=True),
+    Exporter("rhino", "exports", _rhino_files, wanted=_rhino_wanted, aside=True),
     Exporter("collapse", "exports", _collapse_files,
              wanted=lambda made: made.collapse is not None),
     Exporter("printable", "printable", _printable_files,

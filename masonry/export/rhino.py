@@ -1,5 +1,5 @@
 """Rhino 3DM of blocks: one named, closed, unwelded mesh per block, on a layer per block
-class and a ``supports`` layer, with user text (optional extra ``rhino``: rhino3dm).
+class and a ``supports`` layer, with user text (rhino3dm, a dependency).
 
 Names are the OBJ object names (``blocks.block_name``); layers are the
 :data:`~masonry.blocks.BLOCK_CLASSES` of the free blocks and :data:`SUPPORT_LAYER` for the
@@ -25,8 +25,14 @@ SUPPORT_LAYER = "supports"
 _SUPPORT_COLOUR = (60, 60, 60, 255)
 
 
+MISSING = ("bricks.3dm not written: rhino3dm, a dependency of masonry, is not installed "
+           "(pip install rhino3dm; it has wheels for Linux, macOS 12+ and Windows)")
+"""The line a run logs when it cannot write the 3DM file."""
+
+
 def available() -> bool:
-    """Whether the optional rhino3dm package is installed."""
+    """Whether rhino3dm can be imported (an install without its dependencies, or a
+    platform without its wheels, has none)."""
     try:
         import rhino3dm  # noqa: F401
     except ImportError:
@@ -83,13 +89,12 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None) -> bytes:
     Raises
     ------
     ImportError
-        When rhino3dm is not installed (the optional extra ``masonry[rhino]``).
+        When rhino3dm is not installed (:data:`MISSING`).
     """
     try:
         import rhino3dm
     except ImportError as error:
-        raise ImportError("blocks_3dm needs rhino3dm: pip install 'masonry[rhino]' "
-                          "(or pip install rhino3dm)") from error
+        raise ImportError(MISSING) from error
 
     vertices = blocks.vertices if vertices is None else np.asarray(vertices, dtype=float)
     user_text = {} if user_text is None else user_text
