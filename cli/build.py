@@ -2,7 +2,8 @@
 
 from masonry.pipeline import run
 
-from .options import add_model_options, add_output_options, params_from_args, summary
+from .options import (add_boundary_options, add_model_options, add_output_options,
+                      params_from_args, summary)
 
 
 def register(subparsers):
@@ -10,6 +11,7 @@ def register(subparsers):
         "build", help="build the model and its interfaces; write bricks, locations, "
                       "the printable body and plots")
     add_model_options(parser)
+    add_boundary_options(parser.add_argument_group("boundary (its interfaces)"))
     add_output_options(parser)
     parser.set_defaults(handler=handle)
 

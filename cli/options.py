@@ -6,7 +6,7 @@ import shlex
 
 from masonry.errors import ParameterError
 from masonry.outputs import Outputs
-from masonry.parameters import declarations, defaults
+from masonry.parameters import declarations, defaults, read_toml
 from masonry.params import PRESETS, Params, applies, from_preset, load, names, validate
 from masonry.rbe.settings import BOUNDARIES, FRICTION_LAWS, FRICTIONS, Analysis
 from masonry.rbe.accuracy import ACCURACY
@@ -207,14 +207,18 @@ def add_analysis_options(parser, boundary=True):
                         "friction-net), interior (own primal-dual interior point, "
                         "friction+), clarabel (interior point), osqp (ADMM), or "
                         "clarabel-cvxpy / osqp-cvxpy (through cvxpy, the reference)")
-    if not boundary:
-        return
+    if boundary:
+        add_boundary_options(g)
+
+
+def add_boundary_options(g):
+    """``--boundary`` and ``--dome``: what a section's end bricks bear on."""
     g.add_argument("--boundary", choices=BOUNDARIES,
-                   help="boundary of a section: free (free-standing, default), rigid "
-                        "(immovable neighbouring webs) or cyclic (exact rotational symmetry)")
+                   help="what a section's end bricks bear on: cyclic (its neighbours by "
+                        "exact rotational symmetry: the whole dome; the default), free "
+                        "(nothing: the web alone) or rigid (immovable neighbouring webs)")
     g.add_argument("--dome", action="store_true",
-                   help="dome mode: the section with its neighbours, cyclic unless "
-                        "--boundary says otherwise")
+                   help="dome mode, the default of a section: --boundary cyclic")
 
 
 def add_live_load_options(parser):
@@ -320,7 +324,9 @@ def given_inputs(args) -> dict:
 
 def params_from_args(args) -> Params:
     """Preset or file first, then every option the user gave; validated. Options that do
-    not apply to the resulting scene are refused (:func:`masonry.params.applies`)."""
+    not apply to the resulting scene are refused (:func:`masonry.params.applies`). A
+    section whose boundary neither an option nor the file gives is cyclic: it stands for
+    the whole dome, the question a run answers first."""
     given = given_inputs(args)
     scene = given.get("scene")
     if args.params is None and args.preset:
@@ -346,8 +352,20 @@ def params_from_args(args) -> Params:
         params = from_preset(scene, **given)
     else:
         params = validate(Params.of(**given))
+    if ("boundary" not in given and "cyclic" in params.kind.boundaries
+            and not _file_names(args, "boundary")):
+        # a section stands for the whole dome unless asked otherwise (docs/cli.md)
+        params = validate(params.replace(boundary="cyclic"))
     check_print_size(args, params)
     return params
+
+
+def _file_names(args, name) -> bool:
+    """Whether the ``--params`` file (if any) gives the input ``name``."""
+    if args.params is None:
+        return False
+    data = read_toml(args.params, "params")
+    return name in data.get("params", data)
 
 
 def _refuse_inapplicable(given, kind):
@@ -426,6 +444,21 @@ def centering_line(total_N, fraction, held, count, where) -> str:
             f"largest {largest} ({where})")
 
 
+def verdict_meaning(record, verdict) -> str:
+    """The line saying what an RBE verdict means for the scene and boundary that ran."""
+    rbe = record["rbe"]
+    subject = kind_of(record["scene"]).verdict_subject(record["params"].get("boundary"))
+    if verdict == "feasible":
+        return (f"meaning: {subject} stands under its own weight: compression, and friction "
+                f"within mu {rbe['mu']:g}, at its joints balance every block without tension")
+    line = (f"meaning: {subject} cannot stand under its own weight: it would need tension "
+            f"at its joints, which masonry does not carry")
+    if _missing(rbe["moi"]):
+        return line
+    return line + ("; the MoI sums that tension over every joint's vertices (N), the MoI "
+                   "factor divides it by the weight")
+
+
 def rbe_summary(record, report) -> int:
     """The lines about the rigid block equilibrium of a run record; returns the exit code:
     3 when the equilibrium was not solved (no verdict), else 0."""
@@ -443,10 +476,12 @@ def rbe_summary(record, report) -> int:
                f"on friction-{rbe['friction']}, residual {_number(rbe['residual_eq'])}")
         return 3
     model = rbe.get("friction_model", "square")  # records written before the models
+    moi = ("no MoI (friction-net has none)" if _missing(rbe["moi"]) else
+           f"MoI {rbe['moi']:.4g} N, MoI factor {rbe['moi_factor']:.4g}")
     report(f"RBE: {verdict} (friction-{rbe['friction']}, mu {rbe['mu']:g}, friction model "
-           f"{model}), MoI {rbe['moi']:.4g} N, MoI factor "
-           f"{rbe['moi_factor']:.4g}, residual {rbe['residual_eq']:.2g}, {rbe['solver']} "
+           f"{model}), {moi}, residual {_number(rbe['residual_eq'])}, {rbe['solver']} "
            f"{rbe['time_s']:.3g} s")
+    report(verdict_meaning(record, verdict))
     if model == "square":
         report("note: the square friction model is the thesis's pyramid: up to 41 % more "
                "friction than Coulomb's cone where joints slide diagonally to their axes, "

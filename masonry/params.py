@@ -176,8 +176,9 @@ def _check_across(kind, analysis, load):
         # one web with the load repeated in every web is not the asked load case
         option, value = next(iter(load.options().items()))
         raise ParameterError(option, value[0] if option == "point_loads" else value,
-                             "a symmetric load on a cyclic section: this load breaks the "
-                             "dome's rotational symmetry; use --scene dome")
+                             "a symmetric load on a cyclic section (a section's default "
+                             "boundary): this load breaks the dome's rotational symmetry; "
+                             "use --scene dome (or --boundary free: the web alone)")
 
 
 def from_preset(name, **overrides) -> Params:

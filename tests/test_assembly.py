@@ -17,7 +17,7 @@ from masonry_cli.main import main
 # a small free-standing dome section (108 blocks, 273 interfaces, feasible) whose courses
 # lean less than 45 degrees, so that bed joints named from z (an import knows no course
 # directions) are the bed joints the section's own course directions name
-SMALL_SECTION = ["--preset", "1", "--p", "4", "--cut", "0.5"]
+SMALL_SECTION = ["--preset", "1", "--p", "4", "--cut", "0.5", "--boundary", "free"]
 
 
 def run_folder(root, prefix):

@@ -17,7 +17,7 @@ def run_folders(root):
 def test_build_writes_the_run_folder(tmp_path, capsys):
     assert main(["build", "--preset", "1", "--fast", "--out", str(tmp_path), "-q"]) == 0
     (folder,) = run_folders(tmp_path)
-    assert folder.name == "dome0_fast1_fricauto_s1_n8_r1_p10_c0.1_u0.1"
+    assert folder.name == "dome1_fast1_fricauto_s1_n8_r1_p10_c0.1_u0.1"  # cyclic
     for name in ("00_parameters.txt", "run.json", "locations.csv", "bricks.obj",
                  "00_pattern.png", "01_angle/3_structure.png"):
         assert (folder / name).is_file(), name
@@ -72,7 +72,7 @@ def test_params_file(tmp_path, fixtures_dir):
     assert main(["build", "--params", str(fixtures_dir / "presets" / "preset3.toml"),
                  "--no-plots", "--out", str(tmp_path), "-q"]) == 0
     (folder,) = run_folders(tmp_path)
-    assert folder.name.startswith("dome0_fast0_fricauto_s0.8_n4_r1_p13_c0.01")
+    assert folder.name.startswith("dome1_fast0_fricauto_s0.8_n4_r1_p13_c0.01")
 
 
 def test_failed_run_leaves_previous_output(tmp_path, monkeypatch):

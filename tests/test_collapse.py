@@ -567,8 +567,8 @@ def test_run_json_is_strict_json_with_null_where_a_value_is_missing(tmp_path):
     common = ["run", "--scene", "dome", "--stretch", "1", "--n", "6", "--r", "0", "--p",
               "3", "--cut", "0.5", "--no-plots", "--no-printable", "-q"]
     assert main(common + ["--crown-load", "2000", "--out", str(tmp_path / "a")]) == 0
-    assert main(["run", "--preset", "1", "--friction", "net", "--no-plots",
-                 "--no-printable", "-q", "--out", str(tmp_path / "b")]) == 0
+    assert main(["run", "--preset", "1", "--boundary", "free", "--friction", "net",
+                 "--no-plots", "--no-printable", "-q", "--out", str(tmp_path / "b")]) == 0
     for path in tmp_path.glob("*/*/run.json"):
         record = json.loads(path.read_text(), parse_constant=_no_constants)
         if "collapse" in record:

@@ -39,3 +39,41 @@ def test_a_run_writes_the_3dm_and_a_folder_without_it_is_not_up_to_date(
     assert record["outputs"]["3dm"] is True and "bricks.3dm" in record["coordinates"]["model"]
     assert main(["run", *WALL, "--out", str(tmp_path)]) == 0  # and now it is
     assert "up to date, reused" in capsys.readouterr().out
+
+
+SMALL = ["--p", "5", "--no-plots", "--no-printable"]  # 220 bricks
+
+
+def test_the_default_run_is_the_cyclic_section_and_says_what_its_verdict_means(
+        tmp_path, capsys):
+    assert main(["run", *SMALL, "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    (folder,) = [p for p in tmp_path.iterdir() if not p.name.startswith(".")]
+    assert folder.name.startswith("dome1_")  # the section with cyclic neighbours
+    assert json.loads((folder / "run.json").read_text())["params"]["boundary"] == "cyclic"
+    assert "RBE: feasible" in out
+    assert ("meaning: the whole dome (this web with its neighbours by rotational symmetry) "
+            "stands under its own weight") in out
+    # the web alone is one option away, and says what its verdict means
+    assert main(["run", *SMALL, "--boundary", "free", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "RBE: infeasible" in out
+    assert ("meaning: this web alone, without its neighbours, cannot stand under its own "
+            "weight") in out
+
+
+def test_the_readme_says_what_the_default_run_does(fixtures_dir):
+    readme = (fixtures_dir.parent / "README.md").read_text()
+    assert "come next" not in readme
+    assert "exports/dome1_fast0_fricauto_s1_n8_r1_p10_c0.1_u0.1/" in readme
+
+
+def test_a_lateral_load_on_the_default_section_names_the_scene_that_takes_it(
+        tmp_path, capsys):
+    assert main(["run", *SMALL, "--lateral", "0", "--out", str(tmp_path / "o")]) == 2
+    line = one_error_line(capsys)
+    assert line.startswith("masonry: error: --lateral 0: expected a symmetric load on a "
+                           "cyclic section (a section's default boundary)")
+    assert "--scene dome" in line and "--boundary free" in line
+    assert not (tmp_path / "o").exists()
+

@@ -234,8 +234,8 @@ def test_not_solved_has_its_own_exit_code(tmp_path, monkeypatch, capsys):
 
 def test_friction_net_on_an_infeasible_structure_suggests_auto(tmp_path, capsys):
     # a free-standing web is infeasible without tension
-    assert main(["run", "--p", "5", "--friction", "net", "--no-plots", "--no-printable",
-                 "--out", str(tmp_path), "-q"]) == 0
+    assert main(["run", "--p", "5", "--boundary", "free", "--friction", "net",
+                 "--no-plots", "--no-printable", "--out", str(tmp_path), "-q"]) == 0
     out = capsys.readouterr().out
     assert "RBE: infeasible (friction-net" in out and "--friction auto" in out
 

@@ -239,7 +239,7 @@ def test_build_writes_a_plain_dome(tmp_path, capsys):
     assert main(["build", "--preset", "1", "--pattern", "none", "--fast", "--no-printable",
                  "--out", str(tmp_path), "-q"]) == 0
     (folder,) = [p for p in tmp_path.iterdir() if not p.name.startswith(".")]
-    assert folder.name == "dome0_fast1_fricauto_s1_n8_r1_p10_c0.1_u0.1_patnone"
+    assert folder.name == "dome1_fast1_fricauto_s1_n8_r1_p10_c0.1_u0.1_patnone"
     assert (folder / "00_pattern.png").stat().st_size > 10_000
     text = (folder / "00_parameters.txt").read_text()
     assert "pattern = none" in text

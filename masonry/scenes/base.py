@@ -139,6 +139,21 @@ class SceneKind:
         """The scene named in a figure's title."""
         return cls.name
 
+    unit_word = ""
+    """What one unit of a symmetric scene is called (``web``, ``sector``), for kinds with
+    boundaries besides ``free``."""
+
+    @classmethod
+    def verdict_subject(cls, boundary: str) -> str:
+        """What a verdict on the scene with ``boundary`` is about, for the line that
+        says what it means (docs/model.md 6.4)."""
+        if len(cls.boundaries) == 1:
+            return f"this structure (the {cls.name} scene)"
+        return {"cyclic": f"the whole dome (this {cls.unit_word} with its neighbours by "
+                          f"rotational symmetry)",
+                "rigid": f"this {cls.unit_word} between immovable neighbours",
+                }.get(boundary, f"this {cls.unit_word} alone, without its neighbours,")
+
     @classmethod
     def edge_blocks(cls, scene) -> tuple:
         """``(left, right)`` (B,) bool: the blocks of a unit of a symmetric scene (a

@@ -142,6 +142,7 @@ class Section(SceneKind):
     summary = "one web of the polygonal dome (default; see --boundary)"
     geometry = PolygonalDome
     boundaries = ("free", "rigid", "cyclic")
+    unit_word = "web"
     crown = True
 
     @classmethod

@@ -567,6 +567,7 @@ class Sector(SceneKind):
     name = "sector"
     geometry = RevolutionDome
     boundaries = ("free", "rigid", "cyclic")
+    unit_word = "sector"
     crown = True
     moved_for_cad = False  # the bricks share their beds: the printed body needs no offset
     pattern_axis = ("arc length s along the ring (its top inner edge) from the sector's "
