@@ -56,8 +56,9 @@ def describe_error(error, args) -> str:
     name, value, expected = error.name, error.value, " ".join(str(error.expected).split())
     options = getattr(args, "option_names", {})
     option = options.get(name, f"--{name.replace('_', '-')}")
-    if error.where:
-        return f"{error.where}: {name} = {value!r}: expected {expected}"
+    if error.where:  # a file's key, its value as the file writes it
+        text = str(value).lower() if isinstance(value, bool) else repr(value)
+        return f"{error.where}: {name} = {text}: expected {expected}"
     if not option.startswith("--"):  # a positional argument: its value says it
         return f"{_typed(value)}: expected {expected}"
     typed = getattr(args, "typed", {})

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from masonry.errors import ParameterError
 from masonry.parameters import read_toml
-from masonry.params import PRESETS, Params, validate
+from masonry.params import PRESETS, Params, names, validate
 from masonry.runfolder import check_output_root
 from masonry.studies.stages import (BLOCK_ORDERS, BRICK_ORDERS, check_live_load,
                                     stage_params)
@@ -39,17 +39,34 @@ def register(subparsers):
 
 
 def run_option_names() -> dict:
-    """``masonry run``'s long option names (dashes or underscores) -> Params fields."""
+    """``masonry run``'s long option names (dashes or underscores) -> ``(destination,
+    input)``: the Params field it sets, and whether it is a run's input (``--dome`` is:
+    the boundary; ``--out``, ``--force``, and ``--no-plots``, whose value would read
+    backwards, are not)."""
     parser = Parser(prog="masonry")
     run_command.register(parser.add_subparsers())
     run_parser = parser._subparsers._group_actions[0].choices["run"]
-    names = {}
+    inputs = {"scene", "fast", "dome", *names()}
+    found = {}
     for action in run_parser._actions:
+        is_input = action.dest in inputs and action.const is not False
         for option in action.option_strings:
             if option.startswith("--"):
                 long = option[2:]
-                names[long] = names[long.replace("-", "_")] = action.dest
-    return names
+                found[long] = found[long.replace("-", "_")] = (action.dest, is_input)
+    return found
+
+
+NOT_AN_INPUT = {
+    "plots": "an input of each variant: the figures are chosen in the [outputs] table "
+             "(plots = false)",
+    "printable": "an input of each variant: the printable body is chosen in the [outputs] "
+                 "table (printable = false)",
+    "out": "an input of each variant: the study's output root is masonry sweep's --out",
+    "preset": "an input of [base] (preset = 3), not of another table",
+    "params": "an input of each variant: a study names the inputs themselves",
+}
+"""Why a study table refuses a run option that is not an input, by its destination."""
 
 
 TABLES = ("base", "grid", "sample", "outputs")
@@ -188,7 +205,11 @@ def _fields(table, name, names, where, lists=False) -> dict:
         if key not in names:
             raise ParameterError(f"{name}.{key}", value, "a 'masonry run' option (without "
                                  "its dashes)", where=where)
-        dest = names[key]
+        dest, is_input = names[key]
+        if not is_input:
+            raise ParameterError(f"{name}.{key}", value, NOT_AN_INPUT.get(
+                dest, "an input of each variant, not an option of the command"),
+                where=where)
         if dest == "dome":
             def boundary(flag):
                 if not isinstance(flag, bool):

@@ -77,3 +77,30 @@ def test_a_lateral_load_on_the_default_section_names_the_scene_that_takes_it(
     assert "--scene dome" in line and "--boundary free" in line
     assert not (tmp_path / "o").exists()
 
+
+@pytest.mark.parametrize("table, key, value, expected", [
+    ("base", "no-plots", "true", "the figures are chosen in the [outputs] table "
+                                 "(plots = false)"),
+    ("base", "no-printable", "true", "the printable body is chosen in the [outputs] table "
+                                     "(printable = false)"),
+    ("base", "out", '"x"', "the study's output root is masonry sweep's --out"),
+    ("grid", "force", "[true]", "not an option of the command"),
+])
+def test_a_study_table_refuses_a_run_option_that_is_no_input(tmp_path, capsys, table, key,
+                                                             value, expected):
+    study = tmp_path / "study.toml"
+    grid = "" if table == "grid" else "[grid]\nmu = [0.5, 0.7]\n"
+    study.write_text(f"[base]\npreset = 3\n{grid}[{table}]\n{key} = {value}\n"
+                     if table == "grid" else f"[base]\npreset = 3\n{key} = {value}\n{grid}")
+    assert main(["sweep", str(study), "--workers", "1", "--out", str(tmp_path / "o")]) == 2
+    line = one_error_line(capsys)
+    assert line.startswith(f"masonry: error: {study}: {table}.{key} = ")
+    assert line.endswith(expected) and "expected an input of each variant" in line
+    assert not (tmp_path / "o").exists()
+
+
+def test_the_example_study_shows_its_outputs_table(fixtures_dir):
+    import tomllib
+
+    study = tomllib.loads((fixtures_dir / "studies" / "stretch_mu.toml").read_text())
+    assert study["outputs"] == {"plots": False, "printable": False}
