@@ -21,8 +21,9 @@ ANISOTROPIC_NOTE = (
 
 UNBOUNDED_NOTE = (
     "the live load stands at any factor: rigid blocks pass it to the supports in "
-    "compression without a joint reaching its limit (a downward load on a dome's top "
-    "ring; a lateral load on a section whose rigid boundary holds it)")
+    "compression without a joint reaching its limit (a downward load on the nearly flat "
+    "top ring of a dome cut low; a lateral load on a section whose rigid boundary holds "
+    "it)")
 
 RESULT_KEYS = ("load_factor", "dead_load_feasible", "status", "solver", "iterations",
                "time_s", "residual", "work_balance", "mu", "friction_model",
