@@ -247,6 +247,8 @@ def add_live_load_options(parser):
 
 def collapse_summary(record, report):
     """The line about the collapse load factor of a run record."""
+    from masonry.export.summaries import mechanism_words  # the exporters: when reporting
+
     c = record["collapse"]
     live = c["live_load"]
     what = (f"lateral at {c['azimuth_deg']:g} deg" if live["kind"] == "lateral"
@@ -262,9 +264,7 @@ def collapse_summary(record, report):
             report(f"note: {c['note']}")
         return
     report(f"collapse: lambda = {c['load_factor']:.4g} for the {what}; mechanism: "
-           f"{c['main_hinges']} hinges, {c['main_sliding']} sliding joints (of "
-           f"{c['hinges']} and {c['sliding']} that move at all); "
-           f"{c['solver']} {c['time_s']:.3g} s")
+           f"{mechanism_words(c)}; {c['solver']} {c['time_s']:.3g} s (collapse/00_collapse.txt)")
     if c["note"]:
         report(f"note: {c['note']}")
 

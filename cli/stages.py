@@ -51,6 +51,18 @@ def register(subparsers):
     parser.set_defaults(handler=handle)
 
 
+def _timing(stages) -> str:
+    """How long the stages took: wall time, and the stages' own solves when they ran side
+    by side (their sum is then more than the wall time)."""
+    wall, solves = stages.get("wall_s"), stages["solve_s"]
+    if wall is None:  # a record written before the wall time was
+        return f"the stages' solves add up to {solves:.3g} s"
+    text = f"{stages['count']} stages solved in {wall:.3g} s"
+    if solves > wall:
+        text += f" (two at once: their solves add up to {solves:.3g} s)"
+    return text
+
+
 def handle(args, report):
     if args.files:
         given = given_inputs(args)
@@ -74,8 +86,8 @@ def handle(args, report):
     report(f"{record['structure_id']}: {record['plan']['described']}")
     pattern_note(record, report)
     report(f"{stages['standing']} of {stages['count']} stages stand without support "
-           f"(mu {params.analysis.mu:g}, friction {params.analysis.friction}); stage solves "
-           f"{stages['solve_s']:.3g} s")
+           f"(mu {params.analysis.mu:g}, friction {params.analysis.friction}); "
+           f"{_timing(stages)}")
     factors = [(r["load_factor"], r["stage"]) for r in record["rows"]
                if r.get("load_factor") is not None] if "rows" in record else []
     if factors:

@@ -104,3 +104,13 @@ def test_the_example_study_shows_its_outputs_table(fixtures_dir):
 
     study = tomllib.loads((fixtures_dir / "studies" / "stretch_mu.toml").read_text())
     assert study["outputs"] == {"plots": False, "printable": False}
+
+
+def test_the_collapse_line_says_the_mechanism_as_its_file_does(tmp_path, capsys):
+    assert main(["run", *WALL, "--lateral", "0", "--out", str(tmp_path)]) == 0
+    line = next(ln for ln in capsys.readouterr().out.splitlines()
+                if ln.startswith("collapse:"))
+    text = next((tmp_path).glob("wall_*_lat0")).joinpath("collapse", "00_collapse.txt")
+    (mechanism,) = [ln for ln in text.read_text().splitlines() if ln.startswith("mechanism:")]
+    words = mechanism.split(":", 1)[1].strip()
+    assert f"mechanism: {words}; " in line and "collapse/00_collapse.txt" in line

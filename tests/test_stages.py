@@ -386,6 +386,10 @@ def test_imported_stack_laid_by_names_or_height(tmp_path, capsys, order):
     printed = capsys.readouterr().out
     assert "first stage that needs support: 4" in printed
     assert "centering force: supports must give" in printed
+    # the wall time, not the stages' solves summed
+    wall = record["stages"]["wall_s"]
+    assert f"{len(rows)} stages solved in {wall:.3g} s" in printed
+    assert wall == record["timings_s"]["stages"]
 
 
 def test_first_unsupported_stage_is_drawn_with_its_new_block_outlined(tmp_path):

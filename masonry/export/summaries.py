@@ -127,8 +127,7 @@ def collapse_text(result) -> str:
         f"friction law:       {d['friction_law']}"
         + ("" if d["associated_factor"] is None
            else f" (associated factor {d['associated_factor']:.6g})"),
-        f"mechanism:          {d['main_hinges']} hinges, {d['main_sliding']} sliding joints "
-        f"(opening or slipping by {MECHANISM_MAIN:.0%} of the largest or more)",
+        f"mechanism:          {mechanism_words(d)}",
         f"joints that move:   {d['opening']} open ({d['hinges']} hinges), {d['sliding']} "
         f"slide (by {MOTION_TOL:.1%} of the largest displacement or more)",
         f"solver:             {d['solver']} ({d['iterations']} iterations)",
@@ -139,6 +138,15 @@ def collapse_text(result) -> str:
     if d["note"]:
         lines.append(f"note:               {d['note']}")
     return "\n".join(lines) + "\n"
+
+
+def mechanism_words(record: dict) -> str:
+    """The mechanism's joints in words, as ``00_collapse.txt`` and the command line say
+    them (``record``: :meth:`CollapseResult.to_dict`)."""
+    return (f"{record['main_hinges']} hinges, {record['main_sliding']} sliding joints "
+            f"(opening or slipping by {MECHANISM_MAIN:.0%} of the largest or more; "
+            f"{record['hinges']} and {record['sliding']} by {MOTION_TOL:.1%} of the largest "
+            f"displacement or more)")
 
 
 def _readable(value) -> str:
