@@ -86,6 +86,13 @@ def build_web(geometry: PolygonalDome) -> Scene:
     half_width = levels.y[1:] / geometry.unit
     pattern = (build_pattern(half_width, geometry.p, geometry.r)
                if geometry.pattern == "herringbone" else Pattern.none())
+    if geometry.pattern == "herringbone" and not np.any(pattern.course > 1):
+        raise ParameterError(
+            "cut", geometry.cut,
+            f"a dome high enough for its herringbone: its pattern lines end on the first of "
+            f"its {levels.n_courses} courses, so no pattern is laid above it; lower cut, "
+            f"raise p, or --pattern none for the courses without a pattern",
+            related=("p", "r", "stretch", "unit"))
     layout = fill_courses(half_width, pattern, geometry.min_fill, miter=True)
     tan = np.tan(np.pi / geometry.n)
     u = geometry.unit
