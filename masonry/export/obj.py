@@ -6,6 +6,12 @@ from masonry.blocks import Blocks
 from masonry.export._text import format_floats
 
 
+UP_AXIS = ("z up (Blender: import with Up Axis Z and Forward Axis Y; its default, Y up, "
+           "lays the model on its side)")
+"""The axes an OBJ file of masonry states in its first line: Rhino, trimesh, ParaView and
+slicers take z up; Blender's importer assumes Y up unless told."""
+
+
 def blocks_obj(blocks: Blocks, vertices=None) -> bytes:
     """OBJ text with ``o <block name>`` per block and its polygon faces.
 
@@ -37,5 +43,5 @@ def blocks_obj(blocks: Blocks, vertices=None) -> bytes:
         ids = blocks.face_vertices[blocks.face_offsets[faces][:, None] + np.arange(count)]
         text = ("f" + " %d" * count + "\n") * len(faces) % tuple((ids + 1).ravel().tolist())
         lines[face_row[faces]] = text.split("\n")[:-1]
-    header = "# masonry blocks: one object per block, metres, z up"
+    header = f"# masonry blocks: one object per block, metres, {UP_AXIS}"
     return "\n".join([header, *lines.tolist(), ""]).encode()

@@ -11,6 +11,7 @@ import io
 
 import numpy as np
 
+from masonry.export.obj import UP_AXIS
 from masonry.printable import PrintableError
 from masonry.tolerances import READBACK_VOLUME_RTOL
 
@@ -78,7 +79,7 @@ def obj_body_bytes(mesh, name="dome") -> bytes:
 
     text = export_obj(mesh, include_normals=False, include_color=False,
                       include_texture=False, header=None)
-    return (f"# masonry printable body, metres, z up\no {name}\n" + text).encode()
+    return (f"# masonry printable body, metres, {UP_AXIS}\no {name}\n" + text).encode()
 
 
 def readback_check(stl: bytes, volume_m3=None, rtol=READBACK_VOLUME_RTOL) -> dict:
