@@ -208,6 +208,11 @@ def load(path, **overrides) -> Params:
         if key not in known:
             raise ParameterError(key, value, f"a parameter name ({', '.join(known)})",
                                  where=str(path))
+    built = [name for name, kind in KINDS.items() if kind.from_parameters]
+    if "scene" in data and data["scene"] not in built:
+        raise ParameterError("scene", data["scene"], f"one of {', '.join(built)} (blocks read "
+                             f"from files are masonry analyze's assembly scene)",
+                             where=str(path))
     try:
         return validate(Params.of(**{**data, **overrides}))
     except ParameterError as error:

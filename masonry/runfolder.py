@@ -51,6 +51,19 @@ NAME_MAX = 200
 the run folders' temporary names add up to about 50 to a structure id."""
 
 
+RUN_FOLDER_DEPTH = NAME_MAX + 150
+"""Bytes a run folder adds to its root's path: its (temporary) name and the longest path of
+a file inside it, with room to spare."""
+
+
+def _path_max(folder) -> int:
+    """The longest path the file system of ``folder`` takes, in bytes (Windows: 260)."""
+    try:
+        return os.pathconf(folder, "PC_PATH_MAX")
+    except (AttributeError, OSError, ValueError):  # no pathconf (Windows) or no answer
+        return 260 if os.name == "nt" else 4096
+
+
 def _tag() -> str:
     """``<host>-<pid>-<random>``: who writes a temporary file, and a unique suffix."""
     return f"{_HOST}-{os.getpid()}-{uuid.uuid4().hex[:8]}"
@@ -77,7 +90,8 @@ def check_output_root(root, option="out") -> Path:
     Raises
     ------
     ParameterError
-        Named ``option``: the root is empty, is (or lies under) a file, or is not writable.
+        Named ``option``: the root is empty, has a name or a path too long for a run
+        folder inside it, is (or lies under) a file, or is not writable.
     """
     if str(root).strip() == "":
         raise ParameterError(option, str(root), "a folder path (an empty one names nothing)")
@@ -89,6 +103,13 @@ def check_output_root(root, option="out") -> Path:
     existing = path
     while not os.path.lexists(existing) and existing != existing.parent:
         existing = existing.parent
+    length, limit = len(os.fsencode(os.path.abspath(path))), _path_max(existing)
+    if length + RUN_FOLDER_DEPTH > limit:
+        raise ParameterError(option, str(root), f"a folder path at most "
+                                                f"{limit - RUN_FOLDER_DEPTH} bytes long (this "
+                                                f"one has {length}; the system takes paths "
+                                                f"of {limit} bytes, and a run folder adds up "
+                                                f"to {RUN_FOLDER_DEPTH})")
     if not existing.is_dir():
         what = "is a file" if existing == path else f"lies under the file {existing}"
         raise ParameterError(option, str(root), f"a folder, but it {what}")

@@ -282,6 +282,11 @@ mechanism: hinges that open, and joints that slip, by at least this fraction of 
 largest opening or slip (preset 3's full dome at azimuth 0: 124 of 1,811 hinges). The
 plots mark these, the summaries count both."""
 
+MAX_COORDINATE_M = 1e8
+"""Largest coordinate of a block read from a file, metres: map coordinates reach 1e7 m
+(UTM northings), and far beyond that double precision loses the blocks' geometry (at
+1e12 m a 0.4 m cube's volume is 5e-4 off); 1e300 overflows the geometry's sums."""
+
 FACTOR_TIE_REL = 1e-6
 """Load factors of two azimuths this close (relative) are the same worst case: the search
 reports the first azimuth (a symmetric structure's 0 and 180 degrees differ by the LP's

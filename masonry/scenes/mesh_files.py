@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from masonry.errors import MasonryError
+from masonry.tolerances import MAX_COORDINATE_M
 
 FORMATS = (".obj", ".stl", ".ply")
 """File suffixes :func:`read_mesh` reads (case-insensitive)."""
@@ -94,7 +95,7 @@ def read_mesh(path) -> TriangleSoup:
     AssemblyError
         Naming ``path``: an unknown suffix, not a regular file, unreadable, empty, not
         parsable (the OBJ line at fault where there is one), no faces, or a vertex that is
-        not a finite number.
+        not a finite number or lies beyond :data:`~masonry.tolerances.MAX_COORDINATE_M`.
     """
     path = Path(path)
     suffix = path.suffix.lower()
@@ -123,6 +124,12 @@ def read_mesh(path) -> TriangleSoup:
     if bad.any():
         raise AssemblyError(f"{path}: {bad.sum()} vertices are not finite numbers (nan or "
                             f"inf), the first at {soup.vertices[bad][0].tolist()}")
+    far = np.abs(soup.vertices).max(axis=1) > MAX_COORDINATE_M
+    if far.any():
+        raise AssemblyError(f"{path}: {far.sum()} vertices lie farther than "
+                            f"{MAX_COORDINATE_M:g} m from the origin, the first at "
+                            f"{soup.vertices[far][0].tolist()}; masonry reads metres: move "
+                            f"the model near the origin or scale it to metres")
     return soup
 
 
