@@ -3,6 +3,7 @@ must end in one line and exit code 2 (not an internal error) before any work."""
 
 import json
 
+import numpy as np
 import pytest
 
 from masonry_cli.main import main
@@ -114,3 +115,103 @@ def test_the_collapse_line_says_the_mechanism_as_its_file_does(tmp_path, capsys)
     (mechanism,) = [ln for ln in text.read_text().splitlines() if ln.startswith("mechanism:")]
     words = mechanism.split(":", 1)[1].strip()
     assert f"mechanism: {words}; " in line and "collapse/00_collapse.txt" in line
+
+
+def test_obj_files_state_their_axes_for_blender(tmp_path):
+    import trimesh
+
+    assert main(["build", *WALL[:-2], "--no-plots", "--out", str(tmp_path), "-q"]) == 0
+    folder = tmp_path / WALL_ID
+    for name in ("bricks.obj", "dome.obj"):
+        first = (folder / name).read_text().splitlines()[0]
+        assert "z up" in first and "Up Axis Z and Forward Axis Y" in first, name
+    # and the model does stand on z: 3 courses of 0.1 m (the unit) on a slab 0.1 m deep,
+    # 1.2 m long along y (grown by 1e-5 of the size so that touching bricks fuse)
+    body = trimesh.load(folder / "dome.obj", process=False)
+    np.testing.assert_allclose(body.bounds[:, 1:], [[-0.6, -0.1], [0.6, 0.3]], atol=1e-4)
+
+
+def test_a_herringbone_dome_whose_pattern_ends_on_the_first_course_is_refused(tmp_path,
+                                                                             capsys):
+    # two courses: the pattern lines from the corners end on the first, so the inputs
+    # would build a dome without a herringbone (p = 1 is refused by its range already)
+    out = tmp_path / "o"
+    assert main(["build", "--p", "2", "--r", "0", "--n", "3", "--cut", "0.3",
+                 "--out", str(out)]) == 2
+    line = one_error_line(capsys)
+    assert line.startswith("masonry: error: --cut 0.3: expected a dome high enough for its "
+                           "herringbone: its pattern lines end on the first of its 2 courses")
+    assert "--pattern none" in line and not out.exists()
+    assert main(["build", "--p", "2", "--r", "0", "--n", "3", "--cut", "0.3", "--pattern",
+                 "none", "--no-plots", "--no-printable", "--out", str(out), "-q"]) == 0
+
+
+def test_a_sweep_of_point_loads_writes_its_summary_and_plots(tmp_path):
+    # lists as swept values (the point loads) beside another swept input: its values
+    # name the groups of the plots
+    study = tmp_path / "loads.toml"
+    study.write_text('[base]\npreset = "wall"\nwall-courses = 3\nwall-length = 12\n'
+                     'fast = true\n[grid]\nmu = [0.5, 0.7]\n'
+                     'point-load = [["*_c3:100,0,0"], ["*_c2:100,0,0"]]\n')
+    assert main(["sweep", str(study), "--workers", "1", "--out", str(tmp_path), "-q"]) == 0
+    summary = tmp_path / "sweep_loads"
+    assert len((summary / "summary.csv").read_text().splitlines()) == 5
+    for name in ("moi_factor_mu.png", "moi_factor_point_loads.png",
+                 "load_factor_point_loads.png"):
+        assert (summary / name).stat().st_size > 10_000, name
+
+
+def test_an_out_path_too_long_for_a_run_folder_is_refused_before_any_work(tmp_path, capsys):
+    from masonry.runfolder import RUN_FOLDER_DEPTH, _path_max
+
+    limit = _path_max(tmp_path) - RUN_FOLDER_DEPTH
+    root = tmp_path / "/".join(["d" * 150] * (limit // 151 + 1))
+    assert main(["run", *WALL, "--out", str(root)]) == 2
+    line = one_error_line(capsys)
+    assert line.startswith(f"masonry: error: --out {root}: expected a folder path at most "
+                           f"{limit} bytes long (this one has {len(str(root))};")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_mesh_coordinates_beyond_any_map_are_refused_naming_the_file(tmp_path, capsys):
+    from masonry.blocks import Blocks
+    from masonry.export.obj import blocks_obj
+
+    bits = (np.arange(8)[:, None] >> np.arange(3)) & 1  # corner ix + 2 iy + 4 iz
+    corners = np.stack([bits * [2, 2, 1] - [0.5, 0.5, 1], bits * 0.5]).astype(float)
+    for scale, refused in ((1e7, False), (1e300, True)):
+        path = tmp_path / f"far{scale:g}.obj"
+        far = corners + np.array([scale, 0, 0]) if not refused else corners * scale
+        with np.errstate(all="ignore"):  # the file's own frames overflow at 1e300
+            path.write_bytes(blocks_obj(Blocks.from_hexahedra(far, ["ground", "block"])))
+        code = main(["analyze", str(path), "--support", "*ground*", "--no-plots",
+                     "--no-printable", "--out", str(tmp_path / "o"), "-q"])
+        if refused:
+            assert code == 2
+            line = one_error_line(capsys)
+            assert line.startswith(f"masonry: error: {path}: ") and "farther than 1e+08 m" in line
+        else:  # map coordinates (UTM northings reach 1e7 m) are read
+            assert code == 0
+    (folder,) = [p for p in (tmp_path / "o").iterdir() if not p.name.startswith(".")]
+    assert folder.name.startswith("assembly_far1e")
+
+
+def test_a_parameter_file_naming_the_assembly_scene_is_refused_naming_its_key(tmp_path,
+                                                                              capsys):
+    path = tmp_path / "assembly.toml"
+    path.write_text('scene = "assembly"\n')
+    assert main(["run", "--params", str(path), "--out", str(tmp_path / "o")]) == 2
+    line = one_error_line(capsys)
+    assert line.startswith(f"masonry: error: {path}: scene = 'assembly': expected one of "
+                           f"section, ")
+    assert "masonry analyze" in line and not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("command", ["run", "sweep"])
+def test_a_toml_file_nested_thousands_deep_is_one_line(tmp_path, capsys, command):
+    path = tmp_path / "deep.toml"
+    path.write_text("a = " + "[" * 5000 + "]" * 5000 + "\n")
+    args = ["--params", str(path)] if command == "run" else [str(path), "--workers", "1"]
+    assert main([command, *args, "--out", str(tmp_path / "o")]) == 2
+    assert "nested a few levels deep, not thousands" in one_error_line(capsys)
+    assert not (tmp_path / "o").exists()

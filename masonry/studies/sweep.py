@@ -460,6 +460,16 @@ def _fixed_inputs(study: Study) -> str:
     return text if len(text) <= 80 else text[:77] + "..."
 
 
+PLOTTED_LIMIT = 1e15
+"""Swept values at least this large are drawn one tick per value, not on a numeric axis
+(an axis spanning +-1e308 overflows matplotlib's limits)."""
+
+
+def _label(value) -> str:
+    """A swept value as an axis tick or legend entry (any value a study file holds)."""
+    return value if isinstance(value, str) else json.dumps(value)
+
+
 def summary_pngs(study: Study, rows, label="") -> dict:
     """MoI factor and feasibility against each swept input (one figure per input); with
     a second swept input, one colour per value of it (the first other swept input).
@@ -484,17 +494,20 @@ def summary_pngs(study: Study, rows, label="") -> dict:
         group = others[0] if others else None
         fig, (top, bottom) = plt.subplots(2, 1, figsize=(6, 6), sharex=True)
         x = [r[name] for r in done]
-        numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in x)
-        labels = sorted({str(v) for v in x}) if not numeric else None
-        xs = np.array(x if numeric else [labels.index(str(v)) for v in x], dtype=float)
-        keys = [None] if group is None else sorted({r[group] for r in done}, key=str)
+        # numbers on a numeric axis; anything else (names, lists of point loads, numbers
+        # too large to place) one tick per value
+        numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                      and abs(v) < PLOTTED_LIMIT for v in x)
+        labels = sorted({_label(v) for v in x}) if not numeric else None
+        xs = np.array(x if numeric else [labels.index(_label(v)) for v in x], dtype=float)
+        keys = [None] if group is None else sorted({_label(r[group]) for r in done})
         if len(keys) > 8:  # e.g. a sampled input: too many values to tell apart
             group, keys = None, [None]
         # feasibility points of the groups side by side, not on top of each other
         offsets = 0.06 * (np.arange(len(keys)) - (len(keys) - 1) / 2)
         for colour, key, offset in zip(plt.cm.viridis(np.linspace(0, 0.9, len(keys))), keys,
                                        offsets):
-            mine = [i for i, r in enumerate(done) if group is None or r[group] == key]
+            mine = [i for i, r in enumerate(done) if group is None or _label(r[group]) == key]
             mine.sort(key=lambda i: xs[i])
             label = None if group is None else f"{group} = {key}"
             top.plot(xs[mine], [done[i]["moi_factor"] for i in mine], "-o", color=colour,
