@@ -45,5 +45,5 @@ def handle(args, report):
     summary(record, report)
     code = rbe_summary(record, report)
     if "collapse" in record:
-        collapse_summary(record, report)
+        code = max(code, collapse_summary(record, report))
     return code

@@ -8,6 +8,7 @@ from masonry.errors import ParameterError
 from masonry.outputs import Outputs
 from masonry.parameters import declarations, defaults, read_toml
 from masonry.params import PRESETS, Params, applies, from_preset, load, names, validate
+from masonry.rbe.collapse_result import VERDICTS
 from masonry.rbe.settings import BOUNDARIES, FRICTION_LAWS, FRICTIONS, Analysis
 from masonry.rbe.accuracy import ACCURACY
 from masonry.rbe.solvers import RBE, names as solver_names
@@ -245,28 +246,33 @@ def add_live_load_options(parser):
                         "from the last collapse and solved again)")
 
 
-def collapse_summary(record, report):
-    """The line about the collapse load factor of a run record."""
+def collapse_summary(record, report) -> int:
+    """The lines about the collapse load factor of a run record; returns the exit code:
+    3 when the factor asked for has no verdict (:data:`~masonry.rbe.collapse_result.
+    VERDICTS`), else 0."""
     from masonry.export.summaries import mechanism_words  # the exporters: when reporting
 
     c = record["collapse"]
     live = c["live_load"]
     what = (f"lateral at {c['azimuth_deg']:g} deg" if live["kind"] == "lateral"
-            else f"{live['kind']} load")
+            and c["azimuth_deg"] is not None else f"{live['kind']} load")
     if c.get("azimuths"):
         what += f" (worst of {len(c['azimuths'])} azimuths)"
     if c["friction_law"] != "associated" and c["associated_factor"] is not None:
         what += (f", {c['friction_law']} friction (associated: "
                  f"{c['associated_factor']:.4g})")
     if c["load_factor"] is None:
-        report(f"collapse: no load factor ({c['status']}), {what}")
+        decided = c["status"] in VERDICTS
+        report(f"collapse: no load factor ({c['status']}), {what}"
+               + ("" if decided else f"; {c['solver']} stopped without a verdict"))
         if c["note"]:
             report(f"note: {c['note']}")
-        return
+        return 0 if decided else 3
     report(f"collapse: lambda = {c['load_factor']:.4g} for the {what}; mechanism: "
            f"{mechanism_words(c)}; {c['solver']} {c['time_s']:.3g} s (collapse/00_collapse.txt)")
     if c["note"]:
         report(f"note: {c['note']}")
+    return 0
 
 
 def add_material_options(group):

@@ -1,5 +1,6 @@
 """``masonry stages``: does the structure stand at every stage of its laying (docs/model.md 4.7)?"""
 
+from masonry.errors import ParameterError
 from masonry.params import Params, validate
 from masonry.scenes.imported import load_assembly
 from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS, run_stages, stage_params
@@ -63,7 +64,25 @@ def _timing(stages) -> str:
     return text
 
 
+def _refuse_inapplicable(args):
+    """Options that choose what FILE... would not be (the scene to build), or the
+    supports of blocks read from files when there are none."""
+    if args.files:
+        for name in ("preset", "params", "scene"):
+            if getattr(args, name) is not None:
+                raise ParameterError(name, getattr(args, name), "no FILE beside it: the "
+                                     "files are the assembly laid block by block, read, "
+                                     "not built")
+        return
+    for name in ("support", "support_below", "ground"):
+        if getattr(args, name) not in (None, False, []):
+            raise ParameterError(name, getattr(args, name),
+                                 "FILE... beside it: it chooses the supports of blocks read "
+                                 "from files; a dome or wall stands on its ground slab")
+
+
 def handle(args, report):
+    _refuse_inapplicable(args)
     if args.files:
         given = given_inputs(args)
         validate(Params.of(scene="assembly", assembly="-", **given))  # before any reading

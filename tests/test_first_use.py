@@ -215,3 +215,41 @@ def test_a_toml_file_nested_thousands_deep_is_one_line(tmp_path, capsys, command
     assert main([command, *args, "--out", str(tmp_path / "o")]) == 2
     assert "nested a few levels deep, not thousands" in one_error_line(capsys)
     assert not (tmp_path / "o").exists()
+
+
+def test_a_collapse_factor_without_a_verdict_exits_3(tmp_path, monkeypatch, capsys):
+    import dataclasses
+
+    import masonry.pipeline
+
+    solved = masonry.pipeline.collapse_load
+
+    def stopped_short(*args, **kwargs):  # as a solver that hit its time limit
+        result = solved(*args, **kwargs)
+        return dataclasses.replace(result, load_factor=None, status="time limit reached")
+
+    monkeypatch.setattr(masonry.pipeline, "collapse_load", stopped_short)
+    assert main(["run", *WALL, "--lateral", "0", "--out", str(tmp_path)]) == 3
+    out = capsys.readouterr().out
+    assert ("collapse: no load factor (time limit reached), lateral at 0 deg; interior "
+            "stopped without a verdict") in out
+    # a decided answer without a factor is a verdict: exit 0
+    monkeypatch.undo()
+    assert main(["run", "--scene", "dome", "--stretch", "1", "--n", "6", "--r", "0", "--p",
+                 "3", "--cut", "0.5", "--crown-load", "2000", "--no-plots",
+                 "--no-printable", "--out", str(tmp_path)]) == 0
+    assert "collapse: no load factor (unbounded), crown load" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("args, typed", [
+    (["--support", "x"], "--support x"),
+    (["--ground"], "--ground"),
+    (["--support-below", "0.5"], "--support-below 0.5"),
+    (["blocks.obj", "--support", "b*", "--scene", "dome"], "--scene dome"),
+    (["blocks.obj", "--support", "b*", "--preset", "1"], "--preset 1"),
+    (["blocks.obj", "--support", "b*", "--n", "5"], "--n 5"),
+])
+def test_stages_refuses_options_that_do_not_apply(tmp_path, capsys, args, typed):
+    assert main(["stages", *args, "--out", str(tmp_path / "o")]) == 2
+    assert one_error_line(capsys).startswith(f"masonry: error: {typed}: expected ")
+    assert not (tmp_path / "o").exists()

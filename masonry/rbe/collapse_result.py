@@ -25,6 +25,10 @@ UNBOUNDED_NOTE = (
     "top ring of a dome cut low; a lateral load on a section whose rigid boundary holds "
     "it)")
 
+VERDICTS = ("optimal", "dead load infeasible", "unbounded")
+"""The statuses of a decided collapse load factor: any other (a time limit, a solver that
+stopped short, a non-associative estimate that did not settle) leaves it without one."""
+
 RESULT_KEYS = ("load_factor", "dead_load_feasible", "status", "solver", "iterations",
                "time_s", "residual", "work_balance", "mu", "friction_model",
                "friction_capacity_error", "azimuth_deg", "opening", "sliding", "hinges",
