@@ -17,7 +17,7 @@ The package reads as the pipeline, one stage per module or folder::
 
 __version__ = "0.1.0"
 
-_API = ("build", "read", "Structure")
+_API = ("build", "read", "read_table", "Structure")
 
 
 def __getattr__(name):

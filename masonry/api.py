@@ -19,7 +19,7 @@ import dataclasses
 import functools
 
 from masonry.errors import ParameterError
-from masonry.export.csv import forces_columns
+from masonry.export.csv import HEADERS, column_types, forces_columns
 from masonry.params import Params, from_preset, names, structure_id, validate
 from masonry.pipeline import build_model, centering_of, collapse_of, run
 from masonry.rbe.boundary import analysis_model
@@ -186,7 +186,7 @@ class Structure:
         plan = make_plan(self.scene, by, order, course)
         rows = analyse_stages(self.model, self.params, plan)
         frame = pandas.DataFrame(rows, columns=STAGE_COLUMNS)
-        return frame.set_index("stage")
+        return frame.rename(columns=HEADERS).set_index("stage")
 
     def export(self, out="exports", **outputs) -> dict:
         """Write the run folder ``out/<id>`` that ``masonry run`` writes (forces, CAD
@@ -268,3 +268,26 @@ def read(*paths, support=(), support_below=None, ground=False, **inputs) -> Stru
                                   support_below=support_below, ground=ground)
     params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **inputs))
     return Structure(params, scene, analysis_model(scene, params.analysis.boundary), source)
+
+
+def read_table(path):
+    """One of the CSV files masonry writes (``RBE/forces.csv``, ``tension_top.csv``,
+    ``stages.csv``, a sweep's ``summary.csv``, ...) as a pandas DataFrame with every
+    column's type, also when the file holds only its header (nothing in tension): integer
+    ids and counts, text names, booleans ``True``/``False``, floats for the rest (their
+    names carry the unit).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    pandas.DataFrame
+    """
+    import pandas
+
+    with open(path, encoding="utf-8") as f:
+        names = f.readline().strip().split(",")
+    return pandas.read_csv(path, dtype=column_types(names), keep_default_na=False,
+                           na_values=[""])

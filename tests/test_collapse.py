@@ -421,7 +421,8 @@ def test_run_writes_the_collapse_record_and_files(tmp_path, capsys):
     for name in ("forces.csv", "interfaces.vtu", "mechanism.csv", "mechanism.vtu"):
         assert (folder / "collapse" / name).stat().st_size > 0
     rows = (folder / "collapse" / "mechanism.csv").read_text().splitlines()
-    assert rows[0] == "block,name,ux,uy,uz,rx,ry,rz" and len(rows) == 1 + 86
+    assert rows[0] == "block,name,ux_rel,uy_rel,uz_rel,rx_per_m,ry_per_m,rz_per_m"
+    assert len(rows) == 1 + 86
     # the forces at collapse in RBE's table: same columns; the supports carry the lateral
     # load, lambda times the weight, against it (forces act on block_b, the brick)
     with open(folder / "collapse" / "forces.csv") as f:
@@ -432,8 +433,8 @@ def test_run_writes_the_collapse_record_and_files(tmp_path, capsys):
     support = sum(float(r["shear_x_N"]) for r in table if r["kind"] == "support")
     assert support == pytest.approx(-0.2 * weight, rel=1e-6)
     mesh = meshio.read(folder / "collapse" / "interfaces.vtu")
-    assert {"compression_N", "shear_N", "hinge", "slides", "opens", "gap",
-            "slip"} <= set(mesh.cell_data)
+    assert {"compression_N", "shear_N", "hinge", "slides", "opens", "gap_rel",
+            "slip_rel"} <= set(mesh.cell_data)
 
 
 def test_sweep_records_the_load_factor(tmp_path):

@@ -253,3 +253,39 @@ def test_stages_refuses_options_that_do_not_apply(tmp_path, capsys, args, typed)
     assert main(["stages", *args, "--out", str(tmp_path / "o")]) == 2
     assert one_error_line(capsys).startswith(f"masonry: error: {typed}: expected ")
     assert not (tmp_path / "o").exists()
+
+
+DIMENSIONLESS = {"eccentricity", "moi_factor", "load_factor", "residual_eq", "t_over_r",
+                 *(f"{v}_{a}" for v in ("normal", "t1", "t2") for a in "xyz")}
+"""Float columns without a unit: ratios and unit vectors (docs/outputs.md, unit 1)."""
+
+
+def test_every_csv_column_names_its_unit_and_reads_typed_even_when_empty(tmp_path):
+    import re
+    import types
+
+    import pandas
+
+    import masonry
+    from masonry.studies.thickness import steps_csv
+
+    assert main(["run", *WALL, "--lateral", "0", "--out", str(tmp_path), "-q"]) == 0
+    steps = tmp_path / "steps.csv"  # arch-thickness's: True/False as every other CSV
+    steps.write_bytes(steps_csv(types.SimpleNamespace(steps=((0.11, True), (0.10, False)),
+                                                      radius=5.0)))
+    assert steps.read_text().splitlines()[1:] == ["0,0.11,0.55,True", "1,0.1,0.5,False"]
+    files = [*tmp_path.glob("wall_*/**/*.csv"), steps]
+    assert {p.name for p in files} >= {"forces.csv", "tension_top.csv", "interfaces.csv",
+                                       "locations.csv", "mechanism.csv"}
+    for path in files:
+        frame = masonry.read_table(path)
+        for name, dtype in frame.dtypes.items():
+            if dtype.kind == "f":
+                assert (re.search(r"_(N|N2|Nm|m|m2|deg|s|rel|per_m)$", name)
+                        or name in DIMENSIONLESS), f"{path.name}: {name}"
+        # a file of its header alone reads with the types of one with rows
+        empty = tmp_path / "empty.csv"
+        empty.write_text(path.read_text().splitlines()[0] + "\n")
+        assert masonry.read_table(empty).dtypes.to_dict() == frame.dtypes.to_dict(), path
+        assert pandas.read_csv(path).shape == frame.shape
+    assert list(masonry.read_table(steps)["stands"]) == [True, False]

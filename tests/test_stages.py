@@ -336,7 +336,7 @@ def test_stages_command_writes_its_own_folder_reproducibly(tmp_path, capsys):
     assert main([*args, "--force"]) == 0
     with open(folder / "stages.csv") as f:
         again = list(csv.DictReader(f))
-    keep = ("stage", "course", "bricks", "feasible", "moi", "moi_factor")
+    keep = ("stage", "course", "bricks", "feasible", "moi_N", "moi_factor")
     assert [{k: r[k] for k in keep} for r in again] == [{k: r[k] for k in keep}
                                                         for r in rows]
 
@@ -488,4 +488,4 @@ def test_stages_csv_names_what_each_stage_lays(tmp_path):
     with open(folder / "stages.csv") as f:
         rows = list(csv.DictReader(f))
     assert [r["laid"] for r in rows[:2]] == ["v000 v015", "v001 v014"]
-    assert all(r["moi"] == "" or "." in r["moi"] or "e" in r["moi"] for r in rows)
+    assert all(r["moi_N"] == "" or "." in r["moi_N"] or "e" in r["moi_N"] for r in rows)

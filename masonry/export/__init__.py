@@ -172,7 +172,7 @@ def force_tables(blocks, interfaces, result, forces: dict, resultants=None,
         The folder of the files in the run folder.
     flags : dict str -> (K,) bool or float, optional
         More cell data for the VTU (the collapse mechanism's ``opens``, ``slides``,
-        ``hinge``, written as 0/1, and its ``gap`` and ``slip``).
+        ``hinge``, written as 0/1, and its ``gap_rel`` and ``slip_rel``).
     weight_N : float, optional, N
         The reference weight of ``tension_top.csv``; None: ``result.weight_N``.
     """
@@ -213,8 +213,8 @@ def _collapse_files(made: RunOutputs) -> Export:
         files["collapse/azimuths.csv"] = csv.azimuths_csv(result.azimuths)
     if result.forces is not None and result.load_factor is not None:
         blocks, interfaces = made.model.blocks, made.model.interfaces
-        flags = {name: getattr(result, name)
-                 for name in ("opens", "slides", "hinge", "gap", "slip")}
+        flags = {name: getattr(result, name) for name in ("opens", "slides", "hinge")}
+        flags |= {f"{name}_rel": getattr(result, name) for name in ("gap", "slip")}
         files.update(force_tables(blocks, interfaces, result, result.forces,
                                   folder="collapse", flags=flags,
                                   weight_N=made.result.weight_N))

@@ -11,6 +11,32 @@ TENSION_TOP_COUNT = 20
 """Rows of ``RBE/tension_top.csv``: the interfaces with the largest tension."""
 
 
+HEADERS = {"moi": "moi_N", "objective": "objective_N2"}
+"""Record keys whose CSV columns name their unit (``run.json`` keeps the keys)."""
+
+INTEGER_COLUMNS = ("id", "rank", "brick", "block", "block_a", "block_b", "course",
+                   "course_a", "course_b", "vertex", "vertices", "stage", "bricks", "step",
+                   "variant", "interfaces")
+TEXT_COLUMNS = ("name", "name_a", "name_b", "class", "kind", "laid", "status", "error",
+                "friction_used", "friction_model", "structure_id")
+BOOLEAN_COLUMNS = ("feasible", "loose", "stands")
+"""The columns of masonry's CSV files that are not floats, by type: :func:`column_types`."""
+
+
+def header(columns) -> list:
+    """The CSV column names of record keys (:data:`HEADERS`)."""
+    return [HEADERS.get(c, c) for c in columns]
+
+
+def column_types(names) -> dict:
+    """pandas dtypes of masonry's CSV columns ``names``: integers, text and booleans as
+    declared, every other column a float (its name says its unit). ``pd.read_csv(path,
+    dtype=column_types(header))`` types a file with only its header as one with rows;
+    :func:`masonry.read_table` does it."""
+    return {name: "Int64" if name in INTEGER_COLUMNS else "str" if name in TEXT_COLUMNS
+            else "boolean" if name in BOOLEAN_COLUMNS else "float64" for name in names}
+
+
 def _table(columns) -> bytes:
     """CSV bytes: a header line, then one line per row.
 
@@ -36,7 +62,7 @@ def _table(columns) -> bytes:
 
 def locations_csv(blocks: Blocks, vertices=None) -> bytes:
     """``locations.csv``: one row per block vertex (brick id, name, class, course, vertex
-    index, x, y, z in metres).
+    index, x_m, y_m, z_m).
 
     Parameters
     ----------
@@ -50,8 +76,8 @@ def locations_csv(blocks: Blocks, vertices=None) -> bytes:
     classes = np.array(BLOCK_CLASSES, dtype=object)[blocks.block_class][owner]
     x, y, z = np.asarray(vertices, dtype=float).T
     return _table([("brick", owner), ("name", blocks.block_name[owner]), ("class", classes),
-                   ("course", blocks.block_course[owner]), ("vertex", local), ("x", x),
-                   ("y", y), ("z", z)])
+                   ("course", blocks.block_course[owner]), ("vertex", local), ("x_m", x),
+                   ("y_m", y), ("z_m", z)])
 
 
 def _xyz(name, values, unit=""):
@@ -152,16 +178,17 @@ def tension_top_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict,
 
 
 def mechanism_csv(blocks: Blocks, mechanism) -> bytes:
-    """``collapse/mechanism.csv``: one row per block (docs/model.md 6.9): block, name, virtual
-    translation of the centroid ``ux, uy, uz`` and rotation ``rx, ry, rz`` (radians per
-    unit), normalised so the largest block displacement is 1.
+    """``collapse/mechanism.csv``: one row per block (docs/model.md 6.9): block, name,
+    virtual translation of the centroid ``ux_rel, uy_rel, uz_rel`` and rotation
+    ``rx_per_m, ry_per_m, rz_per_m`` (radians per metre), normalised so the largest
+    displacement of a block's vertex is 1 (``_rel``: in units of it).
 
     Parameters
     ----------
     mechanism : (B, 6) float
     """
     mechanism = np.asarray(mechanism, dtype=float)
-    names = ("ux", "uy", "uz", "rx", "ry", "rz")
+    names = ("ux_rel", "uy_rel", "uz_rel", "rx_per_m", "ry_per_m", "rz_per_m")
     return _table([("block", np.arange(blocks.n_blocks)), ("name", blocks.block_name)]
                   + [(name, mechanism[:, i]) for i, name in enumerate(names)])
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from masonry.rbe.boundary import analysis_model
 from masonry.export import force_tables
-from masonry.export.csv import interfaces_csv, locations_csv
+from masonry.export.csv import header, interfaces_csv, locations_csv
 from masonry.export.obj import blocks_obj
 from masonry.dome.levels import Dimensions
 from masonry.params import Params, from_preset, validate
@@ -279,7 +279,7 @@ def table_csv(rows, columns=COLUMNS) -> bytes:
     """Bench rows as CSV (full precision)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(columns)
+    writer.writerow(header(columns))
     for row in rows:
         writer.writerow(["" if row[c] is None else row[c] for c in columns])
     return buffer.getvalue().encode()

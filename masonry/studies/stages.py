@@ -45,7 +45,7 @@ from masonry import forking
 from masonry.blocks import BLOCK_CLASSES
 from masonry.errors import ParameterError
 from masonry.export._text import format_float
-from masonry.export.csv import held_csv
+from masonry.export.csv import header, held_csv
 from masonry.export.summaries import parameters_text
 from masonry.params import FILE_OUTPUTS, structure_id, validate
 from masonry.pipeline import (Timer, identity, model_record, run_model, versions,
@@ -479,7 +479,7 @@ def stages_csv(rows) -> bytes:
     floats as every CSV of the project prints them."""
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(STAGE_COLUMNS)
+    writer.writerow(header(STAGE_COLUMNS))
     for row in rows:
         writer.writerow(["" if row[c] is None else
                          format_float(row[c]) if isinstance(row[c], float)

@@ -14,6 +14,7 @@ import time
 import numpy as np
 
 from masonry.export._text import format_float
+from masonry.export.csv import header
 from masonry.rbe.collapse import worst_lateral
 from masonry.rbe.equilibrium import VariableLayout
 from masonry.params import from_preset
@@ -174,7 +175,7 @@ def table_csv(rows) -> bytes:
     CSV of the project prints them (the Markdown table rounds to 4 digits), None as an
     empty cell."""
     columns = COLUMNS + (LATERAL_COLUMNS if any("lateral_factor" in r for r in rows) else ())
-    lines = [",".join(columns)]
+    lines = [",".join(header(columns))]
     lines += [",".join(format_float(v) if isinstance(v, float) else _cell(v)
                        for v in (row.get(c) for c in columns)) for row in rows]
     return ("\n".join(lines) + "\n").encode()

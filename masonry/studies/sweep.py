@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonry.export._text import format_floats
+from masonry.export.csv import HEADERS, header
 from masonry.errors import ParameterError
 from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run, versions
@@ -429,7 +430,7 @@ def summary_csv(study: Study, rows) -> bytes:
         texts.append(text)
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(columns)
+    writer.writerow(header(columns))
     writer.writerows(zip(*texts))
     return buf.getvalue().encode()
 
@@ -443,7 +444,7 @@ def summary_parquet(study: Study, rows):
     except ImportError:
         return None
     columns = study.columns
-    table = pa.table({c: [None if r.get(c) is None else str(r.get(c))
+    table = pa.table({HEADERS.get(c, c): [None if r.get(c) is None else str(r.get(c))
                           if c in ("error", "status", "friction_used", "friction_model",
                                    "structure_id")
                           else r.get(c) for r in rows] for c in columns})

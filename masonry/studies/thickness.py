@@ -132,6 +132,6 @@ def folder_name(params: Params, rtol: float) -> str:
 def steps_csv(result: ThicknessResult) -> bytes:
     """One row per bisection step: t/R, thickness (metres), whether the arch stands."""
     lines = ["step,t_over_r,thickness_m,stands"]
-    lines += [f"{i},{ratio:.9g},{ratio * result.radius:.9g},{int(stands)}"
+    lines += [f"{i},{ratio:.9g},{ratio * result.radius:.9g},{bool(stands)}"
               for i, (ratio, stands) in enumerate(result.steps)]
     return ("\n".join(lines) + "\n").encode()
