@@ -1,17 +1,19 @@
 """``masonry analyze``: interfaces and rigid block equilibrium of blocks read from files."""
 
 from masonry.params import Params, validate
-from masonry.pipeline import run
-from masonry.scenes.imported import load_assembly
 
 from .options import (add_analysis_options, add_live_load_options, add_output_options,
                       check_print_size, collapse_summary, given_inputs, rbe_summary, summary)
 
 
+NAME = "analyze"
+HELP = ("any assembly of convex blocks from OBJ, STL or PLY files: interfaces, rigid "
+        "block equilibrium, exports")
+"""The subcommand's name and its line in ``masonry --help``."""
+
+
 def register(subparsers):
-    parser = subparsers.add_parser(
-        "analyze", help="any assembly of convex blocks from OBJ, STL or PLY files: "
-                        "interfaces, rigid block equilibrium, exports")
+    parser = subparsers.add_parser(NAME, help=HELP)
     parser.add_argument("files", nargs="+", metavar="FILE",
                         help="OBJ (one block per object or group), STL or PLY (one block "
                              "per connected body); several files add up")
@@ -35,6 +37,9 @@ def handle(args, report):
     # the inputs are checked before any file is read: a placeholder name until then
     given = given_inputs(args)
     check_print_size(args, validate(Params.of(scene="assembly", assembly="-", **given)))
+    from masonry.pipeline import run  # the whole pipeline: once the options are read
+    from masonry.scenes.imported import load_assembly
+
     scene, source = load_assembly(args.files, supports=args.support,
                                   support_below=args.support_below, ground=args.ground)
     params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **given))

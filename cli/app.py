@@ -31,22 +31,35 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM (``kill``, ``timeout``), handled like Ctrl-C: runs unwind and clean up."""
 
 
-def make_parser():
+def make_parser(argv=None):
+    """The command's parser. With ``argv``, only the subcommand it names gets its options
+    (the others their line in ``--help``): building a command's options imports what
+    they are declared with, and a study's the whole pipeline."""
     parser = Parser(prog="masonry", description=(
         "Brunelleschi-style double-helix masonry domes: bricks, interfaces, rigid block "
         "equilibrium, printable exports."))
     parser.add_argument("--version", action="version", version=f"masonry {__version__}")
     subparsers = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+    named = None if argv is None else _command(argv) or ""
     for module in SUBCOMMANDS:
-        module.register(subparsers)
+        if named is None or module.NAME == named:
+            module.register(subparsers)
+        else:
+            subparsers.add_parser(module.NAME, help=module.HELP)
     for subparser in subparsers.choices.values():
         subparser.set_defaults(option_names=option_names(subparser))
     return parser
 
 
+def _command(argv) -> str | None:
+    """The subcommand ``argv`` names: its first word that is not an option (the options
+    before it are the command's own, ``--version`` and ``--help``), or None."""
+    return next((word for word in argv if not word.startswith("-")), None)
+
+
 def main(argv=None) -> int:
     argv = sys.argv[1:] if argv is None else list(argv)
-    args = make_parser().parse_args(argv)
+    args = make_parser(argv).parse_args(argv)
     args.typed = typed_values(argv)
     # progress on a terminal (or with --verbose); --quiet silences it there too
     verbose = getattr(args, "verbose", False) or (sys.stderr.isatty()

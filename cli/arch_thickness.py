@@ -5,8 +5,6 @@ from masonry.params import Params, validate
 from masonry.rbe.solvers import BACKENDS
 from masonry.scenes.arch import arch_radius
 from masonry.runfolder import RunFolder, check_output_root
-from masonry.studies.thickness import folder_name, minimum_thickness, steps_csv
-from masonry.studies.thrust_line import thrust_line_minimum_thickness
 from masonry.tolerances import THICKNESS_RTOL
 
 from .options import add_material_options, add_scene_options, add_verbosity
@@ -15,10 +13,14 @@ ANALYSIS = ("arch_blocks", "arch_span", "arch_shape", "arch_rise", "arch_depth",
             "density", "friction_cone", "solver")
 
 
+NAME = "arch-thickness"
+HELP = ("minimum thickness t/R of an arch under self weight, by bisection on rigid block "
+        "equilibrium")
+"""The subcommand's name and its line in ``masonry --help``."""
+
+
 def register(subparsers):
-    parser = subparsers.add_parser(
-        "arch-thickness", help="minimum thickness t/R of an arch under self weight, by "
-                               "bisection on rigid block equilibrium")
+    parser = subparsers.add_parser(NAME, help=HELP)
     add_scene_options(parser, kinds=("arch",), skip=("arch_thickness",))
     g = parser.add_argument_group("analysis")
     add_material_options(g)
@@ -37,6 +39,9 @@ def handle(args, report):
     given = {k: getattr(args, k) for k in ANALYSIS if getattr(args, k) is not None}
     params = validate(Params.of(scene="arch", **given))
     check_output_root(args.out)
+    from masonry.studies.thickness import folder_name, minimum_thickness, steps_csv
+    from masonry.studies.thrust_line import thrust_line_minimum_thickness
+
     result = minimum_thickness(params, rtol=args.rtol)
     arch, analysis = params.geometry, params.analysis
     line = thrust_line_minimum_thickness(arch.arch_shape, arch.arch_blocks, arch.arch_span,

@@ -3,23 +3,26 @@
 import resource
 
 from masonry.friction import FrictionCone, FrictionModelError
-from masonry.studies.bench import (FRICTION_MODELS, SCENES, bench, collapse_bench,
-                                   collapse_markdown, friction_bench, friction_markdown,
-                                   frontier_png, ratios_markdown, table_csv, table_markdown)
 from masonry.errors import ParameterError
 from masonry.params import Params, from_preset, validate
-from masonry.rbe.solve import ACCURACY
+from masonry.rbe.accuracy import ACCURACY
 from masonry.rbe.solvers import RBE, names as solver_names
-from masonry.studies.reader_bench import reader_bench, readers_markdown
 from masonry.runfolder import RunFolder, check_output_root
 
 from .options import add_verbosity
 
 
+NAME = "bench"
+HELP = ("measure time, iterations and accuracy of every solver preset on the thesis "
+        "structures (section, cyclic section, full dome)")
+"""The subcommand's name and its line in ``masonry --help``."""
+
+
 def register(subparsers):
-    parser = subparsers.add_parser(
-        "bench", help="measure time, iterations and accuracy of every solver preset on the "
-                      "thesis structures (section, cyclic section, full dome)")
+    # the studies load the whole pipeline: imported when this command runs (masonry_cli.app)
+    from masonry.studies.bench import FRICTION_MODELS, SCENES
+
+    parser = subparsers.add_parser(NAME, help=HELP)
     parser.add_argument("--presets", nargs="+", default=["1", "2", "3"],
                         choices=["1", "2", "3"], help="thesis presets (default 1 2 3)")
     parser.add_argument("--scenes", nargs="+", default=list(SCENES), choices=list(SCENES),
@@ -81,6 +84,9 @@ def handle(args, report):
         return _friction(args, report)
     if args.readers:
         return _readers(args, report)
+    from masonry.studies.bench import (bench, frontier_png, ratios_markdown, table_csv,
+                                       table_markdown)
+
     rows = bench(presets=args.presets, scenes=args.scenes, accuracies=args.accuracy,
                  repeats=args.repeats, solvers=args.solvers,
                  overrides=None if args.p is None else {"p": args.p},
@@ -103,6 +109,8 @@ def handle(args, report):
 
 
 def _collapse(args, report):
+    from masonry.studies.bench import collapse_bench, collapse_markdown
+
     overrides = {} if args.p is None else {"p": args.p}
     named = "" if args.p is None else f" (p {args.p})"
     domes = {f"preset {k} full dome{named}": from_preset(k, scene="dome", **overrides)
@@ -120,6 +128,8 @@ def _collapse(args, report):
 
 
 def _friction(args, report):
+    from masonry.studies.bench import FRICTION_MODELS, friction_bench, friction_markdown
+
     models = args.friction_models or list(FRICTION_MODELS)
     for name in models:
         try:
@@ -141,6 +151,8 @@ def _friction(args, report):
 
 
 def _readers(args, report):
+    from masonry.studies.reader_bench import reader_bench, readers_markdown
+
     rows = reader_bench(args.readers, repeats=args.repeats,
                         progress=None if args.quiet else _progress)
     markdown = readers_markdown(rows)

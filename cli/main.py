@@ -2,13 +2,29 @@
 
 The command itself is :mod:`masonry_cli.app`. It is imported here, inside ``main``, so
 that Ctrl-C while numpy, scipy and the solvers load (a second or two) ends as an
-interruption like any other, with exit code 130 and no traceback.
+interruption like any other, with exit code 130 and no traceback. ``--version`` answers
+without it.
 """
 
+import os
 import sys
+
+BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
+"""BLAS runs on one thread in the command (:func:`masonry.forking.use_one_blas_thread`,
+which limits the libraries loaded when it runs): these say so to the libraries that load
+later, as the solvers import scipy's only when a command solves."""
 
 
 def main(argv=None) -> int:
+    if argv is None:  # the command itself, not a host calling it: its own environment
+        for name in BLAS_THREADS:
+            os.environ[name] = "1"
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv == ["--version"]:
+        from masonry import __version__
+
+        print(f"masonry {__version__}")
+        return 0
     try:
         from masonry_cli import app
     except KeyboardInterrupt:

@@ -2,18 +2,22 @@
 
 from masonry.errors import ParameterError
 from masonry.params import Params, validate
-from masonry.scenes.imported import load_assembly
-from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS, run_stages, stage_params
 
 from .options import (add_analysis_options, add_model_options, add_verbosity,
                       centering_line, given_inputs, params_from_args, pattern_note)
 
 
+NAME = "stages"
+HELP = ("construction stages without centering: the rigid block equilibrium of every "
+        "stage, by course, brick by brick, or block by block for imported assemblies")
+"""The subcommand's name and its line in ``masonry --help``."""
+
+
 def register(subparsers):
-    parser = subparsers.add_parser(
-        "stages", help="construction stages without centering: the rigid block "
-                       "equilibrium of every stage, by course, brick by brick, or block by "
-                       "block for imported assemblies")
+    # the study loads the whole pipeline: imported when this command runs (masonry_cli.app)
+    from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS
+
+    parser = subparsers.add_parser(NAME, help=HELP)
     parser.add_argument("files", nargs="*", metavar="FILE",
                         help="an assembly from OBJ, STL or PLY files (as 'masonry "
                              "analyze'), laid block by block; without files, the dome "
@@ -83,6 +87,9 @@ def _refuse_inapplicable(args):
 
 def handle(args, report):
     _refuse_inapplicable(args)
+    from masonry.scenes.imported import load_assembly
+    from masonry.studies.stages import run_stages, stage_params
+
     if args.files:
         given = given_inputs(args)
         validate(Params.of(scene="assembly", assembly="-", **given))  # before any reading

@@ -4,15 +4,18 @@ side by side."""
 from masonry.friction import FrictionCone, FrictionModelError
 from masonry.params import ParameterError
 from masonry.runfolder import RunFolder, check_output_root
-from masonry.studies.structures import structures_table, table_csv, table_markdown
 
 from .options import add_verbosity
 
 
+NAME = "structures"
+HELP = ("reproduce the thesis's structures 1.1 to 3.2 and its friction test, with free, "
+        "rigid and cyclic sections and the full dome")
+"""The subcommand's name and its line in ``masonry --help``."""
+
+
 def register(subparsers):
-    parser = subparsers.add_parser(
-        "structures", help="reproduce the thesis's structures 1.1 to 3.2 and its friction "
-                           "test, with free, rigid and cyclic sections and the full dome")
+    parser = subparsers.add_parser(NAME, help=HELP)
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root: writes DIR/structures/table.csv and table.md "
                              "(default exports)")
@@ -41,6 +44,8 @@ def handle(args, report):
     except FrictionModelError as error:
         raise ParameterError("friction_cone", args.friction_cone, str(error)) from None
     check_output_root(args.out)
+    from masonry.studies.structures import structures_table, table_csv, table_markdown
+
     rows = structures_table(full_dome=args.full_dome, lp_check=args.lp_check,
                             lateral=args.lateral, cone=cone)
     markdown = table_markdown(rows)

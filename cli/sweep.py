@@ -10,9 +10,6 @@ from masonry.errors import ParameterError
 from masonry.parameters import read_toml
 from masonry.params import PRESETS, Params, names, validate
 from masonry.runfolder import check_output_root
-from masonry.studies.stages import (BLOCK_ORDERS, BRICK_ORDERS, check_live_load,
-                                    stage_params)
-from masonry.studies.sweep import Study, execute, publish_summary, summary_rows
 
 from . import run as run_command
 from .options import Parser, add_verbosity
@@ -20,9 +17,13 @@ from .options import Parser, add_verbosity
 log = logging.getLogger("masonry")
 
 
+NAME = "sweep"
+HELP = "a parameter study: every variant an ordinary run, on Dask workers"
+"""The subcommand's name and its line in ``masonry --help``."""
+
+
 def register(subparsers):
-    parser = subparsers.add_parser(
-        "sweep", help="a parameter study: every variant an ordinary run, on Dask workers")
+    parser = subparsers.add_parser(NAME, help=HELP)
     parser.add_argument("study", metavar="STUDY.toml",
                         help="[base] fixed inputs, [grid] lists, optional [sample] ranges "
                              "with count and seed; inputs named as 'masonry run' options")
@@ -74,7 +75,7 @@ MAX_VARIANTS = 100_000
 """Largest study (grid points times samples): a study file asking for more is refused."""
 
 
-def load_study(path) -> Study:
+def load_study(path):
     """Read a study file; names are 'masonry run' options without their dashes.
 
     Raises
@@ -122,6 +123,8 @@ def load_study(path) -> Study:
     if size > MAX_VARIANTS:
         refuse("grid", f"{size} variants", f"at most {MAX_VARIANTS} variants")
     names = run_option_names()
+    from masonry.studies.sweep import Study  # the pipeline: once the file is read
+
     study = Study(
         base={**(PRESETS[str(preset)] if preset is not None else {}),
               **_fields(base, "base", names, where)},
@@ -133,8 +136,11 @@ def load_study(path) -> Study:
     return study
 
 
-STAGE_PLANS = {"course": (), "brick": BRICK_ORDERS, "block": BLOCK_ORDERS}
-"""``[outputs] stages`` values (``masonry stages --by``) and their laying orders."""
+def _stage_plans() -> dict:
+    """``[outputs] stages`` values (``masonry stages --by``) and their laying orders."""
+    from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS  # the pipeline: when asked
+
+    return {"course": (), "brick": BRICK_ORDERS, "block": BLOCK_ORDERS}
 
 
 def _stage_outputs(outputs, refuse) -> dict:
@@ -156,7 +162,8 @@ def _stage_outputs(outputs, refuse) -> dict:
             key = "stages_course" if course is not None else "stages_order"
             refuse(f"outputs.{key}", outputs[key], "with outputs.stages only")
         return {}
-    if by not in STAGE_PLANS:
+    plans = _stage_plans()
+    if by not in plans:
         refuse("outputs.stages", by, '"course", "brick" or "block" (the stage plan of '
                                      "'masonry stages --by')")
     if by == "brick" and not (isinstance(course, int) and not isinstance(course, bool)
@@ -165,14 +172,14 @@ def _stage_outputs(outputs, refuse) -> dict:
                                                 'stages = "brick", an integer >= 1')
     if by != "brick" and course is not None:
         refuse("outputs.stages_course", course, 'none: a course only with stages = "brick"')
-    if order is not None and order not in STAGE_PLANS[by]:
-        expected = (f"one of {', '.join(STAGE_PLANS[by])}" if STAGE_PLANS[by] else
+    if order is not None and order not in plans[by]:
+        expected = (f"one of {', '.join(plans[by])}" if plans[by] else
                     "none: a course plan has no laying order")
         refuse("outputs.stages_order", order, expected)
     return {"stages": by, "stages_course": course, "stages_order": order}
 
 
-def _check_variants(study: Study, where):
+def _check_variants(study, where):
     """Every variant's inputs checked as ``masonry run`` (and for a study of stages
     ``masonry stages``) checks them, before any runs: a value out of range names the
     table and key it came from (of the inputs the check involves, a swept one first; one
@@ -182,6 +189,8 @@ def _check_variants(study: Study, where):
         try:
             params = validate(Params.of(**inputs))
             if study.stages:  # what 'masonry stages' would refuse of the variant
+                from masonry.studies.stages import check_live_load, stage_params
+
                 check_live_load(params)
                 stage_params(params, "boundary" in inputs)
         except ParameterError as error:
@@ -234,6 +243,8 @@ def handle(args, report):
         raise ParameterError("workers", workers, "an integer >= 1")
     check_output_root(args.out)
     study = load_study(args.study)
+    from masonry.studies.sweep import execute, publish_summary, summary_rows
+
     total = len(study.variants())  # validates the study before any run
     if workers > 1 or scheduler:
         try:

@@ -24,7 +24,6 @@ import signal
 import sys
 import traceback
 
-from threadpoolctl import ThreadpoolController
 
 HELD_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 """The signals that end a run (Ctrl-C, ``kill``): held while the process forks."""
@@ -68,8 +67,11 @@ def usable_cores(limit=None) -> int:
 
 
 @functools.cache
-def _blas_controller() -> ThreadpoolController:
-    """The BLAS libraries loaded (numpy's and scipy's), found once."""
+def _blas_controller():
+    """The BLAS libraries loaded (numpy's and scipy's), found once: a
+    ``threadpoolctl.ThreadpoolController``."""
+    from threadpoolctl import ThreadpoolController
+
     return ThreadpoolController()
 
 

@@ -1,8 +1,6 @@
 """Small triangle-mesh operations shared by the importer and the printable body."""
 
 import numpy as np
-from scipy.sparse import coo_array
-from scipy.sparse.csgraph import connected_components
 
 
 def merge_vertices(triangles, pairs, count):
@@ -24,6 +22,9 @@ def merge_vertices(triangles, pairs, count):
     keep : (T,) bool
         Which of the given triangles remain.
     """
+    from scipy.sparse import coo_array  # scipy loads with the first mesh merged
+    from scipy.sparse.csgraph import connected_components
+
     graph = coo_array((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(count, count))
     _, label = connected_components(graph, directed=False)
     first = np.full(label.max() + 1, count)

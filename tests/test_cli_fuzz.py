@@ -422,7 +422,7 @@ def command_lines(draw):
 @given(command_lines())
 def test_fuzz_command_line(argv):
     with tempfile.TemporaryDirectory() as tmp, pytest.MonkeyPatch.context() as patch:
-        patch.setattr("masonry_cli.run.run", stub_pipeline)
+        patch.setattr("masonry.pipeline.run", stub_pipeline)  # imported by the command
         out = Path(tmp) / "out"
         full = ["run", *argv, "--max-bricks", "1500", "--out", str(out), "-q"]
         code, _, err = call(full)
@@ -454,7 +454,7 @@ def toml_value(value) -> str:
     st.binary(max_size=40)))
 def test_fuzz_parameter_files(content):
     with tempfile.TemporaryDirectory() as tmp, pytest.MonkeyPatch.context() as patch:
-        patch.setattr("masonry_cli.build.run", stub_pipeline)
+        patch.setattr("masonry.pipeline.run", stub_pipeline)
         path, out = Path(tmp) / "params.toml", Path(tmp) / "out"
         path.write_bytes(content)
         argv = ["build", "--params", str(path), "--max-bricks", "1500", "--out", str(out)]
@@ -480,7 +480,7 @@ def test_fuzz_study_files(content):
     rows = {"status": "computed", "error": ""}
     with tempfile.TemporaryDirectory() as tmp, pytest.MonkeyPatch.context() as patch:
         # the study is read and checked for real; its variants are not run here
-        patch.setattr("masonry_cli.sweep.execute", lambda study, *args: (
+        patch.setattr("masonry.studies.sweep.execute", lambda study, *args: (
             (i, inputs, rows) for i, inputs in enumerate(study.variants()[:3])))
         path, out = Path(tmp) / "study.toml", Path(tmp) / "out"
         path.write_bytes(content)

@@ -12,7 +12,6 @@ roots and needs the right one picked; this form cannot pick the wrong one).
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from masonry.tolerances import LEVEL_ANGLE_XTOL, LEVEL_TOP_REL
 
@@ -118,6 +117,8 @@ def _next_theta(a, c, theta0, radius):
 
     if gap(np.pi / 2) < 0:
         return None
+    from scipy.optimize import brentq  # scipy loads with the first model built
+
     return brentq(gap, theta0, np.pi / 2, xtol=LEVEL_ANGLE_XTOL, rtol=4 * np.finfo(float).eps)
 
 

@@ -36,9 +36,6 @@ from fnmatch import fnmatchcase
 from pathlib import Path
 
 import numpy as np
-from scipy.sparse import coo_array
-from scipy.sparse.csgraph import connected_components
-from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from masonry.blocks import (BLOCK, BLOCK_CLASSES, Blocks, blocks_from_hulls, concatenate,
                             hull_faces)
@@ -290,6 +287,8 @@ def _merged(soup: TriangleSoup, distance) -> TriangleSoup:
     vertices = soup.vertices[unique % len(soup.vertices)]
     owner = unique // len(soup.vertices)
     triangles = inverse.reshape(-1, 3)
+    from scipy.spatial import cKDTree  # scipy loads with the first file read
+
     # coincident vertices of one block: a k-d tree over all, pairs kept within a block
     pairs = cKDTree(vertices).query_pairs(distance, output_type="ndarray")
     pairs = pairs[owner[pairs[:, 0]] == owner[pairs[:, 1]]]
@@ -352,6 +351,9 @@ def _body_labels(vertices, triangles):
         links.append(_pair_about_edge(vertices, lo[half[0]], hi[half[0]], third[half],
                                       forward[half], tri[half]))
     links = np.concatenate(links).reshape(-1, 2)
+    from scipy.sparse import coo_array
+    from scipy.sparse.csgraph import connected_components
+
     graph = coo_array((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(n_tri, n_tri))
     return connected_components(graph, directed=False)[1]
 
@@ -495,6 +497,8 @@ def _convex_hull(points, volume, triangles):
     the hull's by more than :data:`~masonry.tolerances.CONVEXITY_REL`: it holds several
     bodies (its ``triangles``, (T, 3) int into ``points``, fall apart) or is not
     convex."""
+    from scipy.spatial import ConvexHull, QhullError
+
     try:
         hull = ConvexHull(points)
     except QhullError:

@@ -38,7 +38,6 @@ import functools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import ConvexHull
 
 from masonry.blocks import (GROUND, blocks_from_hulls, concatenate,
                             hull_faces, rotation_z)
@@ -454,6 +453,8 @@ def build_sector(g: RevolutionDome, kind=None) -> Scene:
     points += [_brick_points(prof, grids, start, k - 1, t, a, b, d)
                for k, t, a, b, d in zip(course, top, phi0, phi1, depth)]
     tol = Tolerances.for_points(np.concatenate(points))
+    from scipy.spatial import ConvexHull  # scipy loads with the first model built
+
     faces = [hull_faces(p, ConvexHull(p), tol.contact) for p in points]
     blocks = blocks_from_hulls(points, faces, np.concatenate([[GROUND], klass]),
                                None, block_course=np.concatenate([[0], course]))

@@ -9,7 +9,9 @@ takes the pyramids only. Every outcome carries the residuals recomputed from the
 matrices (:mod:`.residuals`). The analyses (:mod:`masonry.rbe.solve`,
 :mod:`masonry.rbe.collapse`) call a backend by name; they decide the processes and
 threads the solvers run on (:mod:`masonry.rbe.cores`), the solvers never fork nor set
-threads. Adding a solver is adding a module and a line here.
+threads. Adding a solver is adding a module and a line here (:data:`REGISTRY`). A
+backend's module, and the libraries it solves with, load when it is first asked for: a
+command that solves nothing never loads scipy's solvers, Clarabel, HiGHS or cvxpy.
 
 - ``newton``: semismooth Newton on the QP's dual (:mod:`.newton`); friction-net in the
   presets, and the polish of every other solver's point.
@@ -27,23 +29,54 @@ threads. Adding a solver is adding a module and a line here.
   simplex (:mod:`.highs`).
 """
 
-from masonry.rbe.solvers import direct_clarabel, direct_osqp, highs, interior, newton, via_cvxpy
+from collections.abc import Mapping
+from importlib import import_module
+
 from masonry.rbe.solvers.base import COLLAPSE, PROBLEMS, RBE, Backend, Outcome
 
-BACKENDS = {backend.name: backend for backend in (
-    newton.BACKEND, interior.BACKEND, direct_clarabel.BACKEND, direct_osqp.BACKEND,
-    *via_cvxpy.BACKENDS, *highs.BACKENDS)}
-"""Solver name -> :class:`~masonry.rbe.solvers.base.Backend`: the one list of solver
-names."""
+REGISTRY = {
+    # name: (its module in this package, the problems it solves, pyramids only)
+    "newton": ("newton", (RBE,), False),
+    "interior": ("interior", (RBE, COLLAPSE), False),
+    "clarabel": ("direct_clarabel", (RBE, COLLAPSE), False),
+    "osqp": ("direct_osqp", (RBE,), True),
+    "clarabel-cvxpy": ("via_cvxpy", (RBE,), False),
+    "osqp-cvxpy": ("via_cvxpy", (RBE,), True),
+    "highs-ipm": ("highs", (COLLAPSE,), True),
+    "highs-crossover": ("highs", (COLLAPSE,), True),
+    "highs-simplex": ("highs", (COLLAPSE,), True),
+}
+"""The one list of solver names: where each backend is declared and what it takes (the
+tests check it against the backends themselves)."""
+
+
+class _Backends(Mapping):
+    """Solver name -> :class:`~masonry.rbe.solvers.base.Backend`, in :data:`REGISTRY`
+    order; a backend's module is imported when it is first looked up."""
+
+    def __getitem__(self, name) -> Backend:
+        module = import_module(f"{__name__}.{REGISTRY[name][0]}")
+        declared = getattr(module, "BACKENDS", None) or (module.BACKEND,)
+        return next(backend for backend in declared if backend.name == name)
+
+    def __iter__(self):
+        return iter(REGISTRY)
+
+    def __len__(self):
+        return len(REGISTRY)
+
+
+BACKENDS = _Backends()
+"""Solver name -> :class:`~masonry.rbe.solvers.base.Backend`."""
 
 
 def names(problem=None, cone=None) -> tuple:
     """The names of the backends that solve ``problem`` (:data:`PROBLEMS`; None: any)
     and can state the friction model ``cone`` (a
     :class:`~masonry.friction.FrictionCone`; None: any), in registry order."""
-    return tuple(name for name, backend in BACKENDS.items()
-                 if (problem is None or problem in backend.problems)
-                 and (cone is None or backend.states(cone)))
+    return tuple(name for name, (_, problems, pyramids) in REGISTRY.items()
+                 if (problem is None or problem in problems)
+                 and (cone is None or cone.is_polyhedral or not pyramids))
 
 
 def backend(name, problem, cone=None) -> Backend:
@@ -68,4 +101,5 @@ def backend(name, problem, cone=None) -> Backend:
     return chosen
 
 
-__all__ = ["BACKENDS", "COLLAPSE", "RBE", "Backend", "Outcome", "backend", "names"]
+__all__ = ["BACKENDS", "COLLAPSE", "REGISTRY", "RBE", "Backend", "Outcome", "backend",
+           "names"]
