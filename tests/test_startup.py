@@ -13,7 +13,8 @@ import pytest
 from masonry.rbe.solvers import BACKENDS, REGISTRY, names
 
 HEAVY = ("scipy", "matplotlib", "cvxpy", "meshio", "rhino3dm", "dask", "pandas", "trimesh",
-         "manifold3d", "clarabel", "highspy", "osqp", "pymetis", "lxml", "networkx")
+         "manifold3d", "clarabel", "highspy", "osqp", "pymetis", "lxml", "networkx",
+         "plotly")
 """Libraries a command loads only when it does the work that needs them."""
 
 

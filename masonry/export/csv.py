@@ -16,7 +16,9 @@ HEADERS = {"moi": "moi_N", "objective": "objective_N2"}
 
 INTEGER_COLUMNS = ("id", "rank", "brick", "block", "block_a", "block_b", "course",
                    "course_a", "course_b", "vertex", "vertices", "stage", "bricks", "step",
-                   "variant", "interfaces")
+                   "variant", "interfaces", "stages", "stages_standing",
+                   "first_unsupported_stage", "first_unsupported_course",
+                   "first_unsupported_brick")
 TEXT_COLUMNS = ("name", "name_a", "name_b", "class", "kind", "laid", "status", "error",
                 "friction_used", "friction_model", "structure_id")
 BOOLEAN_COLUMNS = ("feasible", "loose", "stands")
