@@ -63,6 +63,8 @@ NOT_AN_INPUT = {
              "(plots = false)",
     "printable": "an input of each variant: the printable body is chosen in the [outputs] "
                  "table (printable = false)",
+    "html": "an input of each variant: dome.html is chosen in the [outputs] table "
+            "(html = false)",
     "out": "an input of each variant: the study's output root is masonry sweep's --out",
     "preset": "an input of [base] (preset = 3), not of another table",
     "params": "an input of each variant: a study names the inputs themselves",
