@@ -14,8 +14,7 @@ HELP = ("construction stages without centering: the rigid block equilibrium of e
 
 
 def register(subparsers):
-    # the study loads the whole pipeline: imported when this command runs (masonry_cli.app)
-    from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS
+    from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
 
     parser = subparsers.add_parser(NAME, help=HELP)
     parser.add_argument("files", nargs="*", metavar="FILE",

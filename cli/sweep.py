@@ -140,7 +140,7 @@ def load_study(path):
 
 def _stage_plans() -> dict:
     """``[outputs] stages`` values (``masonry stages --by``) and their laying orders."""
-    from masonry.studies.stages import BLOCK_ORDERS, BRICK_ORDERS  # the pipeline: when asked
+    from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
 
     return {"course": (), "brick": BRICK_ORDERS, "block": BLOCK_ORDERS}
 

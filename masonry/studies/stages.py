@@ -57,24 +57,10 @@ from masonry.rbe.loads import Lateral
 from masonry.rbe.solve import RBEProblem
 from masonry.runfolder import Publication, check_output_root
 from masonry.scenes import check_size
+from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
 from masonry.tolerances import MAX_BRICKS, Tolerances
 
 log = logging.getLogger(__name__)
-
-BRICK_ORDERS = {
-    "pattern-first": "the pattern bricks that start on the course, from one corner to "
-                     "the other; then the regular and fill-in bricks, nearest to a pattern "
-                     "brick first (each next to one already laid), ties from one corner",
-    "along": "every brick of the course by its position along the course, from the "
-             "corner at -pi/n to the corner at +pi/n",
-}
-"""Laying orders of :func:`brick_plan` (docs/model.md 4.7)."""
-
-BLOCK_ORDERS = {
-    "names": "one block at a time, by name (digits compared as numbers)",
-    "z": "from the bottom up by centroid height; blocks at one height together",
-}
-"""Laying orders of :func:`block_plan`."""
 
 STAGE_COLUMNS = ("stage", "course", "laid", "bricks", "feasible", "loose", "moi",
                  "moi_factor", "centering_N", "centering_fraction", "load_factor", "solve_s")
