@@ -71,8 +71,7 @@ class Structure:
     @functools.cached_property
     def _problem(self) -> RBEProblem:
         model = self.model
-        return RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
-                          side_rotation=model.side_rotation)
+        return RBEProblem(model.blocks, model.interfaces, **model.assembly)
 
     @functools.cached_property
     def _equilibrium(self):

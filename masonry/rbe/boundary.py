@@ -50,6 +50,12 @@ class Model:
     block_source : (B,) int or None
         The scene block each block is (the scene's blocks) or copies (an image); None:
         every block is the scene's own (no images).
+    dropped_rows : (B, 6) bool or None
+        Equilibrium rows a block drops (a half model's blocks cut by its mirror plane,
+        :mod:`masonry.rbe.mirror`); None: none.
+    vertex_share : (IV,) float or None
+        The share of the whole structure's force each interface vertex carries (a half
+        model's, :mod:`masonry.rbe.mirror`); None: all of it.
     """
 
     blocks: Blocks
@@ -57,6 +63,8 @@ class Model:
     side_block: np.ndarray | None = None
     side_rotation: np.ndarray | None = None
     block_source: np.ndarray | None = None
+    dropped_rows: np.ndarray | None = None
+    vertex_share: np.ndarray | None = None
 
     @property
     def boundary_count(self) -> int:
@@ -71,6 +79,13 @@ class Model:
         for side in (0, 1):
             np.maximum.at(largest, sides[:, side], np.asarray(values, dtype=float))
         return largest
+
+    @property
+    def assembly(self) -> dict:
+        """What :func:`masonry.rbe.equilibrium.assemble` takes from the model besides its
+        blocks and interfaces: the routing, the dropped rows, the vertices' shares."""
+        return dict(side_block=self.side_block, side_rotation=self.side_rotation,
+                    dropped_rows=self.dropped_rows, vertex_share=self.vertex_share)
 
 
 class UnsupportedError(MasonryError, ValueError):
@@ -199,5 +214,9 @@ def restrict(model: Model, is_present) -> Model:
     chosen = keep[model.interfaces.pair].all(axis=1)
     side_block = None if model.side_block is None else remap[model.side_block[chosen]]
     side_rotation = None if model.side_rotation is None else model.side_rotation[chosen]
+    dropped = None if model.dropped_rows is None else model.dropped_rows[index]
+    share = (None if model.vertex_share is None else
+             model.vertex_share[np.repeat(chosen, model.interfaces.vertex_count)])
     return Model(blocks.subset(index), model.interfaces.subset(chosen, remap), side_block,
-                 side_rotation, block_source=source[index])
+                 side_rotation, block_source=source[index], dropped_rows=dropped,
+                 vertex_share=share)

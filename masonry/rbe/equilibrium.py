@@ -148,7 +148,8 @@ class EquilibriumSystem:
     lower : (n,) float
         0 for c and t, ``-inf`` for f1 and f2.
     h : (n,) float
-        Diagonal of ``H``: 1 for t, 1e-3 for c, f1, f2.
+        Diagonal of ``H``: 1 for t, 1e-3 for c, f1, f2 (over a vertex's share,
+        :func:`assemble`).
     mu : float
         Friction coefficient.
     block_weight : (B,) float, newtons
@@ -178,6 +179,10 @@ class EquilibriumSystem:
         3.26, 3.25), at ``mu``; rows ``K i .. K i + K - 1`` are vertex ``i``'s.
     cone : masonry.friction.FrictionCone
         The friction model (default Coulomb's cone).
+    row_kept : (6 F,) bool or None
+        False on the rows no force enters (:func:`assemble`'s ``dropped_rows``): zero in
+        ``A_eq`` and ``f_ext``, and a live load is zeroed there too
+        (:meth:`masonry.rbe.collapse.CollapseLP.scaled`); None: every row is kept.
     """
 
     layout: VariableLayout
@@ -194,6 +199,7 @@ class EquilibriumSystem:
 
     density: float = 1.0
     cone: FrictionCone = FrictionCone("circle")
+    row_kept: np.ndarray | None = None
 
     def with_material(self, mu=None, density=None, cone=None) -> "EquilibriumSystem":
         """The same scene with another friction coefficient, density or friction model,
@@ -297,7 +303,8 @@ class EquilibriumSystem:
 
 
 def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
-             side_rotation=None, cone="circle") -> EquilibriumSystem:
+             side_rotation=None, cone="circle", dropped_rows=None,
+             vertex_share=None) -> EquilibriumSystem:
     """Assemble the scaled RBE matrices: the per-vertex coefficients of ``A_eq``
     (vectorized); the sparse ``A_eq`` is built from them when a solver asks for it.
 
@@ -317,10 +324,21 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     side_rotation : (K, 2, 3, 3) float, optional
         Rotation ``Q`` (about the origin) applied to each side before its force reaches
         ``side_block``: that side's force ``Q (+-F)`` acts at the point ``Q v``. Default
-        identity. Cyclic symmetry (docs/model.md 6.4) routes the side on the rotated copy of a
-        section block back onto that block with the inverse rotation.
+        identity. Cyclic symmetry (docs/model.md 6.4) routes the side on the rotated copy
+        of a section block back onto that block with the inverse rotation; mirror
+        symmetry (docs/model.md 6.11) routes a mirror image's side with the reflection
+        (``det Q = -1``: the force ``Q F`` at ``Q v`` is the mirror image of ``F`` at
+        ``v``).
     cone : FrictionCone or str
         The friction model (:mod:`masonry.friction`).
+    dropped_rows : (B, 6) bool, optional
+        Rows of a block that no force enters: its coefficients and its weight are zero
+        there, so the rows hold whatever the forces (unconstrained reactions; a half
+        model's blocks cut by its mirror plane, docs/model.md 6.11).
+    vertex_share : (IV,) float, optional
+        The share of a force of the whole structure that a vertex's variables carry
+        (a half model's vertices in its mirror plane carry half, docs/model.md 6.11);
+        the objective weighs them by ``h / share``. Default 1.
 
     Returns
     -------
@@ -348,27 +366,35 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     block_row[free_block] = np.arange(len(free_block))
     side_block = (np.asarray(interfaces.pair, dtype=np.int64) if side_block is None
                   else np.asarray(side_block, dtype=np.int64))
+    kept = (np.ones((blocks.n_blocks, 6), bool) if dropped_rows is None
+            else ~np.asarray(dropped_rows, dtype=bool))
     coefficients = _vertex_coefficients(blocks, interfaces, layout, side_block[
-        layout.vertex_interface], side_rotation, block_row, length_ref)
+        layout.vertex_interface], side_rotation, block_row, length_ref, kept)
 
     f_ext = np.zeros((len(free_block), 6))
     f_ext[:, 2] = -block_weight[free_block] / weight_ref
+    f_ext *= kept[free_block]
     lower = np.tile([0.0, 0.0, -np.inf, -np.inf], n_vertices)
-    h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], n_vertices)
+    h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], (n_vertices, 1))
+    if vertex_share is not None:
+        h /= np.asarray(vertex_share, dtype=float)[:, None]
     return EquilibriumSystem(layout=layout, free_block=free_block, f_ext=f_ext.ravel(),
-                             lower=lower, h=h, mu=float(mu), block_weight=block_weight,
-                             weight_ref=weight_ref, length_ref=length_ref,
-                             side_row=block_row[side_block],
+                             lower=lower, h=h.ravel(), mu=float(mu),
+                             block_weight=block_weight, weight_ref=weight_ref,
+                             length_ref=length_ref, side_row=block_row[side_block],
                              vertex_coefficients=coefficients, density=float(density),
-                             cone=FrictionCone.parse(cone))
+                             cone=FrictionCone.parse(cone),
+                             row_kept=None if dropped_rows is None
+                             else kept[free_block].ravel())
 
 
 def _vertex_coefficients(blocks, interfaces, layout: VariableLayout, vertex_side_block,
-                         side_rotation, block_row, length_ref: float) -> np.ndarray:
+                         side_rotation, block_row, length_ref: float, kept) -> np.ndarray:
     """(IV, 2, 6, 4) float: the scaled ``A_eq`` rows (force, moment per ``length_ref``)
     that every vertex's ``(c, t, f1, f2)`` give the block of each side,
-    ``vertex_side_block`` ((IV, 2) int); zero for a support side (``block_row`` -1) and
-    for coefficients at or below :data:`~masonry.tolerances.COEFFICIENT_NOISE`."""
+    ``vertex_side_block`` ((IV, 2) int); zero for a support side (``block_row`` -1), in
+    the rows a block drops (``kept`` (B, 6) False) and for coefficients at or below
+    :data:`~masonry.tolerances.COEFFICIENT_NOISE`."""
     vertex_interface = layout.vertex_interface
     point = np.asarray(interfaces.vertices, dtype=float)
     # direction of each variable's unit force on the other block: c -> n, t -> -n,
@@ -390,7 +416,8 @@ def _vertex_coefficients(blocks, interfaces, layout: VariableLayout, vertex_side
         # drop rows of supports, and the zeros and rounding noise of axis-aligned frames
         # (about 40% of the triplets of a wall; HiGHS warns about them and every solver
         # would carry them)
-        keep = (block_row[block] >= 0)[:, None, None] & (np.abs(coeff) > COEFFICIENT_NOISE)
+        keep = ((block_row[block] >= 0)[:, None, None] & kept[block][:, None, :]
+                & (np.abs(coeff) > COEFFICIENT_NOISE))
         out.append(np.where(keep, coeff, 0.0).transpose(0, 2, 1))
     return np.stack(out, axis=1)
 

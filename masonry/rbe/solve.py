@@ -239,15 +239,19 @@ class RBEProblem:
     ----------
     blocks : masonry.blocks.Blocks
     interfaces : masonry.interfaces.Interfaces
-    side_block, side_rotation : optional
-        Force routing for boundary modes, see :func:`masonry.rbe.equilibrium.assemble`.
+    side_block, side_rotation, dropped_rows, vertex_share : optional
+        Force routing for boundary modes and a half model's rows and shares, see
+        :func:`masonry.rbe.equilibrium.assemble` (a model's :attr:`~masonry.rbe.boundary.
+        Model.assembly`).
     """
 
-    def __init__(self, blocks, interfaces, *, side_block=None, side_rotation=None):
+    def __init__(self, blocks, interfaces, *, side_block=None, side_rotation=None,
+                 dropped_rows=None, vertex_share=None):
         if len(interfaces) == 0:
             raise ValueError("no interfaces: nothing can carry the blocks")
         self.system = assemble(blocks, interfaces, side_block=side_block,
-                               side_rotation=side_rotation)
+                               side_rotation=side_rotation, dropped_rows=dropped_rows,
+                               vertex_share=vertex_share)
         self._workspaces = {}
 
     def solve(self, mu=0.7, density=2000.0, friction="auto", solver=None, tol=None, *,

@@ -160,8 +160,7 @@ def _run(params, accuracy, solver, exports=True):
     model = analysis_model(scene, params.analysis.boundary)
     seconds["interfaces"] = time.perf_counter() - start
     start = time.perf_counter()
-    problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
-                         side_rotation=model.side_rotation)
+    problem = RBEProblem(model.blocks, model.interfaces, **model.assembly)
     seconds["assembly"] = time.perf_counter() - start
     start = time.perf_counter()
     result = problem.solve(mu=params.analysis.mu, density=params.analysis.density, friction=params.analysis.friction,
@@ -372,8 +371,7 @@ def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None
         rbe, one, factor = [], [], None
         for _ in range(repeats):
             start = time.perf_counter()
-            RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
-                       side_rotation=model.side_rotation).solve(
+            RBEProblem(model.blocks, model.interfaces, **model.assembly).solve(
                 mu=params.analysis.mu, density=params.analysis.density, accuracy="balanced")
             rbe.append(time.perf_counter() - start)
             start = time.perf_counter()
@@ -470,9 +468,7 @@ def friction_bench(structures, models=FRICTION_MODELS, azimuth=0.0, repeats=1,
             rbe, collapse = [], []
             for _ in range(repeats):
                 start = time.perf_counter()
-                result = RBEProblem(model.blocks, model.interfaces,
-                                    side_block=model.side_block,
-                                    side_rotation=model.side_rotation).solve(
+                result = RBEProblem(model.blocks, model.interfaces, **model.assembly).solve(
                     mu=params.analysis.mu, density=params.analysis.density, cone=name)
                 rbe.append(time.perf_counter() - start)
                 start = time.perf_counter()

@@ -148,8 +148,9 @@ class NewtonSystem:
         # the columns of (c, f1, f2), which the friction model constrains
         self.friction = np.asarray([i for i, c in enumerate(columns) if c != TENSION])
         self.tension = [i for i, c in enumerate(columns) if c == TENSION]
-        if np.ptp(self.h[:, self.friction]) != 0:
-            raise ValueError("the cone's projection needs equal weights on c, f1, f2")
+        if np.ptp(self.h[:, self.friction], axis=1).any():
+            raise ValueError("the cone's projection needs equal weights on a vertex's c, "
+                             "f1, f2")
         self.b = -system.f_ext
         self.mu, self.cone = system.mu, system.cone
         # (IV, 12, width): rows of side 0's block, then side 1's
