@@ -26,8 +26,9 @@ from masonry.params import (FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, geometry_key,
                             validate)
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.centering import CenteringResult, centering_force
-from masonry.rbe.collapse import CollapseResult, collapse_load, worst_lateral
+from masonry.rbe.collapse import CollapseResult, collapse_load, on_the_whole, worst_lateral
 from masonry.rbe.loads import Lateral
+from masonry.rbe.mirror import half_model, symmetric_plane
 from masonry.rbe.solve import RBEProblem, RBEResult
 from masonry.runfolder import (Publication, RunFolder, check_output_root,
                                write_file_atomically)
@@ -481,8 +482,7 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
     """The rigid block equilibrium of a run's model (docs/model.md 6)."""
     analysis = params.analysis
     with timer.stage("assembly"):
-        problem = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
-                             side_rotation=model.side_rotation)
+        problem = RBEProblem(model.blocks, model.interfaces, **model.assembly)
     with timer.stage("solve"):
         return problem.solve(mu=analysis.mu, density=analysis.density,
                              friction=analysis.friction, solver=analysis.solver,
@@ -502,17 +502,27 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     """The collapse load factor of the run's live load (docs/model.md 6.8). A feasible RBE
     verdict stands for the dead load; otherwise the program decides it. A lateral search
     uses the scene's symmetry; a crown load on a part of the dome (a section) is its
-    share of the whole dome's."""
+    share of the whole dome's. A load symmetric in one of the scene's mirror planes (a
+    lateral load along it, a crown load) is solved on the half in that plane and
+    reported on the whole (docs/model.md 6.11), with associated friction."""
     known = True if rbe is not None and rbe.feasible else None
     analysis, load = params.analysis, params.load
     options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone)
     symmetry = params.kind.symmetry(params.geometry)
     if isinstance(load, Lateral) and load.azimuth_deg == "all":
         return worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
-                             dead_load_feasible=known, **options)
-    live = load.on(model, analysis.density, copies=symmetry.order if symmetry.unit else 1)
-    result = collapse_load(model, live, dead_load_feasible=known,
-                           friction=analysis.friction_law, **options)
+                             mirrors=symmetry.mirrors, dead_load_feasible=known, **options)
+    copies = symmetry.order if symmetry.unit else 1
+    live = load.on(model, analysis.density, copies=copies)
+    plane = symmetric_plane(load, symmetry.mirrors)
+    if plane is not None and analysis.friction_law == "associated":
+        half = half_model(model, plane)
+        result = on_the_whole(half, collapse_load(
+            half.model, half.live(load, analysis.density, copies), dead_load_feasible=known,
+            **options), live, **options)
+    else:
+        result = collapse_load(model, live, dead_load_feasible=known,
+                               friction=analysis.friction_law, **options)
     if isinstance(load, Lateral):
         result = dataclasses.replace(result, azimuth_deg=float(load.azimuth_deg))
     return result

@@ -47,7 +47,8 @@ from masonry.friction import FrictionCone
 from masonry.rbe.collapse_result import (ANISOTROPIC_NOTE, ASSOCIATED_NOTE, RESULT_KEYS,
                                          UNBOUNDED_NOTE, CollapseResult)
 from masonry.rbe.equilibrium import assemble, friction_edges
-from masonry.rbe.loads import LiveLoad, lateral
+from masonry.rbe.loads import Lateral, LiveLoad, lateral
+from masonry.rbe.mirror import half_model, in_plane
 from masonry.rbe.cores import solver_threads
 from masonry.rbe.solve import interface_forces
 from masonry.rbe.solvers import BACKENDS, COLLAPSE, backend
@@ -57,7 +58,7 @@ from masonry.tolerances import FACTOR_TIE_REL, MOTION_TOL
 
 __all__ = ["ANISOTROPIC_NOTE", "ASSOCIATED_NOTE", "RESULT_KEYS", "UNBOUNDED_NOTE",
            "CollapseLP", "CollapseResult", "collapse_load", "fixed_capacity_factor",
-           "lateral_azimuths", "worst_lateral"]
+           "lateral_azimuths", "on_the_whole", "symmetric_key", "worst_lateral"]
 
 log = logging.getLogger(__name__)
 
@@ -183,8 +184,7 @@ class CollapseLP:
                  method=None, cores=None):
         self.model = model
         self.system = assemble(model.blocks, model.interfaces, mu=mu, density=density,
-                               side_block=model.side_block,
-                               side_rotation=model.side_rotation, cone=cone)
+                               cone=cone, **model.assembly)
         self.method = METHOD if method is None else method
         backend(self.method, COLLAPSE, self.system.cone)  # refuses what it cannot solve
         self.columns = friction_columns(self.system)
@@ -213,9 +213,8 @@ class CollapseLP:
         return out
 
     def scaled(self, live: LiveLoad) -> np.ndarray:
-        """(6 F,) float: a live load in the rows' scaling (free blocks only)."""
-        wrench = live.wrench[self.system.free_block].ravel()
-        return wrench / self.system.row_scale
+        """(6 F,) float: a live load in the rows' scaling (:func:`scaled_load`)."""
+        return scaled_load(self.system, live)
 
     def solve(self, live: LiveLoad, *, dead_load_feasible=None) -> CollapseResult:
         """The largest factor of ``live``; ``dead_load_feasible`` (e.g. the RBE's verdict)
@@ -280,7 +279,8 @@ class CollapseLP:
             dead_load_feasible = False
         elif dead_load_feasible is None:
             dead_load_feasible = held.stands_unloaded()
-        motion = self._mechanism(outcome.y[: self.system.A_eq.shape[0]], load, factor)
+        motion = mechanism_of(self.system, self.model.blocks,
+                              outcome.y[: self.system.A_eq.shape[0]], load, factor)
         x = self.system.to_newtons(outcome.x)
         log.debug("collapse LP: lambda %.6g, %d iterations", factor, outcome.iterations)
         return CollapseResult(
@@ -289,44 +289,53 @@ class CollapseLP:
             time_s=time.perf_counter() - start, residual=outcome.residuals.equilibrium, x=x,
             forces=interface_forces(self.system.layout, x), **motion, **common)
 
-    def _mechanism(self, dual, load, factor) -> dict:
-        """Mechanism, per-interface flags and the work balance from the equilibrium rows'
-        dual ``y`` ((6 F,) float, scaled) and the scaled live load."""
-        system, blocks = self.system, self.model.blocks
-        if dual @ load < 0:  # HiGHS's sign convention: make the live load do positive work
-            dual = -dual
-        per_block = dual.reshape(-1, 6).copy()
-        per_block[:, 3:] /= system.length_ref  # moment rows: rotation times length_ref
-        mechanism = np.zeros((blocks.n_blocks, 6))
-        mechanism[system.free_block] = per_block
-        # the largest displacement of any vertex: u + theta x (p - c)
-        owner = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
-        arm = blocks.vertices - blocks.block_centroid[owner]
-        motion = mechanism[owner, :3] + np.cross(mechanism[owner, 3:], arm)
-        largest = float(np.linalg.norm(motion, axis=1).max())
-        if largest == 0:
-            return dict(work_balance=np.nan)
-        mechanism /= largest
-        # relative motion at every vertex, per column (c: opening along n; f1, f2: slip
-        # along t1, t2); A_eq^T y routes the cyclic images like the forces
-        relative = (system.A_eq.T @ dual).reshape(-1, 4) / largest
-        layout = system.layout
-        opening, slip = relative[:, 0], np.hypot(relative[:, 2], relative[:, 3])
-        gap, most_slip = np.zeros(layout.n_interfaces), np.zeros(layout.n_interfaces)
-        np.maximum.at(gap, layout.vertex_interface, opening)
-        np.maximum.at(most_slip, layout.vertex_interface, slip)
-        opens, slides = gap > MOTION_TOL, most_slip > MOTION_TOL
-        closed = np.bincount(layout.vertex_interface, opening <= MOTION_TOL,
-                             minlength=layout.n_interfaces) > 0
-        # kinematic theorem on the normalised mechanism, in physical units
-        free = system.free_block
-        work_live = float(np.sum(load.reshape(-1, 6) * system.row_scale.reshape(-1, 6)
-                                 * mechanism[free]))
-        dead = (system.f_ext * system.row_scale).reshape(-1, 6)
-        work_dead = float(np.sum(dead * mechanism[free]))
-        balance = abs(factor * work_live + work_dead) / max(abs(work_dead), abs(work_live))
-        return dict(mechanism=mechanism, opens=opens, slides=slides, hinge=opens & closed,
-                    gap=gap, slip=most_slip, work_balance=balance)
+
+def scaled_load(system, live: LiveLoad) -> np.ndarray:
+    """(6 F,) float: a live load in the rows' scaling of ``system``
+    (:class:`~masonry.rbe.equilibrium.EquilibriumSystem`): free blocks only, zero on the
+    rows the model drops."""
+    wrench = live.wrench[system.free_block].ravel() / system.row_scale
+    return wrench if system.row_kept is None else wrench * system.row_kept
+
+
+def mechanism_of(system, blocks, dual, load, factor) -> dict:
+    """Mechanism, per-interface flags and the work balance from the equilibrium rows'
+    dual ``y`` ((6 F,) float, scaled) of ``system`` on ``blocks``, the scaled live load
+    and the factor (SPEC 6.9)."""
+    if dual @ load < 0:  # HiGHS's sign convention: make the live load do positive work
+        dual = -dual
+    per_block = dual.reshape(-1, 6).copy()
+    per_block[:, 3:] /= system.length_ref  # moment rows: rotation times length_ref
+    mechanism = np.zeros((blocks.n_blocks, 6))
+    mechanism[system.free_block] = per_block
+    # the largest displacement of any vertex: u + theta x (p - c)
+    owner = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
+    arm = blocks.vertices - blocks.block_centroid[owner]
+    motion = mechanism[owner, :3] + np.cross(mechanism[owner, 3:], arm)
+    largest = float(np.linalg.norm(motion, axis=1).max())
+    if largest == 0:
+        return dict(work_balance=np.nan)
+    mechanism /= largest
+    # relative motion at every vertex, per column (c: opening along n; f1, f2: slip
+    # along t1, t2); A_eq^T y routes the cyclic images like the forces
+    relative = (system.A_eq.T @ dual).reshape(-1, 4) / largest
+    layout = system.layout
+    opening, slip = relative[:, 0], np.hypot(relative[:, 2], relative[:, 3])
+    gap, most_slip = np.zeros(layout.n_interfaces), np.zeros(layout.n_interfaces)
+    np.maximum.at(gap, layout.vertex_interface, opening)
+    np.maximum.at(most_slip, layout.vertex_interface, slip)
+    opens, slides = gap > MOTION_TOL, most_slip > MOTION_TOL
+    closed = np.bincount(layout.vertex_interface, opening <= MOTION_TOL,
+                         minlength=layout.n_interfaces) > 0
+    # kinematic theorem on the normalised mechanism, in physical units
+    free = system.free_block
+    work_live = float(np.sum(load.reshape(-1, 6) * system.row_scale.reshape(-1, 6)
+                             * mechanism[free]))
+    dead = (system.f_ext * system.row_scale).reshape(-1, 6)
+    work_dead = float(np.sum(dead * mechanism[free]))
+    balance = abs(factor * work_live + work_dead) / max(abs(work_dead), abs(work_live))
+    return dict(mechanism=mechanism, opens=opens, slides=slides, hinge=opens & closed,
+                gap=gap, slip=most_slip, work_balance=balance)
 
 
 class _Held:
@@ -483,8 +492,8 @@ def lateral_azimuths(n_webs=None, count=24) -> np.ndarray:
 
 
 def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle",
-                  n_webs=None, period_deg=None, dead_load_feasible=None, time_limit=600.0,
-                  method=None, cores=None) -> CollapseResult:
+                  n_webs=None, period_deg=None, mirrors=(), dead_load_feasible=None,
+                  time_limit=600.0, method=None, cores=None) -> CollapseResult:
     """The smallest lateral load factor over ``azimuths`` (``--lateral all``).
 
     One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: the interior point
@@ -492,22 +501,25 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
     the last basis), ``method`` a backend as for :class:`CollapseLP`, and the dead load is
     checked once (unless ``dead_load_feasible`` is given); on large models, when
     ``cores`` (default the process's, :func:`masonry.forking.cores`) allow two, two
-    azimuths at once (:func:`masonry.forking.two_at_once`). ``period_deg``: the model
-    repeats under a rotation by this angle about the z axis (a full dome of ``n`` webs:
-    ``360 / n``), so azimuths that differ by it have the same factor and each is solved
-    once. Returns the
-    worst azimuth's result with every azimuth's factor in ``azimuths`` ((azimuth, factor
-    or None) pairs).
+    azimuths at once (:func:`masonry.forking.two_at_once`). The model's symmetries
+    leave fewer azimuths to solve (:func:`symmetric_key`): ``period_deg``, a rotation
+    about the z axis that maps it onto itself (a full dome of ``n`` webs: ``360 / n``),
+    and ``mirrors``, the azimuths of its mirror planes (SPEC 6.11): azimuths that these
+    map onto each other have the same factor and each is solved once; one that lies in a
+    mirror plane is solved on the model's half in it (:mod:`masonry.rbe.mirror`), and
+    reported, if it is the worst, on the whole. Returns the worst azimuth's result with
+    every azimuth's factor in ``azimuths`` ((azimuth, factor or None) pairs).
     """
     azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
-    problem = CollapseLP(model, mu=mu, density=density, cone=cone, time_limit=time_limit,
-                         method=method, cores=cores)
     start = time.perf_counter()
-    keys = [round(float(a) % period_deg, 9) if period_deg else float(a) for a in azimuths]
+    keys = [symmetric_key(a, period_deg, mirrors) for a in azimuths]
     todo = {}
     for key, azimuth in zip(keys, azimuths):
         todo.setdefault(key, float(azimuth))
-    solved = _solve_azimuths(problem, list(todo.items()), dead_load_feasible,
+    cases = _LateralCases(model, mirrors, todo.values(), dict(
+        mu=mu, density=density, cone=cone, time_limit=time_limit, method=method,
+        cores=cores))
+    solved = _solve_azimuths(cases, list(todo.items()), dead_load_feasible,
                              two=forking.usable_cores(cores) >= 2)
     results = []
     for key in keys:
@@ -524,25 +536,107 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
         least = min(r.load_factor for r in found)
         worst = next(r for r in found
                      if r.load_factor <= least + FACTOR_TIE_REL * abs(least))
-    return dataclasses.replace(worst, azimuths=tuple(factors),
+    return dataclasses.replace(cases.on_the_whole(worst), azimuths=tuple(factors),
                                time_s=time.perf_counter() - start)
 
 
-def _solve_azimuths(problem, todo, known, two) -> dict:
-    """Solve the ``(key, azimuth)`` pairs of ``todo`` in order, each told what the earlier
-    ones found of the dead load; once it is known to stand, and when ``two`` cores may be
-    used by a backend of :data:`TWO_AT_ONCE`, the rest two at once on a large model
+def symmetric_key(azimuth_deg, period_deg=None, mirrors=()) -> float:
+    """The least azimuth (degrees, in [0, 360)) that the rotations by ``period_deg`` and
+    the mirrors in the planes at ``mirrors`` (azimuths) map ``azimuth_deg`` to: azimuths
+    of one key have the same lateral load factor."""
+    orbit, new = set(), [float(azimuth_deg)]
+    while new:
+        angle = round(new.pop() % 360.0, 9) % 360.0
+        if angle in orbit:
+            continue
+        orbit.add(angle)
+        new += [2.0 * plane - angle for plane in mirrors]
+        new += [angle + period_deg] if period_deg else []
+    return min(orbit)
+
+
+class _LateralCases:
+    """The lateral loads of a search on one model: an azimuth in one of its ``mirrors``
+    on the half in that plane (built here for the ``azimuths`` that need it), the others
+    on the whole; each program made once, when first solved (in the process that solves
+    it)."""
+
+    def __init__(self, model, mirrors, azimuths, options):
+        self.model, self.mirrors, self.options = model, tuple(mirrors), options
+        planes = {in_plane(float(a), self.mirrors) for a in azimuths} - {None}
+        self.halves = {plane: half_model(model, plane) for plane in planes}
+        self.method = METHOD if options["method"] is None else options["method"]
+        self.blocks = int((~model.blocks.block_is_support).sum())
+        self._programs = {}
+
+    def _program(self, plane) -> CollapseLP:
+        if plane not in self._programs:
+            model = self.model if plane is None else self.halves[plane].model
+            self._programs[plane] = CollapseLP(model, **self.options)
+        return self._programs[plane]
+
+    def solve(self, azimuth, *, dead_load_feasible=None) -> CollapseResult:
+        """The factor at ``azimuth`` (on a half: the half's result, its azimuth set)."""
+        plane = in_plane(azimuth, self.mirrors)
+        problem = self._program(plane)
+        if plane is None:
+            return problem.solve_lateral(azimuth, dead_load_feasible=dead_load_feasible)
+        live = self.halves[plane].live(Lateral(azimuth), self.options["density"])
+        return dataclasses.replace(problem.solve(live, dead_load_feasible=dead_load_feasible),
+                                   azimuth_deg=float(azimuth) % 360.0)
+
+    def on_the_whole(self, result) -> CollapseResult:
+        """``result`` as the whole model's (:func:`on_the_whole` for a half's)."""
+        plane = (None if result.azimuth_deg is None
+                 else in_plane(result.azimuth_deg, self.mirrors))
+        if plane is None:
+            return result
+        options = {key: self.options[key] for key in ("mu", "density", "cone")}
+        live = lateral(self.model, result.azimuth_deg, options["density"])
+        return on_the_whole(self.halves[plane], result, live, **options)
+
+
+def on_the_whole(half, result: CollapseResult, live: LiveLoad, *, mu=0.7, density=2000.0,
+                 cone="circle") -> CollapseResult:
+    """A result of ``half.model`` (:class:`~masonry.rbe.mirror.Half`) as its whole's:
+    ``live`` the load on the whole, the forces and the mechanism mirrored back, the flags,
+    the work balance and the equilibrium residual computed again on the whole's matrices
+    (the residual checks the map). Without a factor the result keeps none of the half's
+    forces or mechanism."""
+    if result.load_factor is None or result.x is None or result.mechanism is None:
+        return dataclasses.replace(result, live=live, x=None, forces=None, **dict.fromkeys(
+            ("mechanism", "opens", "slides", "hinge", "gap", "slip")))
+    whole = half.whole
+    system = assemble(whole.blocks, whole.interfaces, mu=mu, density=density, cone=cone,
+                      **whole.assembly)
+    x = half.whole_forces(result.x)
+    motion = half.whole_motion(result.mechanism)[system.free_block]
+    motion[:, 3:] *= system.length_ref
+    load, factor = scaled_load(system, live), result.load_factor
+    flags = mechanism_of(system, whole.blocks, motion.ravel(), load, factor)
+    rhs = system.f_ext + factor * load
+    residual = np.abs(system.A_eq @ system.to_scaled(x) + rhs).max() / np.abs(rhs).max()
+    return dataclasses.replace(result, live=live, x=x,
+                               forces=interface_forces(system.layout, x),
+                               residual=float(residual), **flags)
+
+
+def _solve_azimuths(cases, todo, known, two) -> dict:
+    """Solve the ``(key, azimuth)`` pairs of ``todo`` in order (``cases``: a
+    :class:`_LateralCases`), each told what the earlier ones found of the dead load; once
+    it is known to stand, and when ``two`` cores may be used by a backend of
+    :data:`TWO_AT_ONCE`, the rest two at once on a large model
     (:func:`masonry.forking.two_at_once`). Returns key -> :class:`CollapseResult`; ends
     at the first that finds the dead load cannot stand."""
     solved = {}
     for index, (key, azimuth) in enumerate(todo):
-        if known is True and two and problem.method in TWO_AT_ONCE:
+        if known is True and two and cases.method in TWO_AT_ONCE:
             keys, azimuths = zip(*todo[index:])
-            standing = functools.partial(problem.solve_lateral, dead_load_feasible=True)
-            solved.update(zip(keys, forking.two_at_once(
-                standing, azimuths, blocks=len(problem.system.free_block))))
+            standing = functools.partial(cases.solve, dead_load_feasible=True)
+            solved.update(zip(keys, forking.two_at_once(standing, azimuths,
+                                                        blocks=cases.blocks)))
             break
-        solved[key] = problem.solve_lateral(azimuth, dead_load_feasible=known)
+        solved[key] = cases.solve(azimuth, dead_load_feasible=known)
         known = solved[key].dead_load_feasible
         if known is False:
             break

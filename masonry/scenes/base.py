@@ -21,7 +21,8 @@ from masonry.parameters import values
 
 @dataclass(frozen=True)
 class Symmetry:
-    """How a scene repeats about the z axis (docs/model.md 6.4).
+    """How a scene repeats about the z axis (docs/model.md 6.4) and in vertical planes
+    through it (docs/model.md 6.11).
 
     Parameters
     ----------
@@ -32,10 +33,15 @@ class Symmetry:
         The scene is one of the ``order`` equal parts (a section of the dome), not the
         whole: a load on the whole structure falls ``1 / order`` on it, and its
         boundary may stand for the rest.
+    mirrors : tuple of float
+        Azimuths in degrees, in [0, 180), of the vertical planes through the z axis in
+        which the scene is its own mirror image (with its boundary: a section's images
+        are mirror images of each other); a plane at ``a`` is the plane at ``a + 180``.
     """
 
     order: int = 1
     unit: bool = False
+    mirrors: tuple = ()
 
     @property
     def period_deg(self) -> float | None:

@@ -179,7 +179,9 @@ class Section(SceneKind):
 
     @classmethod
     def symmetry(cls, geometry) -> Symmetry:
-        return Symmetry(order=geometry.n, unit=True)
+        """Rotations by ``360 / n`` (with a boundary); the web's mid-plane (its layout is
+        mirror-symmetric about ``s = 0``, docs/model.md 4.3, 4.4)."""
+        return Symmetry(order=geometry.n, unit=True, mirrors=(0.0,))
 
     @classmethod
     def thrust_section(cls, scene) -> ThrustSection:
@@ -235,7 +237,11 @@ class Dome(Section):
 
     @classmethod
     def symmetry(cls, geometry) -> Symmetry:
-        return Symmetry(order=geometry.n, unit=False)
+        """Rotations by ``360 / n``; the mid-plane of every web and every corner plane,
+        every ``180 / n`` degrees (a web's mirror image in its corner plane is the next
+        web)."""
+        return Symmetry(order=geometry.n, unit=False,
+                        mirrors=tuple(180.0 * k / geometry.n for k in range(geometry.n)))
 
     @classmethod
     def describe(cls, boundary) -> str:

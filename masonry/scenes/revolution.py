@@ -596,6 +596,10 @@ class Sector(SceneKind):
 
     @classmethod
     def symmetry(cls, geometry) -> Symmetry:
+        """Rotations by the sector's angle; no mirror plane (docs/model.md 6.11): the
+        pattern is symmetric in its mirror meridians, but the fills between its bricks
+        are laid from left to right and a plain ring starts half a brick on, so the
+        joints, and the bed facets that follow the joints below, are not."""
         return Symmetry(order=ring_pattern(geometry).symmetry, unit=True)
 
     @classmethod
