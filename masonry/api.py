@@ -21,11 +21,10 @@ import functools
 from masonry.errors import ParameterError
 from masonry.export.csv import HEADERS, column_types, forces_columns
 from masonry.params import Params, from_preset, names, structure_id, validate
-from masonry.pipeline import build_model, centering_of, collapse_of, run
+from masonry.pipeline import Timer, build_model, centering_of, collapse_of, run, solve
 from masonry.rbe.boundary import analysis_model
 from masonry.rbe.loads import LOAD_OPTIONS
 from masonry.rbe.resultants import interface_resultants
-from masonry.rbe.solve import RBEProblem
 from masonry.scenes import check_size
 from masonry.scenes.imported import load_assembly
 from masonry.studies.stages import STAGE_COLUMNS, analyse_stages, check_live_load, make_plan
@@ -69,16 +68,8 @@ class Structure:
         return self.model.interfaces
 
     @functools.cached_property
-    def _problem(self) -> RBEProblem:
-        model = self.model
-        return RBEProblem(model.blocks, model.interfaces, **model.assembly)
-
-    @functools.cached_property
     def _equilibrium(self):
-        analysis = self.params.analysis
-        return self._problem.solve(mu=analysis.mu, density=analysis.density,
-                                   friction=analysis.friction, solver=analysis.solver,
-                                   accuracy=analysis.accuracy, cone=analysis.friction_cone)
+        return solve(self.model, self.params, Timer())
 
     def solve(self):
         """The rigid block equilibrium under self-weight (docs/model.md 6): its verdict

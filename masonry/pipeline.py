@@ -26,9 +26,11 @@ from masonry.params import (FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, geometry_key,
                             validate)
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.centering import CenteringResult, centering_force
-from masonry.rbe.collapse import CollapseResult, collapse_load, on_the_whole, worst_lateral
+from masonry.rbe.collapse import (CollapseResult, collapse_load, collapse_on_half,
+                                   worst_lateral)
 from masonry.rbe.loads import Lateral
-from masonry.rbe.mirror import half_model, symmetric_plane
+from masonry.rbe.mirror import (equilibrium_on_the_whole, half_model, states_exactly,
+                                 symmetric_plane)
 from masonry.rbe.solve import RBEProblem, RBEResult
 from masonry.runfolder import (Publication, RunFolder, check_output_root,
                                write_file_atomically)
@@ -479,14 +481,26 @@ def coordinates_record(scene: Scene, cad_offset: float) -> dict:
 
 
 def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
-    """The rigid block equilibrium of a run's model (docs/model.md 6)."""
+    """The rigid block equilibrium of a run's model (docs/model.md 6): on its half in
+    the scene's first mirror plane, if it has one and the friction model is Coulomb's
+    cone (self weight is its own mirror image in every plane), reported on the whole
+    (docs/model.md 6.11)."""
     analysis = params.analysis
+    mirrors = params.kind.symmetry(params.geometry).mirrors
+    half = None
     with timer.stage("assembly"):
-        problem = RBEProblem(model.blocks, model.interfaces, **model.assembly)
+        if mirrors and states_exactly(analysis.cone):
+            half = half_model(model, mirrors[0])
+        solved = model if half is None else half.model
+        problem = RBEProblem(solved.blocks, solved.interfaces, **solved.assembly)
     with timer.stage("solve"):
-        return problem.solve(mu=analysis.mu, density=analysis.density,
-                             friction=analysis.friction, solver=analysis.solver,
-                             accuracy=analysis.accuracy, cone=analysis.friction_cone)
+        result = problem.solve(mu=analysis.mu, density=analysis.density,
+                               friction=analysis.friction, solver=analysis.solver,
+                               accuracy=analysis.accuracy, cone=analysis.friction_cone)
+        if half is None:
+            return result
+        return dataclasses.replace(equilibrium_on_the_whole(half, result, analysis.density),
+                                   time_s=result.time_s)
 
 
 def centering_of(model: Model, params: Params) -> CenteringResult:
@@ -513,16 +527,15 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
         return worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
                              mirrors=symmetry.mirrors, dead_load_feasible=known, **options)
     copies = symmetry.order if symmetry.unit else 1
-    live = load.on(model, analysis.density, copies=copies)
     plane = symmetric_plane(load, symmetry.mirrors)
-    if plane is not None and analysis.friction_law == "associated":
-        half = half_model(model, plane)
-        result = on_the_whole(half, collapse_load(
-            half.model, half.live(load, analysis.density, copies), dead_load_feasible=known,
-            **options), live, **options)
+    if (plane is not None and analysis.friction_law == "associated"
+            and states_exactly(analysis.cone)):
+        result = collapse_on_half(model, load, plane, copies=copies,
+                                  dead_load_feasible=known, **options)
     else:
-        result = collapse_load(model, live, dead_load_feasible=known,
-                               friction=analysis.friction_law, **options)
+        result = collapse_load(model, load.on(model, analysis.density, copies=copies),
+                               dead_load_feasible=known, friction=analysis.friction_law,
+                               **options)
     if isinstance(load, Lateral):
         result = dataclasses.replace(result, azimuth_deg=float(load.azimuth_deg))
     return result

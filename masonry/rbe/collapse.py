@@ -48,7 +48,7 @@ from masonry.rbe.collapse_result import (ANISOTROPIC_NOTE, ASSOCIATED_NOTE, RESU
                                          UNBOUNDED_NOTE, CollapseResult)
 from masonry.rbe.equilibrium import assemble, friction_edges
 from masonry.rbe.loads import Lateral, LiveLoad, lateral
-from masonry.rbe.mirror import half_model, in_plane
+from masonry.rbe.mirror import half_model, in_plane, states_exactly
 from masonry.rbe.cores import solver_threads
 from masonry.rbe.solve import interface_forces
 from masonry.rbe.solvers import BACKENDS, COLLAPSE, backend
@@ -57,7 +57,8 @@ from masonry.rbe.solvers.program import NONNEGATIVE, SECOND_ORDER, Columns, Cone
 from masonry.tolerances import FACTOR_TIE_REL, MOTION_TOL
 
 __all__ = ["ANISOTROPIC_NOTE", "ASSOCIATED_NOTE", "RESULT_KEYS", "UNBOUNDED_NOTE",
-           "CollapseLP", "CollapseResult", "collapse_load", "fixed_capacity_factor",
+           "CollapseLP", "CollapseResult", "collapse_load", "collapse_on_half",
+           "fixed_capacity_factor",
            "lateral_azimuths", "on_the_whole", "symmetric_key", "worst_lateral"]
 
 log = logging.getLogger(__name__)
@@ -301,7 +302,7 @@ def scaled_load(system, live: LiveLoad) -> np.ndarray:
 def mechanism_of(system, blocks, dual, load, factor) -> dict:
     """Mechanism, per-interface flags and the work balance from the equilibrium rows'
     dual ``y`` ((6 F,) float, scaled) of ``system`` on ``blocks``, the scaled live load
-    and the factor (SPEC 6.9)."""
+    and the factor (docs/model.md 6.9)."""
     if dual @ load < 0:  # HiGHS's sign convention: make the live load do positive work
         dual = -dual
     per_block = dual.reshape(-1, 6).copy()
@@ -504,7 +505,8 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
     azimuths at once (:func:`masonry.forking.two_at_once`). The model's symmetries
     leave fewer azimuths to solve (:func:`symmetric_key`): ``period_deg``, a rotation
     about the z axis that maps it onto itself (a full dome of ``n`` webs: ``360 / n``),
-    and ``mirrors``, the azimuths of its mirror planes (SPEC 6.11): azimuths that these
+    and ``mirrors``, the azimuths of its mirror planes (docs/model.md 6.11; used with
+    Coulomb's cone only, :func:`~masonry.rbe.mirror.states_exactly`): azimuths that these
     map onto each other have the same factor and each is solved once; one that lies in a
     mirror plane is solved on the model's half in it (:mod:`masonry.rbe.mirror`), and
     reported, if it is the worst, on the whole. Returns the worst azimuth's result with
@@ -512,6 +514,7 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
     """
     azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
     start = time.perf_counter()
+    mirrors = tuple(mirrors) if states_exactly(cone) else ()
     keys = [symmetric_key(a, period_deg, mirrors) for a in azimuths]
     todo = {}
     for key, azimuth in zip(keys, azimuths):
@@ -594,6 +597,36 @@ class _LateralCases:
         options = {key: self.options[key] for key in ("mu", "density", "cone")}
         live = lateral(self.model, result.azimuth_deg, options["density"])
         return on_the_whole(self.halves[plane], result, live, **options)
+
+
+def collapse_on_half(model, case, plane, *, copies=1, mu=0.7, density=2000.0, cone="circle",
+                     dead_load_feasible=None, time_limit=600.0, method=None,
+                     cores=None) -> CollapseResult:
+    """The collapse load factor of the load ``case`` (a case of :mod:`masonry.rbe.loads`
+    that is its own mirror image in the vertical plane at ``plane`` degrees,
+    :func:`~masonry.rbe.mirror.symmetric_plane`) on ``model``, one of ``copies`` equal
+    parts of the structure: solved on the half of ``model`` in that plane
+    (:func:`~masonry.rbe.mirror.half_model`) and reported on the whole
+    (:func:`on_the_whole`), ``time_s`` all of it. Associated friction with Coulomb's
+    cone only (:func:`~masonry.rbe.mirror.states_exactly`); the other parameters as for
+    :class:`CollapseLP` and :meth:`CollapseLP.solve`.
+
+    Raises
+    ------
+    masonry.rbe.mirror.MirrorError
+        ``model`` is not its own mirror image in that plane.
+    """
+    if not states_exactly(cone):
+        raise ValueError(f"a half states Coulomb's cone only, not {cone}")
+    start = time.perf_counter()
+    half = half_model(model, plane)
+    problem = CollapseLP(half.model, mu=mu, density=density, cone=cone,
+                         time_limit=time_limit, method=method, cores=cores)
+    result = problem.solve(half.live(case, density, copies),
+                           dead_load_feasible=dead_load_feasible)
+    whole = on_the_whole(half, result, case.on(model, density, copies=copies), mu=mu,
+                         density=density, cone=cone)
+    return dataclasses.replace(whole, time_s=time.perf_counter() - start)
 
 
 def on_the_whole(half, result: CollapseResult, live: LiveLoad, *, mu=0.7, density=2000.0,

@@ -1,4 +1,4 @@
-"""Mirror symmetry: a model solved on its half (SPEC 6.11).
+"""Mirror symmetry: a model solved on its half (docs/model.md 6.11).
 
 A model that is its own mirror image in a vertical plane through the z axis, under a load
 that is too (self weight, a crown load, a lateral load along the plane), has a symmetric
@@ -20,7 +20,7 @@ which is therefore symmetric). The symmetric solutions are the solutions of the 
 - A joint in the plane, between a brick and its mirror image, carries a normal force
   only (the mirror image of the force on one brick is the force on the other). The
   image is kept as a support and its side of the joint is routed onto the brick with
-  the reflection, as a cyclic image's is with a rotation (SPEC 6.4): the two sides'
+  the reflection, as a cyclic image's is with a rotation (docs/model.md 6.4): the two sides'
   friction cancels and their normal forces add, so the brick receives twice the
   vertices' compression: half the whole's per variable (``vertex_share`` 1/2).
 - A side the whole routes onto a block on the other side (a cyclic section's image of
@@ -39,10 +39,10 @@ load factor, and the same RBE optimum, mirrored.
 
 The half is posed with its mirror plane as the xz-plane: the model turned by minus the
 plane's azimuth, so that the dropped rows are a cut block's scaled rows ``Fy`` (1),
-``Mx`` (3) and ``Mz`` (5) of SPEC 6.2, zero in ``A_eq``, ``f_ext`` and every live load
-(:attr:`~masonry.rbe.equilibrium.EquilibriumSystem.row_kept`). :class:`Half` maps its
-forces and its mechanism back onto the whole (turned back, mirrored onto the other
-side).
+``Mx`` (3) and ``Mz`` (5) of docs/model.md 6.2, zero in ``A_eq``, ``f_ext`` and every
+live load (:attr:`~masonry.rbe.equilibrium.EquilibriumSystem.row_kept`). :class:`Half`
+maps its forces and its mechanism back onto the whole (turned back, mirrored onto the
+other side).
 """
 
 import dataclasses
@@ -53,9 +53,12 @@ from scipy.spatial import ConvexHull, cKDTree
 
 from masonry.blocks import Blocks, blocks_from_hulls, concatenate, hull_faces, rotation_z
 from masonry.errors import MasonryError
+from masonry.friction import FrictionCone
 from masonry.interfaces import Interfaces
 from masonry.rbe.boundary import Model
+from masonry.rbe.equilibrium import assemble
 from masonry.rbe.loads import CrownLoad, Lateral
+from masonry.rbe.solvers.residuals import rbe_residuals
 from masonry.tolerances import Tolerances
 
 MIRROR = np.diag([1.0, -1.0, 1.0])
@@ -63,7 +66,7 @@ MIRROR = np.diag([1.0, -1.0, 1.0])
 
 DROPPED = np.array([False, True, False, True, False, True])
 """The rows a cut block drops, in the half's frame: the force along y, the moments about x
-and z (SPEC 6.2's row order)."""
+and z (docs/model.md 6.2's row order)."""
 
 ANGLE_SLACK = 1e-9
 """Degrees within which a load's azimuth counts as lying in a mirror plane."""
@@ -149,6 +152,35 @@ class Half:
         if isinstance(case, Lateral):
             case = Lateral(float(case.azimuth_deg) - self.azimuth_deg)
         return case.on(self.model, density, copies=2 * copies)
+
+
+def equilibrium_on_the_whole(half: Half, result, density: float):
+    """An RBE result of ``half.model`` (:class:`~masonry.rbe.solve.RBEResult`, at
+    ``density``) as its whole's: the forces mirrored back, the objective, the MoI, the
+    weight and the residuals computed again on the whole's matrices (the residuals check
+    the map); the verdict and the solvers' record stay the half's."""
+    whole = half.whole
+    system = assemble(whole.blocks, whole.interfaces, mu=result.mu, density=density,
+                      cone=result.cone, **whole.assembly)
+    weight = system.total_weight
+    if result.x is None:
+        return dataclasses.replace(result, layout=system.layout, weight_N=weight,
+                                   moi_factor=result.moi / weight)
+    x = half.whole_forces(result.x)
+    checks = rbe_residuals(system, system.to_scaled(x), result.friction)
+    moi = float(system.layout.component(x, "t").sum())
+    return dataclasses.replace(
+        result, x=x, layout=system.layout, objective=float(0.5 * np.sum(system.h * x**2)),
+        moi=moi, moi_factor=moi / weight, weight_N=weight, residual_eq=checks.equilibrium,
+        friction_violation=checks.friction, net_friction_violation=checks.net_friction)
+
+
+def states_exactly(cone) -> bool:
+    """Whether a half states the friction model ``cone`` (a name or a
+    :class:`~masonry.friction.FrictionCone`) exactly: Coulomb's cone is its own mirror
+    image in any joint's frame; a pyramid is only where the joints' axes are mirror
+    images of each other, which the half does not ask of a model."""
+    return not FrictionCone.parse(cone).is_polyhedral
 
 
 def symmetric_plane(case, mirrors) -> float | None:

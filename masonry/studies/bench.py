@@ -31,8 +31,9 @@ from masonry.dome.levels import Dimensions
 from masonry.params import Params, from_preset, validate
 from masonry.pipeline import build_model
 from masonry.scenes import build
-from masonry.rbe.collapse import CollapseLP, lateral_azimuths, worst_lateral
-from masonry.rbe.loads import lateral
+from masonry.rbe.collapse import CollapseLP, collapse_on_half, lateral_azimuths, worst_lateral
+from masonry.rbe.loads import Lateral, lateral
+from masonry.rbe.mirror import half_model
 from masonry.rbe.solve import ACCURACY, RBEProblem
 
 log = logging.getLogger(__name__)
@@ -338,74 +339,119 @@ def frontier_png(rows) -> bytes:
     return buffer.getvalue()
 
 
-COLLAPSE_COLUMNS = ("structure", "bricks", "unknowns", "azimuths", "rbe_s", "collapse_s",
-                    "ratio", "load_factor", "azimuth_deg", "solver")
+COLLAPSE_COLUMNS = ("structure", "model", "bricks", "unknowns", "azimuths", "rbe_s",
+                    "collapse_s", "ratio", "load_factor", "azimuth_deg", "solver")
 """Columns of a collapse bench row (:data:`COLLAPSE_NOTE` says what they hold)."""
 
 COLLAPSE_NOTE = """Seconds are medians over the repeats, each with its assembly. One azimuth
-(`azimuths` 1): `rbe_s` is the balanced RBE solve, `collapse_s` the collapse LP at that
-azimuth, `ratio` their quotient (the target: at most 3). The azimuth search
-(`azimuths` > 1, `--lateral all`): `rbe_s` holds the sum of independent one-azimuth LPs
-instead, `collapse_s` the search reusing one LP, `ratio` their quotient."""
+(`azimuths` 1): `rbe_s` is the balanced RBE solve of the whole structure, `collapse_s`
+the collapse LP at that azimuth on the `model` named: the whole, or its half in the
+mirror plane along the load (docs/model.md 6.11: building the half, its LP, and its
+result mapped back onto the whole), `ratio` their quotient (the target: at most 4). The
+azimuth search (`azimuths` > 1, `--lateral all`): `rbe_s` holds the sum of independent
+one-azimuth LPs on the whole instead, `collapse_s` the search as `masonry run` makes it
+(one LP per model reused, azimuths reduced by the rotations and mirrors, those in a
+mirror plane on halves), `ratio` their quotient."""
 
 
 def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None,
                    progress=None) -> list:
-    """Time the lateral collapse load factor (docs/model.md 6.8) against the balanced RBE solve.
+    """Time the lateral collapse load factor (docs/model.md 6.8) against the balanced
+    RBE solve of the whole structure.
 
     Parameters
     ----------
     structures : dict str -> Params
         Named structures (e.g. ``{"preset 1 full dome": from_preset("1", scene="dome")}``).
     azimuth : float
-        Of the one-azimuth rows.
+        Of the one-azimuth rows on the whole. A structure with mirror planes (its scene
+        kind's :meth:`~masonry.scenes.base.SceneKind.symmetry`) also gets a row on the
+        half for a load along a web's mid-plane (0 degrees) and one along the plane
+        ``180 / n`` degrees on (a corner plane of the polygonal dome).
     search : bool
         Also a row for ``--lateral all`` (:func:`~masonry.rbe.collapse.worst_lateral`,
-        one LP reused, a full dome's azimuths solved once per rotational period, as
-        ``masonry run`` does) against independent one-azimuth LPs at the same azimuths.
+        as ``masonry run`` makes it) against independent one-azimuth LPs on the whole at
+        the same azimuths.
     """
     rows = []
     for name, params in structures.items():
         _, model = build_model(params)
+        symmetry = params.kind.symmetry(params.geometry)
+        analysis = params.analysis
+        options = dict(mu=analysis.mu, density=analysis.density, method=method)
         bricks = int((~model.blocks.block_is_support).sum())
-        rbe, one, factor = [], [], None
+        rbe = []
         for _ in range(repeats):
             start = time.perf_counter()
             RBEProblem(model.blocks, model.interfaces, **model.assembly).solve(
-                mu=params.analysis.mu, density=params.analysis.density, accuracy="balanced")
+                mu=analysis.mu, density=analysis.density, accuracy="balanced")
             rbe.append(time.perf_counter() - start)
-            start = time.perf_counter()
-            problem = CollapseLP(model, mu=params.analysis.mu, density=params.analysis.density, method=method)
-            result = problem.solve(lateral(model, azimuth, params.analysis.density),
-                                   dead_load_feasible=True)
-            one.append(time.perf_counter() - start)
-            factor = result.load_factor
             if progress:
-                progress(f"{name}: RBE {rbe[-1]:.3g} s, collapse LP {one[-1]:.3g} s")
-        unknowns = problem.matrix.shape[1]
-        rows.append(dict(structure=name, bricks=bricks, unknowns=unknowns, azimuths=1,
-                         rbe_s=statistics.median(rbe), collapse_s=statistics.median(one),
-                         ratio=statistics.median(one) / statistics.median(rbe),
-                         load_factor=factor, azimuth_deg=azimuth, solver=result.solver))
-        if not search:
-            continue
-        symmetry = params.kind.symmetry(params.geometry)
-        angles = lateral_azimuths(symmetry.webs)
-        start = time.perf_counter()
-        period = symmetry.period_deg
-        worst = worst_lateral(model, angles, mu=params.analysis.mu, density=params.analysis.density,
-                              period_deg=period, dead_load_feasible=True, method=method)
-        together = time.perf_counter() - start
-        start = time.perf_counter()
-        for angle in angles:
-            CollapseLP(model, mu=params.analysis.mu, density=params.analysis.density, method=method).solve(
-                lateral(model, angle, params.analysis.density), dead_load_feasible=True)
-        apart = time.perf_counter() - start
-        rows.append(dict(structure=name, bricks=bricks, unknowns=unknowns,
-                         azimuths=len(angles), rbe_s=apart, collapse_s=together,
-                         ratio=together / apart, load_factor=worst.load_factor,
-                         azimuth_deg=worst.azimuth_deg, solver=worst.solver))
+                progress(f"{name}: RBE {rbe[-1]:.3g} s")
+        common = dict(structure=name, bricks=bricks, rbe_s=statistics.median(rbe))
+        rows.append(_whole_row(model, azimuth, repeats, options, progress, **common))
+        planes = symmetry.mirrors[:2] if symmetry.mirrors else ()
+        rows += [_half_row(model, plane, repeats, options, progress, **common)
+                 for plane in planes]
+        if search:
+            rows.append(_search_row(model, symmetry, options, **common))
     return rows
+
+
+def _whole_row(model, azimuth, repeats, options, progress, **common) -> dict:
+    """A collapse bench row: the LP at ``azimuth`` on the whole ``model``."""
+    one = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        problem = CollapseLP(model, **options)
+        result = problem.solve(lateral(model, azimuth, options["density"]),
+                               dead_load_feasible=True)
+        one.append(time.perf_counter() - start)
+        if progress:
+            progress(f"{common['structure']}: collapse LP at {azimuth:g} deg, whole "
+                     f"{one[-1]:.3g} s")
+    return dict(common, model="whole", unknowns=problem.matrix.shape[1], azimuths=1,
+                collapse_s=statistics.median(one),
+                ratio=statistics.median(one) / common["rbe_s"],
+                load_factor=result.load_factor, azimuth_deg=azimuth, solver=result.solver)
+
+
+def _half_row(model, plane, repeats, options, progress, **common) -> dict:
+    """A collapse bench row: a lateral load along the mirror plane at ``plane`` degrees,
+    on the half of ``model`` in it (:func:`~masonry.rbe.collapse.collapse_on_half`)."""
+    one = []
+    for _ in range(repeats):
+        result = collapse_on_half(model, Lateral(plane), plane, dead_load_feasible=True,
+                                  **options)
+        one.append(result.time_s)
+        if progress:
+            progress(f"{common['structure']}: collapse LP at {plane:g} deg, half "
+                     f"{one[-1]:.3g} s")
+    half = half_model(model, plane).model
+    unknowns = CollapseLP(half, **options).matrix.shape[1]
+    return dict(common, model=f"half in {plane:g} deg", unknowns=unknowns, azimuths=1,
+                collapse_s=statistics.median(one),
+                ratio=statistics.median(one) / common["rbe_s"],
+                load_factor=result.load_factor, azimuth_deg=plane, solver=result.solver)
+
+
+def _search_row(model, symmetry, options, **common) -> dict:
+    """A collapse bench row: ``--lateral all`` as ``masonry run`` makes it against
+    independent one-azimuth LPs on the whole."""
+    angles = lateral_azimuths(symmetry.webs)
+    start = time.perf_counter()
+    worst = worst_lateral(model, angles, period_deg=symmetry.period_deg,
+                          mirrors=symmetry.mirrors, dead_load_feasible=True, **options)
+    together = time.perf_counter() - start
+    start = time.perf_counter()
+    for angle in angles:
+        problem = CollapseLP(model, **options)
+        problem.solve(lateral(model, angle, options["density"]), dead_load_feasible=True)
+    apart = time.perf_counter() - start
+    return dict(common, model="search", unknowns=problem.matrix.shape[1],
+                azimuths=len(angles), rbe_s=apart, collapse_s=together,
+                ratio=together / apart, load_factor=worst.load_factor,
+                azimuth_deg=worst.azimuth_deg, solver=worst.solver)
 
 
 def collapse_markdown(rows) -> str:

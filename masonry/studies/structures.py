@@ -76,11 +76,13 @@ def lateral_record(model, params, count=3, cone="circle") -> dict:
     """The worst lateral load factor of a full dome and where its mechanism hinges, with
     the friction model ``cone``. (The thesis's square pyramid is not symmetric under
     the mirror in a web's mid-plane unless the joints' axes are: its search is a
-    reproduction, not a bound.)"""
+    reproduction, not a bound.) With Coulomb's cone the azimuths in the dome's mirror
+    planes are solved on its halves (docs/model.md 6.11)."""
     start = time.perf_counter()
     n = params.geometry.n
     worst = worst_lateral(model, symmetric_azimuths(n, count), mu=params.analysis.mu,
                           density=params.analysis.density, cone=cone, n_webs=n,
+                          mirrors=params.kind.symmetry(params.geometry).mirrors,
                           dead_load_feasible=True)
     out = {"lateral_factor": worst.load_factor, "lateral_azimuth": worst.azimuth_deg,
            "hinge_webs": "", "hinge_courses": "", "sliding": worst.main_sliding,
