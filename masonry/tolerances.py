@@ -300,3 +300,21 @@ held directly or through the one it rests on) its interior point spreads forces 
 1e-9 to 1e-5 of the structure's weight over many bricks (preset 1's free section: 169
 bricks above 1e-9 of the weight, 83 above 1e-3 of their own, carrying all but 4e-5 of the
 total); a thousandth of a brick's weight is no support anyone gives."""
+
+# ---------------------------------------------------------------------- mirror symmetry
+MIRROR_ANGLE_DEG = 1e-9
+"""Degrees within which a load's azimuth lies in a mirror plane
+(:func:`masonry.rbe.mirror.in_plane`)."""
+
+MIRROR_VOLUME_REL = 1e-5
+"""Two blocks whose centroids are mirror images within the contact tolerance and whose
+volumes agree to this fraction are mirror images (:func:`masonry.rbe.mirror.half_model`).
+The polygonal dome's bricks agree to rounding, and so do those of a small dome of
+revolution; on the default dome of revolution some differ by up to 5.4e-6 of their
+volume (centroids by 5.5e-7 m): a brick is the hull of its corners, and the hull merges
+the nearly coplanar facets of a bed in the order qhull finds them. A brick and the one
+the mirror would put beside it differ by far more."""
+
+MIRROR_NORMAL_MISS = 1e-6
+"""A joint and its mirror image face as each other's mirror when their unit normals,
+mapped by the mirror, differ by at most this (:func:`masonry.rbe.mirror.half_model`)."""

@@ -172,3 +172,40 @@ def test_a_run_reports_the_half_on_the_whole_dome(tmp_path, dome):
     for table in ("RBE", "collapse"):
         lines = (folder / table / "forces.csv").read_text().splitlines()
         assert len(lines) == 1 + len(dome.interfaces)
+
+
+REVOLUTION = dict(scene="revolution", radius=12, p=2, spirals=6, cut=0.4)
+"""A small dome of revolution: 198 bricks in 6 sectors, its mirror planes every 30
+degrees (the middle and the edges of every sector)."""
+
+
+@pytest.mark.parametrize("azimuth", [0.0, 30.0])
+def test_the_dome_of_revolution_on_its_half_is_the_whole(azimuth):
+    """Its rings are laid mirror-symmetric in the pattern's meridians (docs/model.md
+    4.8): along a sector's middle (0) or its edge (30) the half dome has the whole's
+    lateral factor and mechanism, and the whole's self-weight forces."""
+    params = validate(Params.of(**REVOLUTION))
+    model = build_model(params)[1]
+    assert params.kind.symmetry(params.geometry).mirrors == tuple(np.arange(6) * 30.0)
+    live = lateral(model, azimuth)
+    whole = collapse_load(model, live)
+    half = collapse_on_half(model, Lateral(azimuth), azimuth)
+    assert half.load_factor == pytest.approx(whole.load_factor, rel=FACTOR_REL)
+    check_mechanism(model, live, half)
+    whole_weight = whole_rbe(model)
+    half_model_ = half_model(model, azimuth)
+    on_half = RBEProblem(half_model_.model.blocks, half_model_.model.interfaces,
+                         **half_model_.model.assembly).solve(density=2000.0,
+                                                             accuracy="accurate")
+    forces = half_model_.whole_forces(on_half.x)
+    assert on_half.verdict == whole_weight.verdict
+    assert np.abs(forces - whole_weight.x).max() <= FORCE_REL * np.abs(whole_weight.x).max()
+
+
+def test_a_sector_of_revolution_states_no_mirror_plane():
+    """A brick across one edge of a sector is the sector's, the one across the other its
+    neighbour's: the sector is not its own mirror image."""
+    params = validate(Params.of(**{**REVOLUTION, "scene": "sector", "boundary": "cyclic"}))
+    assert params.kind.symmetry(params.geometry).mirrors == ()
+    with pytest.raises(MirrorError):
+        half_model(build_model(params)[1], 0.0)

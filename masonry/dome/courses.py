@@ -4,7 +4,8 @@ Works in the flattened section (``s`` along the wall in units, course ``k = 1..L
 Each course's pattern cells split ``[-W_k, W_k]`` into sequences; each sequence gets
 regular bricks (4 units) and fill-in bricks for the remainder. The layout is
 mirror-symmetric about ``s = 0``: a sequence left of the centre is filled and mirrored,
-the centre sequence gets a symmetric fill.
+the centre sequence gets a symmetric fill. A ring of the dome of revolution
+(:func:`fill_ring`) is filled by the same rules, mirror-symmetric in its meridians.
 
 Joints are staggered: among the fills a sequence admits (the fill-in at either end or in
 between, or split into two fill-ins), the one whose joints keep farthest from the joints of
@@ -114,6 +115,20 @@ def _centre_candidates(length, min_fill):
     return out or [[length]]
 
 
+def _mirrored_candidates(length, min_fill):
+    """Symmetric piece lengths filling a sequence centred on a mirror meridian: those of
+    :func:`_centre_candidates`, and a joint on the meridian or a regular brick across it
+    with any fill of :func:`_side_candidates` on either side."""
+    out = _centre_candidates(length, min_fill)
+    for middle in (0.0, REGULAR):
+        side = (length - middle) / 2
+        if side <= UNIT_SLACK or side < min_fill - UNIT_SLACK:
+            continue
+        out += [pieces[::-1] + ([middle] if middle else []) + pieces
+                for pieces in _side_candidates(side, min_fill)]
+    return out
+
+
 def _joints(start, pieces):
     return start + np.cumsum(pieces)[:-1]
 
@@ -205,12 +220,79 @@ def _pieces(candidates, start, length, below, min_fill):
     return _choose(candidates(length, min_fill), start, below), False
 
 
-def fill_gap(start, length, below, min_fill):
-    """The pieces (lengths, units, from ``start``) of regular and fill-in bricks that fill
-    one gap of a course: of the fills the gap admits, the one whose joints keep farthest
-    from the joints ``below`` (units, in ``start``'s coordinate); and True when the gap
-    is shorter than ``min_fill`` (one short piece)."""
-    return _pieces(_side_candidates, start, length, below, min_fill)
+def fill_ring(cells, half, ring, below, min_fill):
+    """The regular and fill-in bricks of one period of a ring that is its own mirror image
+    in the meridians ``s = j half`` (``s`` units along the ring, ``ring`` its length, a
+    multiple of ``2 half``): their extents ``(s0, s1)`` on ``[-half, half]`` and beyond
+    (a brick across ``s = half`` is the period's; the one across ``-half`` is its
+    rotation), mirror-symmetric about ``s = 0`` and ``s = half``, and how many are
+    shorter than ``min_fill``.
+
+    ``cells`` (m, 2) the extents of the ring's pattern bricks (mirror-symmetric likewise),
+    ``below`` the joints of the course below (units, any turn). A gap between cells across
+    a mirror meridian gets a symmetric fill (a joint on the meridian, a regular brick or a
+    fill-in across it); one between two meridians is filled and mirrored; a ring without
+    cells is filled from meridian to meridian (:func:`_between_mirrors`). Each fill is
+    chosen against the joints below as in :func:`fill_courses`."""
+    def near(a):  # the joints below from a, on the nearest turn
+        return np.mod(np.asarray(below, float) - a + ring / 2, ring) - ring / 2
+
+    cells = np.asarray(cells, float).reshape(-1, 2)
+    if len(cells) == 0:
+        right, pieces = _between_mirrors(half, near(0.0), min_fill)
+        rows = _extents(right - half, pieces) + ([(half - right, half + right)] if right
+                                                  else [])
+        return rows, sum(p < min_fill - UNIT_SLACK for p in pieces)
+    cells = cells[np.argsort(cells[:, 0])]
+    rows, short = [], 0
+    for a, b in zip(cells[:, 1], np.append(cells[1:, 0], cells[0, 0] + ring)):
+        middle = np.mod((a + b) / 2 + half, ring) - half
+        a, b = a + middle - (a + b) / 2, b + middle - (a + b) / 2
+        if b - a <= UNIT_SLACK or not -UNIT_SLACK <= middle <= half + UNIT_SLACK:
+            continue  # the mirror image or a rotation of a gap laid here
+        if min(abs(middle), abs(middle - half)) <= UNIT_SLACK:  # across a meridian
+            pieces, too_short = _pieces(_mirrored_candidates, 0.0, b - a, near(a),
+                                        min_fill)
+            rows += _extents(a, pieces)
+            short += too_short
+        else:
+            pieces, too_short = _pieces(_side_candidates, 0.0, b - a, near(a), min_fill)
+            rows += _extents(a, pieces) + _extents(-b, pieces[::-1])
+            short += 2 * too_short
+    return rows, short
+
+
+def _extents(start, pieces) -> list:
+    """``(s0, s1)`` of ``pieces`` (lengths) laid from ``start``."""
+    edges = start + np.concatenate([[0.0], np.cumsum(pieces)])
+    return list(zip(edges[:-1], edges[1:]))
+
+
+def _between_mirrors(length, below, min_fill) -> tuple:
+    """The fill of a ring between mirror meridians ``length`` units apart, at ``s = 0``
+    and ``s = length``: ``(right, pieces)``, ``right`` half the regular brick across
+    ``s = length`` (0: a joint on it), ``pieces`` the lengths from ``right - length`` to
+    ``length - right``, symmetric about ``s = 0`` (:func:`_mirrored_candidates`). Of
+    these, the one whose joints (on the meridians too) repeat fewest of ``below``, then with a joint on one meridian and a brick across
+    the other (the next course can then do the opposite: running bond on a short ring),
+    then with fewest fill-ins, then whose joints keep farthest from those below."""
+    candidates = []
+    for right in (0.0, REGULAR / 2):
+        side = length - right
+        if side >= min_fill - UNIT_SLACK:
+            candidates += [(right, pieces)
+                           for pieces in _mirrored_candidates(2 * side, min_fill)]
+
+    def key(candidate):
+        right, pieces = candidate
+        edges = right - length + np.concatenate([[0.0], np.cumsum(pieces)])
+        joints = edges[edges >= -UNIT_SLACK]
+        across = not np.isclose(joints, 0.0, atol=UNIT_SLACK).any()
+        repeated, closest = _score(joints, below)
+        return (repeated, across == (right > 0), sum(not _is_regular(x) for x in pieces),
+                closest)
+
+    return min(candidates, key=key) if candidates else (0.0, [2 * length])
 
 
 def _fill_course(rows, course, sequences, below, min_fill, miter):

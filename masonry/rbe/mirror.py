@@ -59,7 +59,8 @@ from masonry.rbe.boundary import Model
 from masonry.rbe.equilibrium import assemble
 from masonry.rbe.loads import CrownLoad, Lateral
 from masonry.rbe.solvers.residuals import rbe_residuals
-from masonry.tolerances import Tolerances
+from masonry.tolerances import (MIRROR_ANGLE_DEG, MIRROR_NORMAL_MISS, MIRROR_VOLUME_REL,
+                                Tolerances)
 
 MIRROR = np.diag([1.0, -1.0, 1.0])
 """The reflection in the xz-plane, the half's mirror plane."""
@@ -67,10 +68,6 @@ MIRROR = np.diag([1.0, -1.0, 1.0])
 DROPPED = np.array([False, True, False, True, False, True])
 """The rows a cut block drops, in the half's frame: the force along y, the moments about x
 and z (docs/model.md 6.2's row order)."""
-
-ANGLE_SLACK = 1e-9
-"""Degrees within which a load's azimuth counts as lying in a mirror plane."""
-
 
 class MirrorError(MasonryError, ValueError):
     """The model is not its own mirror image in the plane asked for (a block, an interface
@@ -199,7 +196,7 @@ def in_plane(azimuth_deg: float, mirrors) -> float | None:
     ``azimuth_deg``, or None."""
     for plane in mirrors:
         offset = (azimuth_deg - plane) % 180.0
-        if min(offset, 180.0 - offset) <= ANGLE_SLACK:
+        if min(offset, 180.0 - offset) <= MIRROR_ANGLE_DEG:
             return float(plane)
     return None
 
@@ -271,7 +268,8 @@ def _mirror_blocks(blocks: Blocks, tol) -> np.ndarray:
     centroid = blocks.block_centroid
     distance, image = cKDTree(centroid).query(centroid @ MIRROR)
     volume = blocks.block_volume
-    same = (distance <= tol) & np.isclose(volume[image], volume, rtol=1e-9, atol=0.0)
+    same = (distance <= tol) & np.isclose(volume[image], volume, rtol=MIRROR_VOLUME_REL,
+                                          atol=0.0)
     return np.where(same, image, -1)
 
 
@@ -431,7 +429,7 @@ class _Link:
         there = vertex[np.maximum(sources, 0)]
         normal = np.einsum("vsij,vsj->vsi", forces, itf.normal[there])
         miss = np.linalg.norm(normal - itf.normal[vertex][:, None], axis=2)
-        if (miss[sources >= 0] > 1e-6).any():
+        if (miss[sources >= 0] > MIRROR_NORMAL_MISS).any():
             self._fail("an interface does not face as its mirror image does")
         friction = frame[vertex][:, None].transpose(0, 1, 3, 2) @ forces @ frame[there]
         return np.where(sources >= 0, self.half_index[np.maximum(sources, 0)], -1), friction

@@ -25,7 +25,8 @@ line's zigzag between two mirror meridians, repeated about the dome: its rotatio
 Courses: the gaps between pattern bricks, and the plain rings, are filled by the rules
 of docs/model.md 4.4 (regular bricks of 4 units, fill-ins, joints staggered against the
 course below), measured at the ring's top inner edge; rings are periodic with the dome's
-symmetry, no mitres.
+symmetry and mirror-symmetric in the meridians every ``pi / N``, as the pattern is (it is
+turned so that longitude 0 is one of them), no mitres.
 
 Bricks as solids (convex, faces planar, shared exactly): a bed cone is replaced by its
 chord facets between the head joints of the bricks below it, so a brick's top is one
@@ -41,7 +42,7 @@ import numpy as np
 
 from masonry.blocks import (GROUND, blocks_from_hulls, concatenate,
                             hull_faces, rotation_z)
-from masonry.dome.courses import FILL, PAT, REG, Layout, fill_gap
+from masonry.dome.courses import FILL, PAT, REG, Layout, fill_ring
 from masonry.dome.levels import LevelTable, contact_angles, ellipse_point
 from masonry.dome.pattern import Pattern
 from masonry.errors import ParameterError
@@ -220,9 +221,12 @@ def ring_pattern(g: RevolutionDome) -> RingPattern:
         return RingPattern(np.zeros(0, int), np.zeros(0), np.zeros(0), np.zeros(0, bool),
                            np.zeros(0, int), nothing, nothing, order)
     line, nodes, ended, order = _zigzag(g, prof, spirals)
+    # turned so that the last lines' mirror meridian, a mirror of the whole pattern
+    # (those of the lines below are a finer lattice through it), is longitude 0
+    turn = line[-1][5]
     course, phi0, width, node_step, which = [], [], [], [], []
     for k, lo, hi, node, n, mirror in line:  # the line's brick's orbit on its course
-        turns = 2 * np.pi * np.arange(n) / n
+        turns = 2 * np.pi * np.arange(n) / n - turn
         starts = np.concatenate([lo + turns, 2 * mirror - hi + turns])
         course.append(np.full(2 * n, k))
         phi0.append(starts)
@@ -232,10 +236,10 @@ def ring_pattern(g: RevolutionDome) -> RingPattern:
     course, phi0 = np.concatenate(course), np.mod(np.concatenate(phi0), 2 * np.pi)
     order_ = np.lexsort((phi0, course))
     phi0 = phi0[order_]
+    nodes, ended = (np.array(at, float).reshape(-1, 2) - [0.0, turn] for at in (nodes, ended))
     return RingPattern(course[order_], phi0, phi0 + np.concatenate(width)[order_],
                        np.concatenate(node_step)[order_], np.concatenate(which)[order_],
-                       np.array(nodes, float).reshape(-1, 2),
-                       np.array(ended, float).reshape(-1, 2), order)
+                       nodes, ended, order)
 
 
 # --------------------------------------------------------------------------- courses
@@ -263,34 +267,6 @@ class Rings:
         return self.course + (self.klass == PAT)
 
 
-def _gaps(cells, start, period):
-    """The gaps ``(phi0, phi1)`` between the sorted cells ``(phi0, phi1)`` whose start lies
-    in ``[start, start + period)``, each up to the next cell (the first of the next
-    period after the last); one gap of a whole period from ``start`` without cells."""
-    inside = cells[(cells[:, 0] >= start - UNIT_SLACK) & (cells[:, 0] < start + period
-                                                           - UNIT_SLACK)]
-    if len(inside) == 0:
-        return [(start, start + period)]
-    following = np.concatenate([inside[1:, 0], [inside[0, 0] + period]])
-    return [(a, b) for a, b in zip(inside[:, 1], following) if b - a > UNIT_SLACK * period]
-
-
-def _fill_ring(k, gaps, below, scale, min_fill):
-    """The regular and fill-in bricks ``(phi0, phi1, class)`` of one period's ``gaps`` of
-    course ``k`` (``scale``: units per radian on it), chosen against the joints
-    ``below`` (longitudes), and how many are shorter than ``min_fill``."""
-    rows, short = [], 0
-    for a, b in gaps:
-        relative = np.mod(below - a + np.pi, 2 * np.pi) - np.pi
-        pieces, too_short = fill_gap(0.0, (b - a) * scale, relative * scale, min_fill)
-        short += too_short
-        edges = a + np.concatenate([[0.0], np.cumsum(pieces)]) / scale
-        edges[-1] = b
-        rows += [(p, q, REG if abs(length - 4.0) <= UNIT_SLACK else FILL)
-                 for p, q, length in zip(edges[:-1], edges[1:], pieces)]
-    return rows, short
-
-
 def _around(rows, period, count):
     """``rows`` ``(phi0, phi1, class)`` repeated ``count`` times by ``period``."""
     rows = np.array(rows, float).reshape(-1, 3)
@@ -303,8 +279,9 @@ def _around(rows, period, count):
 @functools.lru_cache(maxsize=16)
 def rings_of(g: RevolutionDome) -> Rings:
     """Lay every ring of the whole dome: the pattern bricks, then regular and fill-in
-    bricks in the gaps (docs/model.md 4.4), periodic with the dome's symmetry; a plain
-    ring starts every other course half a regular brick on."""
+    bricks in the gaps (docs/model.md 4.4, :func:`~masonry.dome.courses.fill_ring`),
+    periodic with the dome's symmetry ``N`` and mirror-symmetric in the meridians
+    ``j pi / N``, as the pattern is."""
     prof, pattern = profile_of(g), ring_pattern(g)
     count = pattern.symmetry
     period, start = 2 * np.pi / count, -np.pi / count
@@ -317,9 +294,11 @@ def rings_of(g: RevolutionDome) -> Rings:
         scale = prof.x[k] / g.unit
         here = (pattern.course == k) | (pattern.course == k - 1)
         cells = _cyclic_cells(pat[here], start)
-        offset = 0.0 if len(cells) or k % 2 else 2.0 / scale
-        fills, too_short = _fill_ring(k, _gaps(cells, start + offset, period), below, scale,
-                                      g.min_fill)
+        extents, too_short = fill_ring(cells * scale, period / 2 * scale, 2 * np.pi * scale,
+                                       below * scale, g.min_fill)
+        extents = np.array(extents, float).reshape(-1, 2) / scale
+        regular = np.abs(np.diff(extents, axis=1)[:, 0] * scale - 4.0) <= UNIT_SLACK
+        fills = np.column_stack([extents, np.where(regular, REG, FILL)])
         ring = _around(fills, period, count)
         rows.append(ring)
         courses.append(np.full(len(ring), k))
@@ -597,9 +576,9 @@ class Sector(SceneKind):
     @classmethod
     def symmetry(cls, geometry) -> Symmetry:
         """Rotations by the sector's angle; no mirror plane (docs/model.md 6.11): the
-        pattern is symmetric in its mirror meridians, but the fills between its bricks
-        are laid from left to right and a plain ring starts half a brick on, so the
-        joints, and the bed facets that follow the joints below, are not."""
+        dome is its own mirror image in its middle meridian, but a brick across one of
+        the sector's edges is the sector's and the one across the other its
+        neighbour's."""
         return Symmetry(order=ring_pattern(geometry).symmetry, unit=True)
 
     @classmethod
@@ -650,7 +629,11 @@ class Revolution(Sector):
 
     @classmethod
     def symmetry(cls, geometry) -> Symmetry:
-        return Symmetry(order=ring_pattern(geometry).symmetry, unit=False)
+        """Rotations by ``2 pi / N``; the meridian planes every ``pi / N``: the middle and
+        the edges of every sector (the rings are laid mirror-symmetric in them, as the
+        pattern is)."""
+        n = ring_pattern(geometry).symmetry
+        return Symmetry(order=n, unit=False, mirrors=tuple(180.0 * k / n for k in range(n)))
 
     @classmethod
     def describe(cls, boundary) -> str:
