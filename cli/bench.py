@@ -40,9 +40,11 @@ def register(subparsers):
                         help="runs per row; times are medians (default 3)")
     parser.add_argument("--collapse", action="store_true",
                         help="instead: the lateral collapse load factor at azimuth 0 of "
-                             "each preset's full dome against its balanced RBE solve, and "
-                             "the azimuth search (--lateral all) on a small dome against "
-                             "independent solves; writes DIR/bench_collapse/collapse.md")
+                             "each preset's full dome, and on its halves along a web's "
+                             "mid-plane and a corner plane, against its balanced RBE "
+                             "solve, and the azimuth search (--lateral all) on a small "
+                             "dome against independent solves; writes "
+                             "DIR/bench_collapse/collapse.md")
     parser.add_argument("--friction-models", dest="friction_models", nargs="*",
                         metavar="MODEL",
                         help="instead: each friction model (default: "
