@@ -18,7 +18,7 @@ from masonry.scenes.revolution import (PAT, RevolutionDome, _zigzag, default_spi
                                        rings_of)
 from masonry_cli.main import main
 
-SMALL = dict(radius=20, p=3, cut=0.3)  # 8 sectors of 11 bricks below, 609 bricks in all
+SMALL = dict(radius=20, p=3, cut=0.3)  # 12 sectors of 63 bricks, 756 bricks in all
 BED = INTERFACE_KINDS.index("horizontal")
 
 
