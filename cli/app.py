@@ -21,10 +21,12 @@ from masonry import __version__
 from masonry.errors import MasonryError
 from masonry.forking import use_one_blas_thread
 
-from . import analyze, arch_thickness, bench, build, run, stages, structures, sweep
+from . import (analyze, arch_thickness, bench, build, optimize, run, stages, structures,
+               sweep)
 from .options import Parser, describe_error, option_names, typed_values
 
-SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, bench, stages)
+SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, optimize, bench,
+               stages)
 
 
 class Terminated(KeyboardInterrupt):

@@ -1,9 +1,11 @@
 """``masonry sweep STUDY.toml``: a parameter study, serially or on a Dask cluster."""
 
+import dataclasses
 import logging
 import math
 import os
 import sys
+from contextlib import contextmanager
 from pathlib import Path
 
 from masonry.errors import ParameterError
@@ -27,16 +29,51 @@ def register(subparsers):
     parser.add_argument("study", metavar="STUDY.toml",
                         help="[base] fixed inputs, [grid] lists, optional [sample] ranges "
                              "with count and seed; inputs named as 'masonry run' options")
+    add_cluster_options(parser)
+    parser.set_defaults(handler=handle)
+
+
+def add_cluster_options(parser):
+    """Where the variants run and go: ``--workers``, ``--scheduler``, ``--out``, and the
+    verbosity options (sweeps and optimisations)."""
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                         help="local Dask worker processes (default: one per core); 1 runs "
                              "serially without Dask")
     parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786")
+                        help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (its "
+                             "workers must reach --out)")
     parser.add_argument("--out", default="exports", metavar="DIR",
-                        help="output root of the variants' run folders and of "
-                             "sweep_<study>/ with the summary (default exports)")
+                        help="output root of the variants' run folders and of the "
+                             "study's folder (default exports)")
     add_verbosity(parser)
-    parser.set_defaults(handler=handle)
+
+
+def resolve_cluster(args):
+    """``(workers, scheduler)`` from ``--workers`` and ``--scheduler``, checked; serially
+    (1, None), with a warning, when Dask is not installed. Dask loads here: call it once
+    the study is read.
+
+    Raises
+    ------
+    ParameterError
+        For ``--workers`` below 1 or a scheduler address Dask cannot parse.
+    """
+    workers, scheduler = args.workers, args.scheduler
+    if workers < 1:
+        raise ParameterError("workers", workers, "an integer >= 1")
+    if workers > 1 or scheduler:
+        try:
+            import dask.distributed  # noqa: F401
+        except ImportError:
+            log.warning("Dask is not installed: running serially. For workers or a "
+                        "cluster: pip install 'masonry[dask]'")
+            return 1, None
+    if scheduler is not None:
+        from masonry.studies.sweep import check_scheduler_address
+
+        check_scheduler_address(scheduler)
+    logging.getLogger("distributed").setLevel(logging.ERROR)  # cluster start and stop
+    return workers, scheduler
 
 
 def run_option_names() -> dict:
@@ -72,13 +109,16 @@ NOT_AN_INPUT = {
 """Why a study table refuses a run option that is not an input, by its destination."""
 
 
-TABLES = ("base", "grid", "sample", "outputs")
+TABLES = ("base", "grid", "sample", "outputs", "constraints")
 MAX_VARIANTS = 100_000
 """Largest study (grid points times samples): a study file asking for more is refused."""
 
 
-def load_study(path):
+def load_study(path, draws=True):
     """Read a study file; names are 'masonry run' options without their dashes.
+
+    ``draws``: the ``[sample]`` ranges are drawn ``count`` times (a sweep: ``count``
+    required with them); False for an optimisation, which searches them.
 
     Raises
     ------
@@ -99,6 +139,7 @@ def load_study(path):
             refuse(key, value, f"a table [{key}]")
     base, grid = dict(data.get("base", {})), dict(data.get("grid", {}))
     sample, outputs = dict(data.get("sample", {})), data.get("outputs", {})
+    constraints = _constraints(data.get("constraints", {}), where)
     preset = base.pop("preset", None)
     if preset is not None and str(preset) not in PRESETS:
         refuse("base.preset", preset, f"one of {', '.join(PRESETS)}")
@@ -119,10 +160,10 @@ def load_study(path):
                 and all(isinstance(b, (int, float)) and not isinstance(b, bool)
                         for b in bounds) and bounds[0] <= bounds[1]):
             refuse(f"sample.{key}", bounds, "[low, high], two numbers with low <= high")
-    if sample and count < 1:
+    if sample and count < 1 and draws:
         refuse("sample.count", count, f"an integer 1 to {MAX_VARIANTS}")
     size = math.prod(len(v) for v in grid.values()) * max(count, 1)
-    if size > MAX_VARIANTS:
+    if size > MAX_VARIANTS and draws:
         refuse("grid", f"{size} variants", f"at most {MAX_VARIANTS} variants")
     names = run_option_names()
     from masonry.studies.sweep import Study  # the pipeline: once the file is read
@@ -133,9 +174,54 @@ def load_study(path):
         grid=_fields(grid, "grid", names, where, lists=True),
         sample=_fields(sample, "sample", names, where), count=count, seed=seed,
         plots=outputs.get("plots", False), printable=outputs.get("printable", False),
-        html=outputs.get("html", False), **stages)
-    _check_variants(study, where)
+        html=outputs.get("html", False), constraints=constraints, **stages)
+    study = _checked_constraints(study, where)
+    _check_variants(study, where, None if draws else _search_probes(study))
     return study
+
+
+def _constraints(table, where) -> dict:
+    """``[constraints]``: result column -> ``[low, high]`` (TOML's ``inf`` for an open
+    end); the columns are checked against the study's (:func:`_check_constraints`)."""
+    out = {}
+    for key, bounds in table.items():
+        if not (isinstance(bounds, list) and len(bounds) == 2
+                and all(isinstance(b, (int, float)) and not isinstance(b, bool)
+                        for b in bounds) and bounds[0] <= bounds[1]):
+            raise ParameterError(f"constraints.{key}", bounds, "[low, high], two numbers "
+                                 "with low <= high (inf or -inf for an open end)",
+                                 where=where)
+        out[key] = list(bounds)
+    return out
+
+
+def _checked_constraints(study, where):
+    """``study`` with its constraints keyed by record key, once every constrained column
+    is one its summary has and that is a number, named as ``summary.csv`` names it
+    (:func:`~masonry.studies.sweep.measure_columns`: a study of stages has its stage
+    columns)."""
+    from masonry.studies.sweep import column_key, measure_columns
+
+    columns = measure_columns(study)
+    for key, bounds in study.constraints.items():
+        if key not in columns:
+            raise ParameterError(f"constraints.{key}", bounds, f"a result column of the "
+                                 f"summary, one of {', '.join(columns)}", where=where)
+    return dataclasses.replace(study, constraints={
+        column_key(key): bounds for key, bounds in study.constraints.items()})
+
+
+def _search_probes(study) -> list:
+    """Variants that try every choice and both ends of every range of a search space,
+    one input at a time (the others at their first choice or lower end), then every
+    input at its upper end: an optimisation cannot check its whole space beforehand."""
+    first = {**{k: v[0] for k, v in study.grid.items()},
+             **{k: b[0] for k, b in study.sample.items()}}
+    probes = [dict(first)]
+    for name, values in [*study.grid.items(), *study.sample.items()]:
+        probes += [{**first, name: value} for value in values[1:]]
+    probes.append({**first, **{k: b[1] for k, b in study.sample.items()}})
+    return [{**study.base, **probe} for probe in probes]
 
 
 def _stage_plans() -> dict:
@@ -181,13 +267,14 @@ def _stage_outputs(outputs, refuse) -> dict:
     return {"stages": by, "stages_course": course, "stages_order": order}
 
 
-def _check_variants(study, where):
-    """Every variant's inputs checked as ``masonry run`` (and for a study of stages
-    ``masonry stages``) checks them, before any runs: a value out of range names the
-    table and key it came from (of the inputs the check involves, a swept one first; one
-    the study leaves at its default says so); a plan by course or brick of a scene not
-    laid in courses names ``outputs.stages``."""
-    for inputs in study.variants():
+def _check_variants(study, where, variants=None):
+    """Every variant's inputs (or ``variants``) checked as ``masonry run`` (and for a
+    study of stages ``masonry stages``) checks them, before any runs: a value out of
+    range names the table and key it came from (the input refused, else the first other
+    input the check involves that the study gives; one the study leaves at its default
+    says so); a plan by course or brick of a scene not laid in courses names
+    ``outputs.stages``."""
+    for inputs in variants if variants is not None else study.variants():
         try:
             params = validate(Params.of(**inputs))
             if study.stages:  # what 'masonry stages' would refuse of the variant
@@ -197,15 +284,24 @@ def _check_variants(study, where):
                 stage_params(params, "boundary" in inputs)
         except ParameterError as error:
             names = (error.name, *error.related)
-            table, name = next(((t, n) for t in ("grid", "sample", "base") for n in names
+            table, name = next(((t, n) for n in names for t in ("grid", "sample", "base")
                                 if n in getattr(study, t)), (None, error.name))
-            key = name.replace("_", "-")
+            key = _option_of(name)
             raise ParameterError(f"{table}.{key}" if table else f"{key} (the default)",
                                  inputs.get(name, error.value), error.expected,
                                  where=where) from None
         if study.stages in ("course", "brick") and not params.kind.has_courses:
             raise ParameterError("outputs.stages", study.stages, f'"block": scene '
                                  f"{params.scene} is not laid in courses", where=where)
+
+
+def _option_of(field: str) -> str:
+    """The 'masonry run' option (without dashes) a study names a Params field by
+    (``arch_thickness`` -> ``thickness``)."""
+    options = {}
+    for option, (dest, _) in run_option_names().items():
+        options.setdefault(dest, option)
+    return options.get(field, field.replace("_", "-"))
 
 
 def _fields(table, name, names, where, lists=False) -> dict:
@@ -231,7 +327,8 @@ def _fields(table, name, names, where, lists=False) -> dict:
     return out
 
 
-def _progress(done, total, failed):
+def progress_bar(done, total, failed):
+    """One line on stderr, redrawn: the variants done of ``total``, and failed ones."""
     width = 30
     filled = int(width * done / max(total, 1))
     sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{total}"
@@ -239,41 +336,41 @@ def _progress(done, total, failed):
     sys.stderr.flush()
 
 
-def handle(args, report):
-    workers, scheduler = args.workers, args.scheduler
-    if workers < 1:
-        raise ParameterError("workers", workers, "an integer >= 1")
-    check_output_root(args.out)
-    study = load_study(args.study)
-    from masonry.studies.sweep import execute, publish_summary, summary_rows
-
-    total = len(study.variants())  # validates the study before any run
-    if workers > 1 or scheduler:
-        try:
-            import dask.distributed  # noqa: F401
-        except ImportError:
-            log.warning("Dask is not installed: running serially. For workers or a "
-                        "cluster: pip install 'masonry[dask]'")
-            workers, scheduler = 1, None
-    logging.getLogger("distributed").setLevel(logging.ERROR)  # cluster start and stop
-    # one display: on a terminal the bar replaces the variants' stage lines (warnings
-    # still show); --verbose shows the lines instead
-    show = sys.stderr.isatty() and not args.quiet and not args.verbose
-    results, failed = [], 0
+@contextmanager
+def quiet_progress(show: bool):
+    """While ``show`` (a progress bar on a terminal), the variants' stage lines are off:
+    the bar replaces them (warnings still show; --verbose shows the lines instead)."""
     library = logging.getLogger("masonry")
     level = library.level
     if show:
         library.setLevel(logging.WARNING)
     try:
-        for i, inputs, row in execute(study, args.out, workers, scheduler):
-            results.append((i, inputs, row))
-            failed += row["status"] == "failed"
-            if show:
-                _progress(len(results), total, failed)
+        yield
     finally:
         library.setLevel(level)
-        if show:
-            sys.stderr.write("\n")
+
+
+def handle(args, report):
+    if args.workers < 1:
+        raise ParameterError("workers", args.workers, "an integer >= 1")
+    check_output_root(args.out)
+    study = load_study(args.study)
+    from masonry.studies.sweep import execute, publish_summary, summary_rows
+
+    total = len(study.variants())  # validates the study before any run
+    workers, scheduler = resolve_cluster(args)
+    show = sys.stderr.isatty() and not args.quiet and not args.verbose
+    results, failed = [], 0
+    with quiet_progress(show):
+        try:
+            for i, inputs, row in execute(study, args.out, workers, scheduler):
+                results.append((i, inputs, row))
+                failed += row["status"] == "failed"
+                if show:
+                    progress_bar(len(results), total, failed)
+        finally:
+            if show:
+                sys.stderr.write("\n")
     rows = summary_rows(study, results)
     stem = Path(args.study).stem
     record = publish_summary(study, rows, args.out, f"sweep_{stem}", stem)

@@ -44,7 +44,8 @@ def test_version_loads_no_library(capsys):
 @pytest.mark.parametrize("argv", [
     ["run", "--mu", "-1"], ["run", "--scene", "arch", "--n", "5"], ["build", "--p", "0"],
     ["stages", "--support", "x"], ["analyze", "x.obj", "--support", "a", "--mu", "20"],
-    ["sweep", "missing.toml"], ["run", "--help"], ["--help"],
+    ["sweep", "missing.toml"], ["optimize", "missing.toml", "--maximize", "bricks"],
+    ["optimize", "--help"], ["run", "--help"], ["--help"],
 ])
 def test_a_refused_option_loads_no_solver_plot_or_exporter(tmp_path, argv):
     code, heavy, _ = loaded_by([*argv, "--out", str(tmp_path / "o")] if "--help" not in argv

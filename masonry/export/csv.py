@@ -18,10 +18,10 @@ INTEGER_COLUMNS = ("id", "rank", "brick", "block", "block_a", "block_b", "course
                    "course_a", "course_b", "vertex", "vertices", "stage", "bricks", "step",
                    "variant", "interfaces", "stages", "stages_standing",
                    "first_unsupported_stage", "first_unsupported_course",
-                   "first_unsupported_brick")
+                   "first_unsupported_brick", "trial")
 TEXT_COLUMNS = ("name", "name_a", "name_b", "class", "kind", "laid", "status", "error",
                 "friction_used", "friction_model", "structure_id")
-BOOLEAN_COLUMNS = ("feasible", "loose", "stands")
+BOOLEAN_COLUMNS = ("feasible", "loose", "stands", "constraints_met", "best")
 """The columns of masonry's CSV files that are not floats, by type: :func:`column_types`."""
 
 

@@ -3,7 +3,8 @@ pattern (:mod:`.pattern`), the structure views (:mod:`.structure`), the interfac
 coloured by their area and forces (:mod:`.forces`), the thrust line (:mod:`.thrust`),
 where the structure fails (:mod:`.failure`), the collapse mechanism
 (:mod:`.mechanism`) and its load factor by azimuth (:mod:`.azimuths`), and the
-construction stages (:mod:`.stages`). They share the views, the drawing helpers
+construction stages (:mod:`.stages`), and an optimisation's convergence
+(:mod:`.convergence`). They share the views, the drawing helpers
 (:mod:`.common`) and the colour scales (:mod:`.colours`).
 
 Every function returns PNG bytes or ``{relative path: png bytes}`` so the run folder
@@ -20,6 +21,7 @@ from masonry.plots.colours import (  # noqa: E402
     BAR_3D, COLOUR_PERCENTILE, DIVERGING, ONE_SIDED, SEQUENTIAL, colour_scale, force_unit)
 from masonry.plots.common import (  # noqa: E402
     ANGLE, CLASS_COLOURS, ELEVATIONS, HORIZONTAL_KINDS, NO_FILL, VIEWS)
+from masonry.plots.convergence import convergence_png  # noqa: E402
 from masonry.plots.failure import RANKED, failure_png  # noqa: E402
 from masonry.plots.forces import (  # noqa: E402
     FORCE_LABELS, FORCE_PLOTS, force_pngs, interface_pngs)
@@ -34,7 +36,7 @@ __all__ = [
     "ANGLE", "BAR_3D", "CLASS_COLOURS", "COLOUR_PERCENTILE", "DIVERGING", "ELEVATIONS",
     "FORCE_LABELS", "FORCE_PLOTS", "HINGE_ECCENTRICITY", "HORIZONTAL_KINDS", "MARK_DECADES",
     "MECHANISM_SCALE", "NO_FILL", "ONE_SIDED", "OUTLINE_COLOUR", "RANKED", "SEQUENTIAL",
-    "VIEWS", "azimuths_png", "colour_scale", "failure_png", "force_pngs", "force_unit",
-    "interface_pngs", "marked_structure_pngs", "mechanism_pngs", "pattern_png",
+    "VIEWS", "azimuths_png", "colour_scale", "convergence_png", "failure_png", "force_pngs",
+    "force_unit", "interface_pngs", "marked_structure_pngs", "mechanism_pngs", "pattern_png",
     "stage_chart_png", "structure_pngs", "thrust_line_png",
 ]

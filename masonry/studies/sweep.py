@@ -16,16 +16,18 @@ import io
 import itertools
 import json
 import logging
+import math
 import signal
 import time
 import traceback
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 
 from masonry.export._text import format_floats
-from masonry.export.csv import HEADERS, header
+from masonry.export.csv import HEADERS, TEXT_COLUMNS, header
 from masonry.errors import ParameterError
 from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run, versions
@@ -72,6 +74,44 @@ def stage_summary(record) -> dict:
             "stages_load_factor_min": stages["load_factor_min"]}
 
 
+STANDS_THROUGHOUT = ("first_unsupported_stage", "first_unsupported_course",
+                     "first_unsupported_brick")
+"""Stage columns left empty when every stage stands; as a measure they are then
+infinite (:func:`measure`): no stage needs support."""
+
+
+def measure(row: dict, column: str):
+    """A result column of a variant's row as a number, for an optimisation: a boolean as
+    0 or 1; a column of :data:`STANDS_THROUGHOUT` as infinity when every stage stands;
+    None when the variant failed or the column is empty."""
+    if row.get("status") == "failed":
+        return None
+    value = row.get(column)
+    if value is not None:
+        return float(value)
+    stands = row.get("stages") is not None and row.get("stages_standing") == row["stages"]
+    return math.inf if column in STANDS_THROUGHOUT and stands else None
+
+
+def result_columns(study) -> list:
+    """The summary's result columns for ``study`` (record keys): its columns after the
+    swept inputs (:attr:`Study.columns`)."""
+    return study.columns[len(study.swept):]
+
+
+def measure_columns(study) -> list:
+    """The result columns an optimisation may maximise, minimise or bound, as
+    ``summary.csv`` names them (:func:`~masonry.export.csv.header`): every result column
+    but the labels (the variant, its status and error, names) and ``constraints_met``."""
+    labels = {"variant", "constraints_met", *TEXT_COLUMNS}
+    return header([c for c in result_columns(study) if c not in labels])
+
+
+def column_key(name: str) -> str:
+    """The record key of a ``summary.csv`` column (``moi_N`` -> ``moi``)."""
+    return {column: key for key, column in HEADERS.items()}.get(name, name)
+
+
 @dataclass(frozen=True)
 class Study:
     """A parameter study over a run's inputs (:func:`masonry.params.names`).
@@ -97,6 +137,10 @@ class Study:
         The course a brick plan lays brick by brick.
     stages_order : str or None
         The laying order of a brick or block plan (its default when None).
+    constraints : dict of (low, high)
+        Bounds on result columns (record keys of :func:`measure_columns`) a variant must
+        meet to count as a solution of an optimisation; a sweep reports them as
+        ``constraints_met``.
     """
 
     base: dict
@@ -111,6 +155,7 @@ class Study:
     stages: str | None = None
     stages_course: int | None = None
     stages_order: str | None = None
+    constraints: dict = dataclasses.field(default_factory=dict)
 
     @property
     def swept(self) -> list:
@@ -119,10 +164,12 @@ class Study:
 
     @property
     def columns(self) -> list:
-        """The summary's columns: the swept inputs, :data:`SUMMARY_COLUMNS`, and
-        :data:`STAGE_SUMMARY_COLUMNS` for a study of stages."""
+        """The summary's columns: the swept inputs, :data:`SUMMARY_COLUMNS`,
+        :data:`STAGE_SUMMARY_COLUMNS` for a study of stages, and ``constraints_met`` for
+        a study with constraints (:meth:`meets`)."""
         return self.swept + list(SUMMARY_COLUMNS) + list(
-            STAGE_SUMMARY_COLUMNS if self.stages else ())
+            STAGE_SUMMARY_COLUMNS if self.stages else ()) + (
+            ["constraints_met"] if self.constraints else [])
 
     def options(self) -> dict:
         """:func:`run_variant`'s keyword arguments: what each variant does and writes."""
@@ -171,6 +218,22 @@ class Study:
                         draw[name] = float(f"{rng.uniform(low, high):.10g}")
                 draws.append(draw)
         return [{**self.base, **point, **draw} for point in points for draw in draws]
+
+    def violations(self, row: dict) -> dict:
+        """How far a variant's result ``row`` lies outside each of :attr:`constraints`:
+        column -> 0 when met, the distance to the nearer bound when not (in the column's
+        unit), None when the column has no value (:func:`measure`: the variant failed or
+        has no such value)."""
+        out = {}
+        for column, (low, high) in self.constraints.items():
+            value = measure(row, column)
+            out[column] = None if value is None else max(low - value, value - high, 0.0)
+        return out
+
+    def meets(self, row: dict) -> bool:
+        """Whether a variant's result ``row`` meets every constraint (an empty column
+        does not)."""
+        return all(v == 0.0 for v in self.violations(row).values())
 
 
 def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=False,
@@ -292,6 +355,97 @@ def check_scheduler_address(address: str) -> None:
                              f"one of {', '.join(backends)})")
 
 
+class Runner:
+    """Where variants run: in this process, on a local Dask cluster or on a running Dask
+    scheduler. A context manager: the cluster or client lives until the block ends.
+
+    Parameters
+    ----------
+    out_root : str or Path
+        Where every variant's run folder goes (a folder every worker reaches).
+    options : dict
+        :func:`run_variant`'s keyword arguments (:meth:`Study.options`).
+    workers : int
+        1 and no ``scheduler``: serially, in this process. More: on a Dask
+        ``LocalCluster`` of ``workers`` single-threaded processes (which ignore Ctrl-C:
+        this process stops them).
+    scheduler : str, optional
+        The address of a running Dask scheduler (``tcp://host:port``), used instead of a
+        local cluster. A worker lost while it runs a variant (killed, its machine gone) is
+        no failure: the scheduler runs the variant again on another worker.
+
+    Raises
+    ------
+    ParameterError
+        Named ``scheduler`` (on entry) when no Dask scheduler answers at that address.
+    """
+
+    def __init__(self, out_root, options: dict, workers=1, scheduler=None):
+        self.out_root, self.options = str(out_root), dict(options)
+        self.workers, self.scheduler = workers, scheduler
+        self.client = self.cluster = None
+
+    def __enter__(self):
+        if self.workers == 1 and self.scheduler is None:
+            return self
+        from dask.distributed import Client, LocalCluster
+
+        if self.scheduler is None:
+            # the scheduler's HTTP routes move to another port when 8787 is taken
+            with _children_ignore_ctrl_c(), warnings.catch_warnings():
+                warnings.filterwarnings("ignore", message="Port .* is already in use")
+                self.cluster = LocalCluster(
+                    n_workers=self.workers, threads_per_worker=1, processes=True,
+                    host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR)
+        try:
+            self.client = Client(self.cluster if self.cluster is not None
+                                 else self.scheduler)
+        except (OSError, ValueError, TypeError) as error:  # no scheduler there
+            if self.cluster is not None:
+                self.cluster.close()
+                raise
+            raise ParameterError("scheduler", self.scheduler, f"the address of a running "
+                                 f"Dask scheduler ({error})") from None
+        return self
+
+    def __exit__(self, *exc):
+        if self.client is not None:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+        return False
+
+    def map(self, variants: list):
+        """Run ``variants`` (dicts of inputs); yield ``(index, row)`` as each finishes,
+        ``row`` as :func:`run_variant` returns it (a variant whose workers all died is a
+        failed row)."""
+        if self.client is None:
+            for i, inputs in enumerate(variants):
+                yield i, run_variant(inputs, self.out_root, **self.options)
+            return
+        from dask.distributed import as_completed
+
+        # the first variant of each geometry builds it; the others of its group wait for
+        # it and reuse the cached geometry instead of building it again in parallel
+        first, futures = {}, {}
+        for i, inputs in enumerate(variants):
+            key, group = f"variant-{i}-{time.time_ns()}", geometry_group(inputs)
+            if group in first:
+                future = self.client.submit(run_after, first[group], inputs, self.out_root,
+                                            **self.options, key=key, pure=False)
+            else:
+                future = first[group] = self.client.submit(
+                    run_variant, inputs, self.out_root, **self.options, key=key, pure=False)
+            futures[future] = i
+        for future in as_completed(futures):
+            try:
+                row = future.result()
+            except Exception as error:  # the workers died (KilledWorker) or were lost
+                row = {"status": "failed", "error": f"{type(error).__name__}: {error}",
+                       "time_s": None}
+            yield futures[future], row
+
+
 def execute(study: Study, out_root, workers=1, scheduler=None):
     """Run every variant; yield ``(index, inputs, row)`` as each finishes.
 
@@ -300,13 +454,8 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
     study : Study
     out_root : str or Path
         Where every variant's run folder goes.
-    workers : int
-        1 and no ``scheduler``: serially, in this process. More: on a Dask
-        ``LocalCluster`` of ``workers`` single-threaded processes (which ignore Ctrl-C:
-        this process stops them).
-    scheduler : str, optional
-        The address of a running Dask scheduler (``tcp://host:port``), used instead of a
-        local cluster.
+    workers, scheduler
+        Where the variants run (:class:`Runner`).
 
     Yields
     ------
@@ -327,52 +476,9 @@ def execute(study: Study, out_root, workers=1, scheduler=None):
     variants = study.variants()
     if scheduler is not None:
         check_scheduler_address(scheduler)
-    options = study.options()
-    if workers == 1 and scheduler is None:
-        for i, inputs in enumerate(variants):
-            yield i, inputs, run_variant(inputs, str(out_root), **options)
-        return
-    from dask.distributed import Client, LocalCluster, as_completed
-
-    cluster = None
-    if scheduler is None:
-        with _children_ignore_ctrl_c():
-            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                   host="127.0.0.1", dashboard_address=None,
-                                   silence_logs=logging.ERROR)
-    try:
-        client = Client(cluster if cluster is not None else scheduler)
-    except (OSError, ValueError, TypeError) as error:  # no scheduler there
-        if cluster is not None:
-            cluster.close()
-            raise
-        raise ParameterError("scheduler", scheduler, f"the address of a running Dask "
-                                                     f"scheduler ({error})") from None
-    try:
-        # the first variant of each geometry builds it; the others of its group wait for
-        # it and reuse the cached geometry instead of building it again in parallel
-        first, futures = {}, {}
-        for i, inputs in enumerate(variants):
-            key, group = f"variant-{i}-{time.time_ns()}", geometry_group(inputs)
-            if group in first:
-                future = client.submit(run_after, first[group], inputs, str(out_root),
-                                       **options, key=key, pure=False)
-            else:
-                future = first[group] = client.submit(run_variant, inputs, str(out_root),
-                                                      **options, key=key, pure=False)
-            futures[future] = i
-        for future in as_completed(futures):
-            i = futures[future]
-            try:
-                row = future.result()
-            except Exception as error:  # the worker died (KilledWorker) or was lost
-                row = {"status": "failed", "error": f"{type(error).__name__}: {error}",
-                       "time_s": None}
+    with Runner(out_root, study.options(), workers, scheduler) as runner:
+        for i, row in runner.map(variants):
             yield i, variants[i], row
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 @contextmanager
@@ -408,17 +514,20 @@ def summary_rows(study: Study, results) -> list:
     """
     rows = []
     for i, inputs, row in sorted(results, key=lambda r: r[0]):
+        if study.constraints:
+            row = {**row, "constraints_met": study.meets(row)}
         rows.append({**{k: inputs.get(k) for k in study.swept}, "variant": i,
-                     **{k: row.get(k) for k in study.columns[len(study.swept):]
-                        if k != "variant"}})
+                     **{k: row.get(k) for k in result_columns(study) if k != "variant"}})
     return rows
 
 
-def summary_csv(study: Study, rows) -> bytes:
-    """CSV (UTF-8 bytes) of :func:`summary_rows`: its columns (``study.columns``); floats as every CSV of the project prints them
-    (:func:`~masonry.export._text.format_floats`: 12 digits, every digit of a sampled
-    input and of its run folder's name), None as an empty cell."""
-    columns = study.columns
+def summary_csv(study: Study, rows, columns=None) -> bytes:
+    """CSV (UTF-8 bytes) of :func:`summary_rows`: its columns (``study.columns``, or
+    ``columns``), named with their units (:func:`~masonry.export.csv.header`); floats as
+    every CSV of the project prints them (:func:`~masonry.export._text.format_floats`:
+    12 digits, every digit of a sampled input and of its run folder's name), None as an
+    empty cell."""
+    columns = columns or study.columns
     texts = []
     for c in columns:
         values = [row.get(c) for row in rows]
