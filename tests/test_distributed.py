@@ -166,3 +166,4 @@ def test_a_worker_killed_mid_study_loses_nothing(cluster, serial, tmp_path):
         assert [r["status"] for r in csv.DictReader(f)] == ["reused"] * 8
     assert _results(tmp_path) == expected
     assert not [p for p in tmp_path.iterdir() if ".tmp-" in p.name]
+
