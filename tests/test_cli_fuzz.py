@@ -144,20 +144,21 @@ def test_other_commands_mistakes(tmp_path, args):
     assert_clean(argv, out, code, err, files=["missing.obj"])
 
 
+@pytest.mark.parametrize("command", [["sweep"], ["optimize", "--maximize", "bricks"]])
 @pytest.mark.parametrize("address", ["foo://bar", "nonsense"])
-def test_a_bad_scheduler_address(tmp_path, address):
+def test_a_bad_scheduler_address(tmp_path, address, command):
     pytest.importorskip("dask.distributed")
     study = tmp_path / "study.toml"
     study.write_text("[grid]\nmu = [0.7]\n")
     out = tmp_path / "out"
-    argv = ["sweep", str(study), "--scheduler", address, "--out", str(out)]
+    argv = [command[0], str(study), *command[1:], "--scheduler", address, "--out", str(out)]
     code, _, err = call(argv)
     assert code == 2 and "running Dask scheduler" in err, err
     assert_clean(argv, out, code, err)
 
 
-@pytest.mark.parametrize("command", ["run", "build", "structures", "sweep", "bench",
-                                     "arch-thickness", "stages"])
+@pytest.mark.parametrize("command", ["run", "build", "structures", "sweep", "optimize",
+                                     "bench", "arch-thickness", "stages"])
 @pytest.mark.parametrize("where", ["file", "under_file", "proc", "empty", "long_name"])
 def test_output_locations(tmp_path, command, where):
     a_file = tmp_path / "a_file"
@@ -166,7 +167,8 @@ def test_output_locations(tmp_path, command, where):
     study.write_text("[grid]\nmu = [0.7]\n")
     out = {"file": a_file, "under_file": a_file / "sub", "proc": "/proc/masonry",
            "empty": "", "long_name": tmp_path / ("a" * 300)}[where]
-    head = {"sweep": ["sweep", str(study)], "bench": ["bench", "--repeats", "1"]}
+    head = {"sweep": ["sweep", str(study)], "bench": ["bench", "--repeats", "1"],
+            "optimize": ["optimize", str(study), "--maximize", "bricks"]}
     argv = [*head.get(command, [command]), "--out", str(out), "-q"]
     code, _, err = call(argv)
     assert code == 2 and err.startswith("masonry: error: --out ")
