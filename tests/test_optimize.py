@@ -185,3 +185,16 @@ def test_a_column_empty_when_every_stage_stands_measures_infinite():
     assert measure(stands, "load_factor") is None and measure(stands, "feasible") == 1.0
     assert measure({**stands, "stages_standing": 10}, "first_unsupported_course") is None
     assert measure({**stands, "status": "failed"}, "feasible") is None
+
+
+def test_columns_are_named_as_summary_csv_names_them(tmp_path):
+    from masonry.studies.optimize import Search
+
+    from masonry_cli.sweep import load_study
+
+    path = tmp_path / "named.toml"
+    path.write_text(ARCHES + "[constraints]\nmoi_N = [0, 1e6]\n")
+    study = load_study(path, draws=False)
+    assert study.constraints == {"moi": [0, 1e6]}
+    search = Search(study, (("moi_N", "minimize"), ("bricks", "maximize"))).checked()
+    assert search.objectives == (("moi", "minimize"), ("bricks", "maximize"))
