@@ -570,4 +570,12 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
                 for relative, data in export.files.items():
                     folder.write(relative, data)
             if export.record is not None:
-                record[exporter.name] = export.record
+                _merge(record, exporter.key, export.record)
+
+
+def _merge(record: dict, key: str, part: dict):
+    """``part`` into ``record[key]``, dict entries of both merged (two exporters' records
+    under one key)."""
+    held = record.setdefault(key, {})
+    for name, value in part.items():
+        held[name] = {**held[name], **value} if isinstance(held.get(name), dict) else value

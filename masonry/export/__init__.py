@@ -18,6 +18,7 @@ from masonry.export import csv, html, obj, rhino, stl, summaries, threemf, vtu
 from masonry.printable import printable_blocks, printable_body
 from masonry.rbe.equilibrium import VariableLayout
 from masonry.rbe.resultants import interface_resultants
+from masonry.tolerances import TENSION_REPORTED_REL
 
 log = logging.getLogger(__name__)
 
@@ -106,6 +107,9 @@ class Exporter:
         Made in a second process while the others are made and written (a long
         exporter that neither needs nor changes what the others make): see
         :func:`masonry.pipeline.write_exports`.
+    record_key : str
+        The run.json key of its record when not its name; exporters that share one
+        merge their records' entries.
     """
 
     name: str
@@ -113,6 +117,12 @@ class Exporter:
     make: Callable
     wanted: Callable = field(default=lambda made: True)
     aside: bool = False
+    record_key: str = ""
+
+    @property
+    def key(self) -> str:
+        """The run.json key of its record."""
+        return self.record_key or self.name
 
 
 def _model_files(made: RunOutputs) -> Export:
@@ -257,6 +267,14 @@ def _mechanism_plots(made: RunOutputs) -> dict:
     return files
 
 
+def _figures(pngs: dict) -> Export:
+    """The figures of ``pngs`` (path -> PNG bytes, or the reason (str) a figure was left
+    out); run.json's ``figures.skipped`` names those left out and why."""
+    files = {path: png for path, png in pngs.items() if not isinstance(png, str)}
+    skipped = {path: why for path, why in pngs.items() if isinstance(why, str)}
+    return Export(files, {"skipped": skipped} if skipped else None)
+
+
 def _plot_files(made: RunOutputs) -> Export:
     """The model's plots: pattern, structure, interfaces (and a collapse mechanism)."""
     # matplotlib takes most of a second to import: a run without plots never does
@@ -266,10 +284,10 @@ def _plot_files(made: RunOutputs) -> Export:
     files = {}
     if scene.layout is not None:
         files["00_pattern.png"] = plots.pattern_png(scene, fast, title)
-    files.update(plots.structure_pngs(scene, fast, title, made.webs))
+    files.update(plots.structure_pngs(scene, fast, title, made.webs, model.interfaces))
     files.update(plots.interface_pngs(model.blocks, model.interfaces, fast, title))
     files.update(_mechanism_plots(made))
-    return Export(files)
+    return _figures(files)
 
 
 def _force_plot_files(made: RunOutputs) -> Export:
@@ -278,7 +296,7 @@ def _force_plot_files(made: RunOutputs) -> Export:
 
     scene, model, fast, title = made.scene, made.model, made.outputs.quick, made.figure_title
     pngs = plots.force_pngs(model.blocks, model.interfaces, made.forces, fast, title,
-                            made.webs)
+                            made.webs, noise=TENSION_REPORTED_REL * made.result.weight_N)
     files = {f"RBE/{name}": png for name, png in pngs.items()}
     section = scene.kind.thrust_section(scene)
     if section is not None:
@@ -290,7 +308,7 @@ def _force_plot_files(made: RunOutputs) -> Export:
     if len(top):
         files["RBE/where_it_fails.png"] = plots.failure_png(
             model.blocks, model.interfaces, top, made.forces, fast, title)
-    return Export(files)
+    return _figures(files)
 
 
 EXPORTERS = (
@@ -307,8 +325,9 @@ EXPORTERS = (
     # the model's plots beside the 3DM file in the second process, the forces' here: the
     # two take about as long
     Exporter("plots", "plots", _plot_files, wanted=lambda made: made.outputs.plots,
-             aside=True),
+             aside=True, record_key="figures"),
     Exporter("force_plots", "plots", _force_plot_files,
-             wanted=lambda made: made.outputs.plots and made.forces is not None),
+             wanted=lambda made: made.outputs.plots and made.forces is not None,
+             record_key="figures"),
 )
 """Every exporter, in the order a run writes them."""

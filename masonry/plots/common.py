@@ -13,16 +13,19 @@ import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.collections import PolyCollection
+from matplotlib.transforms import ScaledTranslation
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from masonry.blocks import CLASS_COLOURS  # noqa: F401 (the figures' name for it)
 from masonry.interfaces import INTERFACE_KINDS
+from masonry.plots.faces import AWAY, facing
 
 # the thesis's four views (section 3.4): a 3D view from an angle (elevation, azimuth in
 # degrees) and three elevations, drawn as 2D projections at equal scale (3D axes seen
 # end on pile their tick labels up): (horizontal axis, vertical axis, depth axis, +1 when
 # a larger depth coordinate is nearer the viewer)
 VIEWS = ("01_angle", "02_front", "03_top", "04_side")
+ANGLE_VIEW = VIEWS[0]
 ANGLE = (25, -50)
 ELEVATIONS = {"02_front": (1, 2, 0, 1), "03_top": (0, 1, 2, 1), "04_side": (0, 2, 1, -1)}
 
@@ -40,6 +43,41 @@ def png_bytes(fig, dpi) -> bytes:
     fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
     plt.close(fig)
     return buf.getvalue()
+
+
+EDGE_ON = (0.25, 0.1)
+"""An elevation is left out when the model's extents in its plane make less than the
+first fraction of the largest elevation's area, or its shorter side less than the
+second fraction of its longer side: it would show the model edge on (an arch's or a
+wall's thickness) or as a sliver. The largest elevation always stays."""
+
+
+def views_of(bounds, fast=False) -> list:
+    """The views that show a model of ``bounds`` ((2, 3) float, metres): the 3D view and
+    the elevations that are not edge on (:data:`EDGE_ON`); the 3D view only when
+    ``fast``."""
+    if fast:
+        return [ANGLE_VIEW]
+    extent = np.ptp(np.asarray(bounds, dtype=float), axis=0)
+    plane = {view: extent[[h, v]] for view, (h, v, _, _) in ELEVATIONS.items()}
+    area = {view: float(np.prod(sides)) for view, sides in plane.items()}
+    largest = max(area, key=area.get)
+    kept = [view for view in ELEVATIONS if view == largest or (
+        area[view] >= EDGE_ON[0] * area[largest]
+        and plane[view].min() >= EDGE_ON[1] * plane[view].max())]
+    return [ANGLE_VIEW, *kept]
+
+
+def legend_below(fig, ax, handles, ncol=3, fontsize=7):
+    """``handles``' legend under the axes, clear of the model and of the tick labels (an
+    elevation's 0.45 inch down, below its x label), centred."""
+    if not handles:
+        return None
+    drop = 0.0 if hasattr(ax, "get_zlim") else -0.45  # 3D axes hold their labels
+    below = ax.transAxes + ScaledTranslation(0, drop, fig.dpi_scale_trans)
+    return ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0),
+                     bbox_transform=below, ncol=min(ncol, len(handles)),
+                     fontsize=fontsize, frameon=False)
 
 
 def view_axes(bounds, view):
@@ -85,10 +123,35 @@ def axes_3d(bounds):
     return fig, ax
 
 
+def toward_viewer(view) -> np.ndarray:
+    """(3,) the unit direction from the model toward ``view``'s camera: an elevation's
+    depth axis, the 3D view's from :data:`ANGLE` (its box is at equal scale, so the
+    direction in data coordinates is the box's)."""
+    if view in ELEVATIONS:
+        _, _, depth, sign = ELEVATIONS[view]
+        return sign * np.eye(3)[depth]
+    elevation, azimuth = np.radians(ANGLE)
+    return np.array([np.cos(elevation) * np.cos(azimuth),
+                     np.cos(elevation) * np.sin(azimuth), np.sin(elevation)])
+
+
+def visible_faces(blocks, mask, view, hidden=None) -> np.ndarray:
+    """The faces of the blocks of ``mask`` ((B,) bool) that ``view`` can show: not
+    ``hidden`` ((F,) bool, :func:`~masonry.plots.faces.hidden_faces`) and turned toward
+    its camera (a 3D view's within :data:`~masonry.plots.faces.AWAY`)."""
+    keep = np.asarray(mask, bool)[blocks.face_block]
+    if hidden is not None:
+        keep &= ~hidden
+    keep &= facing(blocks.face_normal, toward_viewer(view),
+                   1e-9 if view in ELEVATIONS else AWAY)
+    return np.flatnonzero(keep)
+
+
 def add_polygons(ax, view, polygons, facecolors, edgecolors="face", linewidths=0.3):
-    """Draw ``polygons`` (list of (m, 3) float, metres) in ``view``: 3D, or projected
-    onto an elevation's plane, farthest first."""
-    polygons = list(polygons)
+    """Draw ``polygons`` ((n, m, 3) float, metres, :func:`~masonry.plots.faces.padded`)
+    in ``view``: one 3D collection, or projected onto an elevation's plane, farthest
+    first, as one 2D collection."""
+    polygons = np.asarray(polygons, dtype=float).reshape(-1, *np.shape(polygons)[-2:])
     faces = np.broadcast_to(matplotlib.colors.to_rgba_array(facecolors),
                             (len(polygons), 4))
     edges = faces if isinstance(edgecolors, str) and edgecolors == "face" else edgecolors
@@ -97,11 +160,11 @@ def add_polygons(ax, view, polygons, facecolors, edgecolors="face", linewidths=0
                                              linewidths=linewidths))
         return
     h, v, depth, sign = ELEVATIONS[view]
-    order = np.argsort([sign * p[:, depth].mean() for p in polygons], kind="stable")
+    order = np.argsort(sign * polygons[:, :, depth].mean(axis=1), kind="stable")
     if not isinstance(edges, str):
         edges = np.broadcast_to(matplotlib.colors.to_rgba_array(edges),
                                 (len(polygons), 4))[order]
-    ax.add_collection(PolyCollection([polygons[i][:, [h, v]] for i in order],
+    ax.add_collection(PolyCollection(polygons[order][:, :, [h, v]],
                                      facecolors=faces[order], edgecolors=edges,
                                      linewidths=linewidths))
 
@@ -137,8 +200,3 @@ def draw_outline(ax, view, scene):
                  color="b", linewidth=1)
     add_line(ax, view, [[levels.x[0], -levels.y[0], 0.0], [levels.x[0], levels.y[0], 0.0]],
              color="b", linewidth=1)
-
-
-def interface_polygons(interfaces, index) -> list:
-    """The polygons ((m, 3) float, metres) of the interfaces ``index``."""
-    return [interfaces.polygon(k) for k in index]

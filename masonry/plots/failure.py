@@ -5,7 +5,8 @@ import matplotlib
 import numpy as np
 
 from masonry.plots.colours import BAR_3D, force_unit
-from masonry.plots.common import add_polygons, axes_3d, interface_polygons, png_bytes
+from masonry.plots.common import add_polygons, axes_3d, png_bytes
+from masonry.plots.faces import interface_array
 
 RANKED = 10
 """The interfaces of largest tension numbered in ``where_it_fails.png``."""
@@ -33,14 +34,14 @@ def failure_png(blocks, interfaces, top, forces, fast=False, title="") -> bytes:
     first :data:`RANKED` numbered by their rank (neighbours share a label); ``title`` is the
     line under the figure's own."""
     fig, ax = axes_3d(blocks.bounds)
-    add_polygons(ax, "01_angle", interface_polygons(interfaces, range(len(interfaces))),
+    add_polygons(ax, "01_angle", interface_array(interfaces, np.arange(len(interfaces))),
                  (0.6, 0.6, 0.6, 0.2), edgecolors="none")
     tension = np.asarray(forces["tension"], dtype=float)[top]
     factor, unit = force_unit(tension.max())
     norm = matplotlib.colors.Normalize(0, tension.max() * factor)
     cmap = matplotlib.colormaps["inferno_r"]
     colours = cmap(norm(tension * factor))
-    add_polygons(ax, "01_angle", interface_polygons(interfaces, top), colours, linewidths=1.0)
+    add_polygons(ax, "01_angle", interface_array(interfaces, top), colours, linewidths=1.0)
     for ranks, at in _rank_labels(interfaces.centre[top[:RANKED]], blocks.bounds):
         # above the polygons (mplot3d orders collections by depth after the texts)
         ax.text(*at, ranks, fontsize=7, color="k", zorder=1e3,

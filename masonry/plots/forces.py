@@ -1,13 +1,16 @@
 """Interfaces drawn as polygons coloured by one value each: their area (thesis figures
-3.12-3.13) and the forces they carry (figures 4.1-4.8), in the four views; for a cyclic
-section also the whole dome, the section's forces rotated into every web."""
+3.12-3.13) and the forces they carry (figures 4.1-4.8), in the views of the model's
+extent; for a cyclic section also the whole dome, the section's forces rotated into
+every web. A force no interface carries beyond the solver's noise has no figure: the
+returned dict maps it to the reason instead."""
 
 import numpy as np
 
 from masonry.blocks import concatenate, rotated_web, rotation_z
 from masonry.plots.colours import colour_bar, colour_scale
-from masonry.plots.common import (HORIZONTAL_KINDS, VIEWS, add_polygons, axes_3d,
-                                  interface_polygons, png_bytes, view_axes)
+from masonry.plots.common import (HORIZONTAL_KINDS, add_polygons, axes_3d, png_bytes,
+                                  view_axes, views_of)
+from masonry.plots.faces import interface_array
 
 
 def _interface_linewidth(count: int) -> float:
@@ -16,20 +19,26 @@ def _interface_linewidth(count: int) -> float:
     return float(np.clip(12.0 / np.sqrt(max(count, 1)), 0.3, 3.0))
 
 
-def _colour_plot(blocks, interfaces, index, values, title, view, fast, quantity,
-                 signed=False, is_force=True, subtitle="", unit=""):
-    """One view of the interfaces ``index`` coloured by ``values`` (SI units, or ``unit``
-    for values that are not forces)."""
-    fig, ax = view_axes(blocks.bounds, view)
+def _colour_plot(bounds, polygons, values, title, view, fast, quantity, signed=False,
+                 is_force=True, subtitle="", unit=""):
+    """One view of the interfaces ``polygons`` ((n, m, 3), :func:`interface_array`)
+    coloured by ``values`` (SI units, or ``unit`` for values that are not forces)."""
+    fig, ax = view_axes(bounds, view)
     scale = colour_scale(values, signed, is_force, unit)
     shown = np.asarray(values, dtype=float) * scale["factor"]
     colours = scale["cmap"](scale["norm"](shown))
     # edges in the face colour: interfaces seen edge on stay visible as coloured lines
-    add_polygons(ax, view, interface_polygons(interfaces, index), colours,
-                 linewidths=_interface_linewidth(len(index)))
+    add_polygons(ax, view, polygons, colours, linewidths=_interface_linewidth(len(polygons)))
     colour_bar(fig, ax, scale, quantity)
-    ax.set_title(f"{title} ({len(index)} interfaces)\n{subtitle}", fontsize=9)
+    ax.set_title(f"{title} ({len(polygons)} interfaces)\n{subtitle}", fontsize=9)
     return png_bytes(fig, 60 if fast else 110)
+
+
+def _groups(interfaces) -> dict:
+    """{selection: interface ids}: bed joints with the supports, head joints, all."""
+    horizontal = np.isin(interfaces.kind, HORIZONTAL_KINDS)
+    return {"horizontal": np.flatnonzero(horizontal), "vertical": np.flatnonzero(~horizontal),
+            "all": np.arange(len(interfaces))}
 
 
 def interface_pngs(blocks, interfaces, fast=False, title="") -> dict:
@@ -37,17 +46,15 @@ def interface_pngs(blocks, interfaces, fast=False, title="") -> dict:
     coloured by area; a group without interfaces has no plot. ``title`` is the line under
     each figure's own."""
     out = {}
-    views = ["01_angle"] if fast else VIEWS
-    horizontal = np.isin(interfaces.kind, HORIZONTAL_KINDS)
-    groups = {"interfaces_horizontal": np.flatnonzero(horizontal),
-              "interfaces_vertical": np.flatnonzero(~horizontal)}
-    for view in views:
+    groups = {f"interfaces_{name}": index
+              for name, index in list(_groups(interfaces).items())[:2] if len(index)}
+    polygons = {name: interface_array(interfaces, index) for name, index in groups.items()}
+    for view in views_of(blocks.bounds, fast):
         for name, index in groups.items():
-            if len(index):
-                out[f"{view}/{name}.png"] = _colour_plot(
-                    blocks, interfaces, index, interfaces.area[index] * 1e4,
-                    name.replace("_", " "), view, fast, "area", is_force=False,
-                    subtitle=title, unit="cm^2")
+            out[f"{view}/{name}.png"] = _colour_plot(
+                blocks.bounds, polygons[name], interfaces.area[index] * 1e4,
+                name.replace("_", " "), view, fast, "area", is_force=False, subtitle=title,
+                unit="cm^2")
     return out
 
 
@@ -68,40 +75,61 @@ FORCE_LABELS = {"compression": "compression", "tension": "tension",
 """Colour bar labels of the force sums (each interface's sum over its vertices)."""
 
 
-def force_pngs(blocks, interfaces, forces: dict, fast=False, title="", webs=None) -> dict:
-    """Force plots (sums over each interface's vertices), per view
+def _noise(values, noise) -> str | None:
+    """Why ``values`` (N) make no figure: every one within ``noise`` N of zero (the
+    solver's rounding, or none at all); None when some are beyond it."""
+    largest = float(np.abs(values).max(initial=0.0))
+    if largest > noise:
+        return None
+    return (f"nothing to show: the largest is {largest:.2g} N, within the solver's noise "
+            f"({noise:.2g} N)")
+
+
+def force_pngs(blocks, interfaces, forces: dict, fast=False, title="", webs=None,
+               noise=0.0) -> dict:
+    """Force plots (sums over each interface's vertices), per view of the model's extent
     (``<view>/<name>.png``); with ``webs`` (a section that stands for the whole dome of
     ``webs`` webs) also the whole dome (``05_dome/<name>.png``). A selection without
-    interfaces has no plot. ``title`` is the line under each figure's own."""
-    horizontal = np.isin(interfaces.kind, HORIZONTAL_KINDS)
-    select = {"horizontal": np.flatnonzero(horizontal),
-              "vertical": np.flatnonzero(~horizontal),
-              "all": np.arange(len(interfaces))}
-    out = {}
-    views = ["01_angle"] if fast else VIEWS
-    for view in views:
-        for name, key, group, heading, signed in FORCE_PLOTS:
-            index = select[group]
-            if len(index):
-                out[f"{view}/{name}.png"] = _colour_plot(
-                    blocks, interfaces, index, np.asarray(forces[key])[index], heading, view,
-                    fast, FORCE_LABELS[key], signed, subtitle=title)
+    interfaces has no plot; one whose forces all lie within ``noise`` newtons of zero
+    maps ``*/<name>.png`` to the reason instead. ``title`` is the line under each
+    figure's own."""
+    select = _groups(interfaces)
+    out, drawn = {}, []
+    for name, key, group, heading, signed in FORCE_PLOTS:
+        values = np.asarray(forces[key], dtype=float)[select[group]]
+        if len(values):
+            reason = _noise(values, noise)
+            if reason is None:
+                drawn.append((name, key, interface_array(interfaces, select[group]), values,
+                              heading, signed))
+            else:
+                out[f"*/{name}.png"] = f"{heading}: {reason}"
+    for view in views_of(blocks.bounds, fast):
+        for name, key, polygons, values, heading, signed in drawn:
+            out[f"{view}/{name}.png"] = _colour_plot(
+                blocks.bounds, polygons, values, heading, view, fast, FORCE_LABELS[key],
+                signed, subtitle=title)
     if webs:
-        out.update(_whole_dome_pngs(blocks, interfaces, forces, fast, title, webs))
+        out.update(_whole_dome_pngs(blocks, interfaces, forces, fast, title, webs, noise))
     return out
 
 
-def _whole_dome_pngs(blocks, interfaces, forces, fast, title, n) -> dict:
+def _whole_dome_pngs(blocks, interfaces, forces, fast, title, n, noise) -> dict:
     """Normal force and tension on the whole dome: the section's interfaces (its boundary
     interfaces with the next web included) rotated ``n`` times, each copy with the
-    section's forces (exact under the cyclic symmetry of docs/model.md 6.4)."""
-    polygons = [interfaces.polygon(k) @ rotation_z(2 * np.pi * w / n).T
-                for w in range(n) for k in range(len(interfaces))]
+    section's forces (exact under the cyclic symmetry of docs/model.md 6.4); tension within
+    ``noise`` has no figure."""
+    section = interface_array(interfaces, np.arange(len(interfaces)))
+    polygons = np.concatenate([section @ rotation_z(2 * np.pi * w / n).T for w in range(n)])
     whole = concatenate([rotated_web(blocks, w, n) for w in range(n)])
     out = {}
     for name, heading, signed in (("normal", "normal force (tension +)", True),
                                   ("tension", "tension", False)):
         values = np.tile(np.asarray(forces[name], dtype=float), n)
+        reason = _noise(values, noise)
+        if reason is not None:
+            out[f"05_dome/{name}.png"] = f"{heading}: {reason}"
+            continue
         fig, ax = axes_3d(whole.bounds)
         scale = colour_scale(values, signed)
         colours = scale["cmap"](scale["norm"](values * scale["factor"]))

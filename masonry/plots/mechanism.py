@@ -5,11 +5,11 @@ load's direction."""
 import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
-from matplotlib.transforms import ScaledTranslation
 
 from masonry.plots.colours import colour_bar, colour_scale
-from masonry.plots.common import (ELEVATIONS, NO_FILL, VIEWS, add_points, add_polygons,
-                                  interface_polygons, png_bytes, view_axes)
+from masonry.plots.common import (ELEVATIONS, NO_FILL, add_points, add_polygons,
+                                  legend_below, png_bytes, view_axes, views_of)
+from masonry.plots.faces import face_array, interface_array, padded
 from masonry.rbe.collapse_result import vertex_displacements
 from masonry.tolerances import MECHANISM_MAIN
 
@@ -28,9 +28,8 @@ def _mechanism_faces(blocks, mechanism):
     per_block = np.zeros(blocks.n_blocks)
     np.maximum.at(per_block, owner, np.linalg.norm(displacement, axis=1))
     faces = np.flatnonzero(~np.asarray(blocks.block_is_support)[blocks.face_block])
-    starts, ends = blocks.face_offsets[faces], blocks.face_offsets[faces + 1]
-    undeformed = [blocks.vertices[blocks.face_vertices[a:b]] for a, b in zip(starts, ends)]
-    deformed = [moved[blocks.face_vertices[a:b]] for a, b in zip(starts, ends)]
+    undeformed = face_array(blocks, faces)
+    deformed = padded(moved[blocks.face_vertices], blocks.face_offsets, faces)
     bounds = np.array([np.minimum(blocks.bounds[0], moved.min(axis=0)),
                        np.maximum(blocks.bounds[1], moved.max(axis=0))])
     return undeformed, deformed, per_block[blocks.face_block[faces]], bounds
@@ -81,20 +80,10 @@ def _joint_handles(collapse) -> list:
     return handles
 
 
-def _legend(fig, ax, view, handles):
-    """The legend: below an elevation (which fills its axes), inside a 3D view."""
-    if view in ELEVATIONS:
-        # 0.45 inch below the axes, clear of the tick labels at any aspect
-        below = ax.transAxes + ScaledTranslation(0, -0.45, fig.dpi_scale_trans)
-        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0),
-                  bbox_transform=below, ncol=3, fontsize=7, frameon=False)
-    else:
-        ax.legend(handles=handles, loc="upper left", fontsize=7)
-
-
 def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="") -> dict:
-    """The collapse mechanism (docs/model.md 6.9) drawn exaggerated over the undeformed structure,
-    in the four views (``collapse/<view>_mechanism.png``; one view when ``fast``):
+    """The collapse mechanism (docs/model.md 6.9) drawn exaggerated over the undeformed
+    structure, in the views of its extent (``collapse/<view>_mechanism.png``; one view
+    when ``fast``; :func:`~masonry.plots.common.views_of`):
     displaced blocks coloured by their largest vertex displacement, the undeformed ones as
     grey outlines, the hinges and sliding joints that carry the mechanism
     (:data:`~masonry.tolerances.MECHANISM_MAIN`) filled red and outlined blue, at their
@@ -114,12 +103,12 @@ def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="")
     scale = colour_scale(value, signed=False, is_force=False)
     colours = scale["cmap"](scale["norm"](value))
     handles = _joint_handles(collapse)
-    joints = [(interface_polygons(interfaces, np.flatnonzero(mask)), face, edge, width)
+    joints = [(interface_array(interfaces, np.flatnonzero(mask)), face, edge, width)
               for mask, face, edge, width in ((collapse.main_slides, NO_FILL, "blue", 0.6),
                                               (collapse.main_hinge, "red", "red", 0.8))
               if mask.any()]
     out = {}
-    for view in ["01_angle"] if fast else list(VIEWS):
+    for view in views_of(bounds, fast):
         fig, ax = view_axes(bounds, view)
         if view not in ELEVATIONS:
             ax.computed_zorder = False  # in the order drawn: the joints on top
@@ -130,7 +119,7 @@ def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="")
         shown = handles + (_live_load_marks(ax, view, blocks, collapse.live, bounds)
                            if collapse.live is not None else [])
         colour_bar(fig, ax, scale, "virtual displacement (largest = 1)")
-        _legend(fig, ax, view, shown)
+        legend_below(fig, ax, shown)
         ax.set_title(f"{title}; displacement drawn at {MECHANISM_SCALE:g} x size\n"
                      f"{subtitle}", fontsize=9)
         out[f"collapse/{view}_mechanism.png"] = png_bytes(fig, 60 if fast else 110)

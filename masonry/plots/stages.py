@@ -11,8 +11,10 @@ from matplotlib.ticker import MaxNLocator
 
 from masonry.blocks import BLOCK_CLASSES
 from masonry.plots.colours import BAR_3D
-from masonry.plots.common import (CLASS_COLOURS, ELEVATIONS, NO_FILL, VIEWS, add_points,
-                                  add_polygons, draw_outline, png_bytes, view_axes)
+from masonry.plots.common import (CLASS_COLOURS, ELEVATIONS, NO_FILL, add_points,
+                                  add_polygons, draw_outline, legend_below, png_bytes,
+                                  view_axes, views_of, visible_faces)
+from masonry.plots.faces import face_array
 
 OUTLINE_COLOUR = "#ff00ff"
 """Edge colour of the outlined blocks of :func:`marked_structure_pngs`."""
@@ -31,51 +33,51 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
     :data:`MARK_DECADES` decades, in their class colours below it; the blocks of
     ``is_outlined`` ((B,) bool, e.g. the ones just laid) with thick :data:`OUTLINE_COLOUR`
     edges and a ring (legend ``outline_label``); the rest of the scene's blocks as faint
-    outlines. ``{view}.png`` per view, one view at lower resolution when ``fast``;
+    outlines. ``{view}.png`` per view of its extent, one view at lower resolution when
+    ``fast``;
     ``title`` and ``subtitle`` are the figure's title and the line under it."""
     blocks = scene.blocks
     owner = blocks.face_block
-    shown = np.flatnonzero(is_present[owner])
-    ghost = np.flatnonzero(~is_present[owner] & ~blocks.block_is_support[owner])
     top = max(float(np.max(value[is_present], initial=0.0)), 1e-300)
     norm = LogNorm(top * 10.0**-MARK_DECADES, top)
     cmap = plt.get_cmap("viridis_r")
-    face_value = value[owner[shown]]
-    is_marked = face_value >= norm.vmin
-    face_colours = np.array([to_rgba(CLASS_COLOURS[BLOCK_CLASSES[k]])
-                             for k in blocks.block_class[owner[shown]]])
-    face_colours[is_marked] = cmap(norm(face_value[is_marked]))
+    colours = np.array([to_rgba(CLASS_COLOURS[BLOCK_CLASSES[k]]) for k in blocks.block_class])
+    is_marked = value >= norm.vmin
+    colours[is_marked] = cmap(norm(value[is_marked]))
+    is_marked &= is_present
+    outlined = (np.zeros(blocks.n_blocks, bool) if is_outlined is None
+                else is_outlined & is_present)
     out = {}
-    for view in ["01_angle"] if fast else list(VIEWS):
+    for view in views_of(blocks.bounds, fast):
         fig, ax = view_axes(blocks.bounds, view)
         if view not in ELEVATIONS:
             ax.computed_zorder = False  # draw in the order below: the rings on top
         draw_outline(ax, view, scene)
-        if len(ghost):
-            add_polygons(ax, view, [blocks.face_polygon(f) for f in ghost], NO_FILL,
-                         edgecolors="0.87", linewidths=0.1)
-        add_polygons(ax, view, [blocks.face_polygon(f) for f in shown], face_colours,
+        ghost = visible_faces(blocks, ~is_present & ~blocks.block_is_support, view)
+        add_polygons(ax, view, face_array(blocks, ghost), NO_FILL, edgecolors="0.87",
+                     linewidths=0.1)
+        shown = visible_faces(blocks, is_present, view)
+        add_polygons(ax, view, face_array(blocks, shown), colours[owner[shown]],
                      edgecolors="k", linewidths=0.1)
         handles = [Patch(facecolor="none", edgecolor="0.7", label="not yet laid")]
-        if is_outlined is not None and is_outlined.any():
-            edged = np.flatnonzero(is_outlined[owner] & is_present[owner])
-            add_polygons(ax, view, [blocks.face_polygon(f) for f in edged], NO_FILL,
+        if outlined.any():
+            edged = visible_faces(blocks, outlined, view)
+            add_polygons(ax, view, face_array(blocks, edged), NO_FILL,
                          edgecolors=OUTLINE_COLOUR, linewidths=2.0)
             # a ring around each, so that a single brick shows at any scale
-            centre = blocks.block_centroid[is_outlined & is_present]
-            add_points(ax, view, centre, s=160, facecolors="none",
+            add_points(ax, view, blocks.block_centroid[outlined], s=160, facecolors="none",
                        edgecolors=OUTLINE_COLOUR, linewidths=1.5)
             handles.append(Line2D([], [], color=OUTLINE_COLOUR, marker="o", markersize=9,
                                   fillstyle="none", linewidth=2, label=outline_label))
         if is_marked.any():
-            below = bool(((face_value > 0) & ~is_marked).any())
+            below = bool(((value > 0) & ~is_marked & is_present).any())
             bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
                                extend="min" if below else "neither",
                                **(BAR_3D if view not in ELEVATIONS else dict(pad=0.05)))
             bar.set_label(value_label)
             handles.append(Patch(facecolor=CLASS_COLOURS["regular"], edgecolor="k",
                                  label="laid, below the scale (class colours)"))
-        ax.legend(handles=handles, loc="upper left", fontsize=8)
+        legend_below(fig, ax, handles, fontsize=8)
         ax.set_title(f"{title}\n{subtitle}", fontsize=9)
         out[f"{view}.png"] = png_bytes(fig, 60 if fast else 110)
     return out
