@@ -405,7 +405,17 @@ def summary(record, report):
     report(f"{record['structure_id']}: {what}, {interfaces} interfaces, "
            f"weight {record['weight_N']:.4g} N")
     pattern_note(record, report)
+    figures_note(record, report)
     report(f"{state}: {record['path']}")
+
+
+def figures_note(record, report):
+    """The line naming the figures a run left out because they would show nothing (an
+    all-zero tension, solver noise, one web's outline in a whole dome's frame)."""
+    skipped = (record.get("figures") or {}).get("skipped") or {}
+    if skipped:
+        report(f"figures left out, nothing to show: {', '.join(skipped)} (why: run.json "
+               f"figures.skipped)")
 
 
 def pattern_note(record, report):

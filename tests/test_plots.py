@@ -7,7 +7,7 @@ import pytest
 from masonry.export.csv import tension_top
 from masonry.pipeline import build_model
 from masonry.params import Params, from_preset, validate
-from masonry.plots import (COLOUR_PERCENTILE, azimuths_png, colour_scale, force_unit,
+from masonry.plots import (COLOUR_PERCENTILE, VIEWS, azimuths_png, colour_scale, force_unit,
                            mechanism_pngs)
 from masonry.plots.failure import _rank_labels
 from masonry.scenes import build
@@ -129,9 +129,10 @@ def test_mechanism_plots_are_written_in_the_views_of_the_model(load):
             else point_loads(model.blocks, specs[load]))
     result = collapse_load(model, live, mu=0.9, density=DENSITY)
     pngs = mechanism_pngs(model.blocks, model.interfaces, result, "column")
-    # the ground slab, 2 m square and 0.1 m thick, sets the extent: its top view and
-    # the 3D view (its elevations are edge on)
-    assert sorted(pngs) == [f"collapse/{v}_mechanism.png" for v in ("01_angle", "03_top")]
+    # the ground slab, 2 m square and 0.1 m thick, sets the extent: the 3D view and the
+    # top at least (an elevation only where the mechanism lifts the blocks enough)
+    assert {"collapse/01_angle_mechanism.png", "collapse/03_top_mechanism.png"} <= set(pngs)
+    assert {f"collapse/{view}_mechanism.png" for view in VIEWS} >= set(pngs)
     assert all(png.startswith(b"\x89PNG") for png in pngs.values())
 
 

@@ -9,7 +9,8 @@ from masonry.plots.common import png_bytes
 
 def azimuths_png(collapse, title="") -> bytes:
     """``collapse/azimuths.png``: the lateral load factor against the load's azimuth
-    (``--lateral all``) on polar axes, the worst marked; ``title`` is the line under the
+    (``--lateral all``) on polar axes, the worst marked, the radius from a little below
+    the smallest factor (the title says where); ``title`` is the line under the
     figure's own."""
     angle = np.array([a for a, _ in collapse.azimuths])
     factor = np.array([np.nan if f is None else f for _, f in collapse.azimuths])
@@ -21,9 +22,15 @@ def azimuths_png(collapse, title="") -> bytes:
     worst = np.radians(collapse.azimuth_deg)
     ax.plot([worst], [collapse.load_factor], "o", color="#d62728", markersize=8,
             label=f"worst: {collapse.load_factor:.4g} at {collapse.azimuth_deg:g} deg")
-    ax.set_ylim(0, 1.1 * np.nanmax(factor))
+    # the radius starts below the smallest factor: from 0, factors within a few per
+    # cent of each other would look like a circle
+    low, high = np.nanmin(factor), np.nanmax(factor)
+    margin = max(0.25 * (high - low), 0.02 * high)
+    start = max(0.0, low - margin)
+    ax.set_ylim(start, high + 0.5 * margin)
     ax.set_rlabel_position(100)
     ax.legend(loc="lower center", bbox_to_anchor=(0.5, -0.15), fontsize=8, frameon=False)
     ax.set_title(f"lateral load factor against the load's azimuth (from +x toward +y)\n"
+                 f"{'' if start == 0 else f'the radius from {start:.3g}, not 0; '}"
                  f"{title}", fontsize=9, pad=20)
     return png_bytes(fig, 110)

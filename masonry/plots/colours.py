@@ -11,9 +11,16 @@ import matplotlib
 import numpy as np
 from mpl_toolkits.axes_grid1 import make_axes_locatable
 
-BAR_3D = dict(shrink=0.6, pad=0.16)
-"""A colour bar beside a 3D box (which sits inside its axes): shorter, and far enough
-out to clear the z axis's label."""
+BAR_3D = dict(shrink=0.6, pad=0.16, anchor=(0.0, 0.4))
+"""A colour bar beside a 3D box (which sits inside its axes) of a 7 inch tall figure:
+shorter, a little low (clear of the title), and far enough out to clear the z axis's
+label (:func:`bar_3d`)."""
+
+
+def bar_3d(fig) -> dict:
+    """:data:`BAR_3D` for ``fig``: as long as in a 7 inch tall figure in a taller one (the
+    box does not grow with it)."""
+    return {**BAR_3D, "shrink": BAR_3D["shrink"] * min(1.0, 7.0 / fig.get_figheight())}
 
 COLOUR_PERCENTILE = 99.0
 """Colour scales end at this percentile of the plotted magnitudes: a few support values
@@ -92,7 +99,7 @@ def colour_bar(fig, ax, scale, quantity):
     saying where the scale is clipped."""
     mappable = matplotlib.cm.ScalarMappable(norm=scale["norm"], cmap=scale["cmap"])
     if hasattr(ax, "get_zlim"):  # a 3D box sits inside its axes: a shorter bar
-        bar = fig.colorbar(mappable, ax=ax, extend=scale["extend"], **BAR_3D)
+        bar = fig.colorbar(mappable, ax=ax, extend=scale["extend"], **bar_3d(fig))
     else:  # as tall as the equal-scale plot
         cax = make_axes_locatable(ax).append_axes("right", size="4%", pad=0.12)
         bar = fig.colorbar(mappable, cax=cax, extend=scale["extend"])

@@ -95,13 +95,27 @@ def view_axes(bounds, view):
     return fig, ax
 
 
+def _figure_size_3d(extent) -> tuple:
+    """(width, height) inches of a 3D figure whose box has ``extent`` (3,) seen from
+    :data:`ANGLE`: about 7 x 7 in area, in the proportions of the box as drawn (a tall
+    section in a square figure leaves half of it empty), within 0.6 to 1.6."""
+    elevation, azimuth = np.radians(ANGLE)
+    right = np.array([-np.sin(azimuth), np.cos(azimuth), 0.0])
+    up = np.cross(toward_viewer(ANGLE_VIEW), right)
+    corners = np.array(np.meshgrid(*[[0.0, e] for e in extent])).reshape(3, -1).T
+    wide, tall = np.ptp(corners @ right), np.ptp(corners @ up)
+    ratio = float(np.clip(np.sqrt(tall / wide), np.sqrt(0.6), np.sqrt(1.6)))
+    return 7.0 / ratio, 7.0 * ratio
+
+
 def axes_3d(bounds):
-    """3D axes from :data:`ANGLE` on ``bounds`` at equal scale in x, y and z."""
-    fig = plt.figure(figsize=(7, 7))
-    ax = fig.add_subplot(projection="3d")
+    """3D axes from :data:`ANGLE` on ``bounds`` at equal scale in x, y and z, in a
+    figure of the box's proportions."""
     # the box follows the extents (a cube around a flat dome leaves half the figure
     # empty); very thin extents are widened so the box stays readable
     extent = np.maximum(bounds[1] - bounds[0], 0.15 * (bounds[1] - bounds[0]).max())
+    fig = plt.figure(figsize=_figure_size_3d(extent))
+    ax = fig.add_subplot(projection="3d")
     centre = bounds.mean(axis=0)
     low, high = centre - extent / 2, centre + extent / 2
     ax.set_xlim(low[0], high[0])

@@ -10,7 +10,7 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import MaxNLocator
 
 from masonry.blocks import BLOCK_CLASSES
-from masonry.plots.colours import BAR_3D
+from masonry.plots.colours import bar_3d
 from masonry.plots.common import (CLASS_COLOURS, ELEVATIONS, NO_FILL, add_points,
                                   add_polygons, draw_outline, legend_below, png_bytes,
                                   view_axes, views_of, visible_faces)
@@ -54,7 +54,7 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
             ax.computed_zorder = False  # draw in the order below: the rings on top
         draw_outline(ax, view, scene)
         ghost = visible_faces(blocks, ~is_present & ~blocks.block_is_support, view)
-        add_polygons(ax, view, face_array(blocks, ghost), NO_FILL, edgecolors="0.87",
+        add_polygons(ax, view, face_array(blocks, ghost), NO_FILL, edgecolors="0.8",
                      linewidths=0.1)
         shown = visible_faces(blocks, is_present, view)
         add_polygons(ax, view, face_array(blocks, shown), colours[owner[shown]],
@@ -73,7 +73,7 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
             below = bool(((value > 0) & ~is_marked & is_present).any())
             bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax,
                                extend="min" if below else "neither",
-                               **(BAR_3D if view not in ELEVATIONS else dict(pad=0.05)))
+                               **(bar_3d(fig) if view not in ELEVATIONS else dict(pad=0.05)))
             bar.set_label(value_label)
             handles.append(Patch(facecolor=CLASS_COLOURS["regular"], edgecolor="k",
                                  label="laid, below the scale (class colours)"))

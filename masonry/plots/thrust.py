@@ -1,6 +1,7 @@
 """The thrust line: where the resultant of every bed joint that crosses the structure's
 mid-plane acts, drawn in that plane over the joints, hinges and joints that would need
-tension marked."""
+tension marked. A line joins the points only along a chain of joints (one column of
+blocks); a joint with no neighbour in its column is a point alone."""
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -59,6 +60,46 @@ def _joint_segments(section, interfaces, index):
     return segments
 
 
+def chains(pairs) -> list:
+    """The runs of consecutive joints that form a chain: each joint shares a block with
+    the next (one column of bricks, the block above a joint the one below the next).
+
+    Parameters
+    ----------
+    pairs : (n, 2) int
+        The blocks of each joint, in order along the section.
+
+    Returns
+    -------
+    list of (k,) int
+        Positions into ``pairs``, every joint in exactly one run, in order; a joint that
+        shares no block with its neighbours is a run of one.
+    """
+    pairs = np.asarray(pairs).reshape(-1, 2)
+    if len(pairs) == 0:
+        return []
+    linked = [bool(set(a) & set(b)) for a, b in zip(pairs[:-1], pairs[1:])]
+    breaks = np.flatnonzero(~np.array(linked, dtype=bool)) + 1
+    return np.split(np.arange(len(pairs)), breaks)
+
+
+def _draw_points(ax, point, runs) -> int:
+    """The resultants' points, joined by a line along each chain of joints
+    (:func:`chains`), alone (hollow) where a joint is in none; returns how many are
+    alone."""
+    alone = np.concatenate([run for run in runs if len(run) == 1] or [np.zeros(0, int)])
+    line = dict(color="#c0392b", markersize=2.5, linewidth=1.2)
+    for k, run in enumerate(run for run in runs if len(run) > 1):
+        ax.plot(point[run, 0], point[run, 2], "-o", **line,
+                label="point of application of the resultant (thrust line)" if k == 0
+                else None)
+    if len(alone):
+        ax.plot(point[alone, 0], point[alone, 2], "D", markerfacecolor="none",
+                markeredgecolor="#c0392b", markersize=4, linestyle="none",
+                label="a joint's resultant, not in a chain of joints (no line)")
+    return len(alone)
+
+
 def thrust_line_png(interfaces, resultants, section, fast=False, title=""):
     """The thrust line: the resultants' points of application on the bed joints that
     cross the structure's mid-plane (an arch's plane; a dome web's meridian section at
@@ -88,8 +129,7 @@ def thrust_line_png(interfaces, resultants, section, fast=False, title=""):
         ax.plot(segments[:, end, 0], segments[:, end, 1], color="0.3", linewidth=0.6)
     ax.plot([], [], color="0.55", label="bed joints and their ends (mid-plane section)")
     point = resultants["point"][index]
-    ax.plot(point[:, 0], point[:, 2], "-o", color="#c0392b", markersize=2.5, linewidth=1.2,
-            label="point of application of the resultant (thrust line)")
+    alone = _draw_points(ax, point, chains(interfaces.pair[index]))
     e = resultants["eccentricity"][index]
     hinge = (e >= HINGE_ECCENTRICITY) & (e <= 1 + 1e-6)
     outside = e > 1 + 1e-6
@@ -103,7 +143,8 @@ def thrust_line_png(interfaces, resultants, section, fast=False, title=""):
     ax.set_xlabel("x [m]")
     ax.set_ylabel("z [m]")
     fig.legend(loc="outside lower center", fontsize=7, frameon=False)
+    chained = f", {alone} not in a chain" if alone else ""
     ax.set_title(f"thrust line under self-weight through {len(index)} bed joints at "
-                 f"{section.name}: {_count(hinge.sum(), 'hinge')}, "
+                 f"{section.name}{chained}: {_count(hinge.sum(), 'hinge')}, "
                  f"{int(outside.sum())} outside\n{title}", fontsize=9)
     return png_bytes(fig, 80 if fast else 150)

@@ -602,7 +602,8 @@ def summary_pngs(study: Study, rows, label="") -> dict:
     for name in study.swept:
         others = [other for other in study.swept if other != name]
         group = others[0] if others else None
-        fig, (top, bottom) = plt.subplots(2, 1, figsize=(6, 6), sharex=True)
+        fig, (top, bottom) = plt.subplots(2, 1, figsize=(6, 6), sharex=True,
+                                          gridspec_kw={"height_ratios": [3, 1]})
         x = [r[name] for r in done]
         # numbers on a numeric axis; anything else (names, lists of point loads, numbers
         # too large to place) one tick per value
@@ -628,6 +629,7 @@ def summary_pngs(study: Study, rows, label="") -> dict:
             top.legend(fontsize=7, frameon=False)
         top.set_ylabel("MoI factor")
         bottom.set_yticks([0, 1], ["infeasible", "feasible"])
+        bottom.set_ylim(-0.5, 1.5)  # the markers inside the strip, not cut at its edges
         bottom.set_xlabel(name)
         if labels is not None:
             bottom.set_xticks(range(len(labels)), labels)

@@ -1,0 +1,187 @@
+"""Figures, by their layout, not their pixels: legends clear of the model, the views of
+a model's extent, panels with nothing to show left out and named, the faces drawn, the
+thrust line's chains, the azimuths' radius."""
+
+from types import SimpleNamespace
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib.collections import PolyCollection
+from matplotlib.transforms import Bbox
+
+from cli.options import figures_note
+from masonry.export import RunOutputs, _force_plot_files
+from masonry.params import Params, from_preset, validate
+from masonry.pipeline import build_model, run, solve, Timer
+from masonry.plots import azimuths, common, mechanism, stages, structure
+from masonry.plots.common import views_of
+from masonry.plots.faces import hidden_faces
+from masonry.plots.forces import force_pngs
+from masonry.plots.thrust import chains
+from masonry.rbe.collapse import collapse_load
+from masonry.rbe.loads import lateral
+from test_collapse import DENSITY, column
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The figures the plot modules make, drawn and kept open instead of turned into
+    PNG bytes."""
+    kept = []
+
+    def keep(fig, dpi):
+        fig.canvas.draw()
+        kept.append(fig)
+        return b"\x89PNG kept"
+
+    for module in (structure, mechanism, stages, azimuths):
+        monkeypatch.setattr(module, "png_bytes", keep)
+    yield kept
+    plt.close("all")
+
+
+def _model(**inputs):
+    params = validate(Params.of(**inputs))
+    scene, model = build_model(params)
+    return params, scene, model
+
+
+def _data_extent(ax) -> Bbox:
+    """Where the axes' collections (the blocks, joints; a 3D one as last projected) are
+    drawn, display units."""
+    points = np.concatenate([c.get_transform().transform(path.vertices)
+                             for c in ax.collections if isinstance(c, PolyCollection)
+                             for path in c.get_paths()])
+    points = points[np.isfinite(points).all(axis=1)]
+    return Bbox([points.min(axis=0), points.max(axis=0)])
+
+
+def _legends_clear(fig):
+    """Every legend of ``fig`` lies clear of its axes' drawn model."""
+    checked = 0
+    for ax in fig.axes:
+        legend = ax.get_legend()
+        if legend is not None and ax.collections:
+            assert not legend.get_window_extent().overlaps(_data_extent(ax))
+            checked += 1
+    return checked
+
+
+def test_structure_legends_stay_clear_of_the_blocks(figures):
+    _, scene, model = _model(**{**from_preset("3").record(), "p": 4})
+    pngs = structure.structure_pngs(scene, interfaces=model.interfaces)
+    # every figure but the boundaries' (no blocks, no legend)
+    assert sum(_legends_clear(fig) for fig in figures) == len(figures) - 4 > 4
+    assert len(figures) == len(pngs)
+
+
+def test_mechanism_and_stage_legends_stay_clear_of_the_blocks(figures):
+    model = column(3, (0.3, 0.3, 0.4))
+    result = collapse_load(model, lateral(model, 0.0, DENSITY), mu=0.9, density=DENSITY)
+    mechanism.mechanism_pngs(model.blocks, model.interfaces, result, "column")
+    _, scene, _ = _model(scene="arch")
+    laid = scene.blocks.block_centroid[:, 2] < 2.0
+    stages.marked_structure_pngs(scene, laid, laid * 100.0, "stage",
+                                 is_outlined=laid & (scene.blocks.block_centroid[:, 2] > 1))
+    assert sum(_legends_clear(fig) for fig in figures) == len(figures) >= 4
+
+
+@pytest.mark.parametrize("inputs, shown", [
+    (dict(scene="arch"), ["01_angle", "04_side"]),  # the arch in x-z
+    (dict(scene="wall"), ["01_angle", "02_front"]),  # the wall in y-z
+])
+def test_an_arch_and_a_wall_are_seen_face_on(figures, inputs, shown):
+    """No edge-on elevation: the blocks as projected span more than a seventh of every
+    elevation's figure (an arch seen edge on, a stack of rectangles: 0.09; a wall's top:
+    0.04)."""
+    _, scene, model = _model(**inputs)
+    assert views_of(scene.blocks.bounds) == shown
+    structure.structure_pngs(scene, interfaces=model.interfaces)
+    elevations = [fig for fig in figures if not hasattr(fig.axes[0], "get_zlim")]
+    assert len(elevations) == 1
+    for fig in elevations:
+        extent = _data_extent(fig.axes[0])
+        assert extent.width * extent.height > 0.14 * fig.bbox.width * fig.bbox.height
+
+
+def test_a_dome_keeps_its_three_elevations():
+    _, scene, _ = _model(**{**from_preset("1").record(), "p": 4})
+    assert views_of(scene.blocks.bounds) == list(common.VIEWS)
+    assert views_of(scene.blocks.bounds, fast=True) == ["01_angle"]
+
+
+def test_supports_are_drawn_apart_from_the_blocks():
+    _, scene, _ = _model(scene="arch")
+    colours, legend = structure.block_colours(scene.blocks, np.ones(len(scene.blocks), bool))
+    support = scene.blocks.block_is_support
+    assert "support" in legend and len(legend) == 2
+    assert not np.isclose(colours[support][:, None], colours[~support][None]).all(
+        axis=-1).any()
+
+
+def test_faces_inside_the_structure_are_hidden():
+    """Two boxes on a slab: the bed joint hides the lower box's top and the upper box's
+    bottom, the support the lower box's bottom; the slab's top stays (half covered)."""
+    model = column(2, (1.0, 1.0, 0.5))
+    blocks = model.blocks
+    hidden = hidden_faces(blocks, model.interfaces)
+    normal_z = blocks.face_normal[:, 2]
+    expected = ((blocks.face_block == 1) & (np.abs(normal_z) > 0.99)) | (
+        (blocks.face_block == 2) & (normal_z < -0.99))
+    assert (hidden == expected).all() and hidden.sum() == 3
+    # the upper box not drawn: the lower box's top is seen
+    drawn = np.array([True, True, False])
+    assert hidden_faces(blocks, model.interfaces, drawn).sum() == 1
+
+
+def test_a_force_with_nothing_to_show_has_no_figure_and_is_named():
+    _, scene, model = _model(scene="arch")
+    k = len(model.interfaces)
+    forces = {"compression": np.full(k, 5e3), "tension": np.full(k, 1e-9),
+              "normal": np.full(k, -5e3), "friction": np.full(k, 3e2)}
+    pngs = force_pngs(model.blocks, model.interfaces, forces, fast=True, noise=1e-3)
+    assert isinstance(pngs["*/tension.png"], str) and "noise" in pngs["*/tension.png"]
+    assert not [path for path in pngs if path.endswith("/tension.png") and "*" not in path]
+    assert isinstance(pngs["01_angle/normal.png"], bytes)
+
+
+def test_a_feasible_run_names_its_left_out_figures(tmp_path):
+    params = validate(Params.of(scene="arch"))
+    record = run(params, tmp_path, analyse=True)
+    skipped = record["figures"]["skipped"]
+    assert "RBE/*/tension.png" in skipped and "*/1_boundaries.png" not in skipped
+    folder = tmp_path / record["structure_id"]
+    assert not list(folder.glob("RBE/*/tension.png"))
+    assert list(folder.glob("RBE/*/normal.png"))
+    lines = []
+    figures_note(record, lines.append)
+    assert lines and "RBE/*/tension.png" in lines[0]
+
+
+def test_the_whole_dome_has_no_boundaries_figure():
+    params = validate(Params.of(scene="dome", stretch=1.0, n=6, r=0, p=3, cut=0.5))
+    scene, model = build_model(params)
+    made = RunOutputs(params, scene, model, solve(model, params, Timer()))
+    pngs = structure.structure_pngs(scene, fast=True, interfaces=model.interfaces)
+    assert isinstance(pngs["*/1_boundaries.png"], str)
+    assert "01_angle/3_structure.png" in pngs
+    assert "figures" not in _force_plot_files(made).files
+
+
+def test_thrust_line_chains_follow_one_column_of_blocks():
+    # joints as (block below, block above), in order along the section: 0-1-2-3 is a
+    # column, 7-8 stands alone, 9-10-11 another column
+    pairs = [(0, 1), (1, 2), (2, 3), (7, 8), (9, 10), (10, 11)]
+    assert [run.tolist() for run in chains(pairs)] == [[0, 1, 2], [3], [4, 5]]
+    assert chains(np.zeros((0, 2), int)) == []
+    assert [run.tolist() for run in chains([(4, 5)])] == [[0]]
+
+
+def test_the_azimuths_radius_starts_near_the_smallest_factor(figures):
+    factors = [0.79, 0.80, 0.82, 0.81, 0.795, 0.80]
+    collapse = SimpleNamespace(azimuths=[(30.0 * k, f) for k, f in enumerate(factors)],
+                               azimuth_deg=0.0, load_factor=0.79)
+    azimuths.azimuths_png(collapse)
+    low, high = figures[0].axes[0].get_ylim()
+    assert 0.7 < low < 0.79 and 0.82 < high < 0.85
