@@ -56,6 +56,11 @@ def register(subparsers):
                         help="instead: masonry's mesh reader against trimesh's and meshio's "
                              "on each OBJ, STL or PLY file, medians of --repeats reads; "
                              "writes DIR/bench_readers/readers.md")
+    parser.add_argument("--outputs", action="store_true",
+                        help="instead: the time of each exporter (the files and figures a "
+                             "run writes) on each preset's free section and full dome, "
+                             "medians of --repeats makes (e.g. --presets 1 3 --repeats "
+                             "1); writes DIR/bench_outputs/outputs.md")
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root: writes DIR/bench/bench.csv, bench.md and "
                              "frontier.png (default exports)")
@@ -79,7 +84,12 @@ def handle(args, report):
     if args.readers and (args.collapse or args.friction_models is not None):
         raise ParameterError("readers", args.readers, "one bench at a time: not with "
                              "--collapse or --friction-models")
+    if args.outputs and (args.collapse or args.friction_models is not None or args.readers):
+        raise ParameterError("outputs", True, "one bench at a time: not with --collapse, "
+                             "--friction-models or --readers")
     check_output_root(args.out)
+    if args.outputs:
+        return _outputs(args, report)
     if args.collapse:
         return _collapse(args, report)
     if args.friction_models is not None:
@@ -160,6 +170,24 @@ def _readers(args, report):
     markdown = readers_markdown(rows)
     with RunFolder(args.out, "bench_readers") as folder:
         folder.write("readers.md", markdown)
+    report(markdown)
+    report(f"written: {folder.target}")
+    return 0
+
+
+def _outputs(args, report):
+    from masonry.studies.output_bench import output_bench, outputs_markdown
+
+    overrides = {} if args.p is None else {"p": args.p}
+    named = "" if args.p is None else f" (p {args.p})"
+    structures = {f"preset {k} {label}{named}": from_preset(k, scene=scene, **overrides)
+                  for k in args.presets
+                  for label, scene in (("free section", "section"), ("full dome", "dome"))}
+    rows = output_bench(structures, repeats=args.repeats,
+                        progress=None if args.quiet else _progress)
+    markdown = outputs_markdown(rows)
+    with RunFolder(args.out, "bench_outputs") as folder:
+        folder.write("outputs.md", markdown)
     report(markdown)
     report(f"written: {folder.target}")
     return 0
