@@ -21,6 +21,11 @@ method (docs/model.md 7):
 3. ``Manifold.decompose()`` is far too slow and memory-hungry for a body count
    (docs/bench.md, "Measurements behind design choices"); bodies are counted on the
    mesh's connectivity (trimesh's ``body_count``) instead.
+4. One ``batch_boolean`` of all the bricks costs far more than the sum of its parts'
+   (it unites the accumulated body again with every chunk of bricks): preset 1's whole
+   dome (8 webs of 791 blocks) takes about 12 times one web's union. A dome of equal
+   webs is therefore united as one web, cleaned, turned into every web's place and
+   united once more (``copies``; docs/bench.md, "Outputs in the time of the solve").
 
 The result is verified, not assumed: watertight, consistently wound, one body, no
 zero-area triangle and no two vertices closer than ``tol.contact`` (so float32 rounding
@@ -34,7 +39,7 @@ import time
 
 import numpy as np
 
-from masonry.blocks import Blocks, concatenate, rotated_web, rotation_z
+from masonry.blocks import Blocks, rotation_z
 from masonry.errors import MasonryError
 from masonry.meshing import merge_vertices
 from masonry.tolerances import MIN_CORNER_DET, OVERLAP_REL, Tolerances
@@ -168,14 +173,17 @@ def _halfspace_corners(blocks: Blocks, i: int, overlap: float) -> np.ndarray:
                              "no intersection (is it convex and solid?)") from error
 
 
-def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
+def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None, copies=1):
     """One watertight body from all blocks, for 3D printing (docs/model.md 7, thesis 3.4.1).
 
     Every block is grown by ``overlap`` (:func:`grown_blocks`), all are united in one
     ``Manifold.batch_boolean`` call, and the union is cleaned of edges shorter than
     ``tol.contact`` (see the module notes). Support blocks (the ground slab) are
     included: they are the printed dome's base. Pass ``blocks.subset(mask)`` to leave
-    blocks out.
+    blocks out. With ``copies``, the blocks are one of that many equal parts about the
+    z axis (a web of the dome): their cleaned union is turned ``copies`` times and the
+    turned copies are united and cleaned again, which costs about what two parts' unions
+    cost rather than all of them (docs/bench.md).
 
     Parameters
     ----------
@@ -190,9 +198,13 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
         Bricks that touch then overlap by ``2 * overlap``. 0 grows nothing, and bricks
         that only touch will not join (the body check then fails).
     tol : Tolerances, optional
-        Default ``Tolerances.for_points(vertices)``. ``tol.contact`` is the cleaning
-        distance: edges shorter than it are collapsed and surfaces move by less than
-        about it; it must exceed float32 rounding at the model's coordinates.
+        Default ``Tolerances.for_points`` of the whole body's vertices (every copy's).
+        ``tol.contact`` is the cleaning distance: edges shorter than it are collapsed and
+        surfaces move by less than about it; it must exceed float32 rounding at the
+        model's coordinates.
+    copies : int
+        Turns of ``blocks`` by ``360 / copies`` degrees about z that make the body
+        (:func:`printable_blocks`); 1: the blocks alone.
 
     Returns
     -------
@@ -206,8 +218,9 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
         ``triangles``, ``vertices``, ``zero_area_faces``, ``close_vertex_pairs``
         (distinct vertices closer than ``tol.contact``), ``min_edge_m``,
         ``overlap_m``, ``halfspace_blocks`` (grown by qhull, see :func:`grown_blocks`),
-        ``clean_distance_m``, ``collapsed_edges``, ``union_time_s``,
-        ``time_s`` (all of it).
+        ``clean_distance_m``, ``collapsed_edges``, ``copies``, ``union_time_s`` (the
+        unions, and the part's cleaning between them), ``time_s`` (all of it). Volumes
+        and counts are the whole body's, every copy counted.
 
     Raises
     ------
@@ -216,29 +229,29 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None):
         consistently wound, not one body, has zero-area triangles or vertices closer
         than ``tol.contact``. The error's ``report`` holds the measurements.
     """
-    import manifold3d
     import trimesh
 
     start = time.perf_counter()
-    blocks, overlap, tol = _checked_inputs(blocks, vertices, overlap, tol)
+    blocks, overlap, tol = _checked_inputs(blocks, vertices, overlap, tol, copies)
     parts, by_halfspaces = _grown_hulls(blocks, overlap, tol)
     union_start = time.perf_counter()
-    union = manifold3d.Manifold.batch_boolean(parts, manifold3d.OpType.Add)
+    union, collapsed = _united(parts, copies, tol.contact)
     union_volume = union.volume()  # evaluates the lazy boolean
     union_time = time.perf_counter() - union_start
     _require_ok(union, "union")
 
-    body, collapsed = _cleaned(union, tol.contact)
+    body, more = _cleaned(union, tol.contact)
     mesh_data = body.to_mesh64()
     mesh = trimesh.Trimesh(np.array(mesh_data.vert_properties)[:, :3],
                            np.array(mesh_data.tri_verts), process=False)
     report = _body_report(body, mesh, tol) | {
         "union_volume_m3": float(union_volume),
-        "blocks_volume_m3": float(blocks.block_volume.sum()),
-        "grown_volume_m3": float(sum(part.volume() for part in parts)),
+        "blocks_volume_m3": copies * float(blocks.block_volume.sum()),
+        "grown_volume_m3": copies * float(sum(part.volume() for part in parts)),
         "overlap_m": float(overlap),
-        "halfspace_blocks": int(by_halfspaces.sum()),
-        "collapsed_edges": int(collapsed),
+        "halfspace_blocks": copies * int(by_halfspaces.sum()),
+        "collapsed_edges": int(collapsed + more),
+        "copies": int(copies),
         "union_time_s": round(union_time, 4),
         "time_s": round(time.perf_counter() - start, 4),
     }
@@ -266,7 +279,29 @@ def _grown_hulls(blocks: Blocks, overlap, tol):
     return parts, by_halfspaces
 
 
-def _checked_inputs(blocks: Blocks, vertices, overlap, tol):
+def _united(parts, copies, distance):
+    """The union of the manifolds ``parts`` turned ``copies`` times about z (see
+    :func:`printable_body`), and how many short edges the part's cleaning collapsed."""
+    import manifold3d
+
+    union = manifold3d.Manifold.batch_boolean(parts, manifold3d.OpType.Add)
+    if copies == 1:
+        return union, 0
+    _require_ok(union, "union")
+    part, collapsed = _cleaned(union, distance)
+    turns = [part.transform(np.column_stack([rotation_z(2 * np.pi * k / copies),
+                                             np.zeros(3)])) for k in range(copies)]
+    return manifold3d.Manifold.batch_boolean(turns, manifold3d.OpType.Add), collapsed
+
+
+def _turned(points, copies) -> np.ndarray:
+    """(copies * P, 3): ``points`` turned ``copies`` times by ``360 / copies`` degrees
+    about z."""
+    return np.concatenate([points @ rotation_z(2 * np.pi * k / copies).T
+                           for k in range(copies)])
+
+
+def _checked_inputs(blocks: Blocks, vertices, overlap, tol, copies=1):
     """``(blocks, overlap, tol)`` of :func:`printable_body`'s arguments: ``vertices`` put
     in ``blocks``, the defaults filled in; raises ValueError on a bad argument."""
     if vertices is not None:
@@ -275,8 +310,10 @@ def _checked_inputs(blocks: Blocks, vertices, overlap, tol):
             raise ValueError(f"vertices has shape {vertices.shape}, the blocks' vertices "
                              f"{blocks.vertices.shape}")
         blocks = dataclasses.replace(blocks, vertices=vertices)
+    if not (isinstance(copies, (int, np.integer)) and copies >= 1):
+        raise ValueError(f"copies must be an integer >= 1, not {copies!r}")
     if tol is None:
-        tol = Tolerances.for_points(blocks.vertices)
+        tol = Tolerances.for_points(_turned(blocks.vertices, copies))
     if overlap is None:
         overlap = OVERLAP_REL * tol.scale
     if not (np.isfinite(overlap) and overlap >= 0):
@@ -389,14 +426,41 @@ def _require_ok(body, what):
 
 
 def printable_blocks(scene, boundary="free", cad_offset=1.0):
-    """Blocks and CAD-offset vertices of the printable body (``cad_offset`` units inward):
-    the whole dome when the scene is one part of it analysed with its neighbours (a
-    section with a boundary; docs/model.md 7), else the scene itself."""
+    """``(blocks, vertices, copies)`` of the printable body (:func:`printable_body`): the
+    blocks, their vertices moved ``cad_offset`` units inward, and how many turns about z
+    make the body of them. The whole dome when the scene is one part of it analysed with
+    its neighbours (a section with a boundary; docs/model.md 7): the part, turned. A
+    whole scene made of equal turned parts (:func:`repeated_part`) gives its first part,
+    turned; any other scene itself, once."""
     cad = scene.cad_vertices(cad_offset)
     symmetry = scene.symmetry
     if symmetry.unit and boundary != "free":
-        n = symmetry.order
-        blocks = concatenate([rotated_web(scene.blocks, k, n) for k in range(n)])
-        vertices = np.concatenate([cad @ rotation_z(2 * np.pi * k / n).T for k in range(n)])
-        return blocks, vertices
-    return scene.blocks, cad
+        return scene.blocks, cad, symmetry.order
+    if symmetry.period_deg is not None:
+        first = repeated_part(scene.blocks, cad, symmetry.order)
+        if first is not None:
+            vertex = np.repeat(first, np.diff(scene.blocks.vertex_offsets))
+            return scene.blocks.subset(first), cad[vertex], symmetry.order
+    return scene.blocks, cad, 1
+
+
+def repeated_part(blocks: Blocks, vertices, copies: int):
+    """(B,) bool: the blocks of web 0 when ``blocks`` are ``copies`` webs (``block_web``),
+    web after web, each web 0's blocks with the same vertex and face counts, its
+    ``vertices`` ((V, 3), metres) those of web 0 turned by ``360 k / copies`` degrees
+    about z within ``Tolerances.length``; None otherwise."""
+    n = blocks.n_blocks
+    if copies < 2 or n % copies:
+        return None
+    per = n // copies
+    if not np.array_equal(blocks.block_web, np.repeat(np.arange(copies), per)):
+        return None
+    vertex_count = np.diff(blocks.vertex_offsets).reshape(copies, per)
+    face_count = np.bincount(blocks.face_block, minlength=n).reshape(copies, per)
+    if (vertex_count != vertex_count[0]).any() or (face_count != face_count[0]).any():
+        return None
+    own = np.asarray(vertices, dtype=float).reshape(copies, -1, 3)
+    tol = Tolerances.for_points(vertices)
+    if np.abs(_turned(own[0], copies) - own.reshape(-1, 3)).max() > tol.length:
+        return None
+    return blocks.block_web == 0

@@ -234,8 +234,9 @@ def _collapse_files(made: RunOutputs) -> Export:
 
 
 def _printable_files(made: RunOutputs) -> Export:
-    body, report = printable_body(*printable_blocks(
-        made.scene, made.params.analysis.boundary, made.outputs.cad_offset))
+    blocks, vertices, copies = printable_blocks(made.scene, made.params.analysis.boundary,
+                                                made.outputs.cad_offset)
+    body, report = printable_body(blocks, vertices, copies=copies)
     data = stl.stl_bytes(body)
     report["readback"] = stl.readback_check(data, report["volume_m3"])
     files = {"dome.stl": data, "dome.obj": stl.obj_body_bytes(body)}
