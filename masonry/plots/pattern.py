@@ -3,6 +3,7 @@ along the wall and course, by class, inside the web's half width."""
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.collections import PolyCollection
 from matplotlib.patches import Rectangle
 
 from masonry.blocks import BLOCK_CLASSES, PATTERN
@@ -21,10 +22,19 @@ def pattern_png(scene, fast=False, title="") -> bytes:
     s0 = np.where(layout.miter_left, -w_low, layout.s0)
     s1 = np.where(layout.miter_right, w_low, layout.s1)
     fig, ax = plt.subplots(figsize=(6, 7.5))
-    for k, s0, s1, klass, h in zip(layout.course, s0, s1, layout.klass, height):
-        name = BLOCK_CLASSES[klass]
-        ax.add_patch(Rectangle((s0, k - 1), s1 - s0, h, facecolor=CLASS_COLOURS[name],
-                               edgecolor="k", linewidth=0.3, zorder=3 if h == 2 else 2))
+    # the bricks' rectangles as two collections, the pattern bricks (two courses high)
+    # over the others
+    bottom = layout.course - 1.0
+    corners = np.stack([np.column_stack([s0, bottom]), np.column_stack([s1, bottom]),
+                        np.column_stack([s1, bottom + height]),
+                        np.column_stack([s0, bottom + height])], axis=1)
+    colours = np.array([CLASS_COLOURS[name] for name in BLOCK_CLASSES],
+                       dtype=object)[layout.klass]
+    for on_top in (False, True):
+        mine = (layout.klass == PATTERN) == on_top
+        ax.add_collection(PolyCollection(corners[mine], facecolors=list(colours[mine]),
+                                         edgecolors="k", linewidths=0.3,
+                                         zorder=3 if on_top else 2))
     w = levels.y / unit
     z = np.arange(len(w))
     ax.plot(w, z, "b-", -w, z, "b-", linewidth=1.2)
