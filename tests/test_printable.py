@@ -12,7 +12,8 @@ from conftest import scene_of
 from masonry.blocks import Blocks
 from masonry.export.stl import (STL_RECORD, obj_body_bytes, readback_check, stl_bytes,
                                 stored_normal_errors)
-from masonry.printable import PrintableError, grown_blocks, printable_body
+from masonry.printable import (PrintableError, grown_blocks, printable_blocks, printable_body,
+                               repeated_part)
 from masonry.tolerances import OVERLAP_REL, Tolerances
 
 SCENES = ("1", "2", "3", "wall")
@@ -190,6 +191,43 @@ def test_wall_volume_is_invariant_under_a_rigid_motion():
     assert moved["volume_m3"] == pytest.approx(still["volume_m3"], rel=1e-9)
 
 
+SMALL_DOME = dict(stretch=1.0, n=6, r=0, p=3, cut=0.5)
+
+
+def test_turned_web_is_the_union_of_every_web():
+    """The whole dome as one web's union turned into every web's place: the body of all
+    its blocks united at once, within the cleaning's moves (contact times the surface)."""
+    scene = scene_of("1", scene="dome", **SMALL_DOME)
+    blocks, vertices, copies = printable_blocks(scene)
+    assert copies == 6 and blocks.n_blocks * 6 == scene.blocks.n_blocks
+    mesh, turned = printable_body(blocks, vertices, copies=copies)
+    _, whole = printable_body(scene.blocks, scene.cad_vertices())
+    assert turned["watertight"] and turned["bodies"] == mesh.body_count == 1
+    assert turned["copies"] == 6 and whole["copies"] == 1
+    assert turned["clean_distance_m"] == whole["clean_distance_m"]
+    for key in ("blocks_volume_m3", "grown_volume_m3"):
+        assert turned[key] == pytest.approx(whole[key], rel=1e-12)
+    surface = mesh.area
+    assert abs(turned["volume_m3"] - whole["volume_m3"]) < turned["clean_distance_m"] * surface
+    # the section in dome mode: the same body
+    section = scene_of("1", **SMALL_DOME)
+    blocks, vertices, copies = printable_blocks(section, "cyclic")
+    assert copies == 6 and blocks.n_blocks == section.blocks.n_blocks
+    _, cyclic = printable_body(blocks, vertices, copies=copies)
+    assert cyclic["volume_m3"] == pytest.approx(turned["volume_m3"], rel=1e-12)
+
+
+def test_a_dome_whose_webs_differ_is_united_whole():
+    scene = scene_of("1", scene="dome", **SMALL_DOME)
+    cad = scene.cad_vertices()
+    first = repeated_part(scene.blocks, cad, 6)
+    assert first.sum() * 6 == scene.blocks.n_blocks
+    moved = cad.copy()
+    moved[-1, 2] += 1e-6  # one vertex of the last web
+    assert repeated_part(scene.blocks, moved, 6) is None
+    assert repeated_part(scene.blocks, cad, 4) is None  # not 4 equal webs
+
+
 def test_separate_blocks_raise():
     corners = np.stack([box_corners([0, 0, 0], [1, 1, 1]), box_corners([2, 0, 0], [3, 1, 1])])
     with pytest.raises(PrintableError, match="2 bodies") as error:
@@ -203,6 +241,8 @@ def test_bad_overlap_and_vertices_raise():
         printable_body(blocks, overlap=-1e-4)
     with pytest.raises(ValueError, match="shape"):
         printable_body(blocks, blocks.vertices[:-1])
+    with pytest.raises(ValueError, match="copies"):
+        printable_body(blocks, copies=0)
 
 
 # ---------------------------------------------------------------------- files
