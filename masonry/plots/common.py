@@ -14,7 +14,6 @@ import matplotlib.pyplot as plt
 import numpy as np
 import PIL.Image
 from matplotlib.collections import PolyCollection
-from matplotlib.transforms import ScaledTranslation
 from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from masonry.blocks import CLASS_COLOURS  # noqa: F401 (the figures' name for it)
@@ -40,6 +39,9 @@ joint."""
 
 PAD_INCHES = 0.1
 """White margin around what a figure draws (matplotlib's ``savefig.pad_inches``)."""
+
+LEGEND_GAP_INCHES = 0.05
+"""Space between a legend below the axes (:func:`legend_below`) and their labels."""
 
 
 def png_bytes(fig, dpi) -> bytes:
@@ -94,14 +96,18 @@ def views_of(bounds, fast=False) -> list:
 
 
 def legend_below(fig, ax, handles, ncol=3, fontsize=7):
-    """``handles``' legend under the axes, clear of the model and of the tick labels (an
-    elevation's 0.45 inch down, below its x label), centred."""
+    """``handles``' legend under the axes and all they draw beyond their box (tick and
+    axis labels, measured), centred on the axes: clear of the model and of the labels.
+    Call it last but for the title."""
     if not handles:
         return None
-    drop = 0.0 if hasattr(ax, "get_zlim") else -0.45  # 3D axes hold their labels
-    below = ax.transAxes + ScaledTranslation(0, drop, fig.dpi_scale_trans)
-    return ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0),
-                     bbox_transform=below, ncol=min(ncol, len(handles)),
+    drawn = ax.get_tightbbox(fig.canvas.get_renderer())  # pixels; also places the axes
+    box = ax.get_position()
+    top = fig.transFigure.inverted().transform((0.0, drawn.y0))[1]
+    top -= LEGEND_GAP_INCHES / fig.get_figheight()
+    return ax.legend(handles=handles, loc="upper center",
+                     bbox_to_anchor=((box.x0 + box.x1) / 2, top),
+                     bbox_transform=fig.transFigure, ncol=min(ncol, len(handles)),
                      fontsize=fontsize, frameon=False)
 
 
