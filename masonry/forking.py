@@ -3,10 +3,10 @@
 A forked process shares this one's memory at the moment of the fork (copy on write), so
 it needs nothing pickled to start: the calls are closures over what this process
 already holds. Only their results travel back, pickled through a pipe. The run's
-exporters use it (the 3DM file and the plots beside the other files) and so does the
-rigid block equilibrium (friction+ beside friction-net, :mod:`masonry.rbe.solve`), and
-:func:`two_at_once` splits independent solves (a collapse search's azimuths, the
-construction stages) over two processes.
+exporters use it (the printable body and the model's plots beside the other files) and
+so does the rigid block equilibrium (friction+ beside friction-net,
+:mod:`masonry.rbe.solve`), and :func:`two_at_once` splits independent solves (a collapse
+search's azimuths, the construction stages) over two processes.
 
 The solvers (:mod:`masonry.rbe.solvers`) neither fork nor set threads: the analyses that
 call them decide, from :func:`cores` or the cores their caller gives them, and run them
@@ -129,6 +129,79 @@ def two_at_once(function, items, blocks: int) -> list:
     out = [None] * len(items)
     out[0::2], out[1::2] = mine, done
     return out
+
+
+class Shared:
+    """``make(0)`` to ``make(count - 1)`` shared between this process and a forked copy:
+    each takes the next index that neither has taken (a counter in shared memory), so
+    the two finish about together whatever each call costs; order the calls longest
+    first. All here when the process cannot fork, has one core or has fewer than two
+    calls to share, and, with a warning, when the fork cannot start.
+
+    Used as a context manager: :meth:`take` gives this process's next index (None when
+    none is left); :meth:`theirs` then returns the other's results, ``{index: result}``,
+    and makes here what it took but did not return when its process failed
+    (:class:`ForkFailed`). An error of ``make`` in the other process is raised there.
+    """
+
+    def __init__(self, make, count):
+        self.make, self.count = make, count
+        self.forked, self.next, self.mine = None, None, []
+
+    def __enter__(self):
+        context = multiprocessing.get_context("fork") if can_fork() else None
+        if context is None or self.count < 2 or cores() < 2:
+            return self
+        self.next = context.Value("i", 0)
+        self.forked = Forked([self._serve])
+        try:
+            self.forked.start()
+        except OSError as error:  # no memory or processes left for a fork
+            log.warning("the second core is out of reach (%s): one process does all", error)
+            self.forked = None
+        return self
+
+    @property
+    def forked_off(self) -> bool:
+        """Whether a forked process shares the calls."""
+        return self.forked is not None
+
+    def take(self):
+        """This process's next index, None when every one is taken."""
+        if self.forked is None:  # all here
+            index = len(self.mine)
+        else:
+            with self.next.get_lock():
+                index = self.next.value
+                self.next.value = min(index + 1, self.count)
+        if index >= self.count:
+            return None
+        self.mine.append(index)
+        return index
+
+    def _serve(self) -> dict:
+        """In the forked process: make every index it takes."""
+        done = {}
+        while (index := self.take()) is not None:
+            done[index] = self.make(index)
+        return done
+
+    def theirs(self) -> dict:
+        """The other process's results, ``{index: result}`` (empty when all were made
+        here); call it once this process takes no more."""
+        if self.forked is None:
+            return {}
+        try:
+            return self.forked.result()
+        except ForkFailed as error:
+            log.warning("the second process failed (%s): its share is done here", error)
+            return {index: self.make(index) for index in range(self.count)
+                    if index not in self.mine}
+
+    def __exit__(self, kind, error, trace):
+        if self.forked is not None:
+            self.forked.close(cancel=kind is not None)
+        return False
 
 
 def _split(function, items):

@@ -545,10 +545,12 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
     """Every wanted exporter of :data:`masonry.export.EXPORTERS` into ``folder``; their
     records go into ``record`` under their names.
 
-    Where processes fork (Linux), the exporters marked ``aside`` (the 3DM file, the
-    plots) are made in a second process, on the second core, while this one makes and
-    writes the others; this process writes every file. Their stage then counts the time
-    this process waited for them.
+    The forces (what a user waits for) are made here first; where processes fork (Linux)
+    and the process has two cores, this process and a forked copy then share the others,
+    each taking the next exporter not yet taken (:class:`masonry.forking.Shared`; the
+    registry lists the long ones first), and this process writes every file. The
+    exporters made here count their time towards their stage, and the time this process
+    waited for the other's share counts as ``other_process``.
 
     Parameters
     ----------
@@ -562,15 +564,26 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
         Each exporter's time counts towards its stage.
     """
     wanted = [exporter for exporter in EXPORTERS if exporter.wanted(made)]
-    aside = [exporter for exporter in wanted if exporter.aside] if forking.can_fork() else []
-    with forking.Forked([functools.partial(e.make, made) for e in aside]) as second:
-        for exporter in [e for e in wanted if e not in aside] + aside:
-            with timer.stage(exporter.stage):
-                export = second.result() if exporter in aside else exporter.make(made)
-                for relative, data in export.files.items():
-                    folder.write(relative, data)
-            if export.record is not None:
-                _merge(record, exporter.key, export.record)
+
+    def write(exporter, export):
+        for relative, data in export.files.items():
+            folder.write(relative, data)
+        if export.record is not None:
+            _merge(record, exporter.key, export.record)
+
+    first = [exporter for exporter in wanted if exporter.stage == "forces"]
+    for exporter in first:
+        with timer.stage(exporter.stage):
+            write(exporter, exporter.make(made))
+    rest = [exporter for exporter in wanted if exporter not in first]
+    with forking.Shared(lambda index: rest[index].make(made), len(rest)) as shared:
+        while (index := shared.take()) is not None:
+            with timer.stage(rest[index].stage):
+                write(rest[index], rest[index].make(made))
+        if shared.forked_off:
+            with timer.stage("other_process"):
+                for index, export in sorted(shared.theirs().items()):
+                    write(rest[index], export)
 
 
 def _merge(record: dict, key: str, part: dict):

@@ -143,3 +143,60 @@ def test_two_at_once_inside_two_at_once_stays_in_its_process(two_processes):
 def test_two_at_once_on_one_core_does_all_here(monkeypatch):
     monkeypatch.setattr(forking, "cores", lambda: 1)
     assert forking.two_at_once(lambda item: os.getpid(), range(3), blocks=1) == [os.getpid()] * 3
+
+
+def test_shared_calls_are_each_made_once_by_one_of_two_processes(monkeypatch):
+    monkeypatch.setattr(forking, "cores", lambda: 2)
+
+    def make(index):
+        time.sleep(0.05)  # long enough for both processes to take some
+        return index * index, os.getpid()
+
+    mine = {}
+    with forking.Shared(make, 9) as shared:
+        while (index := shared.take()) is not None:
+            mine[index] = make(index)
+        theirs = shared.theirs()
+    assert sorted([*mine, *theirs]) == list(range(9)) and theirs and mine
+    assert {pid for _, pid in theirs.values()} != {os.getpid()}
+    assert {**mine, **theirs} == {i: (i * i, pid) for i, (_, pid) in {**mine, **theirs}.items()}
+
+
+def test_shared_calls_all_here_on_one_core_and_after_a_failed_fork(monkeypatch):
+    monkeypatch.setattr(forking, "cores", lambda: 1)
+    with forking.Shared(lambda index: index, 3) as shared:
+        assert [shared.take() for _ in range(4)] == [0, 1, 2, None]
+        assert shared.theirs() == {}
+    monkeypatch.setattr(forking, "cores", lambda: 2)
+    pid = os.getpid()
+
+    def make(index):
+        if os.getpid() != pid:
+            os._exit(3)  # the other process dies without a result
+        return index
+
+    with forking.Shared(make, 6) as shared:
+        mine = []
+        while (index := shared.take()) is not None:
+            time.sleep(0.05)
+            mine.append(make(index))
+        theirs = shared.theirs()  # the other's share made here
+    assert sorted(mine + list(theirs)) == list(range(6)) and theirs
+    assert all(value == index for index, value in theirs.items())
+
+
+def test_an_error_of_a_shared_call_in_the_other_process_is_raised_here(monkeypatch):
+    monkeypatch.setattr(forking, "cores", lambda: 2)
+    pid = os.getpid()
+
+    def make(index):
+        if os.getpid() != pid:
+            raise ValueError(f"call {index} failed")
+        time.sleep(0.2)
+        return index
+
+    with forking.Shared(make, 4) as shared:
+        while (index := shared.take()) is not None:
+            make(index)
+        with pytest.raises(ValueError, match="failed"):
+            shared.theirs()

@@ -103,10 +103,6 @@ class Exporter:
     make : callable RunOutputs -> Export
     wanted : callable RunOutputs -> bool
         Whether this run writes it.
-    aside : bool
-        Made in a second process while the others are made and written (a long
-        exporter that neither needs nor changes what the others make): see
-        :func:`masonry.pipeline.write_exports`.
     record_key : str
         The run.json key of its record when not its name; exporters that share one
         merge their records' entries.
@@ -116,7 +112,6 @@ class Exporter:
     stage: str
     make: Callable
     wanted: Callable = field(default=lambda made: True)
-    aside: bool = False
     record_key: str = ""
 
     @property
@@ -143,8 +138,8 @@ def _say_rhino_missing():
 
 
 def _rhino_wanted(made: RunOutputs) -> bool:
-    """Whether the run can write ``bricks.3dm`` (asked in the run's process, before the
-    exporters made aside fork); says once why not."""
+    """Whether the run can write ``bricks.3dm`` (asked in the run's process, before its
+    two processes part); says once why not."""
     if rhino.available():
         return True
     _say_rhino_missing()
@@ -316,19 +311,19 @@ EXPORTERS = (
     # the forces first, under a stage of their own: parameters to forces is the time a
     # user waits for results (the model's files do not need them)
     Exporter("rbe", "forces", _rbe_files, wanted=lambda made: made.result is not None),
-    Exporter("model", "exports", _model_files),
-    Exporter("rhino", "exports", _rhino_files, wanted=_rhino_wanted, aside=True),
-    Exporter("collapse", "exports", _collapse_files,
-             wanted=lambda made: made.collapse is not None),
-    Exporter("printable", "printable", _printable_files,
-             wanted=lambda made: made.outputs.printable),
-    Exporter("html", "html", _html_files, wanted=lambda made: made.outputs.html),
-    # the model's plots beside the 3DM file in the second process, the forces' here: the
-    # two take about as long
+    # then the long ones first: two processes share what follows, each taking the next
+    # (masonry.pipeline.write_exports), and finish about together
     Exporter("plots", "plots", _plot_files, wanted=lambda made: made.outputs.plots,
-             aside=True, record_key="figures"),
+             record_key="figures"),
     Exporter("force_plots", "plots", _force_plot_files,
              wanted=lambda made: made.outputs.plots and made.forces is not None,
              record_key="figures"),
+    Exporter("printable", "printable", _printable_files,
+             wanted=lambda made: made.outputs.printable),
+    Exporter("rhino", "exports", _rhino_files, wanted=_rhino_wanted),
+    Exporter("html", "html", _html_files, wanted=lambda made: made.outputs.html),
+    Exporter("collapse", "exports", _collapse_files,
+             wanted=lambda made: made.collapse is not None),
+    Exporter("model", "exports", _model_files),
 )
-"""Every exporter, in the order a run writes them."""
+"""Every exporter, in the order a run takes them."""

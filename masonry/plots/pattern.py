@@ -34,7 +34,7 @@ def pattern_png(scene, fast=False, title="") -> bytes:
         mine = (layout.klass == PATTERN) == on_top
         ax.add_collection(PolyCollection(corners[mine], facecolors=list(colours[mine]),
                                          edgecolors="k", linewidths=0.3,
-                                         zorder=3 if on_top else 2))
+                                         zorder=3 if on_top else 2), autolim=False)
     w = levels.y / unit
     z = np.arange(len(w))
     ax.plot(w, z, "b-", -w, z, "b-", linewidth=1.2)

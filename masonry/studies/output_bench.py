@@ -3,10 +3,9 @@
 
 Every structure is built and solved once (the balanced preset); then each exporter of
 :data:`masonry.export.EXPORTERS` that a run of it writes makes its files (in memory,
-nothing written) ``repeats`` times, in this process, one after the other. A run makes
-the 3DM file and the model's plots in a second process beside the others
-(:func:`masonry.pipeline.write_exports`), so its ``timings_s`` are shorter than the sum
-of these rows.
+nothing written) ``repeats`` times, in this process, one after the other. A run shares
+its exporters between two processes (:func:`masonry.pipeline.write_exports`), so it
+takes about half the sum of these rows.
 """
 
 import statistics
