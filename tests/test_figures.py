@@ -14,10 +14,10 @@ from cli.options import figures_note
 from masonry.export import RunOutputs, _force_plot_files
 from masonry.params import Params, from_preset, validate
 from masonry.pipeline import build_model, run, solve, Timer
-from masonry.plots import azimuths, common, mechanism, stages, structure
+from masonry.plots import azimuths, common, forces as force_figures, mechanism, stages, structure
 from masonry.plots.common import views_of
 from masonry.plots.faces import hidden_faces
-from masonry.plots.forces import force_pngs
+from masonry.plots.forces import force_pngs, interface_pngs
 from masonry.plots.thrust import chains
 from masonry.rbe.collapse import collapse_load
 from masonry.rbe.loads import lateral
@@ -35,7 +35,7 @@ def figures(monkeypatch):
         kept.append(fig)
         return b"\x89PNG kept"
 
-    for module in (structure, mechanism, stages, azimuths):
+    for module in (structure, mechanism, stages, azimuths, force_figures):
         monkeypatch.setattr(module, "png_bytes", keep)
     yield kept
     plt.close("all")
@@ -57,13 +57,24 @@ def _data_extent(ax) -> Bbox:
     return Bbox([points.min(axis=0), points.max(axis=0)])
 
 
+def _labels(ax) -> list:
+    """The axes' axis labels and tick labels with text, as drawn (display units)."""
+    axes = [ax.xaxis, ax.yaxis] + ([ax.zaxis] if hasattr(ax, "zaxis") else [])
+    texts = [axis.label for axis in axes] + [label for axis in axes
+                                             for label in axis.get_ticklabels()]
+    return [text.get_window_extent() for text in texts
+            if text.get_visible() and text.get_text()]
+
+
 def _legends_clear(fig):
-    """Every legend of ``fig`` lies clear of its axes' drawn model."""
+    """Every legend of ``fig`` lies clear of its axes' drawn model and labels."""
     checked = 0
     for ax in fig.axes:
         legend = ax.get_legend()
         if legend is not None and ax.collections:
-            assert not legend.get_window_extent().overlaps(_data_extent(ax))
+            box = legend.get_window_extent()
+            assert not box.overlaps(_data_extent(ax))
+            assert not [label for label in _labels(ax) if box.overlaps(label)]
             checked += 1
     return checked
 
@@ -138,12 +149,38 @@ def test_faces_inside_the_structure_are_hidden():
 def test_a_force_with_nothing_to_show_has_no_figure_and_is_named():
     _, scene, model = _model(scene="arch")
     k = len(model.interfaces)
-    forces = {"compression": np.full(k, 5e3), "tension": np.full(k, 1e-9),
-              "normal": np.full(k, -5e3), "friction": np.full(k, 3e2)}
+    forces = {"compression": np.linspace(1e3, 5e3, k), "tension": np.full(k, 1e-9),
+              "normal": np.linspace(-5e3, -1e3, k), "friction": np.linspace(0, 3e2, k)}
     pngs = force_pngs(model.blocks, model.interfaces, forces, fast=True, noise=1e-3)
     assert isinstance(pngs["*/tension.png"], str) and "noise" in pngs["*/tension.png"]
     assert not [path for path in pngs if path.endswith("/tension.png") and "*" not in path]
     assert isinstance(pngs["01_angle/normal.png"], bytes)
+
+
+def test_no_figure_is_drawn_in_one_colour(figures):
+    """The arch's joints all have one area: their area figures are left out and named;
+    every colour figure drawn colours its interfaces in more than one colour."""
+    params, scene, model = _model(scene="arch")
+    result = solve(model, params, Timer())
+    pngs = interface_pngs(model.blocks, model.interfaces, fast=True)
+    assert "cm^2" in pngs["*/interfaces_horizontal.png"] and len(pngs) == 1
+    forces = result.per_interface()
+    pngs = force_pngs(model.blocks, model.interfaces, forces, fast=True,
+                      noise=1e-6 * result.weight_N)
+    assert "noise" in pngs["*/tension.png"] and len(figures) == len(pngs) - 1 >= 3
+    for fig in figures:
+        (collection,) = [c for c in fig.axes[0].collections if isinstance(c, PolyCollection)]
+        assert len(np.unique(collection.get_facecolor(), axis=0)) > 1
+
+
+def test_a_force_the_same_on_every_interface_has_no_figure():
+    _, scene, model = _model(scene="arch")
+    k = len(model.interfaces)
+    forces = {"compression": np.full(k, 5e3), "tension": np.zeros(k),
+              "normal": np.linspace(-5e3, -1e3, k), "friction": np.full(k, 3e2)}
+    pngs = force_pngs(model.blocks, model.interfaces, forces, fast=True, noise=1e-3)
+    assert pngs["*/compression_horizontal.png"].endswith("every one is 5000 N")
+    assert "*/friction.png" in pngs and isinstance(pngs["01_angle/normal.png"], bytes)
 
 
 def test_a_feasible_run_names_its_left_out_figures(tmp_path):

@@ -26,6 +26,21 @@ COLOUR_PERCENTILE = 99.0
 """Colour scales end at this percentile of the plotted magnitudes: a few support values
 would otherwise set the scale and leave every other interface in one colour."""
 
+ONE_VALUE = 1e-6
+"""Values that all lie within this fraction of their largest magnitude of one another
+would colour a figure in one colour: it has nothing to show (:func:`one_value`)."""
+
+
+def one_value(values) -> float | None:
+    """The value every one of ``values`` has, within :data:`ONE_VALUE` (a figure coloured
+    by them would have one colour); None when they differ, or there are none."""
+    values = np.asarray(values, dtype=float)
+    if not len(values):
+        return None
+    spread, largest = float(np.ptp(values)), float(np.abs(values).max())
+    return float(np.median(values)) if spread <= ONE_VALUE * largest else None
+
+
 SEQUENTIAL, DIVERGING = "viridis", "RdBu_r"
 ONE_SIDED = 1e-6
 """A signed quantity whose values of one sign all stay within this fraction of the colour

@@ -1,13 +1,14 @@
 """Interfaces drawn as polygons coloured by one value each: their area (thesis figures
 3.12-3.13) and the forces they carry (figures 4.1-4.8), in the views of the model's
 extent; for a cyclic section also the whole dome, the section's forces rotated into
-every web. A force no interface carries beyond the solver's noise has no figure: the
-returned dict maps it to the reason instead."""
+every web. A force no interface carries beyond the solver's noise, or a value the same
+on every interface (one colour), has no figure: the returned dict maps it to the reason
+instead."""
 
 import numpy as np
 
 from masonry.blocks import concatenate, rotated_web, rotation_z
-from masonry.plots.colours import colour_bar, colour_scale
+from masonry.plots.colours import colour_bar, colour_scale, one_value
 from masonry.plots.common import (HORIZONTAL_KINDS, add_polygons, axes_3d, png_bytes,
                                   view_axes, views_of)
 from masonry.plots.faces import interface_array
@@ -43,11 +44,18 @@ def _groups(interfaces) -> dict:
 
 def interface_pngs(blocks, interfaces, fast=False, title="") -> dict:
     """Horizontal and vertical interfaces drawn as polygons (thesis figures 3.12-3.13),
-    coloured by area; a group without interfaces has no plot. ``title`` is the line under
-    each figure's own."""
+    coloured by area; a group without interfaces has no plot, one whose interfaces all
+    have the same area (one colour: an arch's joints) maps ``*/<name>.png`` to the reason
+    instead. ``title`` is the line under each figure's own."""
     out = {}
     groups = {f"interfaces_{name}": index
               for name, index in list(_groups(interfaces).items())[:2] if len(index)}
+    for name, index in list(groups.items()):
+        same = one_value(interfaces.area[index])
+        if same is not None:  # one colour: the structure's figures show where they are
+            out[f"*/{name}.png"] = (f"{name.replace('_', ' ')}: nothing to show: every one "
+                                    f"has the same area, {same * 1e4:.4g} cm^2")
+            del groups[name]
     polygons = {name: interface_array(interfaces, index) for name, index in groups.items()}
     for view in views_of(blocks.bounds, fast):
         for name, index in groups.items():
@@ -77,12 +85,16 @@ FORCE_LABELS = {"compression": "compression", "tension": "tension",
 
 def _noise(values, noise) -> str | None:
     """Why ``values`` (N) make no figure: every one within ``noise`` N of zero (the
-    solver's rounding, or none at all); None when some are beyond it."""
+    solver's rounding, or none at all), or every one the same (one colour,
+    :func:`~masonry.plots.colours.one_value`); None when they show something."""
     largest = float(np.abs(values).max(initial=0.0))
-    if largest > noise:
-        return None
-    return (f"nothing to show: the largest is {largest:.2g} N, within the solver's noise "
-            f"({noise:.2g} N)")
+    if largest <= noise:
+        return (f"nothing to show: the largest is {largest:.2g} N, within the solver's "
+                f"noise ({noise:.2g} N)")
+    same = one_value(values)
+    if same is not None:
+        return f"nothing to show: every one is {same:.4g} N"
+    return None
 
 
 def force_pngs(blocks, interfaces, forces: dict, fast=False, title="", webs=None,
