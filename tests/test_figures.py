@@ -14,7 +14,8 @@ from cli.options import figures_note
 from masonry.export import RunOutputs, _force_plot_files
 from masonry.params import Params, from_preset, validate
 from masonry.pipeline import build_model, run, solve, Timer
-from masonry.plots import azimuths, common, forces as force_figures, mechanism, stages, structure
+from masonry.plots import (azimuths, common, forces as force_figures, mechanism, pattern,
+                           stages, structure)
 from masonry.plots.common import views_of
 from masonry.plots.faces import hidden_faces
 from masonry.plots.forces import force_pngs, interface_pngs
@@ -35,7 +36,7 @@ def figures(monkeypatch):
         kept.append(fig)
         return b"\x89PNG kept"
 
-    for module in (structure, mechanism, stages, azimuths, force_figures):
+    for module in (structure, mechanism, stages, azimuths, force_figures, pattern):
         monkeypatch.setattr(module, "png_bytes", keep)
     yield kept
     plt.close("all")
@@ -85,6 +86,21 @@ def test_structure_legends_stay_clear_of_the_blocks(figures):
     # every figure but the boundaries' (no blocks, no legend)
     assert sum(_legends_clear(fig) for fig in figures) == len(figures) - 4 > 4
     assert len(figures) == len(pngs)
+
+
+@pytest.mark.parametrize("inputs", [dict(scene="sector", p=6), dict(preset="3", p=4)])
+def test_the_flattened_pattern_shows_every_brick_and_its_legend_clear(figures, inputs):
+    """A sector's bricks reach past its outline on one side: the axes hold them all."""
+    params = validate(Params.of(**{**(from_preset(inputs.pop("preset")).record()
+                                      if "preset" in inputs else {}), **inputs}))
+    scene, _ = build_model(params)
+    pattern.pattern_png(scene)
+    (fig,) = figures
+    assert _legends_clear(fig) == 1
+    ax = fig.axes[0]
+    drawn = _data_extent(ax).transformed(ax.transData.inverted())
+    (left, right), (bottom, top) = ax.get_xlim(), ax.get_ylim()
+    assert left < drawn.x0 and drawn.x1 < right and bottom < drawn.y0 and drawn.y1 < top
 
 
 def test_mechanism_and_stage_legends_stay_clear_of_the_blocks(figures):

@@ -4,17 +4,17 @@ along the wall and course, by class, inside the web's half width."""
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.collections import PolyCollection
-from matplotlib.patches import Rectangle
+from matplotlib.patches import Patch
 
 from masonry.blocks import BLOCK_CLASSES, PATTERN
-from masonry.plots.common import CLASS_COLOURS, png_bytes
+from masonry.plots.common import CLASS_COLOURS, legend_below, png_bytes
 
 
 def pattern_png(scene, fast=False, title="") -> bytes:
     """The flattened section (thesis figures 3.8-3.9): position along the wall (units)
     against course, pattern, regular and fill-in bricks in distinct colours (the legend
-    names the classes present), the web's half width at every course in blue; ``title`` is
-    the line under the figure's own."""
+    under the axes names the classes present), the web's half width at every course in
+    blue; ``title`` is the line under the figure's own."""
     layout, levels, unit = scene.layout, scene.levels, scene.unit
     height = np.where(layout.klass == PATTERN, 2, 1)
     # mitered ends reach the web's boundary (at the course's lower, wider edge)
@@ -38,15 +38,16 @@ def pattern_png(scene, fast=False, title="") -> bytes:
     w = levels.y / unit
     z = np.arange(len(w))
     ax.plot(w, z, "b-", -w, z, "b-", linewidth=1.2)
-    for name in ("pattern", "regular", "fill_in"):
-        if np.any(layout.klass == BLOCK_CLASSES.index(name)):
-            ax.add_patch(Rectangle((0, 0), 0, 0, facecolor=CLASS_COLOURS[name],
-                                   label=name.replace("_", "-")))
-    ax.legend(loc="upper right", fontsize=7)
     ax.set_xlabel(scene.kind.pattern_axis)
     ax.set_ylabel("course")
-    ax.set_xlim(-w.max() - 1, w.max() + 1)
+    # every brick (a sector's reach past the half width on one side) and the outline
+    ax.set_xlim(min(float(s0.min()), -float(w.max())) - 1,
+                max(float(s1.max()), float(w.max())) + 1)
     ax.set_ylim(-0.5, len(w) + 0.5)
+    legend_below(fig, ax, [Patch(facecolor=CLASS_COLOURS[name], edgecolor="k",
+                                 label=name.replace("_", "-"))
+                           for name in ("pattern", "regular", "fill_in")
+                           if np.any(layout.klass == BLOCK_CLASSES.index(name))])
     pattern = int((layout.klass == PATTERN).sum())
     what = scene.kind.pattern_caption(scene.geometry)
     counts = f"{pattern} pattern" if pattern else "no pattern bricks"
