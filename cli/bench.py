@@ -58,7 +58,8 @@ def register(subparsers):
                              "writes DIR/bench_readers/readers.md")
     parser.add_argument("--outputs", action="store_true",
                         help="instead: the time of each exporter (the files and figures a "
-                             "run writes) on each preset's free section and full dome, "
+                             "run writes) on each preset's cyclic section (--dome) and full "
+                             "dome, "
                              "medians of --repeats makes (e.g. --presets 1 3 --repeats "
                              "1); writes DIR/bench_outputs/outputs.md")
     parser.add_argument("--out", default="exports", metavar="DIR",
@@ -180,9 +181,10 @@ def _outputs(args, report):
 
     overrides = {} if args.p is None else {"p": args.p}
     named = "" if args.p is None else f" (p {args.p})"
-    structures = {f"preset {k} {label}{named}": from_preset(k, scene=scene, **overrides)
+    structures = {f"preset {k} {label}{named}": from_preset(k, **inputs, **overrides)
                   for k in args.presets
-                  for label, scene in (("free section", "section"), ("full dome", "dome"))}
+                  for label, inputs in (("cyclic section", dict(boundary="cyclic")),
+                                        ("full dome", dict(scene="dome")))}
     rows = output_bench(structures, repeats=args.repeats,
                         progress=None if args.quiet else _progress)
     markdown = outputs_markdown(rows)

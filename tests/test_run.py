@@ -253,3 +253,19 @@ def test_run_json_names_only_the_files_the_folder_holds(tmp_path):
     assert "bricks.obj" in listed and "RBE/forces.csv" not in listed
     assert "dome.stl" not in listed and not (folder / "RBE").exists()
     assert all((folder / name).is_file() for name in listed)
+
+
+def test_the_output_bench_times_every_exporter_a_run_writes(tmp_path, capsys):
+    from masonry.studies.output_bench import output_bench, outputs_markdown
+
+    params = validate(Params.of(scene="arch", fast=True))
+    rows = output_bench({"arch": params})
+    # every exporter a run of it writes, in the registry's order
+    assert [row["exporter"] for row in rows] == ["rbe", "plots", "force_plots", "printable",
+                                                 "rhino", "html", "model"]
+    assert all(row["seconds"] > 0 and row["cpu_seconds"] >= 0 for row in rows)
+    plots = [row for row in rows if row["exporter"] == "force_plots"]
+    assert plots and plots[0]["files"] >= 2 and plots[0]["bricks"] == 16
+    assert outputs_markdown(rows).splitlines()[-1].startswith("| arch | | all | |")
+    assert main(["bench", "--outputs", "--collapse", "--out", str(tmp_path)]) == 2
+    assert "one bench at a time" in capsys.readouterr().err
