@@ -9,6 +9,7 @@ and the source of the code that builds them, so a run that changes only ``mu``,
 import dataclasses
 import functools
 import hashlib
+import importlib
 import json
 import logging
 import pickle
@@ -576,6 +577,8 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
         with timer.stage(exporter.stage):
             write(exporter, exporter.make(made))
     rest = [exporter for exporter in wanted if exporter not in first]
+    for name in dict.fromkeys(name for exporter in rest for name in exporter.imports):
+        importlib.import_module(name)  # once, before the processes part
     with forking.Shared(lambda index: rest[index].make(made), len(rest)) as shared:
         while (index := shared.take()) is not None:
             with timer.stage(rest[index].stage):

@@ -106,6 +106,9 @@ class Exporter:
     record_key : str
         The run.json key of its record when not its name; exporters that share one
         merge their records' entries.
+    imports : tuple of str
+        Modules its ``make`` imports when it runs: a run imports them once before its
+        two processes part (:func:`masonry.pipeline.write_exports`), not once in each.
     """
 
     name: str
@@ -113,6 +116,7 @@ class Exporter:
     make: Callable
     wanted: Callable = field(default=lambda made: True)
     record_key: str = ""
+    imports: tuple = ()
 
     @property
     def key(self) -> str:
@@ -314,12 +318,12 @@ EXPORTERS = (
     # then the long ones first: two processes share what follows, each taking the next
     # (masonry.pipeline.write_exports), and finish about together
     Exporter("plots", "plots", _plot_files, wanted=lambda made: made.outputs.plots,
-             record_key="figures"),
+             record_key="figures", imports=("masonry.plots",)),
     Exporter("force_plots", "plots", _force_plot_files,
              wanted=lambda made: made.outputs.plots and made.forces is not None,
-             record_key="figures"),
+             record_key="figures", imports=("masonry.plots",)),
     Exporter("printable", "printable", _printable_files,
-             wanted=lambda made: made.outputs.printable),
+             wanted=lambda made: made.outputs.printable, imports=("manifold3d", "trimesh")),
     Exporter("rhino", "exports", _rhino_files, wanted=_rhino_wanted),
     Exporter("html", "html", _html_files, wanted=lambda made: made.outputs.html),
     Exporter("collapse", "exports", _collapse_files,
