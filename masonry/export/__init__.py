@@ -252,7 +252,7 @@ def _html_files(made: RunOutputs) -> Export:
 
 
 def _mechanism_plots(made: RunOutputs) -> dict:
-    from masonry import plots  # matplotlib: imported by the runs that draw (see _plot_files)
+    from masonry import plots  # matplotlib: imported by the runs that draw
 
     collapse, model = made.collapse, made.model
     if collapse is None or collapse.mechanism is None or not collapse.load_factor:
@@ -275,8 +275,8 @@ def _figures(pngs: dict) -> Export:
     return Export(files, {"skipped": skipped} if skipped else None)
 
 
-def _plot_files(made: RunOutputs) -> Export:
-    """The model's plots: pattern, structure, interfaces (and a collapse mechanism)."""
+def _structure_plot_files(made: RunOutputs) -> Export:
+    """The model's plots of its blocks: the flattened pattern and the structure views."""
     # matplotlib takes most of a second to import: a run without plots never does
     from masonry import plots
 
@@ -285,7 +285,15 @@ def _plot_files(made: RunOutputs) -> Export:
     if scene.layout is not None:
         files["00_pattern.png"] = plots.pattern_png(scene, fast, title)
     files.update(plots.structure_pngs(scene, fast, title, made.webs, model.interfaces))
-    files.update(plots.interface_pngs(model.blocks, model.interfaces, fast, title))
+    return _figures(files)
+
+
+def _interface_plot_files(made: RunOutputs) -> Export:
+    """The model's plots of its interfaces (their areas) and of a collapse mechanism."""
+    from masonry import plots
+
+    files = plots.interface_pngs(made.model.blocks, made.model.interfaces,
+                                 made.outputs.quick, made.figure_title)
     files.update(_mechanism_plots(made))
     return _figures(files)
 
@@ -317,13 +325,17 @@ EXPORTERS = (
     Exporter("rbe", "forces", _rbe_files, wanted=lambda made: made.result is not None),
     # then the long ones first: two processes share what follows, each taking the next
     # (masonry.pipeline.write_exports), and finish about together
-    Exporter("plots", "plots", _plot_files, wanted=lambda made: made.outputs.plots,
-             record_key="figures", imports=("masonry.plots",)),
     Exporter("force_plots", "plots", _force_plot_files,
              wanted=lambda made: made.outputs.plots and made.forces is not None,
              record_key="figures", imports=("masonry.plots",)),
     Exporter("printable", "printable", _printable_files,
              wanted=lambda made: made.outputs.printable, imports=("manifold3d", "trimesh")),
+    Exporter("structure_plots", "plots", _structure_plot_files,
+             wanted=lambda made: made.outputs.plots, record_key="figures",
+             imports=("masonry.plots",)),
+    Exporter("interface_plots", "plots", _interface_plot_files,
+             wanted=lambda made: made.outputs.plots, record_key="figures",
+             imports=("masonry.plots",)),
     Exporter("rhino", "exports", _rhino_files, wanted=_rhino_wanted),
     Exporter("html", "html", _html_files, wanted=lambda made: made.outputs.html),
     Exporter("collapse", "exports", _collapse_files,
