@@ -398,6 +398,7 @@ def test_first_unsupported_stage_is_drawn_with_its_new_block_outlined(tmp_path):
     import matplotlib.image
 
     from masonry.plots import OUTLINE_COLOUR
+    from masonry.plots.common import views_of
 
     blocks, _ = stack(np.full(5, 0.3))
     path = tmp_path / "stack.obj"
@@ -407,8 +408,10 @@ def test_first_unsupported_stage_is_drawn_with_its_new_block_outlined(tmp_path):
     (folder,) = (tmp_path / "out").glob("*_stages_z")
     magenta = np.array(matplotlib.colors.to_rgb(OUTLINE_COLOUR))
     views = sorted((folder / "first_unsupported").glob("*.png"))
-    assert [v.name for v in views] == ["01_angle.png", "02_front.png", "03_top.png",
-                                       "04_side.png"]
+    # the views of the model's extent: the slab 6 m long in x seen end on from the
+    # front (x) is left out
+    assert [v.name for v in views] == ["01_angle.png", "03_top.png", "04_side.png"]
+    assert [f"{view}.png" for view in views_of(blocks.bounds)] == [v.name for v in views]
     for view in views:
         pixels = matplotlib.image.imread(view)[..., :3]
         assert (np.abs(pixels - magenta).max(axis=-1) < 0.05).sum() > 50, view.name

@@ -109,14 +109,24 @@ def colour_scale(values, signed: bool, is_force: bool = True, unit: str = "") ->
             "above": int((values > top).sum()), "below": below, "largest": largest * factor}
 
 
-def colour_bar(fig, ax, scale, quantity):
+def colour_bar(fig, ax, scale, quantity, place=None):
     """A colour bar of ``scale`` (:func:`colour_scale`) labelled ``quantity [unit]``,
-    saying where the scale is clipped."""
+    saying where the scale is clipped. Returns its place, ``(axes, locator)``: pass it
+    as ``place`` to draw the next figure's bar on the same axes in its stead (a colour
+    bar wraps its axes' locator to make room for its arrows: the place keeps the one
+    it had before)."""
     mappable = matplotlib.cm.ScalarMappable(norm=scale["norm"], cmap=scale["cmap"])
-    if hasattr(ax, "get_zlim"):  # a 3D box sits inside its axes: a shorter bar
+    if place is not None:
+        cax, locator = place
+        cax.clear()
+        cax.set_axes_locator(locator)
+        bar = fig.colorbar(mappable, cax=cax, extend=scale["extend"])
+    elif hasattr(ax, "get_zlim"):  # a 3D box sits inside its axes: a shorter bar
         bar = fig.colorbar(mappable, ax=ax, extend=scale["extend"], **bar_3d(fig))
+        place = (bar.ax, None)  # placed by its position
     else:  # as tall as the equal-scale plot
         cax = make_axes_locatable(ax).append_axes("right", size="4%", pad=0.12)
+        place = (cax, cax.get_axes_locator())
         bar = fig.colorbar(mappable, cax=cax, extend=scale["extend"])
     label = f"{quantity} [{scale['unit']}]" if scale["unit"] else quantity
     if scale["largest"] == 0:
@@ -127,3 +137,4 @@ def colour_bar(fig, ax, scale, quantity):
                   f"{', '.join(beyond)}, up to {scale['largest']:.3g} {scale['unit']}"
                   + (" in size" if scale["below"] else "")).rstrip()
     bar.set_label(label, fontsize=8)
+    return place

@@ -44,9 +44,10 @@ LEGEND_GAP_INCHES = 0.05
 """Space between a legend below the axes (:func:`legend_below`) and their labels."""
 
 
-def png_bytes(fig, dpi) -> bytes:
+def png_bytes(fig, dpi, close=True) -> bytes:
     """``fig`` as PNG bytes at ``dpi``, cropped to what it draws (with
-    :data:`PAD_INCHES` around it); the figure is closed.
+    :data:`PAD_INCHES` around it); the figure is closed unless ``close`` is False (the
+    next figure of the same view draws on it).
 
     Drawn once and cropped: ``savefig(bbox_inches="tight")`` draws the figure twice
     (once to measure it), which costs a run's figures about a fifth of their time. A
@@ -69,7 +70,8 @@ def png_bytes(fig, dpi) -> bytes:
         # opaque: RGB, quickly compressed (a fifth larger than the slowest, half the time)
         image = np.asarray(canvas.buffer_rgba())[rows, columns, :3]
         PIL.Image.fromarray(image).save(buf, format="png", compress_level=1)
-    plt.close(fig)
+    if close:
+        plt.close(fig)
     return buf.getvalue()
 
 
@@ -196,7 +198,7 @@ def visible_faces(blocks, mask, view, hidden=None) -> np.ndarray:
 def add_polygons(ax, view, polygons, facecolors, edgecolors="face", linewidths=0.3):
     """Draw ``polygons`` ((n, m, 3) float, metres, :func:`~masonry.plots.faces.padded`)
     in ``view``: one 3D collection, or projected onto an elevation's plane, farthest
-    first, as one 2D collection."""
+    first, as one 2D collection (:class:`Projected`). Returns the collection."""
     polygons = np.asarray(polygons, dtype=float).reshape(-1, *np.shape(polygons)[-2:])
     faces = np.broadcast_to(matplotlib.colors.to_rgba_array(facecolors),
                             (len(polygons), 4))
@@ -206,23 +208,39 @@ def add_polygons(ax, view, polygons, facecolors, edgecolors="face", linewidths=0
                                       linewidths=linewidths)
         ax.add_collection3d(collection, autolim=False)
     else:
-        collection = _projected(view, polygons, faces, edges, linewidths)
+        collection = Projected(view, polygons, faces, edges, linewidths)
         ax.add_collection(collection, autolim=False)
     # the views' limits are set from the model's bounds, and the polygons lie inside
     # the axes, which the figure's tight bounding box holds anyway: measuring thousands
     # of paths for either is wasted
     collection.set_in_layout(False)
+    return collection
 
 
-def _projected(view, polygons, faces, edges, linewidths) -> PolyCollection:
-    """``polygons`` projected onto an elevation's plane, farthest first."""
-    h, v, depth, sign = ELEVATIONS[view]
-    order = np.argsort(sign * polygons[:, :, depth].mean(axis=1), kind="stable")
-    if not isinstance(edges, str):
-        edges = np.broadcast_to(matplotlib.colors.to_rgba_array(edges),
-                                (len(polygons), 4))[order]
-    return PolyCollection(polygons[order][:, :, [h, v]], facecolors=faces[order],
-                          edgecolors=edges, linewidths=linewidths)
+class Projected(PolyCollection):
+    """Polygons projected onto an elevation's plane, drawn farthest first: polygon ``k``
+    of the collection is polygon ``order[k]`` of those given."""
+
+    def __init__(self, view, polygons, faces, edges, linewidths):
+        h, v, depth, sign = ELEVATIONS[view]
+        self.order = np.argsort(sign * polygons[:, :, depth].mean(axis=1), kind="stable")
+        if not isinstance(edges, str):
+            edges = np.broadcast_to(matplotlib.colors.to_rgba_array(edges),
+                                    (len(polygons), 4))[self.order]
+        super().__init__(polygons[self.order][:, :, [h, v]], facecolors=faces[self.order],
+                         edgecolors=edges, linewidths=linewidths)
+
+
+def recolour(collection, facecolors):
+    """New face colours ((n, 4) RGBA, or one colour) for the polygons of
+    :func:`add_polygons`' ``collection``, in the order they were given; edges in the face
+    colour."""
+    faces = np.broadcast_to(matplotlib.colors.to_rgba_array(facecolors),
+                            (len(collection.get_paths()), 4))
+    if isinstance(collection, Projected):
+        faces = faces[collection.order]
+    collection.set_facecolor(faces)
+    collection.set_edgecolor(faces)
 
 
 def add_line(ax, view, points, **style):

@@ -5,12 +5,13 @@ every web. A force no interface carries beyond the solver's noise, or a value th
 on every interface (one colour), has no figure: the returned dict maps it to the reason
 instead."""
 
+import matplotlib.pyplot as plt
 import numpy as np
 
 from masonry.blocks import concatenate, rotated_web, rotation_z
 from masonry.plots.colours import colour_bar, colour_scale, one_value
 from masonry.plots.common import (HORIZONTAL_KINDS, add_polygons, axes_3d, png_bytes,
-                                  view_axes, views_of)
+                                  recolour, view_axes, views_of)
 from masonry.plots.faces import interface_array
 
 
@@ -20,19 +21,42 @@ def _interface_linewidth(count: int) -> float:
     return float(np.clip(12.0 / np.sqrt(max(count, 1)), 0.3, 3.0))
 
 
-def _colour_plot(bounds, polygons, values, title, view, fast, quantity, signed=False,
-                 is_force=True, subtitle="", unit=""):
-    """One view of the interfaces ``polygons`` ((n, m, 3), :func:`interface_array`)
-    coloured by ``values`` (SI units, or ``unit`` for values that are not forces)."""
-    fig, ax = view_axes(bounds, view)
-    scale = colour_scale(values, signed, is_force, unit)
-    shown = np.asarray(values, dtype=float) * scale["factor"]
-    colours = scale["cmap"](scale["norm"](shown))
-    # edges in the face colour: interfaces seen edge on stay visible as coloured lines
-    add_polygons(ax, view, polygons, colours, linewidths=_interface_linewidth(len(polygons)))
-    colour_bar(fig, ax, scale, quantity)
-    ax.set_title(f"{title} ({len(polygons)} interfaces)\n{subtitle}", fontsize=9)
-    return png_bytes(fig, 60 if fast else 110)
+class _ViewFigures:
+    """The colour plots of one view, drawn one after the other on one figure: the axes,
+    their ticks and the colour bar are made once, and a plot of the same polygons as the
+    one before only recolours them (a fifth to a third of each figure's time)."""
+
+    def __init__(self, bounds, view, fast):
+        self.fig, self.ax = view_axes(bounds, view)
+        self.view, self.dpi = view, 60 if fast else 110
+        self.polygons = self.collection = self.bar = None
+
+    def png(self, polygons, values, title, quantity, signed=False, is_force=True,
+            subtitle="", unit="") -> bytes:
+        """The interfaces ``polygons`` ((n, m, 3), :func:`interface_array`) coloured by
+        ``values`` (SI units, or ``unit`` for values that are not forces)."""
+        scale = colour_scale(values, signed, is_force, unit)
+        colours = scale["cmap"](scale["norm"](np.asarray(values, dtype=float)
+                                              * scale["factor"]))
+        if polygons is self.polygons:
+            recolour(self.collection, colours)
+        else:
+            if self.collection is not None:
+                self.collection.remove()
+            # edges in the face colour: interfaces seen edge on stay visible as lines
+            self.collection = add_polygons(self.ax, self.view, polygons, colours,
+                                           linewidths=_interface_linewidth(len(polygons)))
+            self.polygons = polygons
+        self.bar = colour_bar(self.fig, self.ax, scale, quantity, self.bar)
+        self.ax.set_title(f"{title} ({len(polygons)} interfaces)\n{subtitle}", fontsize=9)
+        return png_bytes(self.fig, self.dpi, close=False)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exception):
+        plt.close(self.fig)
+        return False
 
 
 def _groups(interfaces) -> dict:
@@ -58,11 +82,11 @@ def interface_pngs(blocks, interfaces, fast=False, title="") -> dict:
             del groups[name]
     polygons = {name: interface_array(interfaces, index) for name, index in groups.items()}
     for view in views_of(blocks.bounds, fast):
-        for name, index in groups.items():
-            out[f"{view}/{name}.png"] = _colour_plot(
-                blocks.bounds, polygons[name], interfaces.area[index] * 1e4,
-                name.replace("_", " "), view, fast, "area", is_force=False, subtitle=title,
-                unit="cm^2")
+        with _ViewFigures(blocks.bounds, view, fast) as figures:
+            for name, index in groups.items():
+                out[f"{view}/{name}.png"] = figures.png(
+                    polygons[name], interfaces.area[index] * 1e4, name.replace("_", " "),
+                    "area", is_force=False, subtitle=title, unit="cm^2")
     return out
 
 
@@ -117,10 +141,10 @@ def force_pngs(blocks, interfaces, forces: dict, fast=False, title="", webs=None
             else:
                 out[f"*/{name}.png"] = f"{heading}: {reason}"
     for view in views_of(blocks.bounds, fast):
-        for name, key, polygons, values, heading, signed in drawn:
-            out[f"{view}/{name}.png"] = _colour_plot(
-                blocks.bounds, polygons, values, heading, view, fast, FORCE_LABELS[key],
-                signed, subtitle=title)
+        with _ViewFigures(blocks.bounds, view, fast) as figures:
+            for name, key, polygons, values, heading, signed in drawn:
+                out[f"{view}/{name}.png"] = figures.png(
+                    polygons, values, heading, FORCE_LABELS[key], signed, subtitle=title)
     if webs:
         out.update(_whole_dome_pngs(blocks, interfaces, forces, fast, title, webs, noise))
     return out
