@@ -25,26 +25,28 @@ from masonry.rbe.loads import lateral
 from test_collapse import DENSITY, column
 
 
-class Kept(list):
-    """Figures as drawn, and the face colours of their polygon collections then (a figure
-    may be drawn again for the next plot of its view)."""
-
-    def __init__(self):
-        super().__init__()
-        self.colours = []
-
-
 @pytest.fixture
 def figures(monkeypatch):
-    """The figures the plot modules make, drawn and kept open instead of turned into
-    PNG bytes."""
-    kept = Kept()
+    """What the plot modules' figures show as each is saved (drawn and measured instead
+    of turned into PNG bytes: a figure may be drawn on again for the next plot of its
+    view), one namespace per figure: ``legends`` (how many legends were checked clear
+    of the model and labels, :func:`_legends_clear`), ``extent`` (the polygons' extent,
+    display units; None without polygons), ``data`` (the same in data units), ``xlim``,
+    ``ylim``, ``area`` (the figure's, display units), ``is_3d``, ``colours`` (the face
+    colours of each polygon collection)."""
+    kept = []
 
     def keep(fig, dpi, close=True):
         fig.canvas.draw()
-        kept.append(fig)
-        kept.colours.append([c.get_facecolor().copy() for c in fig.axes[0].collections
-                             if isinstance(c, PolyCollection)])
+        ax = fig.axes[0]
+        polygons = [c for c in ax.collections if isinstance(c, PolyCollection)]
+        extent = _data_extent(ax) if polygons else None
+        kept.append(SimpleNamespace(
+            legends=_legends_clear(fig), extent=extent, xlim=ax.get_xlim(),
+            ylim=ax.get_ylim(), area=fig.bbox.width * fig.bbox.height,
+            data=None if extent is None else extent.transformed(ax.transData.inverted()),
+            is_3d=hasattr(ax, "get_zlim"),
+            colours=[c.get_facecolor().copy() for c in polygons]))
         return b"\x89PNG kept"
 
     for module in (structure, mechanism, stages, azimuths, force_figures, pattern):
@@ -95,7 +97,7 @@ def test_structure_legends_stay_clear_of_the_blocks(figures):
     _, scene, model = _model(**{**from_preset("3").record(), "p": 4})
     pngs = structure.structure_pngs(scene, interfaces=model.interfaces)
     # every figure but the boundaries' (no blocks, no legend)
-    assert sum(_legends_clear(fig) for fig in figures) == len(figures) - 4 > 4
+    assert sum(drawn.legends for drawn in figures) == len(figures) - 4 > 4
     assert len(figures) == len(pngs)
 
 
@@ -106,12 +108,11 @@ def test_the_flattened_pattern_shows_every_brick_and_its_legend_clear(figures, i
                                       if "preset" in inputs else {}), **inputs}))
     scene, _ = build_model(params)
     pattern.pattern_png(scene)
-    (fig,) = figures
-    assert _legends_clear(fig) == 1
-    ax = fig.axes[0]
-    drawn = _data_extent(ax).transformed(ax.transData.inverted())
-    (left, right), (bottom, top) = ax.get_xlim(), ax.get_ylim()
-    assert left < drawn.x0 and drawn.x1 < right and bottom < drawn.y0 and drawn.y1 < top
+    (drawn,) = figures
+    assert drawn.legends == 1
+    (left, right), (bottom, top) = drawn.xlim, drawn.ylim
+    data = drawn.data
+    assert left < data.x0 and data.x1 < right and bottom < data.y0 and data.y1 < top
 
 
 def test_mechanism_and_stage_legends_stay_clear_of_the_blocks(figures):
@@ -122,7 +123,7 @@ def test_mechanism_and_stage_legends_stay_clear_of_the_blocks(figures):
     laid = scene.blocks.block_centroid[:, 2] < 2.0
     stages.marked_structure_pngs(scene, laid, laid * 100.0, "stage",
                                  is_outlined=laid & (scene.blocks.block_centroid[:, 2] > 1))
-    assert sum(_legends_clear(fig) for fig in figures) == len(figures) >= 4
+    assert sum(drawn.legends for drawn in figures) == len(figures) >= 4
 
 
 @pytest.mark.parametrize("inputs, shown", [
@@ -136,11 +137,10 @@ def test_an_arch_and_a_wall_are_seen_face_on(figures, inputs, shown):
     _, scene, model = _model(**inputs)
     assert views_of(scene.blocks.bounds) == shown
     structure.structure_pngs(scene, interfaces=model.interfaces)
-    elevations = [fig for fig in figures if not hasattr(fig.axes[0], "get_zlim")]
+    elevations = [drawn for drawn in figures if not drawn.is_3d]
     assert len(elevations) == 1
-    for fig in elevations:
-        extent = _data_extent(fig.axes[0])
-        assert extent.width * extent.height > 0.14 * fig.bbox.width * fig.bbox.height
+    for drawn in elevations:
+        assert drawn.extent.width * drawn.extent.height > 0.14 * drawn.area
 
 
 def test_a_dome_keeps_its_three_elevations():
@@ -195,8 +195,8 @@ def test_no_figure_is_drawn_in_one_colour(figures):
     pngs = force_pngs(model.blocks, model.interfaces, forces, fast=True,
                       noise=1e-6 * result.weight_N)
     assert "noise" in pngs["*/tension.png"] and len(figures) == len(pngs) - 1 >= 3
-    for colours in figures.colours:
-        (faces,) = colours
+    for drawn in figures:
+        (faces,) = drawn.colours
         assert len(np.unique(faces, axis=0)) > 1
 
 
@@ -247,5 +247,5 @@ def test_the_azimuths_radius_starts_near_the_smallest_factor(figures):
     collapse = SimpleNamespace(azimuths=[(30.0 * k, f) for k, f in enumerate(factors)],
                                azimuth_deg=0.0, load_factor=0.79)
     azimuths.azimuths_png(collapse)
-    low, high = figures[0].axes[0].get_ylim()
+    low, high = figures[0].ylim
     assert 0.7 < low < 0.79 and 0.82 < high < 0.85

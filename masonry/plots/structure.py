@@ -5,6 +5,7 @@ their class colours and supports apart; a cyclic section also as the whole dome.
 Only the faces a view can show are drawn (:func:`~masonry.plots.common.visible_faces`):
 the outer faces turned toward it."""
 
+import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import to_rgba
 from matplotlib.patches import Patch
@@ -31,17 +32,19 @@ def block_colours(blocks, mask) -> tuple:
     return np.array([to_rgba(palette[name]) for name in names]).reshape(-1, 4), shown
 
 
-def _draw_blocks(ax, view, blocks, mask, hidden, linewidth=0.1) -> list:
+def _draw_blocks(ax, view, blocks, mask, hidden, linewidth=0.1) -> tuple:
     """The blocks of ``mask`` that ``view`` shows, in their colours (:func:`block_colours`)
-    with black edges; returns the legend handles of what it drew."""
+    with black edges; returns the legend handles of what it drew and its collection
+    (None when it drew nothing)."""
     if not mask.any():
-        return []
+        return [], None
     faces = visible_faces(blocks, mask, view, hidden)
     colours, legend = block_colours(blocks, mask)
-    add_polygons(ax, view, face_array(blocks, faces), colours[blocks.face_block[faces]],
-                 edgecolors="k", linewidths=linewidth)
+    drawn = add_polygons(ax, view, face_array(blocks, faces),
+                         colours[blocks.face_block[faces]], edgecolors="k",
+                         linewidths=linewidth)
     return [Patch(facecolor=colour, edgecolor="k", label=label)
-            for label, colour in legend.items()]
+            for label, colour in legend.items()], drawn
 
 
 def _stages(scene) -> dict:
@@ -73,17 +76,22 @@ def structure_pngs(scene, fast=False, title="", webs=None, interfaces=None) -> d
                                      "structure: the section's figure shows it")
     hidden = hidden_faces(blocks, interfaces)
     for view in views_of(blocks.bounds, fast):
+        # the stages of a view one after the other on one figure: axes, ticks and the
+        # outline made once
+        fig, ax = view_axes(blocks.bounds, view)
+        draw_outline(ax, view, scene)
         for stage, mask in _stages(scene).items():
-            fig, ax = view_axes(blocks.bounds, view)
-            draw_outline(ax, view, scene)
-            handles = _draw_blocks(ax, view, blocks, mask, hidden)
-            if handles:
-                legend_below(fig, ax, handles)
+            handles, drawn = _draw_blocks(ax, view, blocks, mask, hidden)
+            legend = legend_below(fig, ax, handles)
             count = int((mask & ~blocks.block_is_support).sum())
             shown = (f"{count} {scene.kind.block_word}" if mask.any()
                      else "the web's outline (blue), before any brick is laid")
             ax.set_title(f"{stage[2:]}: {shown}\n{title}", fontsize=9)
-            out[f"{view}/{stage}.png"] = png_bytes(fig, 60 if fast else 110)
+            out[f"{view}/{stage}.png"] = png_bytes(fig, 60 if fast else 110, close=False)
+            for artist in (drawn, legend):
+                if artist is not None:
+                    artist.remove()
+        plt.close(fig)
     if webs:
         out["05_dome/3_structure.png"] = _whole_dome_png(blocks, interfaces, webs, fast,
                                                          title)
@@ -98,8 +106,8 @@ def _whole_dome_png(blocks, interfaces, n, fast, title) -> bytes:
     hidden = np.tile(hidden_faces(blocks, interfaces, images=True)[bricks[blocks.face_block]],
                      n)
     fig, ax = axes_3d(whole.bounds)
-    handles = _draw_blocks(ax, "01_angle", whole, np.ones(whole.n_blocks, bool), hidden,
-                           linewidth=0.05)
+    handles, _ = _draw_blocks(ax, "01_angle", whole, np.ones(whole.n_blocks, bool), hidden,
+                              linewidth=0.05)
     legend_below(fig, ax, handles)
     ax.set_title(f"the whole dome: the section rotated {n} times, {whole.n_blocks} "
                  f"bricks\n{title}", fontsize=9)
