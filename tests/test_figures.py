@@ -223,7 +223,7 @@ def test_a_feasible_run_names_its_left_out_figures(tmp_path):
     assert lines and "RBE/*/tension.png" in lines[0]
 
 
-def test_the_whole_dome_has_no_boundaries_figure():
+def test_the_whole_dome_has_no_boundaries_figure_and_no_web_outline():
     params = validate(Params.of(scene="dome", stretch=1.0, n=6, r=0, p=3, cut=0.5))
     scene, model = build_model(params)
     made = RunOutputs(params, scene, model, solve(model, params, Timer()))
@@ -231,6 +231,13 @@ def test_the_whole_dome_has_no_boundaries_figure():
     assert isinstance(pngs["*/1_boundaries.png"], str)
     assert "01_angle/3_structure.png" in pngs
     assert "figures" not in _force_plot_files(made).files
+    # one web's outline is drawn over its section, not over the whole dome
+    section, _ = build_model(validate(Params.of(**{**params.record(), "scene": "section"})))
+    for shown, lines in ((scene, 0), (section, 3)):
+        fig, ax = plt.subplots()
+        common.draw_outline(ax, "02_front", shown)
+        assert len(ax.lines) == lines
+        plt.close(fig)
 
 
 def test_thrust_line_chains_follow_one_column_of_blocks():

@@ -265,9 +265,10 @@ def add_points(ax, view, points, **style):
 
 def draw_outline(ax, view, scene):
     """The web's boundaries (its level table's half widths, both sides) and its base line
-    in blue; nothing for a scene without a level table."""
+    in blue; nothing for a scene without a level table, nor for a whole dome (one web's
+    outline would mark one web of many)."""
     levels = scene.levels
-    if levels is None or scene.dims is None:
+    if levels is None or scene.dims is None or not scene.symmetry.unit:
         return
     for sign in (-1, 1):
         add_line(ax, view, np.column_stack([levels.x, sign * levels.y, levels.z]),
