@@ -180,10 +180,8 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None, copies
     ``Manifold.batch_boolean`` call, and the union is cleaned of edges shorter than
     ``tol.contact`` (see the module notes). Support blocks (the ground slab) are
     included: they are the printed dome's base. Pass ``blocks.subset(mask)`` to leave
-    blocks out. With ``copies``, the blocks are one of that many equal parts about the
-    z axis (a web of the dome): their cleaned union is turned ``copies`` times and the
-    turned copies are united and cleaned again, which costs about what two parts' unions
-    cost rather than all of them (docs/bench.md).
+    blocks out. With ``copies``, the blocks are one of that many equal parts about z (a
+    web): their cleaned union is turned into every part's place and united again.
 
     Parameters
     ----------
@@ -203,24 +201,17 @@ def printable_body(blocks: Blocks, vertices=None, overlap=None, tol=None, copies
         surfaces move by less than about it; it must exceed float32 rounding at the
         model's coordinates.
     copies : int
-        Turns of ``blocks`` by ``360 / copies`` degrees about z that make the body
-        (:func:`printable_blocks`); 1: the blocks alone.
+        Turns of ``blocks`` by ``360 / copies`` degrees about z (1: the blocks alone).
 
     Returns
     -------
     mesh : trimesh.Trimesh
         The body, float64 vertices, built with ``process=False``.
     report : dict
-        ``manifold_status`` (str), ``watertight``, ``winding_consistent`` (bool),
-        ``bodies``, ``genus`` (int), ``volume_m3`` (manifold's, of the cleaned body),
-        ``union_volume_m3`` (before cleaning), ``blocks_volume_m3`` (sum of the block
-        volumes, not grown), ``grown_volume_m3`` (sum of the grown blocks' volumes),
-        ``triangles``, ``vertices``, ``zero_area_faces``, ``close_vertex_pairs``
-        (distinct vertices closer than ``tol.contact``), ``min_edge_m``,
-        ``overlap_m``, ``halfspace_blocks`` (grown by qhull, see :func:`grown_blocks`),
-        ``clean_distance_m``, ``collapsed_edges``, ``copies``, ``union_time_s`` (the
-        unions, and the part's cleaning between them), ``time_s`` (all of it). Volumes
-        and counts are the whole body's, every copy counted.
+        The body's checks and measures: manifold's status, watertight, wound, bodies,
+        genus, volumes (cleaned, united, the blocks', the grown blocks'), triangles,
+        vertices, the smallest edge, close vertex pairs, overlap, cleaning, ``copies``
+        and the times (``union_time_s``, ``time_s``); the whole body's, every copy counted.
 
     Raises
     ------

@@ -324,11 +324,9 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     side_rotation : (K, 2, 3, 3) float, optional
         Rotation ``Q`` (about the origin) applied to each side before its force reaches
         ``side_block``: that side's force ``Q (+-F)`` acts at the point ``Q v``. Default
-        identity. Cyclic symmetry (docs/model.md 6.4) routes the side on the rotated copy
-        of a section block back onto that block with the inverse rotation; mirror
-        symmetry (docs/model.md 6.11) routes a mirror image's side with the reflection
-        (``det Q = -1``: the force ``Q F`` at ``Q v`` is the mirror image of ``F`` at
-        ``v``).
+        identity. Cyclic symmetry (docs/model.md 6.4) routes a rotated copy's side back
+        with the inverse rotation, mirror symmetry (6.11) a mirror image's with the
+        reflection (``det Q = -1``).
     cone : FrictionCone or str
         The friction model (:mod:`masonry.friction`).
     dropped_rows : (B, 6) bool, optional

@@ -563,9 +563,8 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
     ``solver_error`` return none. Under ``'auto'`` any friction-net outcome without an
     accepted point moves on to friction+, so a spurious "infeasible" on a nearly
     feasible structure is caught when the friction+ point meets the friction-net
-    constraints (then ``feasible`` is True and a warning is logged), and the LP's verdict
-    is reported beside the QP's (a disagreement is logged). For several solves of one
-    scene use :class:`RBEProblem`.
+    constraints (then ``feasible`` is True, with a warning); the LP's verdict is reported
+    beside the QP's. For several solves of one scene use :class:`RBEProblem`.
     """
     start = time.perf_counter()
     problem = RBEProblem(blocks, interfaces, side_block=side_block,
