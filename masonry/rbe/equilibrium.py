@@ -341,12 +341,8 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     Returns
     -------
     EquilibriumSystem
-        ``A_eq`` (6 F, 4 IV) and ``f_ext`` (6 F,) scaled, for the ``F`` free blocks.
-
-    Raises
-    ------
-    ValueError
-        When every block is a support.
+        ``A_eq`` (6 F, 4 IV) and ``f_ext`` (6 F,) scaled, for the ``F`` free blocks;
+        ValueError when every block is a support.
     """
     layout = VariableLayout.from_interfaces(interfaces)
     n_vertices = layout.n_vertices
