@@ -341,6 +341,18 @@ def test_stages_command_writes_its_own_folder_reproducibly(tmp_path, capsys):
                                                         for r in rows]
 
 
+def test_friction_net_stages_name_the_first_stage_that_needs_support(tmp_path, capsys):
+    # friction-net measures no MoI, and the report names the stage without one. The
+    # plain sector's top course laid along starts with a brick alone on a bed steeper
+    # than atan(0.7)
+    args = ["stages", "--scene", "sector", "--radius", "10.3923", "--p", "5", "--cut",
+            "0.3", "--pattern", "none", "--by", "brick", "--course", "8", "--order",
+            "along", "--friction", "net", "--fast", "--no-plots", "--out", str(tmp_path)]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "first stage that needs support: 1 (28 bricks)" in out
+
+
 @pytest.mark.parametrize("args, option", [
     (["--preset", "1", "--by", "brick", "--course", "99"], "--course"),
     (["--preset", "1", "--by", "brick"], "--course"),
