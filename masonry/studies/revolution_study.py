@@ -71,7 +71,9 @@ DOME_COLUMNS = ("profile", "kind", "pattern", "sectors", "courses", "bricks",
                 "brick_stages_s")
 BRICK_COLUMNS = ("profile", "kind", "pattern", "order", "course", "incline_deg", "stages",
                  "failing", "first_failing_stage", "first_failing_class",
-                 "confirm_failing", "seconds")
+                 "confirm_failing", "verdicts", "seconds")
+"""Columns of ``revolution_bricks.csv``: ``verdicts`` holds a letter per stage, ``s`` it
+stands, ``f`` it needs support, in capitals where the stage lays a pattern brick."""
 AZIMUTH_COLUMNS = ("profile", "kind", "pattern", "azimuth_deg", "factor")
 
 
@@ -290,8 +292,16 @@ def brick_scan(dome: Dome, settings: Settings, incline, case) -> list:
                 "first_failing_stage": None if first is None else first + 1,
                 "first_failing_class": None if first is None
                 else " ".join(sorted(set(found[k]["laid"][first]))),
-                "confirm_failing": checked.get(k), "seconds": found[k]["seconds"]})
+                "confirm_failing": checked.get(k), "verdicts": verdicts(found[k]),
+                "seconds": found[k]["seconds"]})
     return rows
+
+
+def verdicts(found) -> str:
+    """A :func:`brick_course` result as the letters of :data:`BRICK_COLUMNS`."""
+    letters = ("s" if stands else "f" for stands in found["feasible"])
+    return "".join(letter.upper() if "pattern" in laid else letter
+                   for letter, laid in zip(letters, found["laid"]))
 
 
 def measure(dome: Dome, settings: Settings, cases) -> tuple:
@@ -321,6 +331,62 @@ def measure(dome: Dome, settings: Settings, cases) -> tuple:
     return row, bricks
 
 
+# ---------------------------------------------------------------------- tables
+def order_summary(brick_rows) -> list:
+    """Per dome and order: the scanned courses, the first that needs support at some
+    stage (its incline, failing stages, again at ``confirm``, and what its first failing
+    stage lays) and the first where every stage but the closed ring does."""
+    out = []
+    for key in dict.fromkeys((r["profile"], r["kind"], r["pattern"], r["order"])
+                             for r in brick_rows):
+        mine = [r for r in brick_rows if (r["profile"], r["kind"], r["pattern"],
+                                          r["order"]) == key]
+        failing = [r for r in mine if r["failing"]]
+        first = failing[0] if failing else None
+        every = next((r for r in mine if r["failing"] == r["stages"] - 1), None)
+        out.append({**dict(zip(("profile", "kind", "pattern", "order"), key)),
+                    "scanned": f"{int(mine[0]['course'])}-{int(mine[-1]['course'])}",
+                    "failing_courses": len(failing),
+                    "first_failing": first and int(first["course"]),
+                    "incline_deg": first and first["incline_deg"],
+                    "failing_stages": first and f"{int(first['failing'])}/{int(first['stages'])}",
+                    "confirm_failing": first and first["confirm_failing"],
+                    "first_failing_lays": first and first["first_failing_class"],
+                    "all_fail_from": every and int(every["course"])})
+    return out
+
+
+def markdown(rows, summary) -> str:
+    """The study's two tables in Markdown: the domes, and their brick stages."""
+    def table(header, lines):
+        cells = [header, ["---"] * len(header), *lines]
+        return "\n".join("| " + " | ".join(map(str, c)) + " |" for c in cells)
+
+    def num(value, digits=3):
+        return "-" if value is None else f"{value:.{digits}g}"
+
+    domes_ = table(
+        ["profile", "dome", "bricks (pattern)", "m^3", "sectors", "courses", "self weight",
+         "free part (MoI factor)", "lateral factor (azimuth)", "course stages standing"],
+        [[r["profile"], _label(r["kind"], r["pattern"]),
+          f"{int(r['bricks'])} ({int(r['pattern_bricks'])})", num(r["volume_m3"], 4),
+          int(r["sectors"]), int(r["courses"]), r["cyclic"],
+          f"{r['free']} ({num(r['free_moi_factor'])})",
+          f"{num(r['lateral_factor'], 4)} ({num(r['lateral_azimuth_deg'])} deg)",
+          f"{int(r['course_stages_standing'])}/{int(r['course_stages'])}"] for r in rows])
+    stages = table(
+        ["profile", "dome", "order", "scanned", "courses needing support",
+         "first (incline)", "its stages failing (confirm)", "first failing stage lays",
+         "all but the last fail from"],
+        [[s["profile"], _label(s["kind"], s["pattern"]), s["order"], s["scanned"],
+          s["failing_courses"], "-" if s["first_failing"] is None
+          else f"{s['first_failing']} ({s['incline_deg']:.1f} deg)",
+          "-" if s["failing_stages"] is None
+          else f"{s['failing_stages']} ({num(s['confirm_failing'])})",
+          s["first_failing_lays"] or "-", s["all_fail_from"] or "-"] for s in summary])
+    return f"{domes_}\n\n{stages}\n"
+
+
 # ---------------------------------------------------------------------- figures
 STYLE = {("polygonal", "herringbone"): ("C3", "-", "o"), ("polygonal", "none"): ("C0", "-", "s"),
          ("revolution", "herringbone"): ("C1", "--", "^"),
@@ -333,44 +399,45 @@ def _label(kind, pattern) -> str:
 
 
 def domes_png(domes_, title="") -> bytes:
-    """The whole domes side by side in their class colours, one row per pattern."""
+    """The whole domes in elevation, seen from -y, in their class colours: one row per
+    pattern, one column per profile and kind."""
     import matplotlib.pyplot as plt
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+    from matplotlib.collections import PolyCollection
 
     from masonry.plots.common import CLASS_COLOURS, png_bytes
-    from masonry.scenes import build
 
     columns = list(dict.fromkeys((d.profile, d.kind) for d in domes_))
     patterns = ("herringbone", "none")
-    fig = plt.figure(figsize=(3.0 * len(columns), 3.1 * len(patterns)))
+    fig, axes = plt.subplots(len(patterns), len(columns), figsize=(4.2 * len(columns), 5.2),
+                             squeeze=False)
     for d in domes_:
-        ax = fig.add_subplot(len(patterns), len(columns), patterns.index(d.pattern)
-                             * len(columns) + columns.index((d.profile, d.kind)) + 1,
-                             projection="3d")
-        blocks = build(d.params(whole=True)).blocks
-        # the outer faces of the front half, seen from -y
+        ax = axes[patterns.index(d.pattern)][columns.index((d.profile, d.kind))]
+        blocks = d.model(whole=True)[0].blocks
+        # the faces of the front half that face the viewer, the farthest drawn first
         shown = (blocks.block_centroid[:, 1] < 0) & ~blocks.block_is_support
         faces = np.flatnonzero(shown[blocks.face_block] & (blocks.face_normal[:, 1] < 0))
-        colours = [CLASS_COLOURS[BLOCK_CLASSES[c]] for c in
-                   blocks.block_class[blocks.face_block[faces]]]
-        ax.add_collection3d(Poly3DCollection([blocks.face_polygon(f) for f in faces],
-                                             linewidths=0.05, edgecolors="k",
-                                             facecolors=colours))
+        polygons = [blocks.face_polygon(f) for f in faces]
+        depth = np.argsort([-p[:, 1].mean() for p in polygons])
+        ax.add_collection(PolyCollection(
+            [polygons[i][:, [0, 2]] for i in depth], linewidths=0.1, edgecolors="0.3",
+            facecolors=[CLASS_COLOURS[BLOCK_CLASSES[blocks.block_class[
+                blocks.face_block[faces[i]]]]] for i in depth]))
         lo, hi = blocks.bounds
-        ax.set(xlim=(lo[0], hi[0]), ylim=(lo[1], 0), zlim=(0, hi[2]))
-        ax.set_box_aspect((hi[0] - lo[0], -lo[1], hi[2]), zoom=1.4)
-        ax.view_init(elev=10, azim=-90)
-        ax.set_axis_off()
-        ax.set_title(f"{d.profile}, {_label(d.kind, d.pattern)}\n"
+        ax.set(xlim=(lo[0] - 0.2, hi[0] + 0.2), ylim=(0, hi[2] + 0.2), aspect="equal",
+               xlabel="x [m]",
+               ylabel="z [m]")
+        ax.set_title(f"{d.profile}, {_label(d.kind, d.pattern)}: "
                      f"{int((~blocks.block_is_support).sum())} bricks", fontsize=9)
     fig.suptitle(title, fontsize=10)
-    return png_bytes(fig, 100)
+    fig.tight_layout()
+    return png_bytes(fig, 90)
 
 
 def bricks_png(brick_rows, title="") -> bytes:
     """The share of each scanned course's brick stages that need support: one panel per
     profile and order, one line per dome."""
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     from masonry.plots.common import png_bytes
 
@@ -388,6 +455,7 @@ def bricks_png(brick_rows, title="") -> bytes:
                         color=colour, linestyle=line, marker=mark, markersize=3.5,
                         linewidth=1, label=_label(kind, pattern))
             ax.set_title(f"{profile}, {order}", fontsize=10)
+            ax.xaxis.set_major_locator(MaxNLocator(integer=True))
             ax.set(ylim=(-0.04, 1.04), xlabel="course laid brick by brick" if row else None,
                    ylabel="stages that need support\n(share of the course's stages)"
                    if col == 0 else None)
@@ -396,6 +464,51 @@ def bricks_png(brick_rows, title="") -> bytes:
     fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=9, frameon=False)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout(rect=(0, 0.05, 1, 0.97))
+    return png_bytes(fig, 100)
+
+
+def stages_png(brick_rows, profile, title="") -> bytes:
+    """Every scanned brick stage of one profile's domes as a cell, course against
+    stage, green where it stands and red where it needs support, a dot where it lays a
+    pattern brick: one column per dome, one row per order."""
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import ListedColormap
+    from matplotlib.ticker import MaxNLocator
+
+    from masonry.plots.common import png_bytes
+
+    mine = [r for r in brick_rows if r["profile"] == profile]
+    orders, kinds = list(BRICK_ORDERS), list(STYLE)
+    width = max(len(r["verdicts"]) for r in mine)
+    fig, axes = plt.subplots(len(orders), len(kinds), figsize=(3.2 * len(kinds), 8.2),
+                             squeeze=False, sharex=True, sharey=True)
+    for row, order in enumerate(orders):
+        for col, (kind, pattern) in enumerate(kinds):
+            ax = axes[row][col]
+            scanned = [r for r in mine if (r["kind"], r["pattern"], r["order"])
+                       == (kind, pattern, order)]
+            courses = [int(r["course"]) for r in scanned]
+            grid = np.zeros((len(scanned), width))
+            for i, r in enumerate(scanned):
+                grid[i, :len(r["verdicts"])] = [1 if c in "sS" else 2 for c in r["verdicts"]]
+                dots = [j + 1 for j, c in enumerate(r["verdicts"]) if c.isupper()]
+                ax.plot(dots, [courses[i]] * len(dots), "k.", markersize=4)
+            ax.imshow(grid, cmap=ListedColormap(["white", "#8fd18f", "#d9534f"]), vmin=0,
+                      vmax=2, aspect="auto", interpolation="nearest", origin="lower",
+                      extent=(0.5, width + 0.5, courses[0] - 0.5, courses[-1] + 0.5))
+            ax.set_title(f"{_label(kind, pattern)}\n{order}", fontsize=9)
+            ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+            ax.yaxis.set_major_locator(MaxNLocator(integer=True))
+            if row == len(orders) - 1:
+                ax.set_xlabel("stage (brick laid) on the course")
+            if col == 0:
+                ax.set_ylabel("course laid brick by brick")
+    handles = [plt.Rectangle((0, 0), 1, 1, color=c) for c in ("#8fd18f", "#d9534f")]
+    handles.append(plt.Line2D([], [], color="k", marker=".", linestyle=""))
+    fig.legend(handles, ["stands", "needs support", "lays a pattern brick"],
+               loc="lower center", ncol=3, fontsize=9, frameon=False)
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout(rect=(0, 0.03, 1, 0.97))
     return png_bytes(fig, 100)
 
 
@@ -417,7 +530,7 @@ def lateral_png(rows, azimuth_rows, title="") -> bytes:
                     color=colour, linestyle=line, marker=mark, markersize=3.5, linewidth=1,
                     label=_label(kind, pattern))
         ax.set(title=profile, xlabel="azimuth of the lateral load [deg]", xlim=(0, 360),
-               xticks=range(0, 361, 45))
+               xticks=range(0, 361, 45), ylim=(0, 0.6))
         ax.grid(alpha=0.3)
     axes[0][0].set_ylabel("collapse load factor\n(lateral load / self weight)")
     handles, labels = axes[0][0].get_legend_handles_labels()
@@ -465,6 +578,8 @@ def study(out, domes_=None, settings=Settings()) -> None:
         write_csv(out / "revolution.csv", rows, DOME_COLUMNS)
         write_csv(out / "revolution_bricks.csv", brick_rows, BRICK_COLUMNS)
         write_csv(out / "revolution_azimuths.csv", azimuths, AZIMUTH_COLUMNS)
+    (out / "revolution_tables.md").write_text(markdown(
+        read_csv(out / "revolution.csv"), order_summary(read_csv(out / "revolution_bricks.csv"))))
     figures(out, domes_, f"mu {settings.mu:g}, accuracy {settings.accuracy}")
 
 
@@ -474,10 +589,17 @@ def figures(out, domes_=None, note="") -> None:
     out = Path(out)
     domes_ = domes() if domes_ is None else domes_
     (out / "revolution_domes.png").write_bytes(domes_png(
-        domes_, "the front half of each whole dome, seen from the front"))
+        [d for d in domes_ if d.profile == domes_[0].profile],
+        f"{domes_[0].profile}: the front half of each whole dome, seen from the front "
+        f"(red: pattern bricks, orange: fill-ins)"))
+    bricks = read_csv(out / "revolution_bricks.csv")
     (out / "revolution_bricks.png").write_bytes(bricks_png(
-        read_csv(out / "revolution_bricks.csv"),
+        bricks,
         f"brick-by-brick stages of the cyclic section or sector ({note})"))
+    for profile in dict.fromkeys(r["profile"] for r in bricks):
+        (out / f"revolution_stages_{profile.replace(' ', '')}.png").write_bytes(stages_png(
+            bricks, profile, f"{profile}: the brick stages of each scanned course, cyclic "
+                             f"({note})"))
     (out / "revolution_lateral.png").write_bytes(lateral_png(
         read_csv(out / "revolution.csv"), read_csv(out / "revolution_azimuths.csv"),
         f"the whole domes under a lateral load ({note})"))
