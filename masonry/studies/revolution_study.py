@@ -10,9 +10,8 @@ and the whole ``dome``) and of revolution (a cyclic ``sector`` and the whole
   under its own weight) and of the part standing free;
 - the worst lateral load factor of the whole dome over the azimuths of ``--lateral all``;
 - the course stages of the cyclic part: how many stand;
-- the brick-by-brick stages, cyclic, of every course whose regular bricks stand on a bed
-  steeper than the friction angle (the level table's ``gamma_reg > atan(mu)``) up to the
-  top, in both laying orders (friction-net: the verdict, no MoI); while the lowest of
+- the brick-by-brick stages, cyclic, of every course whose chord leans more than the
+  friction angle (the level table's ``gamma_reg > atan(mu)``) up to the top, in both laying orders (friction-net: the verdict, no MoI); while the lowest of
   them needs support, the courses under it, down to one that stands at every stage. The
   lowest course that needs support and the course under it are solved again at a second
   accuracy preset (``confirm``).
@@ -29,8 +28,10 @@ stopped study goes on where it stopped::
     python -m masonry.studies.revolution_study --out exports/revolution_study
 
 writes ``revolution.csv`` (one row per dome), ``revolution_bricks.csv`` (one row per
-dome, order and course scanned), ``revolution_azimuths.csv`` and the figures
-``revolution_domes.png``, ``revolution_bricks.png`` and ``revolution_lateral.png``.
+dome, order and course scanned), ``revolution_azimuths.csv``, the two tables in
+``revolution_tables.md`` and the figures ``revolution_domes.png``,
+``revolution_bricks.png``, ``revolution_stages_<profile>.png`` and
+``revolution_lateral.png``.
 """
 
 import argparse
