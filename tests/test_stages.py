@@ -355,7 +355,7 @@ def test_friction_net_stages_name_the_first_stage_that_needs_support(tmp_path, c
 
 @pytest.mark.parametrize("args, option", [
     (["--preset", "1", "--by", "brick", "--course", "99"], "--course"),
-    (["--preset", "1", "--by", "brick"], "--course"),
+    (["--preset", "1", "--by", "block", "--course", "3"], "--course"),
     (["--preset", "1", "--by", "course", "--order", "along"], "--order"),
     (["--scene", "arch", "--by", "course"], "--by"),
     (["--preset", "1", "--scene", "arch"], "--scene"),
@@ -504,3 +504,48 @@ def test_stages_csv_names_what_each_stage_lays(tmp_path):
         rows = list(csv.DictReader(f))
     assert [r["laid"] for r in rows[:2]] == ["v000 v015", "v001 v014"]
     assert all(r["moi_N"] == "" or "." in r["moi_N"] or "e" in r["moi_N"] for r in rows)
+
+
+# ---------------------------------------------------------------------- the whole construction
+def test_whole_brick_plan_lays_every_course_brick_by_brick():
+    scene = build(from_preset("1", **SMALL_DOME, boundary="cyclic"))
+    courses = course_plan(scene.blocks)
+    for order in ("pattern-first", "along"):
+        plan = make_plan(scene, "brick", order)
+        free = ~scene.blocks.block_is_support
+        # one brick of the section per stage, every brick once, courses bottom to top
+        assert sorted(plan.block_stage[free]) == list(range(1, free.sum() + 1))
+        assert np.all(np.diff(plan.stage_course) >= 0)
+        assert (plan.stage_course[plan.block_stage[free] - 1]
+                == scene.blocks.block_course[free]).all()
+        # within a course, the order of the course's own brick plan; its last stage is
+        # the course stage
+        for course in (1, 3):
+            alone = brick_plan(scene, course, order)
+            on = scene.blocks.block_course == course
+            assert (np.argsort(plan.block_stage[on]) == np.argsort(alone.block_stage[on])).all()
+            last = np.flatnonzero(plan.stage_course == course)[-1] + 1
+            assert (plan.is_present(last) == courses.is_present(course)).all()
+        assert plan.tag == f"brick_{order}"
+
+
+@pytest.mark.parametrize("mu, order", [(0.7, "pattern-first"), (0.4, "along")])
+def test_stages_solved_in_sequence_equal_stages_solved_alone(mu, order):
+    # every brick stage of a small dome, each from the last one's work (warm starts,
+    # the whole model's matrices and ordering, the local certificate) and each alone:
+    # the same verdicts, and the measure of infeasibility within the acceptance
+    # tolerance (the QP's unique minimiser, both accepted at residual 1e-5)
+    params = validate(from_preset("1", **SMALL_DOME, boundary="cyclic", mu=mu))
+    scene = build(params)
+    model = analysis_model(scene, "cyclic")
+    plan = make_plan(scene, "brick", order)
+    warm = analyse_stages(model, params, plan)
+    cold = analyse_stages(model, params, plan, reuse=False)
+    assert [r["feasible"] for r in warm] == [r["feasible"] for r in cold]
+    assert sum(not r["feasible"] for r in cold) >= 4  # the certificate is exercised
+    weight = max(r["moi"] / r["moi_factor"] for r in cold if r["moi"])
+    for ours, alone in zip(warm, cold):
+        assert (ours["moi"] is None) == (alone["moi"] is None)
+        if alone["moi"] is not None:
+            assert ours["moi"] == pytest.approx(alone["moi"], abs=1e-6 * weight)
+        assert ours["centering_N"] == pytest.approx(alone["centering_N"], abs=1e-6 * weight)

@@ -183,6 +183,17 @@ def _model(scene, mode) -> Model:
     return Model(blocks, interfaces, side_block, side_rotation, block_source=source)
 
 
+def kept_blocks(model: Model, is_present) -> np.ndarray:
+    """(B,) bool: the blocks of ``model`` that :func:`restrict` keeps for ``is_present``
+    ((S,) bool per scene block): the present ones, the images of those present, and the
+    scene's supports."""
+    blocks = model.blocks
+    source = (np.arange(blocks.n_blocks) if model.block_source is None
+              else model.block_source)
+    is_present = np.asarray(is_present, dtype=bool)
+    return is_present[source] | blocks.block_is_support & (source == np.arange(len(source)))
+
+
 def restrict(model: Model, is_present) -> Model:
     """The model of a part of the scene: the blocks present, the images of those present,
     and the interfaces of ``model`` whose two blocks are both kept (docs/model.md 4.7: a stage of
@@ -206,8 +217,7 @@ def restrict(model: Model, is_present) -> Model:
     blocks = model.blocks
     source = (np.arange(blocks.n_blocks) if model.block_source is None
               else model.block_source)
-    is_present = np.asarray(is_present, dtype=bool)
-    keep = is_present[source] | blocks.block_is_support & (source == np.arange(len(source)))
+    keep = kept_blocks(model, is_present)
     index = np.flatnonzero(keep)
     remap = np.full(blocks.n_blocks, -1)
     remap[index] = np.arange(len(index))

@@ -83,6 +83,19 @@ its stall; no feasible structure measured ended two steps in a row there (docs/b
 hand-over costs one LP, never a wrong verdict: a feasible verdict resumes Newton without
 this rule."""
 
+WARM_NEWTON = "newton-warm"
+"""Among the candidates: Newton from a given warm start (:meth:`RBEProblem.of_system`),
+before the preset's solver of a model it does not lead; recorded as ``newton``."""
+
+WARM_STEPS = 30
+"""Newton steps from a warm start before the preset's solver takes over ..."""
+
+WARM_STALL = 8
+"""... or steps without halving the residual. From the last stage's friction+ point,
+the next construction stage's took 2 to 6 steps where it converged (docs/bench.md);
+friction+ from a cold start is slowed by the 1,000:1 tension weight, so a start that
+is not close hands over early."""
+
 SOLVERS = names(RBE)
 """Every solver name :func:`solve_rbe` accepts (the registry's RBE backends)."""
 
@@ -253,6 +266,33 @@ class RBEProblem:
                                side_rotation=side_rotation, dropped_rows=dropped_rows,
                                vertex_share=vertex_share)
         self._workspaces = {}
+        self.duals = {}
+        """Friction model -> the equilibrium multipliers ((6 F,) float, solver units) of
+        its last accepted point: the start of a similar problem's solve."""
+
+    @classmethod
+    def of_system(cls, system, *, symbolic=None, starts=None) -> "RBEProblem":
+        """A problem on an assembled ``system`` (:class:`EquilibriumSystem`, e.g. a part
+        of a larger one: :mod:`masonry.rbe.sequence`).
+
+        Parameters
+        ----------
+        symbolic : BlockCholesky, optional
+            The symbolic factorization of its Newton matrices (six rows per free block on
+            the contact graph), made beforehand (from a given ordering).
+        starts : dict str -> (6 F,) float, optional
+            Per friction model (``'net'``, ``'plus'``), the dual point its Newton
+            iterations start from (a similar problem's :attr:`duals`). friction+ is then
+            tried by Newton from it first, for at most :data:`WARM_STEPS` steps, before
+            the preset's solver.
+        """
+        problem = cls.__new__(cls)
+        problem.system, problem._workspaces, problem.duals = system, {}, {}
+        workspace = problem._workspace("newton")
+        if symbolic is not None:
+            workspace["symbolic"] = symbolic
+        workspace["warm"] = dict(starts or {})
+        return problem
 
     def solve(self, mu=0.7, density=2000.0, friction="auto", solver=None, tol=None, *,
               accuracy="balanced", cone=None, lp_check=None, lp_time_limit=60.0,
@@ -293,8 +333,8 @@ class RBEProblem:
                     log.info("solving friction-%s (mu %.3g, %d unknowns)", method,
                              system.mu, system.layout.n_columns)
                     solved = self._solve_model(
-                        system, method, _candidates(method, solver, preset), preset, tol,
-                        attempts, before_lp=alongside.start if alongside else None)
+                        system, method, self._candidates(method, solver, preset), preset,
+                        tol, attempts, before_lp=alongside.start if alongside else None)
                 if solved.accepted:
                     break
                 if method == "net" and friction == "auto":
@@ -304,6 +344,15 @@ class RBEProblem:
             if alongside is not None:
                 alongside.close()
         return solved, attempts
+
+    def _candidates(self, method, solver, preset) -> list:
+        """:func:`_candidates`, led by Newton where a warm start of ``method`` was given
+        (:meth:`of_system`) and the preset's first solver is another."""
+        candidates = _candidates(method, solver, preset)
+        warm = self._workspace("newton").get("warm", {})
+        if solver is None and method in warm and candidates[0] != "newton":
+            return [WARM_NEWTON, *candidates]
+        return candidates
 
     def _solve_model(self, system, method, candidates, preset, tol, attempts,
                      before_lp=None) -> "_Solved":
@@ -321,6 +370,9 @@ class RBEProblem:
                 # Newton hands over sooner when the load-path LP follows it
                 hand_over = ({"stall": LOAD_PATH_STALL, "damped_out": LOAD_PATH_DAMPED_OUT}
                              if LOAD_PATH in candidates[index:] else {})
+                if name == WARM_NEWTON:
+                    name, hand_over = "newton", {"max_iter": WARM_STEPS,
+                                                 "stall": WARM_STALL}
                 outcome = self._run(system, method, name, preset, **hand_over)
             checks = outcome.residuals
             accepted = _accepted(checks, tol)
@@ -334,6 +386,8 @@ class RBEProblem:
                 polished = self._polish(system, method, outcome, tol, attempts)
                 if polished is not None:
                     outcome, checks, name = polished, polished.residuals, f"{name}+newton"
+            if accepted and outcome.y is not None:
+                self.duals[method] = outcome.y
             if accepted or outcome.status == INFEASIBLE:
                 if outcome.status == INFEASIBLE:
                     log.info("%s certified friction-%s infeasible", name, method)

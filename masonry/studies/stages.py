@@ -19,13 +19,20 @@ A :class:`StagePlan` says when each block is laid:
   pattern brick belongs to the course it starts on), in every web.
 - :func:`brick_plan`: courses ``1..K-1`` complete, then the bricks of course ``K`` one at
   a time, the same step in every web (``pattern-first`` or ``along``, see
-  :data:`BRICK_ORDERS`).
+  :data:`BRICK_ORDERS`); without ``K``, every course so, bottom to top: the whole
+  construction.
 - :func:`block_plan`: any assembly, one block at a time by name (``names``) or from the
   bottom up (``z``: blocks whose centroids lie at one height are laid together, so a
   symmetric arch rises from both springings at once).
 
 A stage laid the same in every web is rotationally symmetric, so the cyclic section
 (docs/model.md 6.4) models it exactly.
+
+The stages are solved in order by one :class:`masonry.rbe.sequence.StageSequence`,
+which carries the work consecutive stages share (matrices, ordering, dual points, a
+local infeasibility certificate on the course being laid) from one to the next; each
+stage alone (:func:`analyse_stage` without it) gives the same verdicts and measures
+within the solver's accuracy.
 """
 
 import csv
@@ -54,6 +61,7 @@ from masonry.rbe.boundary import Model, restrict
 from masonry.rbe.centering import centering_force
 from masonry.rbe.collapse import collapse_load
 from masonry.rbe.loads import Lateral
+from masonry.rbe.sequence import StageSequence
 from masonry.rbe.solve import RBEProblem
 from masonry.runfolder import Publication, check_output_root
 from masonry.scenes import check_size
@@ -95,7 +103,8 @@ class StagePlan:
     order : str or None
         A :data:`BRICK_ORDERS` or :data:`BLOCK_ORDERS` name.
     course : int or None
-        The course of a brick plan.
+        The course of a brick plan; None: every course (a brick plan of the whole
+        construction).
     """
 
     block_stage: np.ndarray
@@ -112,12 +121,21 @@ class StagePlan:
     def tag(self) -> str:
         """The plan's part of the run folder's name."""
         if self.by == "brick":
-            return f"brick{self.course}_{self.order}"
+            return f"brick{self.course or ''}_{self.order}"
         return self.by if self.by == "course" else self.order
 
     def is_present(self, stage: int) -> np.ndarray:
         """(S,) bool: the scene blocks present at ``stage`` (1..N)."""
         return (self.block_stage >= 0) & (self.block_stage <= stage)
+
+    def local(self, stage: int) -> np.ndarray:
+        """(S,) bool: the scene blocks laid so far on the course ``stage`` lays (every
+        block laid at ``stage`` where it has no course): what a mason works on."""
+        course = self.stage_course[stage - 1]
+        laid = (self.block_stage >= 1) & (self.block_stage <= stage)
+        if course == 0:
+            return self.block_stage == stage
+        return laid & (self.stage_course[np.maximum(self.block_stage, 1) - 1] == course)
 
     def record(self) -> dict:
         return {"by": self.by, "order": self.order, "course": self.course,
@@ -149,9 +167,11 @@ def course_plan(blocks) -> StagePlan:
     return StagePlan(stage, np.arange(1, stage.max() + 1), by="course")
 
 
-def brick_plan(scene, course: int, order: str = "pattern-first") -> StagePlan:
+def brick_plan(scene, course: int | None, order: str = "pattern-first") -> StagePlan:
     """Courses ``1..course-1`` complete, then the bricks of ``course`` one at a time in
-    ``order`` (:data:`BRICK_ORDERS`), the same step in every web of a ``dome`` scene.
+    ``order`` (:data:`BRICK_ORDERS`), the same step in every web of a ``dome`` scene;
+    ``course`` None: every course so, from the first (the whole construction: the last
+    stage of each course is its course stage).
 
     Raises
     ------
@@ -165,16 +185,25 @@ def brick_plan(scene, course: int, order: str = "pattern-first") -> StagePlan:
     if order not in BRICK_ORDERS:
         raise ParameterError("order", order, f"one of {', '.join(BRICK_ORDERS)}")
     courses = int(layout.course.max())
-    if not isinstance(course, (int, np.integer)) or not 1 <= course <= courses:
+    if course is not None and (not isinstance(course, (int, np.integer))
+                               or not 1 <= course <= courses):
         raise ParameterError("course", course, f"a course of this model, 1..{courses}")
-    rank = _laying_rank(layout, course, order)
+    if course is not None:
+        rank = _laying_rank(layout, course, order)
+        stage_course = np.full(int(rank.max()), course)
+    else:  # every course's ranks after the courses below
+        rank, stage_course = np.zeros(len(layout.course), int), []
+        for each in range(1, courses + 1):
+            on = layout.course == each
+            rank[on] = _laying_rank(layout, each, order)[on] + len(stage_course)
+            stage_course = np.concatenate([stage_course, np.full(on.sum(), each)])
+        stage_course = stage_course.astype(int)
     per_web = np.concatenate([[0], rank])  # the web's ground slab first (docs/model.md 4.6)
     webs, rest = divmod(scene.blocks.n_blocks, len(per_web))
     if rest:
         raise ValueError("the scene's blocks are not whole webs of its layout")
-    stage = np.tile(per_web, webs)
-    count = int(rank.max())
-    return StagePlan(stage, np.full(count, course), by="brick", order=order, course=course)
+    return StagePlan(np.tile(per_web, webs), stage_course, by="brick", order=order,
+                     course=course)
 
 
 def _laying_rank(layout, course, order) -> np.ndarray:
@@ -240,7 +269,8 @@ def _natural_key(name):
 
 
 # ---------------------------------------------------------------------- one stage
-def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
+def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
+                  sequence: StageSequence | None = None) -> dict:
     """The rigid block equilibrium of one stage, and its centering force, as a row of
     ``stages.csv``.
 
@@ -254,6 +284,9 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
     plan : StagePlan
     stage : int
         1..``plan.n_stages``.
+    sequence : StageSequence, optional
+        Solve it from where the sequence's last stage ended (:func:`analyse_stages`);
+        None: the stage alone, from scratch.
 
     Returns
     -------
@@ -275,12 +308,15 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int) -> dict:
     if len(loose) or len(part.interfaces) == 0:  # no equilibrium: nothing to solve
         row.update(feasible=False, moi=None, moi_factor=None)
     else:
-        problem = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
-                             side_rotation=part.side_rotation)
         analysis = params.analysis
-        result = problem.solve(mu=analysis.mu, density=analysis.density,
-                               friction=analysis.friction, solver=analysis.solver,
-                               accuracy=analysis.accuracy, cone=analysis.friction_cone)
+        options = dict(mu=analysis.mu, density=analysis.density, friction=analysis.friction,
+                       solver=analysis.solver, accuracy=analysis.accuracy,
+                       cone=analysis.friction_cone)
+        if sequence is None:
+            result = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
+                                side_rotation=part.side_rotation).solve(**options)
+        else:
+            result = sequence.solve(plan.is_present(stage), plan.local(stage), **options)
         row.update(feasible=result.feasible, moi=_number(result.moi),
                    moi_factor=_number(result.moi_factor))
         if result.feasible:
@@ -387,9 +423,6 @@ def make_plan(scene, by: str = "course", order: str | None = None,
                                                      "(--by brick --course K)")
         return course_plan(scene.blocks)
     if by == "brick":
-        if course is None:
-            raise ParameterError("course", None, "the course laid brick by brick "
-                                                   "(--by brick --course K)")
         return brick_plan(scene, course, order or "pattern-first")
     if by == "block":
         if course is not None:
@@ -398,17 +431,48 @@ def make_plan(scene, by: str = "course", order: str | None = None,
     raise ParameterError("by", by, "course, brick or block")
 
 
-def analyse_stages(model: Model, params, plan: StagePlan) -> list:
-    """:func:`analyse_stage` of stages ``1..N``, in order, logging ``stage k of N``; two
-    at once on a large model (:func:`masonry.forking.two_at_once`: the stages are
-    independent)."""
-    return forking.two_at_once(functools.partial(_analysed, model, params, plan),
-                               range(1, plan.n_stages + 1),
-                               blocks=int((~model.blocks.block_is_support).sum()))
+def analyse_stages(model: Model, params, plan: StagePlan, reuse: bool = True) -> list:
+    """:func:`analyse_stage` of stages ``1..N``, in order, logging ``stage k of N``.
+
+    With ``reuse``, in runs of consecutive stages, each run solved by one
+    :class:`StageSequence` from its first stage to its last; on a large model two runs at
+    once (:func:`masonry.forking.two_at_once`), every second run in a forked process.
+    Without it, every stage alone, two at once on a large model."""
+    blocks = int((~model.blocks.block_is_support).sum())
+    stages = range(1, plan.n_stages + 1)
+    if not reuse:
+        return forking.two_at_once(functools.partial(_analysed, model, params, plan),
+                                   stages, blocks=blocks)
+    sequence = StageSequence(model)  # made once, before any fork
+    runs = _runs(plan, 2 * STAGE_RUNS if blocks >= forking.TWO_AT_ONCE_BLOCKS else 1)
+    done = forking.two_at_once(functools.partial(_analysed_run, model, params, plan,
+                                                 sequence), runs, blocks=blocks)
+    return [row for run in done for row in run]
 
 
-def _analysed(model: Model, params, plan: StagePlan, stage: int) -> dict:
-    row = analyse_stage(model, params, plan, stage)
+STAGE_RUNS = 3
+"""Runs of consecutive stages each process solves on a large model: a run starts
+without a previous stage, so fewer runs reuse more, and more runs share the work between
+the two processes more evenly (the last stages are the largest)."""
+
+
+def _runs(plan: StagePlan, count: int) -> list:
+    """The stages ``1..N`` in at most ``count`` runs of consecutive stages with about
+    equal work (the blocks laid, summed over the run's stages)."""
+    laid = np.bincount(np.maximum(plan.block_stage, 0), minlength=plan.n_stages + 1)
+    work = np.cumsum(np.cumsum(laid)[1:])
+    cut = np.searchsorted(work, work[-1] * np.arange(1, count) / count) + 1
+    bounds = np.unique(np.concatenate([[1], cut, [plan.n_stages + 1]]))
+    return [range(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+
+
+def _analysed_run(model, params, plan, sequence, stages) -> list:
+    sequence.forget()  # another run's last stage is no start for this one's first
+    return [_analysed(model, params, plan, stage, sequence) for stage in stages]
+
+
+def _analysed(model: Model, params, plan: StagePlan, stage: int, sequence=None) -> dict:
+    row = analyse_stage(model, params, plan, stage, sequence)
     verdict = ("stands" if row["feasible"] else
                f"needs support ({row['loose']} blocks touch nothing that holds them)"
                if row["loose"] else "needs support")
@@ -638,6 +702,8 @@ def _record(params, scene, model, plan, rows, cached, source) -> dict:
 def _described(plan: StagePlan) -> str:
     if plan.by == "course":
         return "stage k: every brick starting on courses 1..k"
+    if plan.by == "brick" and plan.course is None:
+        return "every course brick by brick, from the first: " + BRICK_ORDERS[plan.order]
     if plan.by == "brick":
         return f"courses 1..{plan.course - 1}, then course {plan.course}: " + \
             BRICK_ORDERS[plan.order]
@@ -650,8 +716,9 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
     that stage, its bricks coloured by the support force they need."""
     from masonry import plots  # matplotlib, imported only by the runs that draw
 
-    what = {"course": "course stages", "brick": f"course {plan.course} brick by brick "
-            f"({plan.order})", "block": f"block by block ({plan.order})"}[plan.by]
+    bricks = "every course" if plan.course is None else f"course {plan.course}"
+    what = {"course": "course stages", "brick": f"{bricks} brick by brick ({plan.order})",
+            "block": f"block by block ({plan.order})"}[plan.by]
     title = f"{structure_id(params)}: {what}, {sum(bool(r['feasible']) for r in rows)} of " \
             f"{len(rows)} stages stand (mu {params.analysis.mu:g})"
     out = {"stages.png": plots.stage_chart_png(
@@ -661,8 +728,8 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
         [bool(r["feasible"]) for r in rows],
         [np.nan if r["load_factor"] is None else r["load_factor"] for r in rows],
         loose=[r["loose"] for r in rows], title=title,
-        xlabel={"course": "stage (courses laid)", "brick": f"stage (bricks of course "
-                f"{plan.course} laid, per web)"}.get(plan.by, "stage"))}
+        xlabel={"course": "stage (courses laid)", "brick": f"stage (bricks of {bricks} "
+                f"laid, per web)"}.get(plan.by, "stage"))}
     first = first_unsupported(rows)
     if first is None:
         return out

@@ -210,6 +210,36 @@ class _Supernode:
     position: np.ndarray  # where each of ``rows`` is in the parent's front (block units)
 
 
+def block_graph(n_nodes: int, edges) -> sp.csr_array:
+    """The symmetric 0/1 pattern of a block matrix: ``edges`` ((E, 2) int, either order,
+    repeats allowed) and the diagonal."""
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    edges = edges[edges[:, 0] != edges[:, 1]]
+    ring = np.arange(n_nodes)
+    rows = np.concatenate([edges[:, 0], edges[:, 1], ring])
+    cols = np.concatenate([edges[:, 1], edges[:, 0], ring])
+    graph = sp.csr_array((np.ones(len(rows)), (rows, cols)), shape=(n_nodes, n_nodes))
+    graph.sum_duplicates()
+    graph.data[:] = 1.0
+    return graph
+
+
+def _automatic(n_nodes) -> str:
+    return "metis" if n_nodes >= METIS_NODES and has_metis() else "amd"
+
+
+def fill_reducing_order(graph: sp.csr_array, ordering: str = "auto") -> np.ndarray:
+    """(n,) int: a fill-reducing order of the block graph ``graph`` (:func:`block_graph`):
+    approximate minimum degree (``'amd'``), METIS nested dissection (``'metis'``, needs
+    ``pymetis``), or ``'auto'``: METIS from :data:`METIS_NODES` nodes on when ``pymetis``
+    is installed, else AMD."""
+    n_nodes = graph.shape[0]
+    if ordering == "auto":
+        ordering = _automatic(n_nodes)
+    orderings = {"amd": amd_order, "metis": metis_order}
+    return orderings[ordering](graph) if n_nodes > 1 else np.arange(n_nodes)
+
+
 class BlockCholesky:
     """Symbolic analysis of an SPD block matrix with a fixed block pattern.
 
@@ -222,15 +252,15 @@ class BlockCholesky:
         allowed). Diagonal blocks are always present.
     block_size : int
         Size of the dense blocks (6: the equilibrium rows of one rigid block).
-    ordering : {'auto', 'amd', 'metis'}
-        Fill-reducing ordering of the block graph: approximate minimum degree, METIS
-        nested dissection (needs ``pymetis``), or 'auto': METIS from :data:`METIS_NODES`
-        nodes on when ``pymetis`` is installed, else AMD.
+    ordering : {'auto', 'amd', 'metis'} or (n_nodes,) int
+        Fill-reducing ordering of the block graph (:func:`fill_reducing_order`), or a
+        given order (a permutation of the nodes: a larger graph's order restricted to
+        this one, whose fill it then does not exceed).
 
     Attributes
     ----------
     ordering : str
-        The ordering used ('amd' or 'metis').
+        The ordering used ('amd', 'metis' or 'given').
     lower_rows, lower_cols : (NB,) int
         The stored blocks ``(i, j)``, ``i >= j``, in the caller's numbering; values are
         passed to :meth:`factor` in this order (block ``(i, j)`` of the lower triangle).
@@ -243,22 +273,15 @@ class BlockCholesky:
     def __init__(self, n_nodes: int, edges, block_size: int = 6, ordering: str = "auto"):
         self.n_nodes = int(n_nodes)
         self.block_size = bs = int(block_size)
-        edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-        edges = edges[edges[:, 0] != edges[:, 1]]
-        ring = np.arange(self.n_nodes)
-        rows = np.concatenate([edges[:, 0], edges[:, 1], ring])
-        cols = np.concatenate([edges[:, 1], edges[:, 0], ring])
-        graph = sp.csr_array((np.ones(len(rows)), (rows, cols)),
-                             shape=(self.n_nodes, self.n_nodes))
-        graph.sum_duplicates()
-        graph.data[:] = 1.0
-
-        if ordering == "auto":
-            large = self.n_nodes >= METIS_NODES and has_metis()
-            ordering = "metis" if large else "amd"
-        self.ordering = ordering
-        orderings = {"amd": amd_order, "metis": metis_order}
-        order = orderings[ordering](graph) if self.n_nodes > 1 else np.arange(self.n_nodes)
+        graph = block_graph(self.n_nodes, edges)
+        if isinstance(ordering, str):
+            order = fill_reducing_order(graph, ordering)
+            self.ordering = ordering if ordering != "auto" else _automatic(self.n_nodes)
+        else:
+            order = np.asarray(ordering, dtype=np.int64)
+            if np.sort(order).tolist() != list(range(self.n_nodes)):
+                raise ValueError("the given ordering is not a permutation of the nodes")
+            self.ordering = "given"
         permuted = sp.csr_array(graph[order][:, order])
         parent = elimination_tree(permuted.indptr, permuted.indices)
         # a postorder is an equivalent order: same fill, the tree relabelled

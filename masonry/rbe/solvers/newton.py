@@ -522,10 +522,11 @@ def certifies_infeasibility(ns, d, w_d, b_one, tol) -> bool:
 
 def prepared_system(system, method, workspace) -> NewtonSystem:
     """The :class:`NewtonSystem` of ``method`` kept in ``workspace`` (made on first use;
-    the friction models share one symbolic factorization), set to ``system.mu``."""
+    the friction models share one symbolic factorization, the workspace's ``symbolic``
+    when its caller made one), set to ``system.mu``."""
     prepared = workspace.setdefault("systems", {})
     if method not in prepared:
-        symbolic = next((s.symbolic for s in prepared.values()), None)
+        symbolic = next((s.symbolic for s in prepared.values()), workspace.get("symbolic"))
         prepared[method] = NewtonSystem(system, method, symbolic=symbolic)
     ns = prepared[method]
     ns.mu, ns.cone = system.mu, system.cone

@@ -1,0 +1,213 @@
+"""Rigid block equilibrium of a sequence of parts of one model (construction stages,
+docs/stages.md), the work consecutive parts share kept between their solves.
+
+Each part is the model restricted to the blocks present (:func:`masonry.rbe.boundary.restrict`),
+and its result is the one :class:`~masonry.rbe.solve.RBEProblem` gives that part alone,
+within the solver's accuracy (tests/test_sequence.py). What :class:`StageSequence` keeps:
+
+- **The matrices.** The whole model's equilibrium system is assembled once; a part's is
+  its rows (the part's free blocks) and columns (the vertices of the interfaces whose two
+  blocks are present), :func:`part_system`. The units stay the whole model's (its
+  reference weight and length, docs/model.md "Scaling"): the feasible set and the
+  minimiser do not depend on them, and dual points carry over from part to part.
+- **The ordering.** One fill-reducing order of the whole model's block graph; a part's
+  symbolic factorization takes it restricted to the part's blocks. Every fill path of a
+  part's graph is one of the whole graph, so the part's factor has no more fill than the
+  whole's restricted to it, and no part is ordered again.
+- **The dual points.** The equilibrium multipliers of the last accepted point of each
+  friction model, by block (a virtual displacement per block, in the whole model's
+  units): the next part's Newton iterations start from them (blocks new to the part from
+  zero), friction+ included (:meth:`RBEProblem.of_system`).
+- **A local infeasibility certificate.** Before friction-net, the blocks just laid
+  (``local``: the course being laid) alone, every other present block held fixed: if no
+  forces within friction carry them, the part cannot stand either (a Farkas certificate
+  of that small problem, a virtual motion of the local blocks on which the weight does
+  work and no contact resists, is one of the whole part with the other blocks at rest),
+  and the part goes straight to friction+ for its measure of infeasibility. Where the
+  small problem has a solution nothing follows, and the part is solved as usual.
+"""
+
+import dataclasses
+import logging
+import time
+
+import numpy as np
+
+from masonry.rbe.boundary import Model, kept_blocks
+from masonry.rbe.equilibrium import FRICTION_METHODS, EquilibriumSystem, VariableLayout, assemble
+from masonry.rbe.solve import ACCURACY, RBEProblem, RBEResult, friction_model
+from masonry.rbe.solvers import BACKENDS
+from masonry.rbe.solvers.base import INFEASIBLE
+from masonry.rbe.solvers.cholesky import BlockCholesky, block_graph, fill_reducing_order
+
+log = logging.getLogger(__name__)
+
+CERTIFICATE = "local-certificate"
+"""The local certificate's name in :attr:`RBEResult.attempts`."""
+
+
+def part_system(whole: EquilibriumSystem, rows, interfaces) -> EquilibriumSystem:
+    """The equilibrium system of a part of ``whole``: its free blocks ``rows`` ((F,)
+    bool over ``whole``'s free blocks) and its ``interfaces`` ((K,) bool). A side on a
+    block that is not kept is held fixed (a support: no rows, zero coefficients).
+
+    ``free_block`` and ``block_weight`` stay the whole model's (``free_block`` indexes
+    the whole model's blocks), and so do the units."""
+    rows, interfaces = np.asarray(rows, bool), np.asarray(interfaces, bool)
+    new_row = np.full(len(rows), -1)
+    new_row[rows] = np.arange(int(rows.sum()))
+    side_row = whole.side_row[interfaces]
+    side_row = np.where(side_row >= 0, new_row[np.maximum(side_row, 0)], -1)
+    vertices = interfaces[whole.layout.vertex_interface]
+    counts = np.diff(whole.layout.offsets)[interfaces]
+    layout = VariableLayout(np.concatenate([[0], np.cumsum(counts)]).astype(np.int64))
+    coefficients = whole.vertex_coefficients[vertices]             # a copy
+    coefficients[(side_row < 0)[layout.vertex_interface]] = 0.0    # supports: zero already
+    columns = np.repeat(vertices, VariableLayout.WIDTH)
+    f_ext = whole.f_ext.reshape(-1, 6)[rows].ravel()
+    return dataclasses.replace(whole, layout=layout, free_block=whole.free_block[rows],
+                               f_ext=f_ext, lower=whole.lower[columns], h=whole.h[columns],
+                               side_row=side_row, vertex_coefficients=coefficients)
+
+
+class StageSequence:
+    """Solve parts of ``model`` one after the other, each from where the last one ended
+    (see the module's notes).
+
+    Parameters
+    ----------
+    model : Model
+        The whole structure's analysis model.
+    """
+
+    def __init__(self, model: Model):
+        self.model = model
+        self.whole = assemble(model.blocks, model.interfaces, side_block=model.side_block,
+                              side_rotation=model.side_rotation)
+        n_free = len(self.whole.free_block)
+        rows = self.whole.side_row
+        self._position = np.empty(n_free, dtype=np.int64)
+        self._position[fill_reducing_order(block_graph(
+            n_free, rows[(rows >= 0).all(axis=1)]))] = np.arange(n_free)
+        self._duals = {method: np.zeros((n_free, 6)) for method in FRICTION_METHODS}
+        self._known = {method: np.zeros(n_free, bool) for method in FRICTION_METHODS}
+        # the pairs of free blocks in contact whose forces are not routed elsewhere, and
+        # the blocks' centroids in reference lengths: a block new to a part starts with
+        # the rigid motion of its neighbours
+        routed = (model.side_block if model.side_block is not None
+                  else model.interfaces.pair)
+        direct = (rows >= 0).all(axis=1) & (routed == model.interfaces.pair).all(axis=1)
+        self._pairs = np.unique(np.sort(rows[direct], axis=1), axis=0)
+        self._pairs = self._pairs[self._pairs[:, 0] != self._pairs[:, 1]]
+        self._centroid = (model.blocks.block_centroid[self.whole.free_block]
+                          / self.whole.length_ref)
+        self.certified = 0
+        """Parts whose local certificate spared the friction-net solve."""
+
+    def solve(self, is_present, local=None, *, mu=0.7, density=2000.0, friction="auto",
+              solver=None, accuracy="balanced", cone=None) -> RBEResult:
+        """The RBE of the part of the model whose scene blocks ``is_present`` ((S,) bool,
+        as :func:`~masonry.rbe.boundary.restrict` takes it).
+
+        Parameters
+        ----------
+        local : (S,) bool, optional
+            The scene blocks laid last (a subset of the present ones): with ``friction``
+            ``'auto'``, the local certificate is tried on them first.
+        mu, density, friction, solver, accuracy, cone
+            As :meth:`RBEProblem.solve`.
+
+        Returns
+        -------
+        RBEResult
+            As the part's own :class:`RBEProblem` gives it (in the whole model's units
+            inside; ``x`` in newtons in the layout of the part's interfaces, in their
+            order in the model). A certified part's ``attempts`` begin with
+            :data:`CERTIFICATE`.
+        """
+        start = time.perf_counter()
+        keep = kept_blocks(self.model, is_present)
+        interfaces = keep[self.model.interfaces.pair].all(axis=1)
+        rows = keep[self.whole.free_block]
+        cone = friction_model(accuracy, cone)
+        system = part_system(self.whole, rows, interfaces).with_material(
+            mu=mu, density=density, cone=cone)
+        certificate = None
+        if local is not None and friction == "auto" and solver is None:
+            certificate = self._certificate(system, rows, interfaces,
+                                            kept_blocks(self.model, local) & keep, accuracy)
+        starts = {method: self._start(method, rows) for method in FRICTION_METHODS
+                  if self._known[method][rows].any()}
+        problem = RBEProblem.of_system(system, symbolic=self._symbolic(rows, system),
+                                       starts=starts)
+        result = problem.solve(mu=mu, density=density, accuracy=accuracy, cone=cone,
+                               friction="plus" if certificate else friction, solver=solver)
+        for method, y in problem.duals.items():
+            self._duals[method][rows] = y.reshape(-1, 6)
+            self._known[method][rows] = True
+        if certificate:
+            self.certified += 1
+            result = dataclasses.replace(result, attempts=(certificate, *result.attempts))
+        return dataclasses.replace(result, time_s=time.perf_counter() - start)
+
+    def forget(self) -> None:
+        """Drop the dual points: the next part starts from scratch (its matrices and
+        ordering are still the whole model's)."""
+        for known in self._known.values():
+            known[:] = False
+
+    def _start(self, method, rows) -> np.ndarray:
+        """(6 F,) float: the warm start of ``method`` on the part's ``rows``: the last
+        dual point of every block that had one; a block without one takes the rigid
+        motion of its neighbours that have one (averaged; the dual's six entries per
+        block are its virtual translation and rotation times the reference length),
+        zero where none has."""
+        y = self._duals[method].copy()
+        known = self._known[method] & rows
+        for _ in range(2):  # a block whose neighbours are new too: from the second ring
+            pairs = self._pairs[rows[self._pairs].all(axis=1)
+                                & (known[self._pairs[:, 0]] != known[self._pairs[:, 1]])]
+            if len(pairs) == 0:
+                break
+            new = np.where(known[pairs[:, 0]], pairs[:, 1], pairs[:, 0])
+            old = pairs[:, 0] + pairs[:, 1] - new
+            arm = self._centroid[new] - self._centroid[old]
+            moved = np.concatenate([y[old, :3] + np.cross(y[old, 3:], arm), y[old, 3:]],
+                                   axis=1)
+            total = np.zeros_like(y)
+            np.add.at(total, new, moved)
+            count = np.bincount(new, minlength=len(y))
+            reached = count > 0
+            y[reached] = total[reached] / count[reached, None]
+            known = known | reached
+        y[~known] = 0.0
+        return y[rows].ravel()
+
+    def _symbolic(self, rows, system) -> BlockCholesky:
+        """The part's symbolic factorization, in the whole model's order."""
+        side = system.side_row
+        order = np.argsort(self._position[rows], kind="stable")
+        return BlockCholesky(len(order), side[(side >= 0).all(axis=1)], block_size=6,
+                             ordering=order)
+
+    def _certificate(self, system, rows, interfaces, local, accuracy) -> dict | None:
+        """Friction-net of the ``local`` blocks ((B,) bool) alone, the rest of the part
+        held fixed, by Clarabel: its record when it certifies infeasibility (the part
+        cannot stand), else None."""
+        local_rows = local[self.whole.free_block] & rows
+        if not local_rows.any():
+            return None
+        side = self.whole.side_row
+        touching = interfaces & ((side >= 0) & local_rows[np.maximum(side, 0)]).any(axis=1)
+        small = part_system(self.whole, local_rows, touching).with_material(
+            mu=system.mu, density=system.density, cone=system.cone)
+        clarabel = BACKENDS["clarabel"]
+        outcome = clarabel.solve_rbe(small, "net",
+                                     ACCURACY[accuracy].options.get(clarabel.settings, {}),
+                                     {})
+        record = {"friction": "net", "solver": CERTIFICATE, "status": outcome.status,
+                  "iterations": outcome.iterations,
+                  "setup_s": round(outcome.setup_time, 4),
+                  "solve_s": round(outcome.solve_time, 4), "blocks": int(local_rows.sum())}
+        log.debug("local certificate on %d blocks: %s", record["blocks"], outcome.status)
+        return record if outcome.status == INFEASIBLE else None
