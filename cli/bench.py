@@ -62,6 +62,11 @@ def register(subparsers):
                              "dome, "
                              "medians of --repeats makes (e.g. --presets 1 3 --repeats "
                              "1); writes DIR/bench_outputs/outputs.md")
+    parser.add_argument("--stages", action="store_true",
+                        help="instead: every brick stage of each preset's cyclic section "
+                             "(masonry stages --dome --by brick), both laying orders, "
+                             "solved in sequence and each alone, against one masonry run "
+                             "of the dome; writes DIR/bench_stages/stages.md")
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root: writes DIR/bench/bench.csv, bench.md and "
                              "frontier.png (default exports)")
@@ -88,6 +93,10 @@ def handle(args, report):
     if args.outputs and (args.collapse or args.friction_models is not None or args.readers):
         raise ParameterError("outputs", True, "one bench at a time: not with --collapse, "
                              "--friction-models or --readers")
+    if args.stages and (args.collapse or args.friction_models is not None or args.readers
+                        or args.outputs):
+        raise ParameterError("stages", True, "one bench at a time: not with --collapse, "
+                             "--friction-models, --readers or --outputs")
     check_output_root(args.out)
     if args.outputs:
         return _outputs(args, report)
@@ -97,6 +106,8 @@ def handle(args, report):
         return _friction(args, report)
     if args.readers:
         return _readers(args, report)
+    if args.stages:
+        return _stages(args, report)
     from masonry.studies.bench import (bench, frontier_png, ratios_markdown, table_csv,
                                        table_markdown)
 
@@ -158,6 +169,24 @@ def _friction(args, report):
     markdown = friction_markdown(rows)
     with RunFolder(args.out, "bench_friction") as folder:
         folder.write("friction.md", markdown)
+    report(markdown)
+    report(f"written: {folder.target}")
+    return 0
+
+
+def _stages(args, report):
+    from masonry.studies.stages_bench import stages_bench, stages_markdown
+
+    overrides = {} if args.p is None else {"p": args.p}
+    named = "" if args.p is None else f" (p {args.p})"
+    sections = {f"preset {k} cyclic section{named}": from_preset(k, boundary="cyclic",
+                                                                 **overrides)
+                for k in args.presets}
+    rows = stages_bench(sections, repeats=args.repeats,
+                        progress=None if args.quiet else _progress)
+    markdown = stages_markdown(rows)
+    with RunFolder(args.out, "bench_stages") as folder:
+        folder.write("stages.md", markdown)
     report(markdown)
     report(f"written: {folder.target}")
     return 0

@@ -179,6 +179,43 @@ def test_friction_model_names_are_parsed_and_refused():
             FrictionCone.parse(bad)
 
 
+def test_a_larger_graphs_factorization_serves_a_subgraph():
+    # a graph's symbolic analysis, in a given order, factors the matrix of a subgraph
+    # (the other nodes idle): the same solution as the subgraph's own dense solve
+    rng = np.random.default_rng(3)
+    n, bs = 40, 6
+    edges = np.unique(np.sort(rng.integers(0, n, size=(100, 2)), axis=1), axis=0)
+    edges = edges[edges[:, 0] != edges[:, 1]]
+    order = rng.permutation(n)
+    whole = BlockCholesky(n, edges, block_size=bs, ordering=order)
+    assert whole.ordering == "given"  # then postordered: an equivalent order
+    with pytest.raises(ValueError, match="permutation"):
+        BlockCholesky(n, edges, block_size=bs, ordering=order[1:])
+    nodes = np.sort(rng.choice(n, 25, replace=False))
+    new = np.full(n, -1)
+    new[nodes] = np.arange(len(nodes))
+    inner = new[edges]
+    inner = inner[(inner >= 0).all(axis=1)]
+    sub = cholesky.Embedded(whole, nodes)
+    dense = np.zeros((bs * len(nodes),) * 2)
+    values = np.zeros((len(whole.lower_rows), bs, bs))
+    for i, j in inner:
+        block = rng.normal(size=(bs, bs))
+        stored = sub.block_index([i], [j])[0]
+        values[stored] = block.T if sub.is_transposed([i], [j])[0] else block
+        dense[bs * i:bs * i + bs, bs * j:bs * j + bs] = block
+        dense[bs * j:bs * j + bs, bs * i:bs * i + bs] = block.T
+    strength = np.abs(dense).sum(axis=1) + 1.0
+    diagonal = sub.block_index(np.arange(len(nodes)), np.arange(len(nodes)))
+    for i in range(len(nodes)):
+        values[diagonal[i]] += np.diag(strength[bs * i:bs * i + bs])
+    dense += np.diag(strength)
+    rhs = rng.normal(size=bs * len(nodes))
+    expected = scipy.linalg.solve(dense, rhs, assume_a="pos")
+    np.testing.assert_allclose(sub.factor(values).solve(rhs), expected, rtol=0,
+                               atol=1e-12 * np.abs(expected).max())
+
+
 @pytest.mark.parametrize("ordering", ["amd", "metis"])
 @pytest.mark.parametrize("parallel", [False, True])
 def test_block_cholesky_solves_and_refuses_indefinite_matrices(monkeypatch, ordering, parallel):

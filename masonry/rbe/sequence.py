@@ -38,7 +38,8 @@ from masonry.rbe.equilibrium import FRICTION_METHODS, EquilibriumSystem, Variabl
 from masonry.rbe.solve import ACCURACY, RBEProblem, RBEResult, friction_model
 from masonry.rbe.solvers import BACKENDS
 from masonry.rbe.solvers.base import INFEASIBLE
-from masonry.rbe.solvers.cholesky import BlockCholesky, block_graph, fill_reducing_order
+from masonry.rbe.solvers.cholesky import (BlockCholesky, Embedded, block_graph,
+                                          fill_reducing_order)
 
 log = logging.getLogger(__name__)
 
@@ -101,11 +102,12 @@ class StageSequence:
         self._pairs = self._pairs[self._pairs[:, 0] != self._pairs[:, 1]]
         self._centroid = (model.blocks.block_centroid[self.whole.free_block]
                           / self.whole.length_ref)
+        self._within = None  # (free blocks, their symbolic factorization)
         self.certified = 0
         """Parts whose local certificate spared the friction-net solve."""
 
-    def solve(self, is_present, local=None, *, mu=0.7, density=2000.0, friction="auto",
-              solver=None, accuracy="balanced", cone=None) -> RBEResult:
+    def solve(self, is_present, local=None, within=None, *, mu=0.7, density=2000.0,
+              friction="auto", solver=None, accuracy="balanced", cone=None) -> RBEResult:
         """The RBE of the part of the model whose scene blocks ``is_present`` ((S,) bool,
         as :func:`~masonry.rbe.boundary.restrict` takes it).
 
@@ -114,6 +116,11 @@ class StageSequence:
         local : (S,) bool, optional
             The scene blocks laid last (a subset of the present ones): with ``friction``
             ``'auto'``, the local certificate is tried on them first.
+        within : (S,) bool, optional
+            Scene blocks that the next parts will not outgrow (a superset of the present
+            ones, e.g. the course being laid complete): the symbolic factorization is
+            made once for them and serves every part within
+            (:class:`~masonry.rbe.solvers.cholesky.Embedded`). Default: the part's own.
         mu, density, friction, solver, accuracy, cone
             As :meth:`RBEProblem.solve`.
 
@@ -138,8 +145,9 @@ class StageSequence:
                                             kept_blocks(self.model, local) & keep, accuracy)
         starts = {method: self._start(method, rows) for method in FRICTION_METHODS
                   if self._known[method][rows].any()}
-        problem = RBEProblem.of_system(system, symbolic=self._symbolic(rows, system),
-                                       starts=starts)
+        problem = RBEProblem.of_system(system, symbolic=self._symbolic(
+            rows, rows if within is None else kept_blocks(self.model, within)[
+                self.whole.free_block] | rows), starts=starts)
         result = problem.solve(mu=mu, density=density, accuracy=accuracy, cone=cone,
                                friction="plus" if certificate else friction, solver=solver)
         for method, y in problem.duals.items():
@@ -183,12 +191,19 @@ class StageSequence:
         y[~known] = 0.0
         return y[rows].ravel()
 
-    def _symbolic(self, rows, system) -> BlockCholesky:
-        """The part's symbolic factorization, in the whole model's order."""
-        side = system.side_row
-        order = np.argsort(self._position[rows], kind="stable")
-        return BlockCholesky(len(order), side[(side >= 0).all(axis=1)], block_size=6,
-                             ordering=order)
+    def _symbolic(self, rows, within) -> Embedded:
+        """The part's symbolic factorization: that of the free blocks ``within`` ((F,)
+        bool, a superset of ``rows``), made in the whole model's order when they are not
+        those of the last part's."""
+        if self._within is None or not np.array_equal(self._within[0], within):
+            side = self.whole.side_row
+            new_row = np.cumsum(within) - 1
+            both = (side >= 0).all(axis=1)
+            edges = side[both][within[side[both]].all(axis=1)]
+            order = np.argsort(self._position[within], kind="stable")
+            self._within = within, BlockCholesky(int(within.sum()), new_row[edges],
+                                                 block_size=6, ordering=order)
+        return Embedded(self._within[1], (np.cumsum(self._within[0]) - 1)[rows])
 
     def _certificate(self, system, rows, interfaces, local, accuracy) -> dict | None:
         """Friction-net of the ``local`` blocks ((B,) bool) alone, the rest of the part

@@ -137,6 +137,14 @@ class StagePlan:
             return self.block_stage == stage
         return laid & (self.stage_course[np.maximum(self.block_stage, 1) - 1] == course)
 
+    def course_end(self, stage: int) -> int:
+        """The last stage of the course ``stage`` lays (``stage`` itself where it has no
+        course)."""
+        course = self.stage_course[stage - 1]
+        if course == 0:
+            return stage
+        return stage + int(np.argmax(np.append(self.stage_course[stage:], -1) != course))
+
     def record(self) -> dict:
         return {"by": self.by, "order": self.order, "course": self.course,
                 "stages": self.n_stages}
@@ -316,7 +324,8 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
             result = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
                                 side_rotation=part.side_rotation).solve(**options)
         else:
-            result = sequence.solve(plan.is_present(stage), plan.local(stage), **options)
+            result = sequence.solve(plan.is_present(stage), plan.local(stage),
+                                    plan.is_present(plan.course_end(stage)), **options)
         row.update(feasible=result.feasible, moi=_number(result.moi),
                    moi_factor=_number(result.moi_factor))
         if result.feasible:

@@ -1,0 +1,108 @@
+"""Construction stages, measured (``masonry bench --stages``): every brick stage of a
+dome's cyclic section, in both laying orders, solved in sequence
+(:class:`masonry.rbe.sequence.StageSequence`: the work of one stage reused for the next)
+and each stage alone, against one run of the dome (docs/bench.md, "Construction stages
+brick by brick").
+"""
+
+import statistics
+import tempfile
+import time
+
+from masonry.params import validate
+from masonry.pipeline import build_model, run
+from masonry.studies.stages import BRICK_ORDERS, analyse_stages, make_plan
+
+STAGES_COLUMNS = ("structure", "order", "stages", "standing", "same_verdicts",
+                  "moi_factor_diff", "sequence_s", "alone_s", "speedup", "run_s",
+                  "sequence_runs", "alone_runs")
+"""Columns of a stages bench row (:data:`STAGES_NOTE` says what they hold)."""
+
+STAGES_NOTE = """One row per structure and laying order (`masonry bench --stages`), every
+brick stage of the cyclic section (`masonry stages --dome --by brick`), one pass each.
+`sequence_s`: the stages solved in order, each from the last one's work (the whole
+model's matrices and ordering, the last stage's dual points, the local infeasibility
+certificate); `alone_s`: each stage alone from scratch (as before); both two at once on a
+large model, as `masonry stages` does, the model built beforehand. `standing`: stages
+that stand (in sequence); `same_verdicts`: every stage's verdict is the same both ways;
+`moi_factor_diff`: the largest difference of a stage's MoI factor between the two;
+`speedup`: alone over sequence; `run_s`: one `masonry run` of the dome (analysis and
+exports, no plots, no printable body, no page; median over the repeats, the geometry from
+the cache as a repeated run has it); `sequence_runs`, `alone_runs`: the stages' times
+over the run's."""
+
+
+def stages_bench(structures, orders=tuple(BRICK_ORDERS), repeats=3, alone=True,
+                 progress=None) -> list:
+    """Time every brick stage of each structure, in sequence and alone, against one run.
+
+    Parameters
+    ----------
+    structures : dict str -> Params
+        Named cyclic sections (their ``analysis`` is the stages' and the run's).
+    orders : sequence of str
+        :data:`~masonry.studies.stages.BRICK_ORDERS` names.
+    repeats : int
+        Runs of the dome timed (the stages are timed once).
+    alone : bool
+        Also each stage alone (slow: the reference).
+    """
+    rows = []
+    for name, params in structures.items():
+        run_s = _run_seconds(params, repeats)
+        scene, model = build_model(params)
+        for order in orders:
+            plan = make_plan(scene, "brick", order)
+            start = time.perf_counter()
+            ours = analyse_stages(model, params, plan)
+            sequence_s = time.perf_counter() - start
+            row = dict(structure=name, order=order, stages=plan.n_stages,
+                       standing=sum(bool(r["feasible"]) for r in ours),
+                       sequence_s=sequence_s, run_s=run_s, sequence_runs=sequence_s / run_s)
+            if alone:
+                start = time.perf_counter()
+                theirs = analyse_stages(model, params, plan, reuse=False)
+                row["alone_s"] = time.perf_counter() - start
+                row.update(_agreement(ours, theirs), speedup=row["alone_s"] / sequence_s,
+                           alone_runs=row["alone_s"] / run_s)
+            rows.append(row)
+            if progress:
+                progress(f"{name}, {order}: {plan.n_stages} stages in {sequence_s:.3g} s "
+                         f"({sequence_s / run_s:.3g} runs)"
+                         + (f", alone {row['alone_s']:.3g} s" if alone else ""))
+    return rows
+
+
+def _run_seconds(params, repeats) -> float:
+    """Median seconds of one ``masonry run`` of the dome of ``params`` (no plots, no
+    printable body, no page), after a first run that fills the geometry cache."""
+    dome = validate(params.replace(plots=False, printable=False, html=False))
+    times = []
+    with tempfile.TemporaryDirectory() as out:
+        for index in range(repeats + 1):
+            start = time.perf_counter()
+            run(dome, out, force=True)
+            if index:
+                times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def _agreement(ours, theirs) -> dict:
+    same = all(a["feasible"] == b["feasible"] for a, b in zip(ours, theirs))
+    diff = max((abs(a["moi_factor"] - b["moi_factor"]) for a, b in zip(ours, theirs)
+                if a["moi_factor"] is not None and b["moi_factor"] is not None), default=0.0)
+    return {"same_verdicts": same, "moi_factor_diff": diff}
+
+
+def stages_markdown(rows) -> str:
+    """The rows as a markdown table, then :data:`STAGES_NOTE`."""
+    formats = {"moi_factor_diff": "{:.1e}", "sequence_s": "{:.1f}", "alone_s": "{:.1f}",
+               "speedup": "{:.2f}", "run_s": "{:.2f}", "sequence_runs": "{:.1f}",
+               "alone_runs": "{:.1f}"}
+    lines = ["| " + " | ".join(STAGES_COLUMNS) + " |",
+             "|" + "---|" * len(STAGES_COLUMNS)]
+    for row in rows:
+        lines.append("| " + " | ".join(
+            "" if row.get(c) is None else formats.get(c, "{}").format(row[c])
+            for c in STAGES_COLUMNS) + " |")
+    return "\n".join(lines) + "\n\n" + STAGES_NOTE + "\n"
