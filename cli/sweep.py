@@ -234,7 +234,7 @@ def _stage_plans() -> dict:
 def _stage_outputs(outputs, refuse) -> dict:
     """The ``[outputs]`` table checked: ``plots``, ``printable``, ``html`` (true or
     false) and a stage study's ``stages`` (``course``, ``brick`` or ``block``),
-    ``stages_course`` (the course of ``brick``) and ``stages_order``; returns
+    ``stages_course`` (the course of ``brick``; none: every course) and ``stages_order``; returns
     :class:`Study`'s ``stages*``."""
     for key, value in outputs.items():
         if key in ("plots", "printable", "html"):
@@ -254,10 +254,11 @@ def _stage_outputs(outputs, refuse) -> dict:
     if by not in plans:
         refuse("outputs.stages", by, '"course", "brick" or "block" (the stage plan of '
                                      "'masonry stages --by')")
-    if by == "brick" and not (isinstance(course, int) and not isinstance(course, bool)
-                              and course >= 1):
+    if by == "brick" and course is not None and not (
+            isinstance(course, int) and not isinstance(course, bool) and course >= 1):
         refuse("outputs.stages_course", course, 'the course laid brick by brick with '
-                                                'stages = "brick", an integer >= 1')
+                                                'stages = "brick", an integer >= 1 (none: '
+                                                'every course)')
     if by != "brick" and course is not None:
         refuse("outputs.stages_course", course, 'none: a course only with stages = "brick"')
     if order is not None and order not in plans[by]:

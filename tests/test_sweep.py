@@ -216,7 +216,7 @@ def test_a_sweep_of_stages_under_a_lateral_load_gives_the_worst_stage(tmp_path):
 
 @pytest.mark.parametrize("outputs, shown", [
     ('stages = "height"', "outputs.stages = 'height'"),
-    ('stages = "brick"', "outputs.stages_course = None"),
+    ('stages = "brick"\nstages_course = 0', "outputs.stages_course = 0"),
     ('stages = "course"\nstages_course = 3', "outputs.stages_course = 3"),
     ('stages = "brick"\nstages_course = 3\nstages_order = "z"', "outputs.stages_order = 'z'"),
     ('stages_course = 3', "outputs.stages_course = 3"),

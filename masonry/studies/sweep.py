@@ -134,7 +134,8 @@ class Study:
         laid by ``course``, ``brick`` or ``block``; its results add
         :data:`STAGE_SUMMARY_COLUMNS` to the summary.
     stages_course : int or None
-        The course a brick plan lays brick by brick.
+        The course a brick plan lays brick by brick; None: every course (the whole
+        construction).
     stages_order : str or None
         The laying order of a brick or block plan (its default when None).
     constraints : dict of (low, high)
