@@ -92,9 +92,10 @@ WARM_STEPS = 30
 
 WARM_STALL = 8
 """... or steps without halving the residual. From the last stage's friction+ point,
-the next construction stage's took 2 to 6 steps where it converged (docs/bench.md);
-friction+ from a cold start is slowed by the 1,000:1 tension weight, so a start that
-is not close hands over early."""
+the next construction stage's friction+ took 7 to 14 steps on preset 1's upper courses
+(docs/stages.md), where the interior point method and its polish take about 15
+iterations and 2 steps; friction+ from a cold start is slowed by the 1,000:1 tension
+weight, so a start that is not close hands over early."""
 
 SOLVERS = names(RBE)
 """Every solver name :func:`solve_rbe` accepts (the registry's RBE backends)."""
