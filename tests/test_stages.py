@@ -549,3 +549,18 @@ def test_stages_solved_in_sequence_equal_stages_solved_alone(mu, order):
         if alone["moi"] is not None:
             assert ours["moi"] == pytest.approx(alone["moi"], abs=1e-6 * weight)
         assert ours["centering_N"] == pytest.approx(alone["centering_N"], abs=1e-6 * weight)
+
+
+def test_stages_bench_rows_and_its_refusal(tmp_path, capsys):
+    from masonry.studies.stages_bench import stages_bench, stages_markdown
+
+    params = validate(from_preset("1", **SMALL_DOME, boundary="cyclic"))
+    rows = stages_bench({"small dome": params}, orders=("along",), repeats=1)
+    (row,) = rows
+    assert row["stages"] == make_plan(build(params), "brick", "along").n_stages
+    assert row["same_verdicts"] and row["moi_factor_diff"] < 1e-6
+    assert row["sequence_runs"] == pytest.approx(row["sequence_s"] / row["run_s"])
+    assert "| small dome | along |" in stages_markdown(rows)
+    assert main(["bench", "--stages", "--collapse", "--out", str(tmp_path / "x")]) == 2
+    assert "one bench at a time" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
