@@ -24,9 +24,12 @@ def register(subparsers):
     g = parser.add_argument_group("stages")
     g.add_argument("--by", choices=("course", "brick", "block"),
                    help="course: stage k holds courses 1..k (default for a dome or "
-                        "wall); brick: the bricks of --course K one at a time; block: "
-                        "one block at a time (default with FILE)")
-    g.add_argument("--course", type=int, metavar="K", help="the course of --by brick")
+                        "wall); brick: every course one brick at a time, bottom to top "
+                        "(the whole construction), or --course K alone; block: one block "
+                        "at a time (default with FILE)")
+    g.add_argument("--course", type=int, metavar="K",
+                   help="with --by brick: lay only course K brick by brick, on courses "
+                        "1..K-1 complete")
     g.add_argument("--order", choices=(*BRICK_ORDERS, *BLOCK_ORDERS),
                    help="laying order: pattern-first (default) or along for --by brick; "
                         "z (bottom up, default) or names for --by block")
