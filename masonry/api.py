@@ -27,7 +27,8 @@ from masonry.rbe.loads import LOAD_OPTIONS
 from masonry.rbe.resultants import interface_resultants
 from masonry.scenes import check_size
 from masonry.scenes.imported import load_assembly
-from masonry.studies.stages import STAGE_COLUMNS, analyse_stages, check_live_load, make_plan
+from masonry.studies.plans import make_plan
+from masonry.studies.stages import STAGE_COLUMNS, analyse_stages, check_live_load
 
 
 @dataclasses.dataclass(frozen=True, eq=False)

@@ -11,7 +11,9 @@ import time
 
 from masonry.params import validate
 from masonry.pipeline import build_model, run
-from masonry.studies.stages import BRICK_ORDERS, analyse_stages, make_plan
+from masonry.studies.orders import BRICK_ORDERS
+from masonry.studies.plans import make_plan
+from masonry.studies.stages import analyse_stages
 
 STAGES_COLUMNS = ("structure", "order", "stages", "standing", "same_verdicts",
                   "moi_factor_diff", "sequence_s", "alone_s", "speedup", "run_s",
