@@ -25,6 +25,14 @@ within the solver's accuracy (tests/test_sequence.py). What :class:`StageSequenc
   work and no contact resists, is one of the whole part with the other blocks at rest),
   and the part goes straight to friction+ for its measure of infeasibility. Where the
   small problem has a solution nothing follows, and the part is solved as usual.
+- **A local centering force.** The centering force of a part that cannot stand
+  (docs/model.md 6.10) is first sought on the same small problem: the least support
+  force on the local blocks with every other block held fixed is at most the part's
+  (the part's optimum, restricted to the local blocks, is a point of the small
+  program). If the part then carries those support forces as loads, friction-net has
+  a solution (Newton, from the last stage's start), that point with supports on the
+  local blocks alone is one of the part's program with the same total: the least, so
+  the part's centering force. Otherwise the whole part's program is solved.
 """
 
 import dataclasses
@@ -34,14 +42,20 @@ import time
 import numpy as np
 
 from masonry.rbe.boundary import Model, kept_blocks
+from masonry.rbe.centering import CenteringResult, solve_centering
 from masonry.rbe.equilibrium import FRICTION_METHODS, EquilibriumSystem, VariableLayout, assemble
-from masonry.rbe.solve import ACCURACY, RBEProblem, RBEResult, friction_model
+from masonry.rbe.solve import (ACCURACY, WARM_STALL, WARM_STEPS, RBEProblem, RBEResult,
+                               friction_model)
 from masonry.rbe.solvers import BACKENDS
 from masonry.rbe.solvers.base import INFEASIBLE
 from masonry.rbe.solvers.cholesky import (BlockCholesky, Embedded, block_graph,
                                           fill_reducing_order)
 
 log = logging.getLogger(__name__)
+
+CHECK_TOL = 0.1
+"""Newton's stop on the check of a local centering force, relative to the preset's
+acceptance tolerance."""
 
 CERTIFICATE = "local-certificate"
 """The local certificate's name in :attr:`RBEResult.attempts`."""
@@ -205,6 +219,61 @@ class StageSequence:
                                                  block_size=6, ordering=order)
         return Embedded(self._within[1], (np.cumsum(self._within[0]) - 1)[rows])
 
+    def centering(self, is_present, local, *, mu=0.7, density=2000.0, accuracy="balanced",
+                  cone=None) -> CenteringResult | None:
+        """The centering force of the part whose scene blocks ``is_present`` (see the
+        module's notes: from the ``local`` blocks alone, checked on the whole part);
+        None where that does not give it (the caller solves the part's own program).
+        ``weight_N`` is the part's; ``block`` the scene's blocks."""
+        keep = kept_blocks(self.model, is_present)
+        interfaces = keep[self.model.interfaces.pair].all(axis=1)
+        rows = keep[self.whole.free_block]
+        local_rows = kept_blocks(self.model, local)[self.whole.free_block] & rows
+        if not local_rows.any():
+            return None
+        cone = friction_model(accuracy, cone)
+        small = part_system(self.whole, local_rows, interfaces & self._touching(
+            local_rows)).with_material(mu=mu, density=density, cone=cone)
+        reduced = solve_centering(small)
+        if reduced.total_N is None:
+            return None
+        system = part_system(self.whole, rows, interfaces).with_material(
+            mu=mu, density=density, cone=cone)
+        load = np.zeros((int(rows.sum()), 6))
+        load[(np.cumsum(rows) - 1)[local_rows], :3] = reduced.force / system.weight_ref
+        loaded = dataclasses.replace(system, f_ext=system.f_ext + load.ravel())
+        # the loads are at the limit of what the part carries (the least support), where
+        # Newton creeps: a point within the acceptance tolerance is all the check needs
+        preset = ACCURACY[accuracy]
+        within = rows
+        if self._within is not None and not (rows & ~self._within[0]).any():
+            within = self._within[0]  # the part's own solve's
+        workspace = {"symbolic": self._symbolic(rows, within)}
+        if self._known["net"][rows].any():
+            workspace["warm"] = {"net": self._start("net", rows)}
+        outcome = BACKENDS["newton"].solve_rbe(loaded, "net", {
+            **preset.options.get("newton", {}), "tol": CHECK_TOL * preset.residual,
+            "stall": WARM_STALL, "max_iter": WARM_STEPS}, workspace)
+        checks = outcome.residuals
+        carried = checks is not None and max(checks.equilibrium,
+                                             checks.friction) <= preset.residual
+        log.debug("local centering force %.6g N: %s on the whole part (Newton, %d steps)",
+                  reduced.total_N, "carried" if carried else "not carried",
+                  outcome.iterations)
+        if not carried:
+            return None
+        self._duals["net"][rows] = outcome.y.reshape(-1, 6)  # the next check's start
+        self._known["net"][rows] = True
+        source = (np.arange(self.model.blocks.n_blocks) if self.model.block_source is None
+                  else self.model.block_source)
+        return dataclasses.replace(reduced, weight_N=system.total_weight,
+                                   block=source[reduced.block])
+
+    def _touching(self, rows) -> np.ndarray:
+        """(K,) bool: the interfaces with a side on the free blocks ``rows``."""
+        side = self.whole.side_row
+        return ((side >= 0) & rows[np.maximum(side, 0)]).any(axis=1)
+
     def _certificate(self, system, rows, interfaces, local, accuracy) -> dict | None:
         """Friction-net of the ``local`` blocks ((B,) bool) alone, the rest of the part
         held fixed, by Clarabel: its record when it certifies infeasibility (the part
@@ -212,9 +281,8 @@ class StageSequence:
         local_rows = local[self.whole.free_block] & rows
         if not local_rows.any():
             return None
-        side = self.whole.side_row
-        touching = interfaces & ((side >= 0) & local_rows[np.maximum(side, 0)]).any(axis=1)
-        small = part_system(self.whole, local_rows, touching).with_material(
+        small = part_system(self.whole, local_rows,
+                            interfaces & self._touching(local_rows)).with_material(
             mu=system.mu, density=system.density, cone=system.cone)
         clarabel = BACKENDS["clarabel"]
         outcome = clarabel.solve_rbe(small, "net",

@@ -125,12 +125,18 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
                    moi_factor=_number(result.moi_factor))
         if result.feasible:
             row["load_factor"] = stage_load_factor(part, params)
-    row.update(stage_centering(part, params, row["feasible"]))
+    centering = None
+    if sequence is not None and not row["feasible"] and not len(loose):
+        analysis = params.analysis
+        centering = sequence.centering(plan.is_present(stage), plan.local(stage),
+                                       mu=analysis.mu, density=analysis.density,
+                                       accuracy=analysis.accuracy, cone=analysis.friction_cone)
+    row.update(stage_centering(part, params, row["feasible"], centering))
     row["solve_s"] = round(time.perf_counter() - start, 4)
     return row
 
 
-def stage_centering(part: Model, params, stands: bool) -> dict:
+def stage_centering(part: Model, params, stands: bool, result=None) -> dict:
     """The centering force of a stage (docs/model.md 6.10, :mod:`masonry.rbe.centering`): 0 for a
     stage that stands (its equilibrium needs none), else the least total force that
     supports at the laid blocks' centroids must give, loose blocks included (they must
@@ -144,6 +150,9 @@ def stage_centering(part: Model, params, stands: bool) -> dict:
         ``mu``, ``density`` and the friction model.
     stands : bool
         The stage's verdict.
+    result : CenteringResult, optional
+        The stage's centering force found already
+        (:meth:`masonry.rbe.sequence.StageSequence.centering`, its blocks the scene's).
 
     Returns
     -------
@@ -154,11 +163,14 @@ def stage_centering(part: Model, params, stands: bool) -> dict:
     """
     if stands:
         return {"centering_N": 0.0, "centering_fraction": 0.0, "held": []}
-    analysis = params.analysis
-    result = centering_force(part, mu=analysis.mu, density=analysis.density,
-                             cone=analysis.cone)
+    source = None  # a given result's blocks are the scene's
+    if result is None:
+        analysis = params.analysis
+        result = centering_force(part, mu=analysis.mu, density=analysis.density,
+                                 cone=analysis.cone)
+        source = part.block_source
     return {"centering_N": result.total_N, "centering_fraction": result.fraction,
-            "held": result.held_forces(part.block_source)}
+            "held": result.held_forces(source)}
 
 
 def loose_blocks(part: Model) -> np.ndarray:
