@@ -3,21 +3,25 @@ docs/stages.md), the work consecutive parts share kept between their solves.
 
 Each part is the model restricted to the blocks present (:func:`masonry.rbe.boundary.restrict`),
 and its result is the one :class:`~masonry.rbe.solve.RBEProblem` gives that part alone,
-within the solver's accuracy (tests/test_sequence.py). What :class:`StageSequence` keeps:
+within the solver's accuracy (tests/test_stages.py). What :class:`StageSequence` keeps:
 
 - **The matrices.** The whole model's equilibrium system is assembled once; a part's is
   its rows (the part's free blocks) and columns (the vertices of the interfaces whose two
   blocks are present), :func:`part_system`. The units stay the whole model's (its
-  reference weight and length, docs/model.md "Scaling"): the feasible set and the
+  reference weight and length, docs/model.md 6.2): the feasible set and the
   minimiser do not depend on them, and dual points carry over from part to part.
 - **The ordering.** One fill-reducing order of the whole model's block graph; a part's
   symbolic factorization takes it restricted to the part's blocks. Every fill path of a
   part's graph is one of the whole graph, so the part's factor has no more fill than the
-  whole's restricted to it, and no part is ordered again.
+  whole's restricted to it, and no part is ordered again. The symbolic factorization is
+  made for a superset the next parts will not outgrow (``within``: the course being
+  laid, complete) and serves each of them
+  (:class:`~masonry.rbe.solvers.cholesky.Embedded`).
 - **The dual points.** The equilibrium multipliers of the last accepted point of each
   friction model, by block (a virtual displacement per block, in the whole model's
-  units): the next part's Newton iterations start from them (blocks new to the part from
-  zero), friction+ included (:meth:`RBEProblem.of_system`).
+  units): the next part's Newton iterations start from them, friction+ included
+  (:meth:`RBEProblem.of_system`); a block new to the part starts with the rigid motion of
+  its neighbours.
 - **A local infeasibility certificate.** Before friction-net, the blocks just laid
   (``local``: the course being laid) alone, every other present block held fixed: if no
   forces within friction carry them, the part cannot stand either (a Farkas certificate
