@@ -31,6 +31,7 @@ from masonry.rbe.cores import solver_threads
 from masonry.rbe.solvers import BACKENDS, COLLAPSE, RBE, backend, names
 from masonry.rbe.solvers import cholesky, ordering
 from masonry.rbe.solvers.cholesky import BlockCholesky
+from masonry.rbe.solvers.embedded import Embedded
 from masonry.rbe.solvers.highs import highs_lp
 from masonry.rbe.solvers.interior import _scaling, vertex_cones, vertex_inverse
 from masonry.rbe.solvers.net_feasibility import decide
@@ -196,7 +197,7 @@ def test_a_larger_graphs_factorization_serves_a_subgraph():
     new[nodes] = np.arange(len(nodes))
     inner = new[edges]
     inner = inner[(inner >= 0).all(axis=1)]
-    sub = cholesky.Embedded(whole, nodes)
+    sub = Embedded(whole, nodes)
     dense = np.zeros((bs * len(nodes),) * 2)
     values = np.zeros((len(whole.lower_rows), bs, bs))
     for i, j in inner:

@@ -16,7 +16,7 @@ within the solver's accuracy (tests/test_stages.py). What :class:`StageSequence`
   whole's restricted to it, and no part is ordered again. The symbolic factorization is
   made for a superset the next parts will not outgrow (``within``: the course being
   laid, complete) and serves each of them
-  (:class:`~masonry.rbe.solvers.cholesky.Embedded`).
+  (:class:`~masonry.rbe.solvers.embedded.Embedded`).
 - **The dual points.** The equilibrium multipliers of the last accepted point of each
   friction model, by block (a virtual displacement per block, in the whole model's
   units): the next part's Newton iterations start from them, friction+ included
@@ -52,8 +52,8 @@ from masonry.rbe.solve import (ACCURACY, WARM_STALL, WARM_STEPS, RBEProblem, RBE
                                friction_model)
 from masonry.rbe.solvers import BACKENDS
 from masonry.rbe.solvers.base import INFEASIBLE
-from masonry.rbe.solvers.cholesky import (BlockCholesky, Embedded, block_graph,
-                                          fill_reducing_order)
+from masonry.rbe.solvers.cholesky import BlockCholesky, block_graph, fill_reducing_order
+from masonry.rbe.solvers.embedded import Embedded
 
 log = logging.getLogger(__name__)
 
@@ -138,7 +138,7 @@ class StageSequence:
             Scene blocks that the next parts will not outgrow (a superset of the present
             ones, e.g. the course being laid complete): the symbolic factorization is
             made once for them and serves every part within
-            (:class:`~masonry.rbe.solvers.cholesky.Embedded`). Default: the part's own.
+            (:class:`~masonry.rbe.solvers.embedded.Embedded`). Default: the part's own.
         mu, density, friction, solver, accuracy, cone
             As :meth:`RBEProblem.solve`.
 
