@@ -350,7 +350,7 @@ def test_friction_net_stages_name_the_first_stage_that_needs_support(tmp_path, c
             "along", "--friction", "net", "--fast", "--no-plots", "--out", str(tmp_path)]
     assert main(args) == 0
     out = capsys.readouterr().out
-    assert "first stage that needs support: 1 (28 bricks)" in out
+    assert "first stage that needs support: 1 (32 bricks)" in out
 
 
 @pytest.mark.parametrize("args, option", [
