@@ -128,7 +128,8 @@ OTHER_COMMANDS = [
     ["arch-thickness", "--rtol", "nan"], ["arch-thickness", "--blocks", "1"],
     ["arch-thickness", "--mu", "0.01", "--blocks", "8"],  # slides at every thickness
     ["analyze", "missing.obj", "--ground"], ["--bogus"], [],
-    ["stages", "--by", "brick"], ["stages", "--by", "brick", "--course", "0"],
+    ["stages", "--by", "brick", "--order", "sideways"],
+    ["stages", "--by", "brick", "--course", "0"],
     ["stages", "--n", "1000000"], ["stages", "--scene", "arch", "--by", "course"],
     ["stages", "--scene", "dome", "--lateral", "all"], ["stages", "--lateral", "30"],
     ["stages", "--scene", "dome", "--lateral", "north"],
