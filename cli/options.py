@@ -270,6 +270,9 @@ def collapse_summary(record, report) -> int:
         return 0 if decided else 3
     report(f"collapse: lambda = {c['load_factor']:.4g} for the {what}; mechanism: "
            f"{mechanism_words(c)}; {c['solver']} {c['time_s']:.3g} s (collapse/00_collapse.txt)")
+    if c.get("solved_on") == "whole, the half rejected":
+        report("note: the mirror half's collapse forces failed their check on the whole, so "
+               "the whole model was solved (run.json: collapse.solved_on)")
     if c["note"]:
         report(f"note: {c['note']}")
     return 0
@@ -499,6 +502,14 @@ def rbe_summary(record, report) -> int:
            f"{model}), {moi}, residual {_number(rbe['residual_eq'])}, {rbe['solver']} "
            f"{rbe['time_s']:.3g} s")
     report(verdict_meaning(record, verdict))
+    if rbe.get("solved_on") == "whole, the half rejected":
+        report("note: the mirror half's forces failed their check on the whole, so the "
+               "whole model was solved (run.json: rbe.solved_on)")
+    if verdict == "feasible" and rbe["friction"] == "plus" and not _missing(rbe["moi"]) \
+            and rbe["moi"] > 0:
+        report("note: the MoI is the tension of the friction+ optimum (thesis 3.3.3), "
+               "which trades compression for some tension; friction-net shows that none is "
+               "needed")
     if model == "square":
         report("note: the square friction model is the thesis's pyramid: up to 41 % more "
                "friction than Coulomb's cone where joints slide diagonally to their axes, "

@@ -485,7 +485,9 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
     """The rigid block equilibrium of a run's model (docs/model.md 6): on its half in
     the scene's first mirror plane, if it has one and the friction model is Coulomb's
     cone (self weight is its own mirror image in every plane), reported on the whole
-    (docs/model.md 6.11)."""
+    (docs/model.md 6.11) once its forces pass the check there
+    (:meth:`~masonry.rbe.solve.RBEResult.checked`); where they do not, the whole is
+    solved (``solved_on``, logged as a warning)."""
     analysis = params.analysis
     mirrors = params.kind.symmetry(params.geometry).mirrors
     half = None
@@ -494,14 +496,22 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
             half = half_model(model, mirrors[0])
         solved = model if half is None else half.model
         problem = RBEProblem(solved.blocks, solved.interfaces, **solved.assembly)
+    options = dict(mu=analysis.mu, density=analysis.density, friction=analysis.friction,
+                   solver=analysis.solver, accuracy=analysis.accuracy,
+                   cone=analysis.friction_cone)
     with timer.stage("solve"):
-        result = problem.solve(mu=analysis.mu, density=analysis.density,
-                               friction=analysis.friction, solver=analysis.solver,
-                               accuracy=analysis.accuracy, cone=analysis.friction_cone)
+        result = problem.solve(**options)
         if half is None:
             return result
-        return dataclasses.replace(equilibrium_on_the_whole(half, result, analysis.density),
-                                   time_s=result.time_s)
+        whole = equilibrium_on_the_whole(half, result, analysis.density)
+        if whole.checked():
+            return dataclasses.replace(whole, time_s=result.time_s, solved_on="half")
+        log.warning("the half's forces fail their check on the whole (equilibrium residual "
+                    "%.2g, friction violation %.2g): the whole model is solved instead",
+                    whole.residual_eq, whole.friction_violation)
+        problem = RBEProblem(model.blocks, model.interfaces, **model.assembly)
+        result = problem.solve(**options)
+        return dataclasses.replace(result, solved_on="whole, the half rejected")
 
 
 def centering_of(model: Model, params: Params) -> CenteringResult:
@@ -524,10 +534,11 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     analysis, load = params.analysis, params.load
     options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone)
     symmetry = params.kind.symmetry(params.geometry)
-    if isinstance(load, Lateral) and load.azimuth_deg == "all":
-        return worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
-                             mirrors=symmetry.mirrors, dead_load_feasible=known, **options)
     copies = symmetry.order if symmetry.unit else 1
+    if isinstance(load, Lateral) and load.azimuth_deg == "all":
+        result = worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
+                               mirrors=symmetry.mirrors, dead_load_feasible=known, **options)
+        return _checked_collapse(model, params, result, 1, known)
     plane = symmetric_plane(load, symmetry.mirrors)
     if (plane is not None and analysis.friction_law == "associated"
             and states_exactly(analysis.cone)):
@@ -537,9 +548,28 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
         result = collapse_load(model, load.on(model, analysis.density, copies=copies),
                                dead_load_feasible=known, friction=analysis.friction_law,
                                **options)
-    if isinstance(load, Lateral):
+    if isinstance(load, Lateral) and load.azimuth_deg != "all":
         result = dataclasses.replace(result, azimuth_deg=float(load.azimuth_deg))
-    return result
+    return _checked_collapse(model, params, result, copies, known)
+
+
+def _checked_collapse(model, params, result, copies, known) -> CollapseResult:
+    """``result``, or where it was solved on a half whose forces fail their check on the
+    whole (:meth:`~masonry.rbe.collapse_result.CollapseResult.checked`), the same load
+    (at the same azimuth) solved on the whole (``solved_on``, logged as a warning)."""
+    if result.solved_on != "half" or result.checked():
+        return result
+    log.warning("the half's collapse forces fail their check on the whole (residual %.2g): "
+                "the whole model is solved instead", result.residual)
+    analysis = params.analysis
+    load = params.load
+    if isinstance(load, Lateral):
+        load = Lateral(result.azimuth_deg)
+    whole = collapse_load(model, load.on(model, analysis.density, copies=copies),
+                          dead_load_feasible=known, friction=analysis.friction_law,
+                          mu=analysis.mu, density=analysis.density, cone=analysis.cone)
+    return dataclasses.replace(whole, azimuth_deg=result.azimuth_deg,
+                               azimuths=result.azimuths, solved_on="whole, the half rejected")
 
 
 def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer):

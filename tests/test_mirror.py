@@ -9,7 +9,7 @@ import json
 import numpy as np
 import pytest
 
-from masonry.params import Params, validate
+from masonry.params import Params, from_preset, validate
 from masonry.pipeline import Timer, build_model, collapse_of, solve
 from masonry.rbe.collapse import collapse_load, collapse_on_half, worst_lateral
 from masonry.rbe.loads import CrownLoad, Lateral, crown_load, lateral
@@ -209,3 +209,51 @@ def test_a_sector_of_revolution_states_no_mirror_plane():
     assert params.kind.symmetry(params.geometry).mirrors == ()
     with pytest.raises(MirrorError):
         half_model(build_model(params)[1], 0.0)
+
+
+SMALL_ARGS = [f"--{key}={value}" for key, value in SMALL_DOME.items()]
+
+CLOSED_CROWNS = {
+    "8 webs closed at the crown": dict(preset="1", n=8, r=1, p=6, cut=0.0),
+    "preset 3 at p 4": dict(preset="3", p=4),
+    "preset 3 closed at the crown": dict(preset="3", cut=0.0),
+}
+
+
+@pytest.mark.parametrize("inputs", CLOSED_CROWNS.values(), ids=CLOSED_CROWNS.keys())
+def test_a_cyclic_section_whose_top_courses_span_the_web_is_its_half(inputs):
+    """Near a closed crown a course is one brick across the web, cut by the mid-plane and
+    closed by its own cyclic images at both corners: the image's side lands on the other
+    half of the brick and is sent across the plane. The run's equilibrium, solved on the
+    half, is the whole section's (solved on its own matrices): the same verdict, the same
+    unique optimum, and forces that balance every block of the whole."""
+    inputs = dict(inputs)
+    params = validate(from_preset(inputs.pop("preset"), boundary="cyclic",
+                                  accuracy="accurate", **inputs))
+    model = build_model(params)[1]
+    on_half = solve(model, params, Timer())
+    whole = whole_rbe(model, mu=params.analysis.mu)
+    assert on_half.solved_on == "half" and whole.verdict == "feasible"
+    assert on_half.verdict == whole.verdict
+    assert on_half.residual_eq <= 1e-9 and on_half.net_friction_violation <= 1e-9
+    scale = np.abs(whole.x).max()
+    assert np.abs(on_half.x - whole.x).max() <= FORCE_REL * scale
+
+
+def test_a_half_whose_forces_fail_on_the_whole_gives_way_to_the_whole(
+        tmp_path, monkeypatch, capsys):
+    """A map back that loses forces (simulated: the half's forces halved on the way) is
+    caught by the residuals recomputed on the whole: the run solves the whole model, says
+    so in one line and in run.json, and publishes forces that balance it."""
+    from masonry.rbe.mirror import Half
+
+    mapped = Half.whole_forces
+    monkeypatch.setattr(Half, "whole_forces", lambda self, x: 0.5 * mapped(self, x))
+    out = tmp_path / "out"
+    assert main(["run", *SMALL_ARGS, "--boundary", "cyclic", "--no-plots", "--no-printable",
+                 "--out", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert "the whole model was solved" in said
+    record = json.loads(next(out.glob("*/run.json")).read_text())
+    assert record["rbe"]["solved_on"] == "whole, the half rejected"
+    assert record["rbe"]["verdict"] == "feasible" and record["rbe"]["residual_eq"] <= 1e-5

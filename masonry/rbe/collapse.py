@@ -651,7 +651,7 @@ def on_the_whole(half, result: CollapseResult, live: LiveLoad, *, mu=0.7, densit
     residual = np.abs(system.A_eq @ system.to_scaled(x) + rhs).max() / np.abs(rhs).max()
     return dataclasses.replace(result, live=live, x=x,
                                forces=interface_forces(system.layout, x),
-                               residual=float(residual), **flags)
+                               residual=float(residual), solved_on="half", **flags)
 
 
 def _solve_azimuths(cases, todo, known, two) -> dict:

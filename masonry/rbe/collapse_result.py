@@ -1,13 +1,14 @@
 """The outcome of a collapse load factor LP (docs/model.md 6.8, 6.9): the factor, its mechanism,
 and what they mean (:mod:`masonry.rbe.collapse` computes it)."""
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from masonry.friction import FrictionCone
 from masonry.rbe.loads import LiveLoad
-from masonry.tolerances import MECHANISM_MAIN
+from masonry.tolerances import ACCEPT_RESIDUAL, MECHANISM_MAIN
 
 ASSOCIATED_NOTE = (
     "sliding interfaces take part in this mechanism: the load factor assumes associated "
@@ -32,7 +33,8 @@ stopped short, a non-associative estimate that did not settle) leaves it without
 RESULT_KEYS = ("load_factor", "dead_load_feasible", "status", "solver", "iterations",
                "time_s", "residual", "work_balance", "mu", "friction_model",
                "friction_capacity_error", "azimuth_deg", "opening", "sliding", "hinges",
-               "main_hinges", "main_sliding", "friction_law", "associated_factor", "note")
+               "main_hinges", "main_sliding", "friction_law", "associated_factor", "note",
+               "solved_on")
 """Scalar fields of :class:`CollapseResult` in run.json, in order (plus ``live_load``)."""
 
 
@@ -91,6 +93,8 @@ class CollapseResult:
         With ``non-associative``: the associated factor it started from.
     cone : FrictionCone
         The friction model.
+    solved_on : {'whole', 'half', 'whole, the half rejected'}
+        As :attr:`masonry.rbe.solve.RBEResult.solved_on`.
     """
 
     load_factor: float | None
@@ -116,6 +120,15 @@ class CollapseResult:
     friction_law: str = "associated"
     associated_factor: float | None = None
     cone: FrictionCone = FrictionCone("circle")
+    solved_on: str = "whole"
+
+    def checked(self) -> bool:
+        """Whether a factor's equilibrium residual, recomputed on the model this result
+        describes, meets the acceptance tolerance (:data:`ACCEPT_RESIDUAL`); a result
+        without a factor has nothing to check."""
+        if self.load_factor is None:
+            return True
+        return math.isfinite(self.residual) and self.residual <= ACCEPT_RESIDUAL
 
     @property
     def friction_model(self) -> str:

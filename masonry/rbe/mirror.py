@@ -334,7 +334,11 @@ class _Link:
         rotation = np.broadcast_to(np.eye(3), block.shape + (3, 3))
         if model.side_rotation is not None:
             rotation = turn.T @ model.side_rotation[self.kept] @ turn
-        across = block_side[block] < 0
+        # where each side acts: a cut block receives a side routed onto its other half
+        # (a course of one brick across the web, closed by its cyclic images) there
+        acting = np.einsum("ksij,kj->ksi", rotation, self.interfaces.centre[self.kept])
+        across = (block_side[block] < 0) | (block_side[block] == 0) & (
+            acting[..., 1] < -self.tol)
         image = self.mirror[block]
         if (image[across] < 0).any() or across.all(axis=1).any():
             self._fail("a side of a kept interface acts on the other side of the plane "

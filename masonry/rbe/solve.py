@@ -103,7 +103,8 @@ SOLVERS = names(RBE)
 RESULT_KEYS = ("verdict", "feasible", "friction", "mu", "friction_model",
                "friction_capacity_error", "objective", "moi", "moi_factor", "weight_N",
                "solver", "status", "iterations", "residual_eq", "friction_violation",
-               "net_friction_violation", "time_s", "lp_feasible", "accuracy", "lp_time_s")
+               "net_friction_violation", "time_s", "lp_feasible", "accuracy", "lp_time_s",
+               "solved_on")
 """Scalar fields of :class:`RBEResult` written to run.json, in order."""
 
 INTERFACE_FORCE_KEYS = ("compression", "tension", "normal", "t1", "t2", "friction")
@@ -163,6 +164,10 @@ class RBEResult:
         a second attempt of the same model).
     cone : FrictionCone
         The friction model (:mod:`masonry.friction`).
+    solved_on : {'whole', 'half', 'whole, the half rejected'}
+        The model whose program gave the forces: the whole; its half in a mirror plane,
+        mapped back and checked on the whole (docs/model.md 6.11); or the whole, solved
+        because the half's forces failed that check.
     verdict : {'feasible', 'infeasible', 'not solved'}
         ``'feasible'``: ``feasible`` is True. ``'infeasible'``: friction-net has no
         accepted point, and either a solver certified that (a Farkas certificate, an
@@ -193,6 +198,7 @@ class RBEResult:
     attempts: tuple = ()
     verdict: str = "not solved"
     cone: FrictionCone = FrictionCone("circle")
+    solved_on: str = "whole"
 
     @property
     def friction_model(self) -> str:
@@ -203,6 +209,19 @@ class RBEResult:
         """The model's bound on the error of the friction capacity (see
         :attr:`~masonry.friction.FrictionCone.capacity_error`)."""
         return self.cone.capacity_error
+
+    def checked(self) -> bool:
+        """Whether the residuals, recomputed on the model this result describes, meet its
+        accuracy preset's acceptance tolerance (docs/model.md 6.5): equilibrium and the
+        friction model solved and, for a feasible verdict, friction-net. A result without
+        forces has nothing to check."""
+        if self.x is None:
+            return True
+        tol = ACCURACY[self.accuracy].residual
+        checks = [self.residual_eq, self.friction_violation]
+        if self.feasible:
+            checks.append(self.net_friction_violation)
+        return all(math.isfinite(value) and value <= tol for value in checks)
 
     def to_dict(self) -> dict:
         """The scalar fields (:data:`RESULT_KEYS`) as plain Python values, for run.json."""
@@ -308,8 +327,10 @@ class RBEProblem:
         cores = forking.usable_cores(cores)
         with solver_threads(cores):
             solved, attempts = self._flow(system, friction, solver, preset, tol, cores)
+            standing = self._standing(system, solved, friction, solver, preset, tol,
+                                      attempts)
             result = self._result(system, solved, tol, lp_check, lp_time_limit, accuracy,
-                                  attempts, friction)
+                                  attempts, friction, standing)
         log.info("%s: %s, MoI factor %.4g, residual %.1e, %.2f s", result.solver,
                  result.verdict, result.moi_factor, result.residual_eq,
                  time.perf_counter() - start)
@@ -345,6 +366,18 @@ class RBEProblem:
             if alongside is not None:
                 alongside.close()
         return solved, attempts
+
+    def _standing(self, system, solved, friction, solver, preset, tol, attempts):
+        """Whether the structure stands, where the one model asked for does not say:
+        a friction+ point may carry tension where none is needed (its optimum trades
+        compression for a little tension), so only friction-net decides. Returns
+        friction-net's :class:`_Solved` (its solves join ``attempts``: an accepted point
+        or a certificate decides), or None where ``solved`` decides already."""
+        if friction != "plus" or not solved.accepted or (
+                solved.checks.net_friction <= tol.residual):
+            return None
+        return self._solve_model(system, "net", self._candidates("net", solver, preset),
+                                 preset, tol, attempts)
 
     def _candidates(self, method, solver, preset) -> list:
         """:func:`_candidates`, led by Newton where a warm start of ``method`` was given
@@ -438,15 +471,17 @@ class RBEProblem:
         return None
 
     def _result(self, system, solved, tol, lp_check, lp_time_limit, accuracy, attempts,
-                friction) -> RBEResult:
-        """Pack the last model's outcome: residuals, forces in newtons, the verdict and
-        the LP's second opinion."""
+                friction, standing=None) -> RBEResult:
+        """Pack the last model's outcome: residuals, forces in newtons, the verdict
+        (with ``standing``, friction-net's outcome where it decides for a friction+
+        point, :meth:`_standing`) and the LP's second opinion."""
         checks, accepted, outcome = solved.checks, solved.accepted, solved.outcome
         residual_eq, violation, net_violation = ((np.nan,) * 3 if checks is None else (
             checks.equilibrium, checks.friction, checks.net_friction))
         # a rejected point is no solution: its residuals are reported, its forces are not
         x = system.to_newtons(outcome.x) if accepted else None
-        feasible = bool(accepted and net_violation <= tol.residual)
+        feasible = bool(accepted and net_violation <= tol.residual
+                        or standing is not None and standing.accepted)
         run_lp = ((lp_check == "infeasible" and not feasible) if isinstance(lp_check, str)
                   else bool(lp_check))
         lp_start = time.perf_counter()
@@ -472,7 +507,8 @@ class RBEProblem:
             net_friction_violation=float(net_violation), time_s=0.0,
             lp_feasible=lp_feasible, x=x, layout=system.layout, accuracy=accuracy,
             lp_time_s=lp_time, attempts=tuple(attempts),
-            verdict=_verdict(feasible, x, attempts, lp_feasible), cone=system.cone)
+            verdict=_verdict(feasible, x, attempts, lp_feasible, standing),
+            cone=system.cone)
 
     def _workspace(self, name):
         """The workspace of a backend; the Newton-system backends (semismooth Newton,
@@ -539,13 +575,17 @@ def _record(method, name, outcome) -> dict:
             "solve_s": round(outcome.solve_time, 4)}
 
 
-def _verdict(feasible, x, attempts, lp_feasible) -> str:
-    """See :attr:`RBEResult.verdict`."""
+def _verdict(feasible, x, attempts, lp_feasible, standing=None) -> str:
+    """See :attr:`RBEResult.verdict`; ``standing`` as for :meth:`RBEProblem._result`."""
     if feasible:
         return "feasible"
     certified = lp_feasible is False or any(
         a["friction"] == "net" and a["status"] == INFEASIBLE for a in attempts)
-    return "infeasible" if certified or x is not None else "not solved"
+    if certified:
+        return "infeasible"
+    if standing is not None:  # friction-net decided neither way for a friction+ point
+        return "not solved"
+    return "infeasible" if x is not None else "not solved"
 
 
 def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solver=None,
