@@ -40,8 +40,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.blocks import (GROUND, blocks_from_hulls, concatenate,
-                            hull_faces, rotation_z)
+from masonry.blocks import (GROUND, blocks_from_hulls, hull_faces, rotation_z,
+                            whole_of_web)
 from masonry.dome.courses import FILL, PAT, REG, Layout, fill_ring
 from masonry.dome.levels import LevelTable, contact_angles, ellipse_point
 from masonry.dome.pattern import Pattern
@@ -488,21 +488,13 @@ def _pattern_record(g: RevolutionDome, prof: Profile) -> Pattern:
 
 def whole_dome(section: Scene, kind) -> Scene:
     """The whole dome: ``section`` (a sector of the dome's symmetry order ``N``) and its
-    ``N - 1`` rotations, sector after sector."""
+    ``N - 1`` rotations, sector after sector, each brick named after its sector
+    (``w<sector>_<name>``: :func:`~masonry.blocks.whole_of_web`)."""
     n = kind.symmetry(section.geometry).order
-    blocks = concatenate([section.blocks.transformed(_turn(2 * np.pi * j / n))
-                          for j in range(n)])
-    blocks = dataclasses.replace(blocks, block_web=np.repeat(np.arange(n),
-                                                             section.blocks.n_blocks))
+    blocks = whole_of_web(section.blocks, n, rename_first=True)
     up = np.concatenate([section.block_up @ rotation_z(2 * np.pi * j / n).T
                          for j in range(n)])
     return dataclasses.replace(section, kind=kind, blocks=blocks, block_up=up)
-
-
-def _turn(angle) -> np.ndarray:
-    matrix = np.eye(4)
-    matrix[:3, :3] = rotation_z(angle)
-    return matrix
 
 
 # --------------------------------------------------------------------------- kinds
