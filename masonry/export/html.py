@@ -191,15 +191,14 @@ def colourings(made) -> list:
     """The page's colourings of a run (:class:`~masonry.export.RunOutputs`): class; after
     a solve, each brick's largest compression and tension sum over its interfaces
     (:meth:`~masonry.rbe.boundary.Model.block_largest`, those of ``bricks.3dm``); after a
-    collapse with a mechanism, each brick's largest vertex displacement (largest 1). A
+    collapse with a mechanism, each brick's largest vertex displacement (largest 1); on
+    a cyclic section's whole dome, the solved section against its turned copies. A
     force none of whose values exceeds
     :data:`~masonry.tolerances.TENSION_REPORTED_REL` of the weight is empty (solver
     noise, the limit of ``RBE/tension_top.csv``)."""
     blocks, model, shown = made.scene.blocks, made.model, made.per_shown
     n, free = blocks.n_blocks, shown(~np.asarray(blocks.block_is_support))
     out = [_class_colouring(made.shown)]
-    if not made.is_solved.all():
-        out.append(_solved_colouring(made.is_solved))
     if made.forces is not None:
         for name, scale in (("compression", "Viridis"), ("tension", "Reds")):
             largest = shown(model.block_largest(made.forces[name])[:n])
@@ -216,6 +215,8 @@ def colourings(made) -> list:
             "collapse displacement", shown(largest), free, "", "Viridis",
             relative=f"collapse displacement (largest = 1) at lambda = "
                 f"{collapse.load_factor:.4g}"))
+    if not made.is_solved.all():
+        out.append(_solved_colouring(made.is_solved))
     return out
 
 
