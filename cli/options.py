@@ -7,7 +7,8 @@ import shlex
 from masonry.errors import ParameterError
 from masonry.outputs import Outputs
 from masonry.parameters import declarations, defaults, read_toml
-from masonry.params import PRESETS, Params, applies, from_preset, load, names, validate
+from masonry.params import (PRESETS, Params, applies, from_preset, load, names,
+                            section_default, validate)
 from masonry.rbe.collapse_result import VERDICTS
 from masonry.rbe.settings import BOUNDARIES, FRICTION_LAWS, FRICTIONS, Analysis
 from masonry.rbe.accuracy import ACCURACY
@@ -256,6 +257,8 @@ def collapse_summary(record, report) -> int:
     live = c["live_load"]
     what = (f"lateral at {c['azimuth_deg']:g} deg" if live["kind"] == "lateral"
             and c["azimuth_deg"] is not None else f"{live['kind']} load")
+    if live["kind"] == "point":
+        what += f" on {live['blocks']} block{'s' * (live['blocks'] != 1)}"
     if c.get("azimuths"):
         what += f" (worst of {len(c['azimuths'])} azimuths)"
     if c["friction_law"] != "associated" and c["associated_factor"] is not None:
@@ -362,10 +365,7 @@ def params_from_args(args) -> Params:
         params = from_preset(scene, **given)
     else:
         params = validate(Params.of(**given))
-    if ("boundary" not in given and "cyclic" in params.kind.boundaries
-            and not _file_names(args, "boundary")):
-        # a section stands for the whole dome unless asked otherwise (docs/cli.md)
-        params = validate(params.replace(boundary="cyclic"))
+    params = section_default(params, "boundary" in given or _file_names(args, "boundary"))
     check_print_size(args, params)
     return params
 

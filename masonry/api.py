@@ -20,7 +20,8 @@ import functools
 
 from masonry.errors import ParameterError
 from masonry.export.csv import HEADERS, column_types, forces_columns
-from masonry.params import Params, from_preset, names, structure_id, validate
+from masonry.params import (Params, from_preset, names, section_default, structure_id,
+                            validate)
 from masonry.pipeline import Timer, build_model, centering_of, collapse_of, run, solve
 from masonry.rbe.boundary import analysis_model
 from masonry.rbe.loads import LOAD_OPTIONS
@@ -216,7 +217,8 @@ def build(preset=None, **inputs) -> Structure:
         The thesis's structures 1-3 (a section of the dome) or the straight wall.
     **inputs
         Flat input names as the command line's options (``scene``, ``n``, ``mu``,
-        ``boundary``, ``lateral`` ...; ``masonry run --help``).
+        ``boundary``, ``lateral`` ...; ``masonry run --help``), with its defaults: a
+        section's boundary is ``cyclic`` (the whole dome) unless given.
 
     Raises
     ------
@@ -226,6 +228,7 @@ def build(preset=None, **inputs) -> Structure:
     """
     params = from_preset(preset, **inputs) if preset is not None \
         else validate(Params.of(**inputs))
+    params = section_default(params, "boundary" in inputs)
     check_size(params)
     scene, model = build_model(params)
     return Structure(params, scene, model)

@@ -526,6 +526,15 @@ def rotated_web(blocks: Blocks, web: int, n: int, mask=None) -> Blocks:
         block_web=np.full(part.n_blocks, web % n))
 
 
+def whole_of_web(blocks: Blocks, n: int, rename_first=False) -> Blocks:
+    """The whole dome that ``blocks`` (web 0 of ``n`` equal webs) stand for: them, then
+    their ``n - 1`` rotations about z (:func:`rotated_web`, named ``w<web>_<name>``), so
+    that every name is unique. Web 0 keeps its names (the names its analysis reports)
+    unless ``rename_first``, which names it ``w0_<name>`` as the others."""
+    first = rotated_web(blocks, 0, n) if rename_first else blocks
+    return concatenate([first] + [rotated_web(blocks, web, n) for web in range(1, n)])
+
+
 def _newell(polygons):
     """(k, m, 3) polygons -> (k, 3) Newell normals (area-weighted, not normalised)."""
     nxt = np.roll(polygons, -1, axis=1)

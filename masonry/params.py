@@ -181,6 +181,15 @@ def _check_across(kind, analysis, load):
                              "use --scene dome (or --boundary free: the web alone)")
 
 
+def section_default(params: Params, boundary_given: bool) -> Params:
+    """``params`` with a section's boundary ``cyclic`` where the inputs did not give
+    one: a section stands for the whole dome, the question a run answers first
+    (docs/cli.md); the command line and the Python API alike."""
+    if boundary_given or "cyclic" not in params.kind.boundaries:
+        return params
+    return validate(params.replace(boundary="cyclic"))
+
+
 def from_preset(name, **overrides) -> Params:
     """The inputs of a preset (``1``, ``2``, ``3`` or ``wall``) with overrides, validated."""
     key = str(name)

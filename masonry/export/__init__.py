@@ -6,6 +6,7 @@ writes them. An exporter may also return a record for ``run.json`` (the printabl
 checks). A new format is a module and one :class:`Exporter` row in :data:`EXPORTERS`.
 """
 
+import dataclasses
 import functools
 import logging
 from functools import cache
@@ -14,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from masonry.blocks import whole_of_web
 from masonry.export import csv, html, obj, rhino, stl, summaries, threemf, vtu
 from masonry.printable import printable_blocks, printable_body
 from masonry.rbe.equilibrium import VariableLayout
@@ -73,6 +75,38 @@ class RunOutputs:
         return None
 
     @functools.cached_property
+    def shown(self):
+        """The blocks of the files that show the structure (``bricks.obj``,
+        ``bricks.3dm``, ``dome.html``, ``locations.csv``): the scene's, or the whole dome
+        a cyclic section stands for (:func:`~masonry.blocks.whole_of_web`: the section
+        first, under the names its analysis reports, then its turned copies, web after
+        web), so that the files are the structure the verdict is about."""
+        return self._whole(self.scene.blocks)
+
+    @functools.cached_property
+    def shown_cad_vertices(self) -> np.ndarray:
+        """(V, 3) float, metres: :attr:`shown`'s vertices moved by the CAD offset."""
+        blocks = self.scene.blocks
+        cad = dataclasses.replace(blocks, vertices=self.scene.cad_vertices(
+            self.outputs.cad_offset))
+        return self._whole(cad).vertices
+
+    @property
+    def is_solved(self) -> np.ndarray:
+        """(B,) bool per block of :attr:`shown`: whether the analysis solved it (every
+        block but a cyclic section's turned copies)."""
+        return np.arange(self.shown.n_blocks) < self.scene.blocks.n_blocks
+
+    def per_shown(self, values) -> np.ndarray:
+        """(B,) values per block of :attr:`shown` from ``values`` per block of the scene:
+        a turned copy carries its section block's (cyclic symmetry: the same forces in
+        every web)."""
+        return np.tile(np.asarray(values), self.shown.n_blocks // self.scene.blocks.n_blocks)
+
+    def _whole(self, blocks):
+        return blocks if self.webs is None else whole_of_web(blocks, self.webs)
+
+    @functools.cached_property
     def forces(self) -> dict | None:
         """Per-interface force sums (:func:`masonry.rbe.solve.interface_forces`), newtons;
         None without an accepted solution."""
@@ -125,12 +159,12 @@ class Exporter:
 
 
 def _model_files(made: RunOutputs) -> Export:
-    scene, model = made.scene, made.model
+    model, solved = made.model, made.is_solved
+    groups = None if solved.all() else np.where(solved, obj.SOLVED_GROUP, obj.COPIES_GROUP)
     return Export({
         "00_parameters.txt": summaries.parameters_text(made.params, made.title),
-        "locations.csv": csv.locations_csv(scene.blocks,
-                                           scene.cad_vertices(made.outputs.cad_offset)),
-        "bricks.obj": obj.blocks_obj(scene.blocks),
+        "locations.csv": csv.locations_csv(made.shown, made.shown_cad_vertices),
+        "bricks.obj": obj.blocks_obj(made.shown, groups=groups),
         "interfaces.csv": csv.interfaces_csv(model.blocks, model.interfaces),
     })
 
@@ -151,9 +185,14 @@ def _rhino_wanted(made: RunOutputs) -> bool:
 
 
 def _rhino_files(made: RunOutputs) -> Export:
-    blocks = made.scene.blocks
-    text = rhino.block_user_text(blocks, made.model, made.forces)
-    return Export({"bricks.3dm": rhino.blocks_3dm(blocks, user_text=text)})
+    text = rhino.block_user_text(made.scene.blocks, made.model, made.forces)
+    solved = made.is_solved
+    text = {key: made.per_shown(values) for key, values in text.items()}
+    text["web"] = made.shown.block_web.astype(str)
+    if not solved.all():
+        text["solved"] = np.where(solved, "yes", "no (a turned copy)")
+    return Export({"bricks.3dm": rhino.blocks_3dm(made.shown, user_text=text,
+                                                  is_copy=~solved)})
 
 
 @functools.lru_cache(maxsize=1)

@@ -76,7 +76,8 @@ select.onchange = () => {
 };
 function pick(brick) {
   const rows = [page.name[brick],
-                'course ' + page.course[brick] + ', web ' + page.web[brick]];
+                'course ' + page.course[brick] + ', web ' + page.web[brick]
+                + (page.solved[brick] ? '' : ' (a turned copy of the solved section)')];
   for (const c of page.colourings) {
     const v = c.values[brick];
     const shown = c.names ? c.names[v]
@@ -157,6 +158,17 @@ def _class_colouring(blocks) -> dict:
                                    "ticktext": names}}}
 
 
+def _solved_colouring(is_solved) -> dict:
+    """The solved section against its turned copies (a cyclic section's whole dome)."""
+    names = ["turned copy", "solved section"]
+    steps = [[0.0, "#bebebe"], [0.5, "#bebebe"], [0.5, "#c8503c"], [1.0, "#c8503c"]]
+    return {"label": "solved section", "names": names,
+            "values": np.asarray(is_solved, dtype=int).tolist(),
+            "style": {"colorscale": steps, "cmin": -0.5, "cmax": 1.5,
+                      "colorbar": {"title": {"text": "solved section", "side": "right"},
+                                   "tickvals": [0, 1], "ticktext": names}}}
+
+
 def _scale_colouring(label, values, free, unit, colorscale, relative=None,
                      noise=0.0) -> dict:
     """``values`` (B,) on a sequential scale from 0 to the :data:`FORCE_PERCENTILE` th
@@ -179,16 +191,17 @@ def colourings(made) -> list:
     """The page's colourings of a run (:class:`~masonry.export.RunOutputs`): class; after
     a solve, each brick's largest compression and tension sum over its interfaces
     (:meth:`~masonry.rbe.boundary.Model.block_largest`, those of ``bricks.3dm``); after a
-    collapse with a mechanism, each brick's largest vertex displacement (largest 1). A
+    collapse with a mechanism, each brick's largest vertex displacement (largest 1); on
+    a cyclic section's whole dome, the solved section against its turned copies. A
     force none of whose values exceeds
     :data:`~masonry.tolerances.TENSION_REPORTED_REL` of the weight is empty (solver
     noise, the limit of ``RBE/tension_top.csv``)."""
-    blocks, model = made.scene.blocks, made.model
-    n, free = blocks.n_blocks, ~np.asarray(blocks.block_is_support)
-    out = [_class_colouring(blocks)]
+    blocks, model, shown = made.scene.blocks, made.model, made.per_shown
+    n, free = blocks.n_blocks, shown(~np.asarray(blocks.block_is_support))
+    out = [_class_colouring(made.shown)]
     if made.forces is not None:
         for name, scale in (("compression", "Viridis"), ("tension", "Reds")):
-            largest = model.block_largest(made.forces[name])[:n]
+            largest = shown(model.block_largest(made.forces[name])[:n])
             out.append(_scale_colouring(f"largest {name}", largest, free, "N", scale,
                                         noise=TENSION_REPORTED_REL * made.result.weight_N))
     collapse = made.collapse
@@ -199,9 +212,11 @@ def colourings(made) -> list:
         np.maximum.at(largest, np.repeat(np.arange(n), np.diff(blocks.vertex_offsets)),
                       moved)
         out.append(_scale_colouring(
-            "collapse displacement", largest, free, "", "Viridis",
+            "collapse displacement", shown(largest), free, "", "Viridis",
             relative=f"collapse displacement (largest = 1) at lambda = "
                 f"{collapse.load_factor:.4g}"))
+    if not made.is_solved.all():
+        out.append(_solved_colouring(made.is_solved))
     return out
 
 
@@ -264,9 +279,11 @@ def dome_html(made) -> str:
     load's direction as an arrow, and a picked brick's name, course, web and values."""
     import plotly.graph_objects as go
 
-    blocks = made.scene.blocks
-    vertices, triangles, first = brick_mesh(blocks,
-                                            outer_faces(blocks, made.model.interfaces))
+    blocks = made.shown
+    # a turned copy's faces are seen where its section block's are (cyclic symmetry)
+    faces = np.tile(outer_faces(made.scene.blocks, made.model.interfaces),
+                    blocks.n_blocks // made.scene.blocks.n_blocks)
+    vertices, triangles, first = brick_mesh(blocks, faces)
     shown = colourings(made)
     owner = np.repeat(np.arange(blocks.n_blocks), np.diff(first))
     mesh = go.Mesh3d(x=vertices[:, 0], y=vertices[:, 1], z=vertices[:, 2],
@@ -289,7 +306,7 @@ def dome_html(made) -> str:
                        post_script=_SCRIPT)
     bricks = {"first": first.tolist(), "name": blocks.block_name.tolist(),
               "course": blocks.block_course.tolist(), "web": blocks.block_web.tolist(),
-              "colourings": shown}
+              "solved": made.is_solved.tolist(), "colourings": shown}
     data = json.dumps(bricks, separators=(",", ":"), allow_nan=False)
     return _PAGE.format(title=html.escape(made.figure_title), plot=plot,
                         bricks=data.replace("</", "<\\/"))

@@ -12,7 +12,13 @@ UP_AXIS = ("z up (Blender: import with Up Axis Z and Forward Axis Y; its default
 slicers take z up; Blender's importer assumes Y up unless told."""
 
 
-def blocks_obj(blocks: Blocks, vertices=None) -> bytes:
+SOLVED_GROUP = "solved_section"
+COPIES_GROUP = "turned_copies"
+"""The OBJ groups of a whole dome that a cyclic section stands for: the section the
+analysis solved, and its copies turned about the axis (drawn, not solved)."""
+
+
+def blocks_obj(blocks: Blocks, vertices=None, groups=None) -> bytes:
     """OBJ text with ``o <block name>`` per block and its polygon faces.
 
     Parameters
@@ -21,6 +27,9 @@ def blocks_obj(blocks: Blocks, vertices=None) -> bytes:
         Faces sorted by block (``face_block`` ascending).
     vertices : (V, 3) float, optional
         Vertex positions to write instead of ``blocks.vertices`` (e.g. CAD-offset ones).
+    groups : (B,) str, optional
+        A group per block: a ``g <group>`` line before the first block of each run of
+        blocks of one group (readers that split by object, as ours does, ignore it).
     """
     vertices = blocks.vertices if vertices is None else vertices
     # block i's lines: its "o" line, its vertices, its faces; every line's row in the
@@ -43,5 +52,11 @@ def blocks_obj(blocks: Blocks, vertices=None) -> bytes:
         ids = blocks.face_vertices[blocks.face_offsets[faces][:, None] + np.arange(count)]
         text = ("f" + " %d" * count + "\n") * len(faces) % tuple((ids + 1).ravel().tolist())
         lines[face_row[faces]] = text.split("\n")[:-1]
+    lines = lines.tolist()
+    if groups is not None:
+        groups = np.asarray(groups, dtype=object)
+        starts = np.flatnonzero(np.concatenate([[True], groups[1:] != groups[:-1]]))
+        for start in starts[::-1]:  # from the end: the rows before stay where they are
+            lines.insert(int(block_row[start]), f"g {groups[start]}")
     header = f"# masonry blocks: one object per block, metres, {UP_AXIS}"
-    return "\n".join([header, *lines.tolist(), ""]).encode()
+    return "\n".join([header, *lines, ""]).encode()

@@ -1,5 +1,6 @@
 """Rhino 3DM of blocks: one named, closed, unwelded mesh per block, on a layer per block
-class and a ``supports`` layer, with user text (rhino3dm, a dependency).
+class and a ``supports`` layer (a cyclic section's turned copies on a layer of their
+own), with user text (rhino3dm, a dependency).
 
 Names are the OBJ object names (``blocks.block_name``); layers are the
 :data:`~masonry.blocks.BLOCK_CLASSES` of the free blocks and :data:`SUPPORT_LAYER` for the
@@ -23,6 +24,10 @@ _LAYER_COLOURS = ((128, 128, 128, 255), (200, 120, 80, 255), (200, 40, 40, 255),
                   (80, 120, 200, 255), (120, 180, 90, 255))
 SUPPORT_LAYER = "supports"
 _SUPPORT_COLOUR = (60, 60, 60, 255)
+COPIES_LAYER = "turned copies (not solved)"
+"""The layer of a whole dome's blocks that copy the solved section by rotation (a cyclic
+section's run); the solved section's blocks are on the class and support layers."""
+_COPIES_COLOUR = (190, 190, 190, 255)
 
 
 MISSING = ("bricks.3dm not written: rhino3dm, a dependency of masonry, is not installed "
@@ -71,7 +76,7 @@ def block_user_text(blocks: Blocks, model=None, forces=None) -> dict:
     return text
 
 
-def blocks_3dm(blocks: Blocks, vertices=None, user_text=None) -> bytes:
+def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, is_copy=None) -> bytes:
     """3DM bytes (Rhino 8 file format) with one closed, unwelded mesh per block.
 
     Faces of 3 and 4 vertices become mesh triangles and quads; larger faces are fanned
@@ -85,6 +90,8 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None) -> bytes:
         Positions to write instead of ``blocks.vertices`` (e.g. the CAD-offset ones).
     user_text : dict str -> (B,) str, optional
         Per-block user text (Rhino: Properties > Attribute User Text), key -> values.
+    is_copy : (B,) bool, optional
+        Blocks on :data:`COPIES_LAYER` instead of their class's or the supports' layer.
 
     Raises
     ------
@@ -105,6 +112,9 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None) -> bytes:
              for code in np.unique(blocks.block_class[free])}
     if blocks.block_is_support.any():
         support_layer = model.Layers.AddLayer(SUPPORT_LAYER, _SUPPORT_COLOUR)
+    is_copy = np.zeros(blocks.n_blocks, bool) if is_copy is None else np.asarray(is_copy)
+    if is_copy.any():
+        copies_layer = model.Layers.AddLayer(COPIES_LAYER, _COPIES_COLOUR)
 
     face_start = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks + 1))
     corner_start = blocks.face_offsets[face_start].tolist()
@@ -115,7 +125,8 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None) -> bytes:
                               sizes[face_start[i]:face_start[i + 1]])
         attributes = rhino3dm.ObjectAttributes()
         attributes.Name = str(blocks.block_name[i])
-        attributes.LayerIndex = (layer[blocks.block_class[i]] if free[i] else support_layer)
+        attributes.LayerIndex = (copies_layer if is_copy[i] else layer[blocks.block_class[i]]
+                                 if free[i] else support_layer)
         for key, values in user_text.items():
             attributes.SetUserString(key, str(values[i]))
         model.Objects.AddMesh(mesh, attributes)

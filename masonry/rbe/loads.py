@@ -135,7 +135,9 @@ def _at_points(blocks, block, point, force) -> np.ndarray:
 
 
 def point_loads(blocks, specs) -> LiveLoad:
-    """Forces at the centre of the top face of the blocks each spec names.
+    """Forces at the centre of the top face of the blocks each spec names; its
+    description's ``blocks`` counts the blocks loaded (block names are unique in every
+    scene, so a name loads one block and a pattern the blocks it matches).
 
     Parameters
     ----------
@@ -172,7 +174,7 @@ def point_loads(blocks, specs) -> LiveLoad:
         raise ParameterError("point_loads", specs[0], "point loads that do not cancel "
                              "(these add up to zero on every block they match)")
     return LiveLoad(wrench, _describe("point", wrench, specs=list(specs),
-                                      blocks=len(chosen)))
+                                      blocks=len(np.unique(chosen))))
 
 
 def top_course(blocks) -> np.ndarray:

@@ -49,8 +49,9 @@ from masonry.tolerances import (COINCIDENT_ANGLE, CONVEXITY_REL,
 
 log = logging.getLogger(__name__)
 
-OUR_NAME = re.compile(r"^b\d+_(" + "|".join(BLOCK_CLASSES) + r")_c(\d+)$")
-"""Block names written by :func:`masonry.export.obj.blocks_obj`: class and course."""
+OUR_NAME = re.compile(r"^(?:w\d+_)?b\d+_(" + "|".join(BLOCK_CLASSES) + r")_c(\d+)$")
+"""Block names written by :func:`masonry.export.obj.blocks_obj`: class and course (a web's
+or sector's bricks of a whole dome carry ``w<web>_`` before them)."""
 
 
 # ---------------------------------------------------------------------- public API

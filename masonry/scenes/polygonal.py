@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.blocks import concatenate, rotated_web, rotation_z
+from masonry.blocks import rotation_z, whole_of_web
 from masonry.dome.courses import fill_courses
 from masonry.dome.levels import Dimensions, level_table
 from masonry.dome.pattern import Pattern, build_pattern
@@ -220,7 +220,7 @@ class Dome(Section):
     def build(cls, geometry) -> Scene:
         section = build_web(geometry)
         n = geometry.n
-        blocks = concatenate([rotated_web(section.blocks, k, n) for k in range(n)])
+        blocks = whole_of_web(section.blocks, n, rename_first=True)
         turns = [rotation_z(2 * np.pi * k / n).T for k in range(n)]
         up = np.concatenate([section.block_up @ q for q in turns])
         inward = np.concatenate([section.block_inward @ q for q in turns])

@@ -40,15 +40,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.blocks import (GROUND, blocks_from_hulls, concatenate,
-                            hull_faces, rotation_z)
+from masonry.blocks import (GROUND, blocks_from_hulls, hull_faces, rotation_z,
+                            whole_of_web)
 from masonry.dome.courses import FILL, PAT, REG, Layout, fill_ring
 from masonry.dome.levels import LevelTable, contact_angles, ellipse_point
 from masonry.dome.pattern import Pattern
 from masonry.errors import ParameterError
 from masonry.parameters import declare
 from masonry.scenes.base import Scene, SceneKind, Symmetry, ThrustSection
-from masonry.tolerances import UNIT_SLACK, UNITS_PER_BRICK, Tolerances
+from masonry.tolerances import (BRICKS_PER_COURSE_AND_NODE, PATTERN_CHECKED_BRICKS,
+                                REVOLUTION_UNITS_PER_BRICK, UNIT_SLACK, Tolerances)
 
 DEPTH = {REG: 2.0, FILL: 2.0, PAT: 4.0}
 """Brick depth through the wall, units (a pattern brick stands proud: docs/model.md 4.5)."""
@@ -421,6 +422,7 @@ def build_sector(g: RevolutionDome, kind=None) -> Scene:
     """One sector of the dome (docs/model.md 4.8): its ground slab (block 0), then the
     bricks whose start lies in it (``[-pi / N, pi / N)`` for the dome's symmetry ``N``),
     by course and longitude; the whole dome is its ``N`` rotations."""
+    check_revolution(g, pattern=True)
     prof, rings = profile_of(g), rings_of(g)
     start, period = -rings.period / 2, rings.period
     mine = rings.phi0 < start + period - UNIT_SLACK * period
@@ -488,40 +490,74 @@ def _pattern_record(g: RevolutionDome, prof: Profile) -> Pattern:
 
 def whole_dome(section: Scene, kind) -> Scene:
     """The whole dome: ``section`` (a sector of the dome's symmetry order ``N``) and its
-    ``N - 1`` rotations, sector after sector."""
+    ``N - 1`` rotations, sector after sector, each brick named after its sector
+    (``w<sector>_<name>``: :func:`~masonry.blocks.whole_of_web`)."""
     n = kind.symmetry(section.geometry).order
-    blocks = concatenate([section.blocks.transformed(_turn(2 * np.pi * j / n))
-                          for j in range(n)])
-    blocks = dataclasses.replace(blocks, block_web=np.repeat(np.arange(n),
-                                                             section.blocks.n_blocks))
+    blocks = whole_of_web(section.blocks, n, rename_first=True)
     up = np.concatenate([section.block_up @ rotation_z(2 * np.pi * j / n).T
                          for j in range(n)])
     return dataclasses.replace(section, kind=kind, blocks=blocks, block_up=up)
 
 
-def _turn(angle) -> np.ndarray:
-    matrix = np.eye(4)
-    matrix[:3, :3] = rotation_z(angle)
-    return matrix
-
-
 # --------------------------------------------------------------------------- kinds
 def intrados_bricks(g: RevolutionDome) -> float:
-    """The whole dome's bricks from its intrados area (the zone of the ellipsoid up to
-    the oculus) over :data:`~masonry.tolerances.UNITS_PER_BRICK`."""
+    """The whole dome's bricks from its intrados (the zone of the ellipsoid up to the
+    oculus, in square units) and its meridian's length ``L`` (units, about its courses):
+    the area over :data:`~masonry.tolerances.REVOLUTION_UNITS_PER_BRICK` and
+    :data:`~masonry.tolerances.BRICKS_PER_COURSE_AND_NODE` per course and start node
+    (pattern bricks and the fill-ins beside them; a plain dome's fill-ins, one per
+    course and period)."""
     with np.errstate(all="ignore"):
         a = g.radius
         c = a * g.stretch
         theta = np.linspace(0.0, np.arcsin(1 - g.cut), 257)
-        f = 2 * np.pi * a * np.cos(theta) * np.hypot(a * np.sin(theta), c * np.cos(theta))
-        area = np.sum((f[1:] + f[:-1]) / 2 * np.diff(theta))
-    return float(area) / UNITS_PER_BRICK
+        arc = np.hypot(a * np.sin(theta), c * np.cos(theta))
+        f = 2 * np.pi * a * np.cos(theta) * arc
+        area = float(np.sum((f[1:] + f[:-1]) / 2 * np.diff(theta)))
+        length = float(np.sum((arc[1:] + arc[:-1]) / 2 * np.diff(theta)))
+    nodes = g.spirals or default_spirals(g)
+    per_node = BRICKS_PER_COURSE_AND_NODE if g.pattern == "herringbone" else 1.0
+    return area / REVOLUTION_UNITS_PER_BRICK + per_node * length * nodes
 
 
-def check_revolution(g: RevolutionDome) -> None:
+def estimated_symmetry(g: RevolutionDome) -> int:
+    """The dome's symmetry order (:attr:`RingPattern.symmetry`) from the continuous
+    helix instead of the lattice of bricks, in time independent of the dome's size: a
+    line travels ``pi / N`` of longitude from node to node (``tan(beta) / x`` per unit
+    of meridian for a loxodrome, ``tan(beta) / R`` for a clelia), and at a node where the
+    ``N`` nodes of the ring come closer than ``2 (p + 1)`` units ``N`` halves (an odd
+    ``N`` ends every line), as :func:`ring_pattern` lays them."""
+    count = g.spirals or default_spirals(g)
+    if g.pattern == "none":
+        return count
+    with np.errstate(all="ignore"):
+        a = g.radius
+        theta = np.linspace(0.0, np.arcsin(1 - g.cut), 4097)
+        x = a * np.cos(theta)
+        ds = np.hypot(a * np.sin(theta), a * g.stretch * np.cos(theta)) * np.diff(theta)[0]
+        tan = max(np.tan(np.radians(g.helix_angle)), 1.0)
+        rate = tan / (x if g.helix == "loxodrome" else np.full(len(x), a))
+        phi = np.concatenate([[0.0], np.cumsum((rate[1:] + rate[:-1]) / 2 * ds[1:])])
+    travelled = np.pi / count
+    while (k := int(np.searchsorted(phi, travelled))) < len(phi):
+        if 2 * np.pi / count * x[k] < 2 * (g.p + 1):
+            if count % 2:
+                break
+            count //= 2
+        travelled += np.pi / count
+    return count
+
+
+def check_revolution(g: RevolutionDome, pattern=None) -> None:
     """Refuse a dome of fewer than three courses, more start nodes than its springing
     ring holds (two pattern bricks and a regular brick between nodes), or sectors too
-    narrow at the oculus for a regular brick."""
+    narrow at the oculus for a regular brick.
+
+    The last check lays the whole dome's pattern (:func:`ring_pattern`), which takes
+    time and memory in proportion to the dome's bricks: by default (``pattern`` None) it
+    runs only on a dome estimated at most :data:`~masonry.tolerances.PATTERN_CHECKED_BRICKS`
+    bricks, so that a dome too large to build is refused by its size
+    (:func:`masonry.scenes.check_size`) at once; building runs it always (True)."""
     if g.radius * np.arcsin(1 - g.cut) < 3:
         raise ParameterError("cut", g.cut, "a dome at least three courses high; lower cut",
                              related=("radius", "stretch"))
@@ -531,6 +567,10 @@ def check_revolution(g: RevolutionDome) -> None:
                              f"start nodes on a springing ring of radius {g.radius:g} units "
                              "(two pattern bricks and a regular brick between nodes)",
                              related=("radius", "p"))
+    if pattern is None:
+        pattern = intrados_bricks(g) <= PATTERN_CHECKED_BRICKS
+    if not pattern:
+        return
     prof = profile_of(g)
     top, sectors = prof.x[-1] / g.unit, ring_pattern(g).symmetry
     if 2 * np.pi * top / sectors < 4:
@@ -565,9 +605,7 @@ class Sector(SceneKind):
 
     @classmethod
     def estimate_blocks(cls, geometry) -> float:
-        bricks = intrados_bricks(geometry)
-        return bricks / (geometry.spirals or default_spirals(geometry)) \
-            if bricks < 1e8 else bricks
+        return intrados_bricks(geometry) / estimated_symmetry(geometry)
 
     @classmethod
     def id_prefix(cls, geometry, boundary) -> str:
