@@ -161,10 +161,15 @@ class Exporter:
 def _model_files(made: RunOutputs) -> Export:
     model, solved = made.model, made.is_solved
     groups = None if solved.all() else np.where(solved, obj.SOLVED_GROUP, obj.COPIES_GROUP)
+    blocks = made.shown
+    if made.params.analysis.boundary == "rigid":  # the neighbours its verdict stands on
+        blocks = model.blocks
+        groups = np.where(np.arange(blocks.n_blocks) < made.scene.blocks.n_blocks,
+                          obj.SOLVED_GROUP, obj.NEIGHBOURS_GROUP)
     return Export({
         "00_parameters.txt": summaries.parameters_text(made.params, made.title),
         "locations.csv": csv.locations_csv(made.shown, made.shown_cad_vertices),
-        "bricks.obj": obj.blocks_obj(made.shown, groups=groups),
+        "bricks.obj": obj.blocks_obj(blocks, groups=groups),
         "interfaces.csv": csv.interfaces_csv(model.blocks, model.interfaces),
     })
 

@@ -16,6 +16,10 @@ SOLVED_GROUP = "solved_section"
 COPIES_GROUP = "turned_copies"
 """The OBJ groups of a whole dome that a cyclic section stands for: the section the
 analysis solved, and its copies turned about the axis (drawn, not solved)."""
+NEIGHBOURS_GROUP = "rigid_neighbours"
+"""The OBJ group of a rigid section's immovable neighbours (images of the next webs' end
+bricks, supports of its analysis): analysed with them as supports, the file gives the
+run's verdict."""
 
 
 def blocks_obj(blocks: Blocks, vertices=None, groups=None) -> bytes:
