@@ -173,3 +173,25 @@ def test_a_live_loads_factor_is_the_wholes(scene, load):
     if whole.load_factor is not None:
         assert ran.load_factor == pytest.approx(whole.load_factor, rel=FACTOR_REL)
         assert ran.checked()
+
+
+def test_an_imported_assembly_analysed_back_gives_its_verdict(fixtures_dir, tmp_path, capsys):
+    """Blocks read from a file (Rhino's OBJ of an arch on two piers): the run's residuals
+    meet the tolerance, its CSVs read back typed, and its own ``bricks.obj`` analysed
+    again gives the same verdict and weight."""
+    records = []
+    source = fixtures_dir / "assembly" / "arch_rhino.obj"
+    for step in range(2):
+        out = tmp_path / f"run{step}"
+        assert main(["analyze", str(source), "--support", "pier_*", "--no-plots",
+                     "--no-printable", "-q", "--out", str(out)]) == 0
+        (path,) = out.glob("*/run.json")
+        records.append(json.loads(path.read_text()))
+        for table in path.parent.rglob("*.csv"):
+            masonry.read_table(table)
+        source = path.parent / "bricks.obj"
+    capsys.readouterr()
+    first, again = (record["rbe"] for record in records)
+    assert first["residual_eq"] <= ACCEPT_RESIDUAL
+    assert again["verdict"] == first["verdict"]
+    assert again["weight_N"] == pytest.approx(first["weight_N"], rel=1e-9)
