@@ -98,9 +98,8 @@ def _selection(layout) -> sp.csr_array:
 
 def friction_columns(system) -> Columns:
     """The friction model's columns: a pyramid's edge ray weights ``g >= 0``, or the
-    forces ``(c, f1, f2)`` with ``(mu c, f1, f2)`` in the second-order cone; and a
-    tension cut-off's ``c >= floor`` rows where it truncates the cone
-    (:attr:`~masonry.rbe.equilibrium.EquilibriumSystem.compression_floor`)."""
+    forces ``(c, f1, f2)`` with ``(mu c, f1, f2)`` in the second-order cone; and rows
+    ``c >= floor`` where a tension cut-off truncates the cone (masonry.contact)."""
     n_vertices, cone, mu = system.layout.n_vertices, system.cone, system.mu
     if cone.is_polyhedral:
         edges = friction_edges(n_vertices, cone, mu)
@@ -115,8 +114,7 @@ def friction_columns(system) -> Columns:
     floor = system.compression_floor
     if floor is None:
         return columns
-    # c of every vertex is its row of edges (the rays' c is 1, the cone's c itself)
-    compression = sp.csc_array(columns.edges[system.layout.columns("c")])
+    compression = sp.csc_array(columns.edges[system.layout.columns("c")])  # c of each vertex
     return Columns(columns.edges, sp.csc_array(sp.vstack([columns.G, -compression])),
                    np.concatenate([columns.h, -floor]),
                    (*columns.cones, (NONNEGATIVE, n_vertices, 1)), is_rays=False)
@@ -176,11 +174,10 @@ class CollapseLP:
     mu : float
     density : float, kg/m^3
     cone : FrictionCone or str
-        The friction model (:mod:`masonry.friction`; default Coulomb's cone).
+        The friction model (:mod:`masonry.friction`; default Coulomb's cone); with
+        ``cohesion``, ``tensile`` (Pa; default dry), the contact law (:mod:`masonry.contact`).
     time_limit : float, s
         HiGHS's and Clarabel's limit per solve.
-    cohesion, tensile : float, Pa
-        The mortar (:mod:`masonry.contact`); default dry joints.
     method : str, optional
         The backend (:mod:`masonry.rbe.solvers`, one that solves
         :data:`~masonry.rbe.solvers.base.COLLAPSE`); default :data:`METHOD`.
@@ -204,8 +201,7 @@ class CollapseLP:
                                cone=cone, cohesion=cohesion, tensile=tensile,
                                **model.assembly)
         self.method = METHOD if method is None else method
-        # refuses what it cannot solve; the default hands a tension cut-off it does not
-        # state to clarabel, said in the log and the result's solver
+        # the default hands a tension cut-off it cannot state to clarabel (logged)
         refusal = backend(self.method, COLLAPSE, self.system.cone).refusal(self.system)
         if refusal is not None and method is not None:
             raise ValueError(refusal)
