@@ -539,23 +539,23 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     reported on the whole (docs/model.md 6.11), with associated friction."""
     known = True if rbe is not None and rbe.feasible else None
     analysis, load = params.analysis, params.load
-    options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone,
-                   **mortar(analysis))
+    options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone)
     symmetry = params.kind.symmetry(params.geometry)
     copies = symmetry.order if symmetry.unit else 1
     if isinstance(load, Lateral) and load.azimuth_deg == "all":
         result = worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
-                               mirrors=symmetry.mirrors, dead_load_feasible=known, **options)
+                               mirrors=symmetry.mirrors, dead_load_feasible=known, **options,
+                               **mortar(analysis))
         return _checked_collapse(model, params, result, 1, known)
     plane = symmetric_plane(load, symmetry.mirrors)
     if (plane is not None and analysis.friction_law == "associated"
-            and states_exactly(analysis.cone, analysis.law.cohesion_Pa)):
+            and states_exactly(analysis.cone, analysis.law.cohesion_Pa)):  # dry joints
         result = collapse_on_half(model, load, plane, copies=copies,
                                   dead_load_feasible=known, **options)
     else:
         result = collapse_load(model, load.on(model, analysis.density, copies=copies),
                                dead_load_feasible=known, friction=analysis.friction_law,
-                               **options)
+                               **options, **mortar(analysis))
     if isinstance(load, Lateral) and load.azimuth_deg != "all":
         result = dataclasses.replace(result, azimuth_deg=float(load.azimuth_deg))
     return _checked_collapse(model, params, result, copies, known)
