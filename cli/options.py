@@ -295,6 +295,12 @@ def add_material_options(group):
                             "to reproduce the thesis only)")
     group.add_argument("--density", type=float, help=f"kg/m^3 ({_range('density')}; "
                                                      f"default {DEFAULTS['density']:g})")
+    group.add_argument("--cohesion-kpa", dest="cohesion_kpa", type=float, metavar="KPA",
+                       help="the mortar's cohesion at every joint, kPa (|f| <= mu n + c A "
+                            "at a vertex of tributary area A; default 0: dry joints)")
+    group.add_argument("--tensile-kpa", dest="tensile_kpa", type=float, metavar="KPA",
+                       help="the mortar's tensile strength at every joint, kPa (n >= -t A; "
+                            "cut off at cohesion/mu; default 0)")
 
 
 def add_output_options(parser):

@@ -189,7 +189,7 @@ class FrictionCone:
         reach = np.max(f1[:, None] * normals[:, 0] + f2[:, None] * normals[:, 1], axis=1)
         return reach - self.apothem(mu) * load
 
-    def project(self, p, mu):
+    def project(self, p, mu, floor=None):
         """Euclidean projection onto the model and an element of its generalized Jacobian.
 
         Parameters
@@ -197,6 +197,9 @@ class FrictionCone:
         p : (V, 3) float
             Points ``(c, f1, f2)``.
         mu : float
+        floor : (V,) float, optional
+            A lower bound ``c >= floor`` (>= 0) per point: the cone truncated by a
+            tension cut-off (:mod:`masonry.contact`); the circle only.
 
         Returns
         -------
@@ -207,6 +210,11 @@ class FrictionCone:
             the cone's surface (which varies with the point), zero at the apex.
         """
         p = np.asarray(p, dtype=float)
+        if floor is not None:
+            if self.kind != CIRCLE:
+                raise ValueError(f"{self.name}: no closed-form projection onto a truncated "
+                                 f"pyramid")
+            return _project_truncated(p, mu, np.asarray(floor, dtype=float))
         if self.kind == CIRCLE:
             return _project_circle(p, mu)
         radius, offset = self._ray_geometry()
@@ -235,6 +243,40 @@ def _project_circle(p, mu):
     turn = mu * s / norm[side]
     jacobian[side] = u[:, :, None] * u[:, None, :]
     jacobian[side, 1:, 1:] += turn[:, None, None] * (np.eye(2) - d[:, :, None] * d[:, None, :])
+    return x, jacobian
+
+
+def _project_truncated(p, mu, floor):
+    """:meth:`FrictionCone.project` for ``{c >= floor, ||f|| <= mu c}``: in the half-plane
+    ``(c, ||f||)`` a 2D projection onto the slanted side (as :func:`_project_circle`,
+    where it lands at ``c >= floor``), the flat side ``c = floor`` (Jacobian
+    ``diag(0, 1, 1)``) or the corner ``(floor, mu floor d)`` (``c`` fixed, ``d`` turning:
+    ``mu floor / ||f|| (I - d d^T)``)."""
+    c, f = p[:, 0], p[:, 1:]
+    norm = np.hypot(f[:, 0], f[:, 1])
+    s = (c + mu * norm) / (1.0 + mu * mu)
+    inside = (norm <= mu * c) & (c >= floor)
+    flat = ~inside & (c < floor) & (norm <= mu * floor)
+    slant = ~inside & ~flat & (s >= floor)
+    corner = ~(inside | flat | slant)
+    x = np.zeros_like(p)
+    jacobian = np.zeros((len(p), 3, 3))
+    x[inside] = p[inside]
+    jacobian[inside] = np.eye(3)
+    x[flat, 0] = floor[flat]
+    x[flat, 1:] = f[flat]
+    jacobian[flat, 1, 1] = jacobian[flat, 2, 2] = 1.0
+    safe = np.where(norm > 0, norm, 1.0)
+    d = f / safe[:, None]
+    across = np.eye(2) - d[:, :, None] * d[:, None, :]
+    x[slant, 0] = s[slant]
+    x[slant, 1:] = mu * s[slant, None] * d[slant]
+    u = np.concatenate([np.ones((len(d), 1)), mu * d], axis=1) / math.sqrt(1.0 + mu * mu)
+    jacobian[slant] = u[slant, :, None] * u[slant, None, :]
+    jacobian[slant, 1:, 1:] += (mu * s / safe)[slant, None, None] * across[slant]
+    x[corner, 0] = floor[corner]
+    x[corner, 1:] = mu * floor[corner, None] * d[corner]
+    jacobian[corner, 1:, 1:] = (mu * floor / safe)[corner, None, None] * across[corner]
     return x, jacobian
 
 

@@ -200,7 +200,8 @@ def from_preset(name, **overrides) -> Params:
 
 def load(path, **overrides) -> Params:
     """The inputs of a TOML file of flat names (e.g. ``fixtures/presets/*.toml``), at the
-    top level or in a ``[params]`` table; ``overrides`` win over the file.
+    top level or in a ``[params]`` table, and the mortar's in a ``[mortar]`` table
+    (:data:`MORTAR_KEYS`); ``overrides`` win over the file.
 
     Raises
     ------
@@ -208,10 +209,13 @@ def load(path, **overrides) -> Params:
         Named ``params`` when the file cannot be read or is not TOML; named after the key
         (with ``where`` the file) when a key is unknown or its value invalid.
     """
-    data = read_toml(path, "params")
-    data = data.get("params", data)
+    raw = read_toml(path, "params")
+    data = raw.get("params", raw)
     if not isinstance(data, dict):
         raise ParameterError("params", str(path), "a file whose [params] is a table")
+    mortar = raw.get("mortar", data.get("mortar", {}))
+    data = {key: value for key, value in data.items() if key != "mortar"}
+    data.update(_mortar_table(mortar, path))
     known = ["scene", "fast", *names()]
     for key, value in data.items():
         if key not in known:
@@ -229,6 +233,23 @@ def load(path, **overrides) -> Params:
             raise
         raise ParameterError(error.name, error.value, error.expected,
                              related=error.related, where=str(path)) from None
+
+
+MORTAR_KEYS = ("cohesion_kpa", "tensile_kpa")
+"""The keys of a parameter file's ``[mortar]`` table (the analysis's mortar inputs)."""
+
+
+def _mortar_table(table, path) -> dict:
+    """The inputs of a parameter file's ``[mortar]`` table (``cohesion_kpa``,
+    ``tensile_kpa``), refused by key when it is not a table or names another key."""
+    if not isinstance(table, dict):
+        raise ParameterError("mortar", table, f"a table of {' and '.join(MORTAR_KEYS)}",
+                             where=str(path))
+    for key, value in table.items():
+        if key not in MORTAR_KEYS:
+            raise ParameterError(key, value, f"{' or '.join(MORTAR_KEYS)} in [mortar]",
+                                 where=str(path))
+    return dict(table)
 
 
 def structure_id(params: Params) -> str:

@@ -492,13 +492,13 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
     mirrors = params.kind.symmetry(params.geometry).mirrors
     half = None
     with timer.stage("assembly"):
-        if mirrors and states_exactly(analysis.cone):
+        if mirrors and states_exactly(analysis.cone, analysis.law.cohesion_Pa):
             half = half_model(model, mirrors[0])
         solved = model if half is None else half.model
         problem = RBEProblem(solved.blocks, solved.interfaces, **solved.assembly)
     options = dict(mu=analysis.mu, density=analysis.density, friction=analysis.friction,
                    solver=analysis.solver, accuracy=analysis.accuracy,
-                   cone=analysis.friction_cone)
+                   cone=analysis.friction_cone, **mortar(analysis))
     with timer.stage("solve"):
         result = problem.solve(**options)
         if half is None:
@@ -514,13 +514,20 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
         return dataclasses.replace(result, solved_on="whole, the half rejected")
 
 
+def mortar(analysis) -> dict:
+    """The analyses' keyword arguments of the run's mortar: cohesion and tensile
+    strength, pascals (:attr:`~masonry.rbe.settings.Analysis.law`)."""
+    law = analysis.law
+    return dict(cohesion=law.cohesion_Pa, tensile=law.tensile_Pa)
+
+
 def centering_of(model: Model, params: Params) -> CenteringResult:
     """The centering force of a run's model (docs/model.md 6.10): the least force that
     supports at the blocks' centroids must give for it to stand, under the run's friction
     model. A run computes it when the structure cannot stand."""
     analysis = params.analysis
     return centering_force(model, mu=analysis.mu, density=analysis.density,
-                           cone=analysis.cone)
+                           cone=analysis.cone, **mortar(analysis))
 
 
 def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> CollapseResult:
@@ -537,17 +544,18 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     copies = symmetry.order if symmetry.unit else 1
     if isinstance(load, Lateral) and load.azimuth_deg == "all":
         result = worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
-                               mirrors=symmetry.mirrors, dead_load_feasible=known, **options)
+                               mirrors=symmetry.mirrors, dead_load_feasible=known, **options,
+                               **mortar(analysis))
         return _checked_collapse(model, params, result, 1, known)
     plane = symmetric_plane(load, symmetry.mirrors)
     if (plane is not None and analysis.friction_law == "associated"
-            and states_exactly(analysis.cone)):
+            and states_exactly(analysis.cone, analysis.law.cohesion_Pa)):  # dry joints
         result = collapse_on_half(model, load, plane, copies=copies,
                                   dead_load_feasible=known, **options)
     else:
         result = collapse_load(model, load.on(model, analysis.density, copies=copies),
                                dead_load_feasible=known, friction=analysis.friction_law,
-                               **options)
+                               **options, **mortar(analysis))
     if isinstance(load, Lateral) and load.azimuth_deg != "all":
         result = dataclasses.replace(result, azimuth_deg=float(load.azimuth_deg))
     return _checked_collapse(model, params, result, copies, known)
@@ -567,7 +575,8 @@ def _checked_collapse(model, params, result, copies, known) -> CollapseResult:
         load = Lateral(result.azimuth_deg)
     whole = collapse_load(model, load.on(model, analysis.density, copies=copies),
                           dead_load_feasible=known, friction=analysis.friction_law,
-                          mu=analysis.mu, density=analysis.density, cone=analysis.cone)
+                          mu=analysis.mu, density=analysis.density, cone=analysis.cone,
+                          **mortar(analysis))
     return dataclasses.replace(whole, azimuth_deg=result.azimuth_deg,
                                azimuths=result.azimuths, solved_on="whole, the half rejected")
 

@@ -39,6 +39,7 @@ def parameters_text(params, structure_id: str) -> str:
     cone = analysis.cone
     lines += ["", *_lines(analysis, values(analysis), ANALYSIS_SHOWN),
               _line("friction_cone", cone.name, cone.describe()),
+              _line("contact_law", analysis.law.describe(), ""),
               _line("accuracy", preset.name, f"solver preset; residual <= {preset.residual:g}"),
               _line("solver", solvers, "" if analysis.solver is None else "set by --solver"),
               ""]
@@ -79,6 +80,7 @@ def objective_text(result, centering=None) -> str:
         f"friction method:    friction-{d['friction']} (mu = {d['mu']:g}; the problem "
         "whose solution is reported)",
         f"friction model:     {result.cone.describe()}",
+        f"contact law:        {result.contact_law}",
         f"objective:          {d['objective']:.6g} N^2 (1/2 x^T H x, weights: tension 1, "
         "compression and friction 1e-3)",
         f"MoI:                {d['moi']:.6g} N (sum of all vertex tensions: the QP's "
@@ -124,6 +126,7 @@ def collapse_text(result) -> str:
         f"azimuth:            {d['azimuth_deg']}",
         f"mu:                 {d['mu']:g}",
         f"friction model:     {result.cone.describe()}",
+        f"contact law:        {result.contact_law}",
         f"friction law:       {d['friction_law']}"
         + ("" if d["associated_factor"] is None
            else f" (associated factor {d['associated_factor']:.6g})"),

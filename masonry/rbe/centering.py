@@ -45,6 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from masonry.contact import ContactLaw
 from masonry.friction import FrictionCone
 from masonry.rbe.collapse import friction_columns
 from masonry.rbe.equilibrium import EquilibriumSystem, assemble
@@ -59,7 +60,7 @@ SOLVER = "clarabel"
 
 RESULT_KEYS = ("total_N", "fraction", "weight_N", "held_count", "status", "solver",
                "iterations", "time_s", "residual_eq", "friction_violation", "mu",
-               "friction_model", "point")
+               "friction_model", "point", "contact_law")
 """Scalar fields of :class:`CenteringResult` in run.json, in order (then ``held``)."""
 
 
@@ -92,7 +93,10 @@ class CenteringResult:
     mu : float
     cone : FrictionCone
     x : (4 IV,) float or None
-        The vertex forces ``(c, 0, f1, f2)``, newtons, in the layout's order.
+        The vertex forces ``(c, 0, f1, f2)``, newtons, in the layout's order; with mortar
+        ``c`` is the normal force (negative where the mortar holds in tension).
+    law : ContactLaw
+        The contact law (:mod:`masonry.contact`).
     """
 
     total_N: float | None
@@ -110,6 +114,12 @@ class CenteringResult:
     x: np.ndarray | None = None
     solver: str = SOLVER
     point: str = "centroid"
+    law: ContactLaw = ContactLaw()
+
+    @property
+    def contact_law(self) -> str:
+        """The contact law in one line (:meth:`~masonry.contact.ContactLaw.describe`)."""
+        return self.law.describe()
 
     @property
     def fraction(self) -> float | None:
@@ -164,7 +174,7 @@ class CenteringResult:
 
 
 def centering_force(model, *, mu=0.7, density=2000.0, cone="circle",
-                    time_limit=600.0) -> CenteringResult:
+                    time_limit=600.0, cohesion=0.0, tensile=0.0) -> CenteringResult:
     """The least total support force that lets ``model`` stand (module docstring).
 
     Parameters
@@ -179,16 +189,19 @@ def centering_force(model, *, mu=0.7, density=2000.0, cone="circle",
         The friction model (:mod:`masonry.friction`).
     time_limit : float, s
         Clarabel's limit.
+    cohesion, tensile : float, Pa
+        The mortar (:mod:`masonry.contact`); default dry joints.
 
     Returns
     -------
     CenteringResult
     """
+    ContactLaw.of(cone, mu, cohesion, tensile)  # refuses a strength out of range
     if len(model.interfaces) == 0:
         return _held_by_weight(model.blocks, mu, density, cone)
     system = assemble(model.blocks, model.interfaces, mu=mu, density=density,
                       side_block=model.side_block, side_rotation=model.side_rotation,
-                      cone=cone)
+                      cone=cone, cohesion=cohesion, tensile=tensile)
     return solve_centering(system, time_limit=time_limit)
 
 
@@ -205,7 +218,7 @@ def solve_centering(system: EquilibriumSystem, *, time_limit=600.0) -> Centering
     status, z, iterations = solve_cone_program(q, A, b, rows, h, cones, time_limit)
     common = dict(weight_N=system.total_weight, block=system.free_block,
                   block_weight=system.block_weight[system.free_block],
-                  iterations=iterations, mu=system.mu, cone=system.cone)
+                  iterations=iterations, mu=system.mu, cone=system.cone, law=system.law)
     if z is None:
         log.warning("centering force: Clarabel ended %s", status)
         return CenteringResult(None, force=None, status=status, residual_eq=np.nan,
@@ -227,7 +240,8 @@ def solve_centering(system: EquilibriumSystem, *, time_limit=600.0) -> Centering
     return CenteringResult(
         total if accepted else None, force=force if accepted else None,
         status="optimal" if accepted else status, residual_eq=residual,
-        friction_violation=violation, x=system.to_newtons(x) if accepted else None,
+        friction_violation=violation,
+        x=system.to_newtons(system.shifted(x, -1.0)) if accepted else None,
         time_s=time.perf_counter() - start, **common)
 
 
@@ -277,5 +291,7 @@ def _residuals(system, x, support) -> tuple:
     residual = float(np.abs(total).max() / np.abs(system.f_ext).max())
     c, _, f1, f2 = np.asarray(x).reshape(-1, 4).T
     excess = system.cone.excess(c, f1, f2, system.mu)
-    violation = max(0.0, float(excess.max(initial=0.0)), float((-c).max(initial=0.0)))
+    # c >= 0, or a tension cut-off's floor (c is the shifted compression)
+    below = system.lower[system.layout.columns("c")] - c
+    violation = max(0.0, float(excess.max(initial=0.0)), float(below.max(initial=0.0)))
     return residual, violation

@@ -43,6 +43,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from masonry import forking
+from masonry.contact import ContactLaw
 from masonry.friction import FrictionCone
 from masonry.rbe.collapse_result import (ANISOTROPIC_NOTE, ASSOCIATED_NOTE, RESULT_KEYS,
                                          UNBOUNDED_NOTE, CollapseResult)
@@ -97,17 +98,26 @@ def _selection(layout) -> sp.csr_array:
 
 def friction_columns(system) -> Columns:
     """The friction model's columns: a pyramid's edge ray weights ``g >= 0``, or the
-    forces ``(c, f1, f2)`` with ``(mu c, f1, f2)`` in the second-order cone."""
+    forces ``(c, f1, f2)`` with ``(mu c, f1, f2)`` in the second-order cone; and rows
+    ``c >= floor`` where a tension cut-off truncates the cone (masonry.contact)."""
     n_vertices, cone, mu = system.layout.n_vertices, system.cone, system.mu
     if cone.is_polyhedral:
         edges = friction_edges(n_vertices, cone, mu)
         n = edges.shape[1]
-        return Columns(edges, sp.csc_array(-sp.identity(n)), np.zeros(n),
-                       ((NONNEGATIVE, n, 1),), is_rays=True)
-    scale = sp.kron(sp.identity(n_vertices), sp.diags_array([mu, 1.0, 1.0]))
-    return Columns(_selection(system.layout), sp.csc_array(-scale),
-                   np.zeros(3 * n_vertices), ((SECOND_ORDER, 3, n_vertices),),
-                   is_rays=False)
+        columns = Columns(edges, sp.csc_array(-sp.identity(n)), np.zeros(n),
+                          ((NONNEGATIVE, n, 1),), is_rays=True)
+    else:
+        scale = sp.kron(sp.identity(n_vertices), sp.diags_array([mu, 1.0, 1.0]))
+        columns = Columns(_selection(system.layout), sp.csc_array(-scale),
+                          np.zeros(3 * n_vertices), ((SECOND_ORDER, 3, n_vertices),),
+                          is_rays=False)
+    floor = system.compression_floor
+    if floor is None:
+        return columns
+    compression = sp.csc_array(columns.edges[system.layout.columns("c")])  # c of each vertex
+    return Columns(columns.edges, sp.csc_array(sp.vstack([columns.G, -compression])),
+                   np.concatenate([columns.h, -floor]),
+                   (*columns.cones, (NONNEGATIVE, n_vertices, 1)), is_rays=False)
 
 
 def _capacity_columns(system, capacity) -> Columns:
@@ -118,10 +128,11 @@ def _capacity_columns(system, capacity) -> Columns:
     n_vertices, cone = system.layout.n_vertices, system.cone
     capacity = np.asarray(capacity, dtype=float)
     vertex = np.arange(n_vertices)
-    # c >= 0: -(-c) in the nonnegative cone
+    # c >= 0 (or a tension cut-off's floor): -(-c) in the nonnegative cone
     rows = [sp.csc_array((-np.ones(n_vertices), (vertex, 3 * vertex)),
                          shape=(n_vertices, 3 * n_vertices))]
-    h = [np.zeros(n_vertices)]
+    floor = system.compression_floor
+    h = [np.zeros(n_vertices) if floor is None else -floor]
     if cone.is_polyhedral:
         normals = cone.face_normals()                       # (K, 2)
         sides = len(normals)
@@ -163,7 +174,8 @@ class CollapseLP:
     mu : float
     density : float, kg/m^3
     cone : FrictionCone or str
-        The friction model (:mod:`masonry.friction`; default Coulomb's cone).
+        The friction model (:mod:`masonry.friction`; default Coulomb's cone); with
+        ``cohesion``, ``tensile`` (Pa; default dry), the contact law (:mod:`masonry.contact`).
     time_limit : float, s
         HiGHS's and Clarabel's limit per solve.
     method : str, optional
@@ -182,12 +194,20 @@ class CollapseLP:
     """
 
     def __init__(self, model, *, mu=0.7, density=2000.0, cone="circle", time_limit=600.0,
-                 method=None, cores=None):
+                 method=None, cores=None, cohesion=0.0, tensile=0.0):
         self.model = model
+        ContactLaw.of(cone, mu, cohesion, tensile)  # refuses a strength out of range
         self.system = assemble(model.blocks, model.interfaces, mu=mu, density=density,
-                               cone=cone, **model.assembly)
+                               cone=cone, cohesion=cohesion, tensile=tensile,
+                               **model.assembly)
         self.method = METHOD if method is None else method
-        backend(self.method, COLLAPSE, self.system.cone)  # refuses what it cannot solve
+        # the default hands a tension cut-off it cannot state to clarabel (logged)
+        refusal = backend(self.method, COLLAPSE, self.system.cone).refusal(self.system)
+        if refusal is not None and method is not None:
+            raise ValueError(refusal)
+        if refusal is not None:
+            log.warning("%s; clarabel solves the collapse program", refusal)
+            self.method = "clarabel"
         self.columns = friction_columns(self.system)
         self.matrix = sp.csc_array(self.system.A_eq @ self.columns.edges)
         self.mu, self.density, self.time_limit = float(mu), float(density), time_limit
@@ -265,7 +285,7 @@ class CollapseLP:
         outcome = held.run(load, per_unit)
         status = STATUS.get(outcome.status, outcome.status)
         common = dict(solver=held.name, mu=self.mu, live=live, azimuth_deg=azimuth,
-                      iterations=outcome.iterations, cone=self.cone)
+                      iterations=outcome.iterations, cone=self.cone, law=self.system.law)
         if status != "optimal":
             feasible = False if status == "dead load infeasible" else dead_load_feasible
             if status == "unbounded" and feasible is None:
@@ -282,7 +302,7 @@ class CollapseLP:
             dead_load_feasible = held.stands_unloaded()
         motion = mechanism_of(self.system, self.model.blocks,
                               outcome.y[: self.system.A_eq.shape[0]], load, factor)
-        x = self.system.to_newtons(outcome.x)
+        x = self.system.to_newtons(self.system.shifted(outcome.x, -1.0))
         log.debug("collapse LP: lambda %.6g, %d iterations", factor, outcome.iterations)
         return CollapseResult(
             factor if dead_load_feasible else None, dead_load_feasible,
@@ -384,7 +404,7 @@ class _Held:
 
 def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, cone="circle",
                   friction=None, dead_load_feasible=None, time_limit=600.0,
-                  cores=None) -> CollapseResult:
+                  cores=None, cohesion=0.0, tensile=0.0) -> CollapseResult:
     """The collapse load factor of ``live`` on ``model`` and its mechanism (docs/model.md 6.8, 6.9).
 
     Parameters
@@ -417,7 +437,7 @@ def collapse_load(model, live: LiveLoad, *, mu=0.7, density=2000.0, cone="circle
         raise ValueError(f"live load of shape {live.wrench.shape} for "
                          f"{model.blocks.n_blocks} blocks")
     problem = CollapseLP(model, mu=mu, density=density, cone=cone, time_limit=time_limit,
-                         cores=cores)
+                         cores=cores, cohesion=cohesion, tensile=tensile)
     if friction in (None, "associated"):
         return problem.solve(live, dead_load_feasible=dead_load_feasible)
     if friction == "non-associative":
@@ -459,7 +479,9 @@ def fixed_capacity_factor(problem: CollapseLP, live: LiveLoad, *, dead_load_feas
                                    time_s=time.perf_counter() - start)
     settled = 0
     for done in range(1, rounds + 1):
-        compression = problem.system.to_scaled(result.x).reshape(-1, 4)[:, 0]
+        # the capacity mu c~ = mu n + c A of the shifted compression (masonry.contact)
+        shifted = problem.system.shifted(problem.system.to_scaled(result.x))
+        compression = shifted.reshape(-1, 4)[:, 0]
         following = problem.with_friction_capacity(problem.mu * compression).solve(
             live, dead_load_feasible=known)
         if following.load_factor is None:
@@ -494,7 +516,8 @@ def lateral_azimuths(n_webs=None, count=24) -> np.ndarray:
 
 def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle",
                   n_webs=None, period_deg=None, mirrors=(), dead_load_feasible=None,
-                  time_limit=600.0, method=None, cores=None) -> CollapseResult:
+                  time_limit=600.0, method=None, cores=None, cohesion=0.0,
+                  tensile=0.0) -> CollapseResult:
     """The smallest lateral load factor over ``azimuths`` (``--lateral all``).
 
     One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: the interior point
@@ -514,14 +537,14 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
     """
     azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
     start = time.perf_counter()
-    mirrors = tuple(mirrors) if states_exactly(cone) else ()
+    mirrors = tuple(mirrors) if states_exactly(cone, cohesion) else ()
     keys = [symmetric_key(a, period_deg, mirrors) for a in azimuths]
     todo = {}
     for key, azimuth in zip(keys, azimuths):
         todo.setdefault(key, float(azimuth))
     cases = _LateralCases(model, mirrors, todo.values(), dict(
         mu=mu, density=density, cone=cone, time_limit=time_limit, method=method,
-        cores=cores))
+        cores=cores, cohesion=cohesion, tensile=tensile))
     solved = _solve_azimuths(cases, list(todo.items()), dead_load_feasible,
                              two=forking.usable_cores(cores) >= 2)
     results = []

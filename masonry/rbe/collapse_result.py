@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from masonry.contact import ContactLaw
 from masonry.friction import FrictionCone
 from masonry.rbe.loads import LiveLoad
 from masonry.tolerances import ACCEPT_RESIDUAL, MECHANISM_MAIN
@@ -14,6 +15,11 @@ ASSOCIATED_NOTE = (
     "sliding interfaces take part in this mechanism: the load factor assumes associated "
     "friction (the friction cone's normal as flow rule, joints that dilate as they slide) "
     "and can overestimate the collapse load of real, non-dilatant joints (docs/model.md 6.8)")
+
+COHESIVE_NOTE = (
+    "the joints have mortar: its cohesion and tensile strength are taken as rigid-plastic "
+    "with associated flow (no softening once a joint opens or slides), an idealisation "
+    "like associated friction's (docs/model.md 6.3)")
 
 ANISOTROPIC_NOTE = (
     "the friction model is the thesis's square pyramid: it carries up to 41 % more "
@@ -34,7 +40,7 @@ RESULT_KEYS = ("load_factor", "dead_load_feasible", "status", "solver", "iterati
                "time_s", "residual", "work_balance", "mu", "friction_model",
                "friction_capacity_error", "azimuth_deg", "opening", "sliding", "hinges",
                "main_hinges", "main_sliding", "friction_law", "associated_factor", "note",
-               "solved_on")
+               "solved_on", "contact_law")
 """Scalar fields of :class:`CollapseResult` in run.json, in order (plus ``live_load``)."""
 
 
@@ -93,6 +99,8 @@ class CollapseResult:
         With ``non-associative``: the associated factor it started from.
     cone : FrictionCone
         The friction model.
+    law : ContactLaw
+        The contact law (friction model, ``mu``, the mortar's strengths).
     solved_on : {'whole', 'half', 'whole, the half rejected'}
         As :attr:`masonry.rbe.solve.RBEResult.solved_on`.
     """
@@ -121,6 +129,12 @@ class CollapseResult:
     associated_factor: float | None = None
     cone: FrictionCone = FrictionCone("circle")
     solved_on: str = "whole"
+    law: ContactLaw = ContactLaw()
+
+    @property
+    def contact_law(self) -> str:
+        """The contact law in one line (:meth:`~masonry.contact.ContactLaw.describe`)."""
+        return self.law.describe()
 
     def checked(self) -> bool:
         """Whether a factor's equilibrium residual, recomputed on the model this result
@@ -174,13 +188,17 @@ class CollapseResult:
     @property
     def note(self) -> str | None:
         """:data:`UNBOUNDED_NOTE` when no factor bounds the live load, else
-        :data:`ASSOCIATED_NOTE` when sliding takes part in an associated mechanism, and
+        :data:`ASSOCIATED_NOTE` when sliding takes part in an associated mechanism,
+        :data:`COHESIVE_NOTE` when joints with mortar open or slide in it, and
         :data:`ANISOTROPIC_NOTE` for a model that is not isotropic."""
         notes = []
         if self.status == "unbounded":
             notes.append(UNBOUNDED_NOTE)
         elif self.sliding > 0 and self.friction_law == "associated":
             notes.append(ASSOCIATED_NOTE)
+        if (not self.law.is_dry and self.status != "unbounded"
+                and self.sliding + self.opening > 0):
+            notes.append(COHESIVE_NOTE)
         if not self.cone.is_isotropic:
             notes.append(ANISOTROPIC_NOTE)
         return "; ".join(notes) if notes else None

@@ -48,6 +48,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
+from masonry.contact import ContactLaw, tributary_area
 from masonry.friction import FrictionCone
 from masonry.tolerances import COEFFICIENT_NOISE, G
 
@@ -183,6 +184,15 @@ class EquilibriumSystem:
         False on the rows no force enters (:func:`assemble`'s ``dropped_rows``): zero in
         ``A_eq`` and ``f_ext``, and a live load is zeroed there too
         (:meth:`masonry.rbe.collapse.CollapseLP.scaled`); None: every row is kept.
+    vertex_area : (IV,) float or None, m^2
+        Every vertex's tributary area (:func:`masonry.contact.tributary_area`).
+    cohesion, tensile : float, Pa
+        The mortar's cohesion and tensile strength (:class:`masonry.contact.ContactLaw`,
+        :attr:`law`); 0: dry joints.
+    f_weight : (6 F,) float or None
+        The self weight before the cohesion shift when there is one: ``f_ext`` is then
+        ``f_weight - A_eq[:, c] s`` (:attr:`compression_shift`); None: ``f_ext`` is the
+        self weight.
     """
 
     layout: VariableLayout
@@ -200,13 +210,19 @@ class EquilibriumSystem:
     density: float = 1.0
     cone: FrictionCone = FrictionCone("circle")
     row_kept: np.ndarray | None = None
+    vertex_area: np.ndarray | None = None
+    cohesion: float = 0.0
+    tensile: float = 0.0
+    f_weight: np.ndarray | None = None
 
-    def with_material(self, mu=None, density=None, cone=None) -> "EquilibriumSystem":
-        """The same scene with another friction coefficient, density or friction model,
-        without assembling again: ``mu`` and ``cone`` change only the friction
+    def with_material(self, mu=None, density=None, cone=None, cohesion=None,
+                      tensile=None) -> "EquilibriumSystem":
+        """The same scene with another friction coefficient, density, friction model or
+        mortar, without assembling again: ``mu`` and ``cone`` change only the friction
         constraints, and ``density`` only the newtons per solver unit (the scaled ``A_eq``
-        and ``f_ext`` depend on none of them, since the reference weight grows with the
-        density).
+        and the self weight depend on none of them, since the reference weight grows with
+        the density); a cohesion shifts ``f_ext`` and bounds the compressions
+        (:meth:`_with_mortar`).
 
         Parameters
         ----------
@@ -216,6 +232,8 @@ class EquilibriumSystem:
             Default unchanged.
         cone : FrictionCone or str, optional
             Friction model; default unchanged.
+        cohesion, tensile : float, Pa, optional
+            The mortar's strengths; default unchanged.
 
         Returns
         -------
@@ -232,8 +250,61 @@ class EquilibriumSystem:
             out = dataclasses.replace(out, block_weight=self.block_weight * ratio,
                                       weight_ref=self.weight_ref * ratio,
                                       density=float(density))
+        for name, value in (("cohesion", cohesion), ("tensile", tensile)):
+            if value is not None and float(value) != getattr(self, name):
+                out = dataclasses.replace(out, **{name: float(value)})
+        if out is not self and (out.cohesion or self.cohesion):
+            out = out._with_mortar()
         if out is not self and "A_eq" in self.__dict__:  # the matrix depends on neither
             out.__dict__["A_eq"] = self.A_eq
+        return out
+
+    @property
+    def law(self) -> ContactLaw:
+        """The contact law the constraints state (:class:`~masonry.contact.ContactLaw`)."""
+        return ContactLaw(self.cone, self.mu, self.cohesion, self.tensile)
+
+    @property
+    def compression_shift(self) -> np.ndarray | None:
+        """(IV,) float, solver units: ``s_i = c A_i / mu``, the solver's compression
+        ``c~ = n + s`` (module docstring of :mod:`masonry.contact`); None for dry joints,
+        whose arithmetic takes no shift at all."""
+        law = self.law
+        return None if law.is_dry else law.shift(self.vertex_area) / self.weight_ref
+
+    @property
+    def compression_floor(self) -> np.ndarray | None:
+        """(IV,) float, solver units: the lower bound ``c~_i >= l_i`` of a tension
+        cut-off before the cone's apex (``t_c < c / mu``); None where the cone's own
+        ``c~ >= 0`` is the bound."""
+        law = self.law
+        return law.floor(self.vertex_area) / self.weight_ref if law.is_truncated else None
+
+    def _with_mortar(self) -> "EquilibriumSystem":
+        """``f_ext`` and ``lower`` for the current law from the self weight: ``f_ext =
+        f_weight - A_eq[:, c] s`` (so ``A_eq x~ + f_ext = A_eq x + f_weight`` with ``x~``
+        the shifted forces) and ``c~ >= l`` where the cut-off truncates the cone."""
+        weight = self.f_ext if self.f_weight is None else self.f_weight
+        lower = np.tile([0.0, 0.0, -np.inf, -np.inf], self.layout.n_vertices)
+        shift = self.compression_shift
+        if shift is None:
+            return dataclasses.replace(self, f_ext=weight, f_weight=None, lower=lower)
+        floor = self.compression_floor
+        if floor is not None:
+            lower[self.layout.columns("c")] = floor
+        return dataclasses.replace(self, f_ext=weight - self.times_A_eq(self.shifted(0.0)),
+                                   f_weight=weight, lower=lower)
+
+    def shifted(self, x, sign=1.0) -> np.ndarray:
+        """(n,) float: ``x`` (solver units) with ``sign`` times the compression shift
+        added to its ``c`` columns (``x`` itself for dry joints); ``sign = -1`` turns a
+        solver's point into physical forces, whose ``c`` is the normal force (negative
+        where the mortar holds in tension)."""
+        shift = self.compression_shift
+        if shift is None:
+            return np.asarray(x, dtype=float)
+        out = np.array(np.broadcast_to(np.asarray(x, dtype=float), (self.layout.n_columns,)))
+        out[self.layout.columns("c")] += sign * shift
         return out
 
     @cached_property
@@ -304,7 +375,7 @@ class EquilibriumSystem:
 
 def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
              side_rotation=None, cone="circle", dropped_rows=None,
-             vertex_share=None) -> EquilibriumSystem:
+             vertex_share=None, cohesion=0.0, tensile=0.0) -> EquilibriumSystem:
     """Assemble the scaled RBE matrices: the per-vertex coefficients of ``A_eq``
     (vectorized); the sparse ``A_eq`` is built from them when a solver asks for it.
 
@@ -337,6 +408,8 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
         The share of a force of the whole structure that a vertex's variables carry
         (a half model's vertices in its mirror plane carry half, docs/model.md 6.11);
         the objective weighs them by ``h / share``. Default 1.
+    cohesion, tensile : float, Pa
+        The mortar (:mod:`masonry.contact`); default dry joints.
 
     Returns
     -------
@@ -372,14 +445,16 @@ def assemble(blocks, interfaces, mu=0.7, density=2000.0, side_block=None,
     h = np.tile([OTHER_WEIGHT, TENSION_WEIGHT, OTHER_WEIGHT, OTHER_WEIGHT], (n_vertices, 1))
     if vertex_share is not None:
         h /= np.asarray(vertex_share, dtype=float)[:, None]
-    return EquilibriumSystem(layout=layout, free_block=free_block, f_ext=f_ext.ravel(),
-                             lower=lower, h=h.ravel(), mu=float(mu),
-                             block_weight=block_weight, weight_ref=weight_ref,
-                             length_ref=length_ref, side_row=block_row[side_block],
-                             vertex_coefficients=coefficients, density=float(density),
-                             cone=FrictionCone.parse(cone),
-                             row_kept=None if dropped_rows is None
-                             else kept[free_block].ravel())
+    system = EquilibriumSystem(layout=layout, free_block=free_block, f_ext=f_ext.ravel(),
+                               lower=lower, h=h.ravel(), mu=float(mu),
+                               block_weight=block_weight, weight_ref=weight_ref,
+                               length_ref=length_ref, side_row=block_row[side_block],
+                               vertex_coefficients=coefficients, density=float(density),
+                               cone=FrictionCone.parse(cone),
+                               row_kept=None if dropped_rows is None
+                               else kept[free_block].ravel(),
+                               vertex_area=tributary_area(interfaces))
+    return system.with_material(cohesion=cohesion, tensile=tensile)
 
 
 def _vertex_coefficients(blocks, interfaces, layout: VariableLayout, vertex_side_block,

@@ -172,12 +172,14 @@ def equilibrium_on_the_whole(half: Half, result, density: float):
         friction_violation=checks.friction, net_friction_violation=checks.net_friction)
 
 
-def states_exactly(cone) -> bool:
+def states_exactly(cone, cohesion=0.0) -> bool:
     """Whether a half states the friction model ``cone`` (a name or a
     :class:`~masonry.friction.FrictionCone`) exactly: Coulomb's cone is its own mirror
     image in any joint's frame; a pyramid is only where the joints' axes are mirror
-    images of each other, which the half does not ask of a model."""
-    return not FrictionCone.parse(cone).is_polyhedral
+    images of each other, which the half does not ask of a model. A ``cohesion`` (Pa)
+    is not: a joint cut by the plane has other vertices, so other tributary areas, in
+    the half than in the whole (:func:`masonry.contact.tributary_area`)."""
+    return not FrictionCone.parse(cone).is_polyhedral and cohesion == 0
 
 
 def symmetric_plane(case, mirrors) -> float | None:

@@ -3,6 +3,7 @@ law and model, the boundary of a section, and the solvers' accuracy."""
 
 from dataclasses import dataclass
 
+from masonry.contact import ContactLaw
 from masonry.friction import FrictionCone, FrictionModelError
 from masonry.parameters import check_fields, declare
 from masonry.errors import ParameterError
@@ -24,7 +25,9 @@ class Analysis:
     (:data:`masonry.rbe.solve.ACCURACY`), ``solver`` a solver in place of the preset's,
     ``boundary`` what a section's end bricks bear on (free, rigid, cyclic; other scenes
     are free), ``friction_law`` of the collapse load factor (associated: the cone
-    program; non-associative: joints that slide without dilating, an estimate).
+    program; non-associative: joints that slide without dilating, an estimate),
+    ``cohesion_kpa`` and ``tensile_kpa`` the mortar's cohesion and tensile strength at
+    every joint (kPa; 0: dry joints; :mod:`masonry.contact`).
     """
 
     mu: float = declare(0.7, "friction coefficient", low=0.01, high=10.0, tag="mu",
@@ -46,6 +49,13 @@ class Analysis:
                             choices=BOUNDARIES, tag="b", names_geometry=True)
     friction_law: str = declare("associated", "of the collapse load factor", kind="str",
                                 choices=FRICTION_LAWS)
+    cohesion_kpa: float = declare(0.0, "kPa, the mortar's cohesion at every joint", low=0.0,
+                                  high=1e6, tag="coh",
+                                  expected="0 to 1e+06 (kPa: fresh mortar 0.1 to a few, "
+                                           "hardened lime mortar 100 to 300)")
+    tensile_kpa: float = declare(0.0, "kPa, the mortar's tensile strength at every joint",
+                                 low=0.0, high=1e6, tag="ten",
+                                 expected="0 to 1e+06 (kPa; cut off at cohesion/mu)")
 
     def checked(self) -> "Analysis":
         """This analysis validated, the friction model in its canonical spelling; raises
@@ -67,6 +77,11 @@ class Analysis:
         if self.friction_cone is None:
             return self
         return Analysis(**{**self.__dict__, "friction_cone": cone.name})
+
+    @property
+    def law(self) -> ContactLaw:
+        """The contact law every analysis of the run asks (:mod:`masonry.contact`)."""
+        return ContactLaw(self.cone, self.mu, 1e3 * self.cohesion_kpa, 1e3 * self.tensile_kpa)
 
     @property
     def cone(self) -> FrictionCone:

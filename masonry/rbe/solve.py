@@ -33,6 +33,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from masonry import forking
+from masonry.contact import ContactLaw
 from masonry.friction import FrictionCone
 from masonry.rbe.accuracy import ACCURACY, AccuracyPreset, friction_model
 from masonry.rbe.cores import Alongside, solver_threads
@@ -104,7 +105,7 @@ RESULT_KEYS = ("verdict", "feasible", "friction", "mu", "friction_model",
                "friction_capacity_error", "objective", "moi", "moi_factor", "weight_N",
                "solver", "status", "iterations", "residual_eq", "friction_violation",
                "net_friction_violation", "time_s", "lp_feasible", "accuracy", "lp_time_s",
-               "solved_on")
+               "solved_on", "contact_law")
 """Scalar fields of :class:`RBEResult` written to run.json, in order."""
 
 INTERFACE_FORCE_KEYS = ("compression", "tension", "normal", "t1", "t2", "friction")
@@ -152,7 +153,10 @@ class RBEResult:
         Verdict of the independent friction-net LP (HiGHS); None when not run or
         inconclusive.
     x : (4 IV,) float or None, N
-        Solution in the :class:`~masonry.rbe.equilibrium.VariableLayout` order.
+        Solution in the :class:`~masonry.rbe.equilibrium.VariableLayout` order, physical
+        forces: with mortar (:mod:`masonry.contact`) ``c`` is the normal force the
+        law carries, negative where the mortar holds in tension, and ``t`` the tension
+        beyond the law (the MoI's).
     layout : VariableLayout
     accuracy : str
         The accuracy preset.
@@ -164,6 +168,8 @@ class RBEResult:
         a second attempt of the same model).
     cone : FrictionCone
         The friction model (:mod:`masonry.friction`).
+    law : ContactLaw
+        The contact law (the friction model, ``mu`` and the mortar's strengths).
     solved_on : {'whole', 'half', 'whole, the half rejected'}
         The model whose program gave the forces: the whole; its half in a mirror plane,
         mapped back and checked on the whole (docs/model.md 6.11); or the whole, solved
@@ -199,6 +205,12 @@ class RBEResult:
     verdict: str = "not solved"
     cone: FrictionCone = FrictionCone("circle")
     solved_on: str = "whole"
+    law: ContactLaw = ContactLaw()
+
+    @property
+    def contact_law(self) -> str:
+        """The contact law in one line (:meth:`~masonry.contact.ContactLaw.describe`)."""
+        return self.law.describe()
 
     @property
     def friction_model(self) -> str:
@@ -316,14 +328,18 @@ class RBEProblem:
 
     def solve(self, mu=0.7, density=2000.0, friction="auto", solver=None, tol=None, *,
               accuracy="balanced", cone=None, lp_check=None, lp_time_limit=60.0,
-              cores=None) -> RBEResult:
+              cores=None, cohesion=0.0, tensile=0.0) -> RBEResult:
         """Solve at ``mu`` and ``density``; see :func:`solve_rbe` for the parameters."""
         start = time.perf_counter()
         preset, tol, lp_check = _settings(friction, solver, tol, accuracy, lp_check)
         cone = friction_model(preset.name, cone)
+        ContactLaw.of(cone, mu, cohesion, tensile)  # refuses a strength out of range
         if solver is not None:
             backend(solver, RBE, cone)  # refuses a friction model it cannot state
-        system = self.system.with_material(mu=mu, density=density, cone=cone)
+        system = self.system.with_material(mu=mu, density=density, cone=cone,
+                                           cohesion=cohesion, tensile=tensile)
+        if solver is not None and BACKENDS[solver].refusal(system) is not None:
+            raise ValueError(BACKENDS[solver].refusal(system))
         cores = forking.usable_cores(cores)
         with solver_threads(cores):
             solved, attempts = self._flow(system, friction, solver, preset, tol, cores)
@@ -395,6 +411,7 @@ class RBEProblem:
         Every QP solved is appended to ``attempts``; ``before_lp`` (a callable) is
         called when Newton hands friction-net over to the load-path LP."""
         outcome = None
+        candidates = _stated(system, method, candidates, attempts)
         for index, name in enumerate(candidates):
             if name == LOAD_PATH:
                 if before_lp is not None:
@@ -416,7 +433,8 @@ class RBEProblem:
                          "residual %.2e, friction violation %.2e (tolerance %.1e)",
                          name, method, outcome.status, checks.equilibrium,
                          checks.friction, tol.residual)
-            if accepted and preset.polish and name != "newton" and outcome.y is not None:
+            if (accepted and preset.polish and name != "newton" and outcome.y is not None
+                    and BACKENDS["newton"].refusal(system) is None):
                 polished = self._polish(system, method, outcome, tol, attempts)
                 if polished is not None:
                     outcome, checks, name = polished, polished.residuals, f"{name}+newton"
@@ -478,8 +496,9 @@ class RBEProblem:
         checks, accepted, outcome = solved.checks, solved.accepted, solved.outcome
         residual_eq, violation, net_violation = ((np.nan,) * 3 if checks is None else (
             checks.equilibrium, checks.friction, checks.net_friction))
-        # a rejected point is no solution: its residuals are reported, its forces are not
-        x = system.to_newtons(outcome.x) if accepted else None
+        # a rejected point is no solution: its residuals are reported, its forces are not;
+        # the forces are physical (a cohesion's shift taken off the compressions)
+        x = system.to_newtons(system.shifted(outcome.x, -1.0)) if accepted else None
         feasible = bool(accepted and net_violation <= tol.residual
                         or standing is not None and standing.accepted)
         run_lp = ((lp_check == "infeasible" and not feasible) if isinstance(lp_check, str)
@@ -497,7 +516,8 @@ class RBEProblem:
         weight = system.total_weight
         objective = moi = np.nan
         if x is not None:
-            objective = float(0.5 * np.sum(system.h * x**2))
+            solved_x = system.to_newtons(outcome.x)  # the program's own variables
+            objective = float(0.5 * np.sum(system.h * solved_x**2))
             moi = float(system.layout.component(x, "t").sum())
         return RBEResult(
             feasible=feasible, friction=solved.method, mu=float(system.mu),
@@ -508,7 +528,7 @@ class RBEProblem:
             lp_feasible=lp_feasible, x=x, layout=system.layout, accuracy=accuracy,
             lp_time_s=lp_time, attempts=tuple(attempts),
             verdict=_verdict(feasible, x, attempts, lp_feasible, standing),
-            cone=system.cone)
+            cone=system.cone, law=system.law)
 
     def _workspace(self, name):
         """The workspace of a backend; the Newton-system backends (semismooth Newton,
@@ -564,6 +584,25 @@ def _candidates(method, solver, preset) -> list:
     return [chosen, "clarabel"]
 
 
+def _stated(system, method, candidates, attempts) -> list:
+    """``candidates`` without the solvers that cannot state ``system``'s constraints (a
+    tension cut-off some do not take, :meth:`~masonry.rbe.solvers.base.Backend.refusal`),
+    each refusal warned and kept in ``attempts``; the load-path LP goes with Newton,
+    whose stalled point it needs."""
+    kept = []
+    for name in candidates:
+        real = "newton" if name in (WARM_NEWTON, LOAD_PATH) else name
+        refusal = BACKENDS[real].refusal(system)
+        if refusal is None:
+            kept.append(name)
+        elif name != LOAD_PATH:
+            log.warning("%s; the next solver takes friction-%s", refusal, method)
+            attempts.append({"friction": method, "solver": real, "status": "refused",
+                             "iterations": -1, "setup_s": 0.0, "solve_s": 0.0,
+                             "reason": refusal})
+    return kept
+
+
 def _accepted(checks, tol) -> bool:
     return checks is not None and max(checks.equilibrium, checks.friction) <= tol.residual
 
@@ -590,7 +629,8 @@ def _verdict(feasible, x, attempts, lp_feasible, standing=None) -> str:
 
 def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solver=None,
               tol=None, *, accuracy="balanced", cone=None, lp_check=None,
-              lp_time_limit=60.0, side_block=None, side_rotation=None, cores=None) -> RBEResult:
+              lp_time_limit=60.0, side_block=None, side_rotation=None, cores=None,
+              cohesion=0.0, tensile=0.0) -> RBEResult:
     """Rigid block equilibrium as a quadratic program (thesis 3.3.4).
 
     With ``x`` the vertex forces ``(c, t, f1, f2)`` of every interface vertex (thesis
@@ -600,6 +640,11 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
         subject to  A_eq x + f_ext = 0           force and moment balance of free blocks
                     (f1, f2) in the friction model at mu (c - t) (net) or mu c (plus)
                     c >= 0, t >= 0
+
+    With mortar (``cohesion``, ``tensile``; :mod:`masonry.contact`) ``c`` is the shifted
+    compression ``n + c A / mu``, ``f_ext`` takes the shift and a tension cut-off below
+    the cone's apex bounds ``c - t`` (net) or ``c`` (plus) from below, so the tension
+    ``t`` is what the law cannot carry.
 
     friction-net: the friction within the model at ``c - t`` (eq. 3.26, infeasible when
     the structure cannot stand without tension); friction+: within it at ``c`` (eq.
@@ -641,6 +686,9 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
     cores : int, optional
         The cores it may use: friction+ forked onto a second, factorizations on two threads
         (:mod:`masonry.rbe.cores`). Default: the process's (:func:`masonry.forking.cores`).
+    cohesion, tensile : float, Pa
+        The mortar's cohesion and tensile strength (:class:`~masonry.contact.ContactLaw`);
+        default dry joints.
 
     Returns
     -------
@@ -666,7 +714,8 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
                          side_rotation=side_rotation)
     result = problem.solve(mu=mu, density=density, friction=friction, solver=solver,
                            tol=tol, accuracy=accuracy, cone=cone, lp_check=lp_check,
-                           lp_time_limit=lp_time_limit, cores=cores)
+                           lp_time_limit=lp_time_limit, cores=cores, cohesion=cohesion,
+                           tensile=tensile)
     return dataclasses.replace(result, time_s=time.perf_counter() - start)
 
 
@@ -699,13 +748,27 @@ def _lp_feasible(system: EquilibriumSystem, time_limit: float, verdict: bool):
     Returns True, False, or None when HiGHS ends without a verdict (time limit) or the
     pyramid cannot decide for the cone.
     """
+    if system.compression_floor is not None:
+        # the rays state the cone, not its truncation by a tension cut-off: they can
+        # prove it infeasible (the truncated cone lies inside), never feasible
+        if verdict:
+            return None
+        outer_mu = system.mu / (1.0 if system.cone.is_polyhedral
+                                else math.cos(math.pi / LP_CHECK_SIDES))
+        outer = system.cone if system.cone.is_polyhedral else pyramid_of(LP_CHECK_SIDES)
+        return False if _edges_feasible(system, outer, outer_mu, time_limit) is False else None
     if system.cone.is_polyhedral:
         return _edges_feasible(system, system.cone, system.mu, time_limit)
-    pyramid = FrictionCone.parse(f"polygon:{LP_CHECK_SIDES}")
+    pyramid = pyramid_of(LP_CHECK_SIDES)
     if verdict:
         return True if _edges_feasible(system, pyramid, system.mu, time_limit) else None
     outer_mu = system.mu / math.cos(math.pi / LP_CHECK_SIDES)
     return False if _edges_feasible(system, pyramid, outer_mu, time_limit) is False else None
+
+
+def pyramid_of(sides) -> FrictionCone:
+    """The inscribed ``sides``-sided pyramid."""
+    return FrictionCone.parse(f"polygon:{sides}")
 
 
 def _edges_feasible(system, cone, mu, time_limit):

@@ -107,6 +107,11 @@ class Backend:
     workspace : str
         The workspace it uses: its own name, or a backend's whose prepared systems it
         shares (the interior point method shares Newton's).
+    truncated : tuple of str
+        The friction models (:data:`masonry.friction.KINDS`) it states truncated by a
+        tension cut-off before the cone's apex (a lower bound on the compression,
+        :attr:`~masonry.rbe.equilibrium.EquilibriumSystem.compression_floor`); the
+        others it refuses by name.
     """
 
     name: str
@@ -115,6 +120,7 @@ class Backend:
     collapse: object = None
     polyhedral_only: bool = False
     workspace: str = ""
+    truncated: tuple = ()
 
     def __post_init__(self):
         if not self.workspace:
@@ -126,9 +132,21 @@ class Backend:
         return tuple(p for p, solver in ((RBE, self.rbe), (COLLAPSE, self.collapse))
                      if solver is not None)
 
-    def states(self, cone) -> bool:
-        """Whether it can state the friction model ``cone``."""
-        return cone.is_polyhedral or not self.polyhedral_only
+    def states(self, cone, truncated=False) -> bool:
+        """Whether it can state the friction model ``cone``, ``truncated`` by a tension
+        cut-off or not."""
+        return ((cone.is_polyhedral or not self.polyhedral_only)
+                and (not truncated or cone.kind in self.truncated))
+
+    def refusal(self, system) -> str | None:
+        """One line saying why it cannot state ``system``'s constraints, or None."""
+        if not self.states(system.cone):
+            return (f"{self.name} takes linear constraints only: the friction model "
+                    f"{system.cone} needs another solver, or a polygon:K model")
+        if not self.states(system.cone, system.compression_floor is not None):
+            return (f"{self.name} does not state the {system.cone} model truncated by a "
+                    f"tension cut-off (tensile strength below cohesion/mu)")
+        return None
 
     def solve_rbe(self, system, method, options, workspace, **extra) -> Outcome:
         """The RBE QP (see :attr:`rbe`), its residuals recomputed from the matrices
@@ -139,10 +157,9 @@ class Backend:
         ValueError
             A friction model it cannot state (:attr:`polyhedral_only`).
         """
-        if not self.states(system.cone):
-            raise ValueError(f"{self.name} takes linear constraints only: the friction "
-                             f"model {system.cone} needs another solver, or a polygon:K "
-                             f"model")
+        refusal = self.refusal(system)
+        if refusal is not None:
+            raise ValueError(refusal)
         outcome = self.rbe(system, method, options, workspace, **extra)
         return dataclasses.replace(outcome,
                                    residuals=rbe_residuals(system, outcome.x, method))

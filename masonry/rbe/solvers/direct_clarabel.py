@@ -21,6 +21,7 @@ import clarabel
 import numpy as np
 import scipy.sparse as sp
 
+from masonry.friction import KINDS
 from masonry.rbe.solvers.base import (INFEASIBLE, INFEASIBLE_INACCURATE, OPTIMAL,
                                       OPTIMAL_INACCURATE, SOLVER_ERROR, UNBOUNDED, USER_LIMIT,
                                       Backend, Outcome)
@@ -57,7 +58,8 @@ def solve(system, method, options, workspace) -> Outcome:
     # Clarabel's rows are A x + s = b: the t rows enter negated
     values[_tension_rows(form)] *= -1.0
     solver = workspace.get("solver")
-    if solver is None or workspace.get("options") != options:
+    floor = system.compression_floor
+    if solver is None or workspace.get("options") != options or floor is not None:
         settings = clarabel.DefaultSettings()
         for name, value in {**DEFAULTS, **options}.items():
             setattr(settings, name, value)
@@ -71,9 +73,14 @@ def solve(system, method, options, workspace) -> Outcome:
             cones = [clarabel.ZeroConeT(form.n_eq),
                      *[clarabel.SecondOrderConeT(3)] * (form.n_friction // 3),
                      clarabel.NonnegativeConeT(form.n_tension)]
+        if floor is not None:
+            matrix, b = _with_floor(system, method, matrix, b, floor)
+            cones.append(clarabel.NonnegativeConeT(len(floor)))
         solver = clarabel.DefaultSolver(form.P, np.zeros(form.P.shape[0]), matrix, b,
                                         cones, settings)
-        workspace.update(solver=solver, options=options, values=values)
+        # a truncated cone's solver is not kept: its rows are not the form's
+        workspace.update(solver=None if floor is not None else solver, options=options,
+                         values=values)
     elif not np.array_equal(workspace["values"], values):
         solver.update(A=values)
         workspace["values"] = values
@@ -86,6 +93,22 @@ def solve(system, method, options, workspace) -> Outcome:
     y = None if x is None else -np.array(result.z)[:form.n_eq]
     return Outcome(status=status, x=x, iterations=int(result.iterations), y=y,
                    setup_time=setup, solve_time=time.perf_counter() - start - setup)
+
+
+def _with_floor(system, method, matrix, b, floor):
+    """``matrix`` and ``b`` with one row per vertex for the tension cut-off: ``c - t >=
+    floor`` (friction-net) or ``c >= floor`` (friction+), as ``-(c - t) + s = -floor``
+    with ``s`` nonnegative."""
+    layout = system.layout
+    vertex = np.arange(layout.n_vertices)
+    rows = [vertex, vertex] if method == "net" else [vertex]
+    cols = [layout.columns("c"), layout.columns("t")] if method == "net" else [
+        layout.columns("c")]
+    vals = [-np.ones(len(vertex)), np.ones(len(vertex))][:len(rows)]
+    extra = sp.csc_array((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(len(vertex), matrix.shape[1]))
+    return (sp.csc_array(sp.vstack([matrix, extra], format="csc")),
+            np.concatenate([b, -np.asarray(floor, dtype=float)]))
 
 
 def _tension_rows(form):
@@ -227,5 +250,6 @@ def clarabel_cones(cones) -> list:
     return out
 
 
-BACKEND = Backend("clarabel", settings="clarabel", rbe=solve, collapse=ClarabelProgram)
+BACKEND = Backend("clarabel", settings="clarabel", rbe=solve, collapse=ClarabelProgram,
+                  truncated=KINDS)
 """Clarabel: the RBE QP (every friction model) and the collapse program."""

@@ -153,6 +153,7 @@ class NewtonSystem:
                              "f1, f2")
         self.b = -system.f_ext
         self.mu, self.cone = system.mu, system.cone
+        self.floor = system.compression_floor
         # (IV, 12, width): rows of side 0's block, then side 1's
         self.coefficients = np.ascontiguousarray(
             system.vertex_coefficients[:, :, :, columns].reshape(layout.n_vertices, 12, width))
@@ -210,10 +211,13 @@ class NewtonSystem:
         return other
 
     # ------------------------------------------------------------------ kernels
-    def project(self, w):
-        """``x(y)`` for ``w = A^T y`` ((IV, width)) and the projection's Jacobian."""
+    def project(self, w, truncated=True):
+        """``x(y)`` for ``w = A^T y`` ((IV, width)) and the projection's Jacobian; onto
+        the cone truncated by the tension cut-off (:attr:`floor`) unless ``truncated`` is
+        False (the cone itself, whose polar cone a Farkas certificate asks of)."""
         p = self.friction
-        x_p, j_p = self.cone.project(w[:, p] / self.h[:, p[:1]], self.mu)
+        floor = self.floor if truncated else None
+        x_p, j_p = self.cone.project(w[:, p] / self.h[:, p[:1]], self.mu, floor)
         j_p /= self.h[:, p[:1], None]
         if not self.tension:  # friction-net: the cone is every column
             return x_p, j_p
@@ -331,8 +335,9 @@ class NewtonSystem:
 
     def polar_excess(self, w):
         """Per vertex, the norm of the part of ``w`` that is not in the polar cone of K
-        (the projection of ``H^-1 w`` onto K, in the metric of H)."""
-        x, _ = self.project(w)
+        (the projection of ``H^-1 w`` onto K, in the metric of H). A tension cut-off's
+        truncated cone lies in K, so a certificate on K is one on it."""
+        x, _ = self.project(w, truncated=False)
         return np.sqrt(np.sum(self.h * x * x, axis=1))
 
 
@@ -529,7 +534,8 @@ def prepared_system(system, method, workspace) -> NewtonSystem:
         symbolic = next((s.symbolic for s in prepared.values()), workspace.get("symbolic"))
         prepared[method] = NewtonSystem(system, method, symbolic=symbolic)
     ns = prepared[method]
-    ns.mu, ns.cone = system.mu, system.cone
+    ns.mu, ns.cone, ns.floor = system.mu, system.cone, system.compression_floor
+    ns.b = -system.f_ext  # a cohesion's shift (another mu, density) changes it
     return ns
 
 
@@ -549,6 +555,6 @@ def backend(system, method, options, workspace, y0=None) -> Outcome:
     return dataclasses.replace(outcome, setup_time=outcome.setup_time + preparation)
 
 
-BACKEND = Backend("newton", settings="newton", rbe=backend)
+BACKEND = Backend("newton", settings="newton", rbe=backend, truncated=("circle",))
 """The semismooth Newton method: the RBE QP (every friction model); the polish of the
 other backends' points."""

@@ -41,7 +41,10 @@ def rbe_residuals(system, x_scaled, method: str) -> Residuals | None:
 
     The violations are the largest excess of every vertex force over its friction model
     (:meth:`~masonry.friction.FrictionCone.excess`, at ``c - t`` for friction-net, at
-    ``c`` for friction+) or over a bound, in units of the reference weight.
+    ``c`` for friction+) or over a bound (``system.lower``; for friction-net also the
+    tension cut-off on ``c - t``, :attr:`~masonry.rbe.equilibrium.EquilibriumSystem.
+    compression_floor`), in units of the reference weight. ``c`` is the solver's
+    (shifted) compression.
     """
     if x_scaled is None:
         return None
@@ -50,9 +53,13 @@ def rbe_residuals(system, x_scaled, method: str) -> Residuals | None:
     bound = max(0.0, float((system.lower - x_scaled).max()))
     c, t, f1, f2 = np.asarray(x_scaled).reshape(-1, 4).T
 
+    floor = system.compression_floor
+
     def violation(name):
         load = c - t if name == "net" else c
         excess = system.cone.excess(load, f1, f2, system.mu)
+        if floor is not None and name == "net":  # the cut-off bounds the net force
+            excess = np.maximum(excess, floor - load)
         return max(bound, float(excess.max(initial=0.0)))
 
     return Residuals(float(residual_eq), violation(method), violation("net"))

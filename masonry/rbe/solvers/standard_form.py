@@ -18,6 +18,7 @@ solver set up once is updated in place between the two models and between fricti
 coefficients (OSQP and Clarabel keep their symbolic factorization).
 """
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -127,4 +128,8 @@ def kept_form(system, workspace: dict) -> StandardForm:
     if form is None or form.cone != system.cone:
         form = workspace["form"] = standard_form(system)
         workspace.pop("solver", None)  # a solver set up for another model's rows
+    elif not np.array_equal(form.b, -system.f_ext):
+        # a cohesion's shift (another cohesion or mu) moves the right-hand side
+        form = workspace["form"] = dataclasses.replace(form, b=-system.f_ext)
+        workspace.pop("solver", None)
     return form

@@ -12,6 +12,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from masonry.friction import KINDS
 from masonry.rbe.solvers.base import SOLVER_ERROR, Backend, Outcome
 
 log = logging.getLogger(__name__)
@@ -35,6 +36,10 @@ def _solve(system, method, name, options) -> Outcome:
     # H is a constant positive diagonal: psd_wrap skips cvxpy's eigenvalue check
     objective = cp.Minimize(0.5 * cp.quad_form(x, cp.psd_wrap(sp.diags_array(system.h_solver))))
     constraints = [system.A_eq @ x == -system.f_ext, x[bounded] >= system.lower[bounded]]
+    floor = system.compression_floor
+    if floor is not None and method == "net":  # the tension cut-off on the net force
+        constraints.append(x[system.layout.columns("c")] - x[system.layout.columns("t")]
+                           >= floor)
     if system.cone.is_polyhedral:
         constraints.append(system.A_fr[method] @ x <= 0)
     else:
@@ -62,7 +67,10 @@ def _solve(system, method, name, options) -> Outcome:
                    setup_time=max(total - solver_time, 0.0), solve_time=solver_time)
 
 
-BACKENDS = (Backend("clarabel-cvxpy", settings="clarabel", rbe=solver_for("CLARABEL")),
+BACKENDS = (Backend("clarabel-cvxpy", settings="clarabel", rbe=solver_for("CLARABEL"),
+                    truncated=KINDS),
             Backend("osqp-cvxpy", settings="osqp", rbe=solver_for("OSQP"),
-                    polyhedral_only=True))
-"""Clarabel and OSQP through cvxpy: the RBE QP, with the direct paths' settings."""
+                    polyhedral_only=True, truncated=KINDS))
+"""Clarabel and OSQP through cvxpy: the RBE QP, with the direct paths' settings (a
+tension cut-off is a bound on ``c``, ``system.lower``, and on ``c - t`` for
+friction-net)."""

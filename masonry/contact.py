@@ -1,0 +1,162 @@
+"""The contact law of a joint: Coulomb's friction with mortar's cohesion and tensile
+strength (docs/model.md 6.3, 6.4).
+
+At an interface vertex ``i`` of tributary area ``A_i`` (:func:`tributary_area`), with
+normal force ``n_i`` (compression positive) and friction ``f_i`` in the joint's plane,
+Mohr-Coulomb's law with a tension cut-off::
+
+    ||f_i|| <= mu n_i + c A_i          (a pyramid: each face shifted by c A_i)
+    n_i >= -t_c A_i
+
+``c`` the cohesion and ``t_c`` the tensile strength, pascals. The cone is empty beyond
+its apex ``n = -c A_i / mu``, so the tension a joint carries is cut off at
+``min(t_c, c / mu)`` per unit area (:attr:`ContactLaw.cutoff_Pa`); without cohesion a
+tensile strength has nothing to act on: the law is the dry one.
+
+Cohesion is a shift of the friction model: with ``s_i = c A_i / mu`` and the solver's
+compression ``c~_i = n_i + s_i``, the law is the dry model in ``(c~, f)``
+(:class:`~masonry.friction.FrictionCone`), plus the lower bound ``c~_i >= l_i = s_i -
+t_c A_i`` where ``t_c < c / mu`` (the truncated cone). The equilibrium's right-hand side
+takes the shift (:class:`masonry.rbe.equilibrium.EquilibriumSystem`), so every solver
+states the same cones as for dry joints.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from masonry.errors import MasonryError
+from masonry.friction import FrictionCone
+
+
+class ContactLawError(MasonryError, ValueError):
+    """A strength that is negative or not finite, or a friction coefficient that is not
+    positive."""
+
+
+@dataclass(frozen=True)
+class ContactLaw:
+    """One joint's strength (module docstring).
+
+    Parameters
+    ----------
+    cone : FrictionCone
+        The friction model (circle, polygon:K, square).
+    mu : float
+        Friction coefficient, > 0.
+    cohesion_Pa : float
+        ``c``, pascals, >= 0 (0: dry joints).
+    tensile_Pa : float
+        ``t_c``, pascals, >= 0.
+    """
+
+    cone: FrictionCone = FrictionCone("circle")
+    mu: float = 0.7
+    cohesion_Pa: float = 0.0
+    tensile_Pa: float = 0.0
+
+    @classmethod
+    def of(cls, cone="circle", mu=0.7, cohesion_Pa=0.0, tensile_Pa=0.0) -> "ContactLaw":
+        """The law of a friction model (name or :class:`FrictionCone`), ``mu`` and the
+        strengths, checked.
+
+        Raises
+        ------
+        ContactLawError
+            Naming the argument, its value and what is expected.
+        """
+        for name, value in (("mu", mu), ("cohesion_Pa", cohesion_Pa),
+                            ("tensile_Pa", tensile_Pa)):
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise ContactLawError(f"{name} {value!r}: expected a number")
+            low_ok = value > 0 if name == "mu" else value >= 0
+            if not (math.isfinite(value) and low_ok):
+                raise ContactLawError(f"{name} {value!r}: expected a finite number "
+                                      f"{'> 0' if name == 'mu' else '>= 0'}")
+        return cls(FrictionCone.parse(cone), float(mu), float(cohesion_Pa),
+                   float(tensile_Pa))
+
+    @property
+    def is_dry(self) -> bool:
+        """No cohesion: the friction model alone (a tensile strength without cohesion is
+        cut off at the cone's apex, 0)."""
+        return self.cohesion_Pa == 0.0
+
+    @property
+    def cutoff_Pa(self) -> float:
+        """The tension a joint carries per unit area: ``min(t_c, c / mu)``."""
+        return min(self.tensile_Pa, self.cohesion_Pa / self.mu)
+
+    @property
+    def is_truncated(self) -> bool:
+        """The cut-off lies before the cone's apex (``t_c < c / mu``): the solvers need
+        the lower bound ``c~ >= l``."""
+        return not self.is_dry and self.tensile_Pa < self.cohesion_Pa / self.mu
+
+    def shift(self, area) -> np.ndarray:
+        """(IV,) float, newtons: ``s_i = c A_i / mu`` for tributary areas ``area``
+        ((IV,) float, m^2)."""
+        return self.cohesion_Pa / self.mu * np.asarray(area, dtype=float)
+
+    def floor(self, area) -> np.ndarray:
+        """(IV,) float, newtons: the lower bound ``l_i = s_i - t_c A_i = (c / mu -
+        cutoff) A_i`` of the shifted compression ``c~_i`` (0 where the cut-off is the
+        apex)."""
+        return (self.cohesion_Pa / self.mu - self.cutoff_Pa) * np.asarray(area, dtype=float)
+
+    def describe(self) -> str:
+        """The law in one line, e.g. ``Coulomb circle, mu 0.7, cohesion 0.5 kPa,
+        tensile strength 0.25 kPa``."""
+        head = f"Coulomb {self.cone.name}, mu {self.mu:g}"
+        if self.is_dry:
+            return f"{head}, dry joints (no cohesion, no tension)"
+        text = (f"{head}, cohesion {self.cohesion_Pa / 1e3:g} kPa, tensile strength "
+                f"{self.tensile_Pa / 1e3:g} kPa")
+        if self.tensile_Pa > self.cohesion_Pa / self.mu:
+            text += f" (cut off at the cone's apex, c/mu = {self.cutoff_Pa / 1e3:.4g} kPa)"
+        return text
+
+    def __str__(self) -> str:
+        return self.describe()
+
+    def record(self) -> dict:
+        """run.json's ``contact_law``: the model, ``mu``, the strengths and the
+        effective tension cut-off (pascals), and the one line."""
+        return {"friction_model": self.cone.name, "mu": self.mu,
+                "cohesion_Pa": self.cohesion_Pa, "tensile_Pa": self.tensile_Pa,
+                "tension_cutoff_Pa": self.cutoff_Pa, "text": self.describe()}
+
+
+def tributary_area(interfaces) -> np.ndarray:
+    """(IV,) float, m^2: every interface vertex's share of its polygon's area.
+
+    Vertex ``i`` gets the quadrilateral of the vertex, the midpoint of its next edge,
+    the polygon's area centroid and the midpoint of its previous edge: the part of the
+    polygon nearer to it along the boundary. The two triangles of an edge ``(v_i,
+    v_i+1)`` with the centroid make up that edge's triangle, so the shares sum to the
+    polygon's area (signed areas about the normal, exact for any polygon).
+
+    Parameters
+    ----------
+    interfaces : masonry.interfaces.Interfaces
+        Polygons counter-clockwise about their normals, metres.
+    """
+    vertices = np.asarray(interfaces.vertices, dtype=float)
+    offsets = np.asarray(interfaces.offsets, dtype=np.int64)
+    owner = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
+    index = np.arange(len(vertices))
+    count = np.diff(offsets)[owner]
+    start = offsets[owner]
+    following = start + (index - start + 1) % count
+    previous = start + (index - start - 1) % count
+    centre = np.asarray(interfaces.centre, dtype=float)[owner]
+    normal = np.asarray(interfaces.normal, dtype=float)[owner]
+    here = vertices
+    next_mid = 0.5 * (here + vertices[following])
+    prev_mid = 0.5 * (here + vertices[previous])
+
+    def signed(a, b):
+        return 0.5 * np.einsum("vi,vi->v", np.cross(a - here, b - here), normal)
+
+    return signed(next_mid, centre) + signed(centre, prev_mid)
