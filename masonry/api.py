@@ -79,7 +79,7 @@ class Structure:
 
         Returns
         -------
-        masonry.rbe.solve.RBEResult
+        masonry.rbe.result.RBEResult
             Computed once per structure; :meth:`forces` reads it.
         """
         return self._equilibrium

@@ -32,7 +32,8 @@ from masonry.rbe.collapse import (CollapseResult, collapse_load, collapse_on_hal
 from masonry.rbe.loads import Lateral
 from masonry.rbe.mirror import (equilibrium_on_the_whole, half_model, states_exactly,
                                  symmetric_plane)
-from masonry.rbe.solve import RBEProblem, RBEResult
+from masonry.rbe.result import RBEResult
+from masonry.rbe.solve import RBEProblem
 from masonry.runfolder import (Publication, RunFolder, check_output_root,
                                write_file_atomically)
 from masonry.scenes import Scene, build, check_size
@@ -486,7 +487,7 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
     the scene's first mirror plane, if it has one and the friction model is Coulomb's
     cone (self weight is its own mirror image in every plane), reported on the whole
     (docs/model.md 6.11) once its forces pass the check there
-    (:meth:`~masonry.rbe.solve.RBEResult.checked`); where they do not, the whole is
+    (:meth:`~masonry.rbe.result.RBEResult.checked`); where they do not, the whole is
     solved (``solved_on``, logged as a warning)."""
     analysis = params.analysis
     mirrors = params.kind.symmetry(params.geometry).mirrors

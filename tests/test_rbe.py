@@ -11,7 +11,8 @@ from masonry.blocks import Blocks, tangent_basis
 from masonry.rbe.equilibrium import VariableLayout, assemble
 from masonry.tolerances import G
 from masonry.interfaces import INTERFACE_KINDS, Interfaces
-from masonry.rbe.solve import RESULT_KEYS, interface_forces, solve_rbe
+from masonry.rbe.result import RESULT_KEYS, interface_forces
+from masonry.rbe.solve import solve_rbe
 from masonry.tolerances import Tolerances
 
 MU = 0.7

@@ -26,7 +26,8 @@ from masonry.errors import ParameterError
 from masonry.params import Params, from_preset, structure_id
 from masonry.rbe import cores as cores_module
 from masonry.rbe import solve as solve_module
-from masonry.rbe.solve import ACCURACY, LOAD_PATH, RBEProblem, _lp_feasible, solve_rbe
+from masonry.rbe.lp_check import lp_feasible
+from masonry.rbe.solve import ACCURACY, LOAD_PATH, RBEProblem, solve_rbe
 from masonry.rbe.cores import solver_threads
 from masonry.rbe.solvers import BACKENDS, COLLAPSE, RBE, backend, names
 from masonry.rbe.solvers import cholesky, ordering
@@ -653,7 +654,7 @@ def test_the_load_path_lp_agrees_with_highs_and_clarabel(preset, boundary, mu, c
     feasible = clarabel.status == "optimal"
     assert clarabel.status in ("optimal", "infeasible")
     if system.cone.is_polyhedral:  # HiGHS, a third opinion
-        assert _lp_feasible(system, 60.0, feasible) == feasible
+        assert lp_feasible(system, 60.0, feasible) == feasible
     # the verdict's evidence, recomputed from the layout's matrices
     b = -system.f_ext
     forces_columns = _selection(system.layout)

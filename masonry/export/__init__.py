@@ -36,7 +36,7 @@ class RunOutputs:
     scene : masonry.scenes.base.Scene
     model : masonry.rbe.boundary.Model
         The analysed blocks (the scene's, then any neighbour images) and interfaces.
-    result : masonry.rbe.solve.RBEResult or None
+    result : masonry.rbe.result.RBEResult or None
         The rigid block equilibrium; None when the run only builds.
     collapse : masonry.rbe.collapse.CollapseResult or None
         The collapse load factor of the run's live load (docs/model.md 6.8), if it has
@@ -108,7 +108,7 @@ class RunOutputs:
 
     @functools.cached_property
     def forces(self) -> dict | None:
-        """Per-interface force sums (:func:`masonry.rbe.solve.interface_forces`), newtons;
+        """Per-interface force sums (:func:`masonry.rbe.result.interface_forces`), newtons;
         None without an accepted solution."""
         if self.result is None or self.result.x is None:
             return None
@@ -215,7 +215,7 @@ def force_tables(blocks, interfaces, result, forces: dict, resultants=None,
     Parameters
     ----------
     blocks, interfaces : the analysed model's
-    result : masonry.rbe.solve.RBEResult or masonry.rbe.collapse.CollapseResult
+    result : masonry.rbe.result.RBEResult or masonry.rbe.collapse.CollapseResult
         With a solution (``x``) in the layout of ``interfaces``.
     forces : dict str -> (K,) float, N
         ``result.per_interface()`` (a collapse result's ``forces``).

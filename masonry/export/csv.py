@@ -111,7 +111,7 @@ def interfaces_csv(blocks: Blocks, interfaces) -> bytes:
 
 
 FORCE_SUMS = ("compression", "tension", "normal", "t1", "t2", "friction")
-"""The per-interface sums of :func:`masonry.rbe.solve.interface_forces`, in column order."""
+"""The per-interface sums of :func:`masonry.rbe.result.interface_forces`, in column order."""
 
 
 def forces_columns(blocks: Blocks, interfaces, forces: dict, resultants: dict) -> list:

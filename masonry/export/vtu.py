@@ -82,7 +82,7 @@ def interfaces_vtu(interfaces, forces: dict, kind_names=INTERFACE_KINDS) -> byte
         ``K`` interfaces; their polygon vertices become the points (metres).
     forces : dict of str to (K,) or (K, 3) float
         Per-interface values, e.g. the sums ``compression``, ``tension``, ``normal``,
-        ``t1``, ``t2``, ``friction`` in newtons (:func:`masonry.rbe.solve.interface_forces`)
+        ``t1``, ``t2``, ``friction`` in newtons (:func:`masonry.rbe.result.interface_forces`)
         and the resultants' ``shear`` (K, 3), ``eccentricity``
         (:func:`masonry.rbe.resultants.interface_resultants`).
     kind_names : sequence of str

@@ -51,7 +51,7 @@ from masonry.rbe.equilibrium import assemble, friction_edges
 from masonry.rbe.loads import Lateral, LiveLoad, lateral
 from masonry.rbe.mirror import half_model, in_plane, states_exactly
 from masonry.rbe.cores import solver_threads
-from masonry.rbe.solve import interface_forces
+from masonry.rbe.result import interface_forces
 from masonry.rbe.solvers import BACKENDS, COLLAPSE, backend
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL, UNBOUNDED
 from masonry.rbe.solvers.program import NONNEGATIVE, SECOND_ORDER, Columns, ConeProgram

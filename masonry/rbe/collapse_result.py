@@ -76,7 +76,7 @@ class CollapseResult:
         Vertex forces at collapse in the :class:`~masonry.rbe.equilibrium.VariableLayout`
         order, newtons.
     forces : dict str -> (K,) float or None
-        Per-interface sums (:func:`masonry.rbe.solve.interface_forces`).
+        Per-interface sums (:func:`masonry.rbe.result.interface_forces`).
     mechanism : (B, 6) float or None
         ``(ux, uy, uz, rx, ry, rz)`` per block: translation of the centroid and rotation
         (radians per unit), normalised so the largest displacement of any block vertex is
@@ -102,7 +102,7 @@ class CollapseResult:
     law : ContactLaw
         The contact law (friction model, ``mu``, the mortar's strengths).
     solved_on : {'whole', 'half', 'whole, the half rejected'}
-        As :attr:`masonry.rbe.solve.RBEResult.solved_on`.
+        As :attr:`masonry.rbe.result.RBEResult.solved_on`.
     """
 
     load_factor: float | None

@@ -152,7 +152,7 @@ class Half:
 
 
 def equilibrium_on_the_whole(half: Half, result, density: float):
-    """An RBE result of ``half.model`` (:class:`~masonry.rbe.solve.RBEResult`, at
+    """An RBE result of ``half.model`` (:class:`~masonry.rbe.result.RBEResult`, at
     ``density``) as its whole's: the forces mirrored back, the objective, the MoI, the
     weight and the residuals computed again on the whole's matrices (the residuals check
     the map); the verdict and the solvers' record stay the half's."""

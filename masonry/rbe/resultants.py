@@ -2,7 +2,7 @@
 application and its eccentricity (the thrust line's points, Heyman's hinges).
 
 The RBE solves for forces at the interface polygon's vertices (thesis eq. 3.23). Their
-sums (:func:`masonry.rbe.solve.interface_forces`) say how much is transmitted but not
+sums (:func:`masonry.rbe.result.interface_forces`) say how much is transmitted but not
 where. Here the vertex forces of interface ``k`` (frame ``t1, t2, n``, centre ``C``: the
 polygon's area centroid) are reduced to
 
@@ -44,7 +44,7 @@ def interface_resultants(interfaces, layout, x) -> dict:
     -------
     dict
         ``sigma`` (K,) float, N: net normal force, compression positive (``-normal`` of
-        :func:`~masonry.rbe.solve.interface_forces`); ``shear`` (K, 3) float, N;
+        :func:`~masonry.rbe.result.interface_forces`); ``shear`` (K, 3) float, N;
         ``moment`` (K, 3) float, N m: the vertex forces' moment about the centre;
         ``point`` (K, 3) float, m: point of application (NaN without normal force);
         ``torsion`` (K,) float, N m (the moment about ``n`` at ``point``, or at the centre

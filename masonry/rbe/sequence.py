@@ -48,8 +48,8 @@ import numpy as np
 from masonry.rbe.boundary import Model, kept_blocks
 from masonry.rbe.centering import CenteringResult, solve_centering
 from masonry.rbe.equilibrium import FRICTION_METHODS, EquilibriumSystem, VariableLayout, assemble
-from masonry.rbe.solve import (ACCURACY, WARM_STALL, WARM_STEPS, RBEProblem, RBEResult,
-                               friction_model)
+from masonry.rbe.result import RBEResult
+from masonry.rbe.solve import ACCURACY, WARM_STALL, WARM_STEPS, RBEProblem, friction_model
 from masonry.rbe.solvers import BACKENDS
 from masonry.rbe.solvers.base import INFEASIBLE
 from masonry.rbe.solvers.cholesky import BlockCholesky, block_graph, fill_reducing_order

@@ -25,29 +25,26 @@ solves friction+ there while the load-path LP decides friction-net
 import dataclasses
 import functools
 import logging
-import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
 from masonry import forking
 from masonry.contact import ContactLaw
-from masonry.friction import FrictionCone
 from masonry.rbe.accuracy import ACCURACY, AccuracyPreset, friction_model
 from masonry.rbe.cores import Alongside, solver_threads
-from masonry.rbe.equilibrium import (FRICTION_METHODS, EquilibriumSystem, VariableLayout,
-                                     assemble, friction_edges)
+from masonry.rbe.equilibrium import FRICTION_METHODS, assemble
+from masonry.rbe.lp_check import lp_feasible as check_by_lp
+from masonry.rbe.result import RBEResult
 from masonry.rbe.solvers import BACKENDS, RBE, backend, names, net_feasibility
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL
-from masonry.rbe.solvers.highs import nonnegative_solution
 from masonry.rbe.solvers.newton import NewtonOptions, prepared_system
 from masonry.rbe.solvers.residuals import Residuals
 from masonry.tolerances import Tolerances
 
 __all__ = ["ACCURACY", "AccuracyPreset", "RBEProblem", "RBEResult", "friction_model",
-           "interface_forces", "solve_rbe"]
+           "solve_rbe"]
 
 log = logging.getLogger(__name__)
 
@@ -100,176 +97,6 @@ weight, so a start that is not close hands over early."""
 
 SOLVERS = names(RBE)
 """Every solver name :func:`solve_rbe` accepts (the registry's RBE backends)."""
-
-RESULT_KEYS = ("verdict", "feasible", "friction", "mu", "friction_model",
-               "friction_capacity_error", "objective", "moi", "moi_factor", "weight_N",
-               "solver", "status", "iterations", "residual_eq", "friction_violation",
-               "net_friction_violation", "time_s", "lp_feasible", "accuracy", "lp_time_s",
-               "solved_on", "contact_law")
-"""Scalar fields of :class:`RBEResult` written to run.json, in order."""
-
-INTERFACE_FORCE_KEYS = ("compression", "tension", "normal", "t1", "t2", "friction")
-
-
-@dataclass(frozen=True, eq=False)
-class RBEResult:
-    """Outcome of :func:`solve_rbe`. Forces in newtons.
-
-    Parameters
-    ----------
-    feasible : bool
-        ``x`` satisfies equilibrium and the friction-net constraints, both within
-        ``tol.residual`` (relative equilibrium residual, and friction violation relative
-        to the reference weight): the structure stands without tension.
-    friction : str
-        ``'net'`` or ``'plus'``: the problem (friction-net or friction+) whose solution
-        ``x`` is.
-    mu : float
-    objective : float, N^2
-        ``1/2 x^T H x`` (thesis eq. 3.27); only an optimality criterion. NaN without ``x``.
-    moi : float, N
-        Measure of infeasibility, the sum of all tension (thesis eq. 3.28).
-    moi_factor : float
-        ``moi / weight_N``.
-    weight_N : float, N
-        Total weight of the free blocks.
-    solver, status : str
-        Solver name and its status (cvxpy's words) for the problem that produced ``x``
-        (the last attempt).
-    iterations : int
-        That solver's iterations, -1 when not reported.
-    residual_eq : float
-        ``||A_eq x + f_ext||_inf / ||f_ext||_inf`` (scaled rows: forces per reference
-        weight, moments per reference weight times reference length).
-    friction_violation : float
-        Largest violation of the friction rows of the problem solved and of the sign
-        bounds ``c, t >= 0``, per reference weight.
-    net_friction_violation : float
-        The same on the friction-net rows, whatever problem was solved.
-    time_s : float, s
-        Wall time of the solve (every QP and the LP check; assembly too for
-        :func:`solve_rbe`).
-    lp_feasible : bool or None
-        Verdict of the independent friction-net LP (HiGHS); None when not run or
-        inconclusive.
-    x : (4 IV,) float or None, N
-        Solution in the :class:`~masonry.rbe.equilibrium.VariableLayout` order, physical
-        forces: with mortar (:mod:`masonry.contact`) ``c`` is the normal force the
-        law carries, negative where the mortar holds in tension, and ``t`` the tension
-        beyond the law (the MoI's).
-    layout : VariableLayout
-    accuracy : str
-        The accuracy preset.
-    lp_time_s : float, s
-        Time of the LP check (0 when not run).
-    attempts : tuple of dict
-        Every QP solved (and the load-path LP, :data:`LOAD_PATH`), in order: friction
-        model, solver, status, iterations, setup and solve seconds (a fallback shows as
-        a second attempt of the same model).
-    cone : FrictionCone
-        The friction model (:mod:`masonry.friction`).
-    law : ContactLaw
-        The contact law (the friction model, ``mu`` and the mortar's strengths).
-    solved_on : {'whole', 'half', 'whole, the half rejected'}
-        The model whose program gave the forces: the whole; its half in a mirror plane,
-        mapped back and checked on the whole (docs/model.md 6.11); or the whole, solved
-        because the half's forces failed that check.
-    verdict : {'feasible', 'infeasible', 'not solved'}
-        ``'feasible'``: ``feasible`` is True. ``'infeasible'``: friction-net has no
-        accepted point, and either a solver certified that (a Farkas certificate, an
-        infeasibility status, the LP) or an accepted friction+ point carries the
-        tension it needs. ``'not solved'``: no solver returned an accepted point and
-        none certified infeasibility; the residuals say how far the last point was.
-    """
-
-    feasible: bool
-    friction: str
-    mu: float
-    objective: float
-    moi: float
-    moi_factor: float
-    weight_N: float
-    solver: str
-    status: str
-    iterations: int
-    residual_eq: float
-    friction_violation: float
-    net_friction_violation: float
-    time_s: float
-    lp_feasible: bool | None
-    x: np.ndarray | None
-    layout: VariableLayout
-    accuracy: str = "balanced"
-    lp_time_s: float = 0.0
-    attempts: tuple = ()
-    verdict: str = "not solved"
-    cone: FrictionCone = FrictionCone("circle")
-    solved_on: str = "whole"
-    law: ContactLaw = ContactLaw()
-
-    @property
-    def contact_law(self) -> str:
-        """The contact law in one line (:meth:`~masonry.contact.ContactLaw.describe`)."""
-        return self.law.describe()
-
-    @property
-    def friction_model(self) -> str:
-        return self.cone.name
-
-    @property
-    def friction_capacity_error(self) -> float:
-        """The model's bound on the error of the friction capacity (see
-        :attr:`~masonry.friction.FrictionCone.capacity_error`)."""
-        return self.cone.capacity_error
-
-    def checked(self) -> bool:
-        """Whether the residuals, recomputed on the model this result describes, meet its
-        accuracy preset's acceptance tolerance (docs/model.md 6.5): equilibrium and the
-        friction model solved and, for a feasible verdict, friction-net. A result without
-        forces has nothing to check."""
-        if self.x is None:
-            return True
-        tol = ACCURACY[self.accuracy].residual
-        checks = [self.residual_eq, self.friction_violation]
-        if self.feasible:
-            checks.append(self.net_friction_violation)
-        return all(math.isfinite(value) and value <= tol for value in checks)
-
-    def to_dict(self) -> dict:
-        """The scalar fields (:data:`RESULT_KEYS`) as plain Python values, for run.json."""
-        out = {}
-        for key in RESULT_KEYS:
-            value = getattr(self, key)
-            out[key] = value.item() if isinstance(value, np.generic) else value
-        return out
-
-    def per_interface(self) -> dict:
-        """Per-interface force sums; see :func:`interface_forces`."""
-        if self.x is None:
-            raise ValueError(f"no solution ({self.friction}: {self.status})")
-        return interface_forces(self.layout, self.x)
-
-
-def interface_forces(layout, x) -> dict:
-    """Sum the vertex forces of every interface (docs/model.md 6.7, thesis eq. 3.29-3.34).
-
-    Parameters
-    ----------
-    layout : VariableLayout
-    x : (4 IV,) float, N
-
-    Returns
-    -------
-    dict str -> (K,) float, N
-        ``compression`` (sum c), ``tension`` (sum t), ``normal`` (sum of t - c, tension
-        positive), ``t1`` (sum f1), ``t2`` (sum f2), ``friction``
-        ``sqrt((sum f1)^2 + (sum f2)^2)`` (the thesis's eq. 3.34 is garbled; this is the
-        reading of docs/model.md 6.7).
-    """
-    c, t, f1, f2 = (layout.interface_sum(layout.component(x, name))
-                    for name in layout.COMPONENTS)
-    return dict(zip(INTERFACE_FORCE_KEYS, (c, t, t - c, f1, f2, np.hypot(f1, f2))))
-
 
 class RBEProblem:
     """One scene's rigid block equilibrium, prepared for any number of solves.
@@ -504,7 +331,7 @@ class RBEProblem:
         run_lp = ((lp_check == "infeasible" and not feasible) if isinstance(lp_check, str)
                   else bool(lp_check))
         lp_start = time.perf_counter()
-        lp_feasible = _lp_feasible(system, lp_time_limit, feasible) if run_lp else None
+        lp_feasible = check_by_lp(system, lp_time_limit, feasible) if run_lp else None
         lp_time = time.perf_counter() - lp_start if run_lp else 0.0
         if feasible and solved.method == "plus" and friction == "auto":
             log.warning("friction-net was not solved, yet the friction+ solution meets the "
@@ -717,66 +544,3 @@ def solve_rbe(blocks, interfaces, mu=0.7, density=2000.0, friction="auto", solve
                            lp_time_limit=lp_time_limit, cores=cores, cohesion=cohesion,
                            tensile=tensile)
     return dataclasses.replace(result, time_s=time.perf_counter() - start)
-
-
-LP_CHECK_SIDES = 16
-"""Coulomb's cone is checked by linear programming on a 16-sided pyramid: the inscribed
-one (1.9 % short of the cone) for a feasible verdict, the circumscribed one (1.9 % over)
-for an infeasible one."""
-
-
-def _lp_feasible(system: EquilibriumSystem, time_limit: float, verdict: bool):
-    """Friction-net feasibility by linear programming (HiGHS, zero objective), to check
-    the QP's ``verdict``.
-
-    A pyramid is written by its edge rays instead of its faces: a vertex force with
-    ``t = 0`` inside it is a nonnegative combination of its rays
-    (:func:`~masonry.rbe.equilibrium.friction_edges`), so the LP is ``A_eq E lam =
-    -f_ext, lam >= 0`` with ``K`` unknowns per vertex and no inequality rows. Fixing
-    ``t = 0`` loses nothing: a friction-net point with ``0 < t <= c`` stays one with
-    ``(c - t, 0)``. The edge form is also a second, independent way to state the
-    constraints. Coulomb's cone is not a pyramid: it lies between the inscribed and the
-    circumscribed :data:`LP_CHECK_SIDES`-sided ones, so a feasible verdict is checked
-    on the inscribed one (feasible there proves it) and an infeasible one on the
-    circumscribed one (infeasible there proves it); a structure within 2 % of its friction
-    limit gets no second opinion (None). HiGHS's interior point method decides, without
-    crossover (a vertex solution is not needed, only the verdict; crossover and the dual
-    simplex were measured slower: docs/bench.md, "Measurements behind design choices").
-    Proving feasibility takes far longer
-    than proving infeasibility and grows faster than linearly, hence ``time_limit``.
-
-    Returns True, False, or None when HiGHS ends without a verdict (time limit) or the
-    pyramid cannot decide for the cone.
-    """
-    if system.compression_floor is not None:
-        # the rays state the cone, not its truncation by a tension cut-off: they can
-        # prove it infeasible (the truncated cone lies inside), never feasible
-        if verdict:
-            return None
-        outer_mu = system.mu / (1.0 if system.cone.is_polyhedral
-                                else math.cos(math.pi / LP_CHECK_SIDES))
-        outer = system.cone if system.cone.is_polyhedral else pyramid_of(LP_CHECK_SIDES)
-        return False if _edges_feasible(system, outer, outer_mu, time_limit) is False else None
-    if system.cone.is_polyhedral:
-        return _edges_feasible(system, system.cone, system.mu, time_limit)
-    pyramid = pyramid_of(LP_CHECK_SIDES)
-    if verdict:
-        return True if _edges_feasible(system, pyramid, system.mu, time_limit) else None
-    outer_mu = system.mu / math.cos(math.pi / LP_CHECK_SIDES)
-    return False if _edges_feasible(system, pyramid, outer_mu, time_limit) is False else None
-
-
-def pyramid_of(sides) -> FrictionCone:
-    """The inscribed ``sides``-sided pyramid."""
-    return FrictionCone.parse(f"polygon:{sides}")
-
-
-def _edges_feasible(system, cone, mu, time_limit):
-    """Whether the pyramid ``cone`` at ``mu`` carries the dead load (:func:`_lp_feasible`):
-    True, False or None (no verdict)."""
-    generators = friction_edges(system.layout.n_vertices, cone, mu)
-    A = sp.csc_array(system.A_eq @ generators)
-    verdict, words = nonnegative_solution(A, -system.f_ext, time_limit)
-    if verdict is None:
-        log.warning("friction-net LP inconclusive: %s", words)
-    return verdict

@@ -333,9 +333,15 @@ def stages_folder_name(params, plan: StagePlan) -> str:
 
 
 def check_live_load(params) -> None:
-    """Refuse the live loads a stage study does not take (:class:`ParameterError`): point
-    and crown loads (they name blocks a stage may not hold yet) and ``--lateral all``
-    (an azimuth search at every stage: one azimuth per study)."""
+    """Refuse the inputs a stage study does not take (:class:`ParameterError`): mortar
+    (the stages solve dry joints only so far), point and crown loads (they name blocks a
+    stage may not hold yet) and ``--lateral all`` (an azimuth search at every stage: one
+    azimuth per study)."""
+    analysis = params.analysis
+    for name in ("cohesion_kpa", "tensile_kpa"):
+        if getattr(analysis, name) != 0:
+            raise ParameterError(name, getattr(analysis, name), "0 for stages: construction "
+                                 "stages solve dry joints only so far")
     load = params.load
     if load is None:
         return

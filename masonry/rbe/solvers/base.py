@@ -85,7 +85,7 @@ class Backend:
     ----------
     name : str
         Its name in the registry (:data:`masonry.rbe.solvers.BACKENDS`), in
-        :attr:`masonry.rbe.solve.RBEResult.solver` and
+        :attr:`masonry.rbe.result.RBEResult.solver` and
         :attr:`masonry.rbe.collapse.CollapseResult.solver`.
     settings : str
         Whose settings it takes from an accuracy preset's ``options``

@@ -3,7 +3,7 @@
 :func:`highs_lp` makes a HiGHS linear program from scipy.sparse arrays;
 :class:`HighsProgram` holds a collapse program (:mod:`masonry.rbe.solvers.program`) by
 the settings of one of :data:`SETTINGS`; :func:`nonnegative_solution` decides the RBE's
-independent friction-net LP (:func:`masonry.rbe.solve._lp_feasible`).
+independent friction-net LP (:func:`masonry.rbe.lp_check.lp_feasible`).
 """
 
 import functools
