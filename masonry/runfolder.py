@@ -32,7 +32,7 @@ import uuid
 from contextlib import contextmanager
 from pathlib import Path
 
-from masonry.errors import ParameterError
+from masonry.errors import MasonryError, ParameterError
 
 try:
     import fcntl
@@ -189,6 +189,34 @@ def locked(folder):
     fd = os.open(folder, os.O_RDONLY)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
+
+
+@contextmanager
+def alone(path):
+    """Hold ``path`` (a file, created empty with its folder if missing) for the block,
+    or refuse at once if another process holds it: a file that one process at a time
+    may append to (an optimisation's journal). A POSIX advisory lock, released when the
+    process ends however it ends; nothing on systems without one.
+
+    Raises
+    ------
+    MasonryError
+        Another process holds ``path``.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        if fcntl is not None:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                raise MasonryError(f"{path} is in use by another process (another "
+                                   f"'masonry optimize' of this study into this --out): "
+                                   f"wait for it to end, or give another --out") from None
         yield
     finally:
         os.close(fd)  # closing releases the lock

@@ -264,6 +264,16 @@ THICKNESS_RTOL = 1e-4
 bisection (:func:`masonry.studies.thickness.minimum_thickness`, ``masonry
 arch-thickness --rtol``)."""
 
+MIN_SEARCH_RTOL = 1e-15
+"""The least relative width a search by bisection takes (``masonry arch-thickness
+--rtol``): a few units in the last place of a float64 (2.2e-16); a bracket narrower than
+that cannot shrink, and the search would never end."""
+
+MIN_THICKNESS_BLOCKS = 4
+"""The fewest voussoirs whose minimum thickness is searched: an arch needs four hinges
+to move, and one of three voussoirs has only four joints, so it stands at every
+thickness (its thrust line fits any)."""
+
 THICKNESS_LIMIT_FRACTION = 0.99
 """The thickest arch the bisection starts from is at most this fraction of the
 thickness at which the shape's intrados vanishes
