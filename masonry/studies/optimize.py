@@ -214,7 +214,9 @@ def open_study(search: Search, journal, label: str):
 
     _quiet_optuna()
     try:
+        _check_entries(journal)
         storage = JournalStorage(JournalFileBackend(str(journal)))
+        storage.get_all_studies()  # replayed through before anything is written to it
         study = optuna.create_study(
             study_name=search.journal_name(label), storage=storage, load_if_exists=True,
             directions=[direction for _, direction in search.objectives])
@@ -228,6 +230,19 @@ def open_study(search: Search, journal, label: str):
         study.enqueue_trial(trial.params)
         log.info("trial %d was not finished: queued again", trial.number)
     return study
+
+
+def _check_entries(journal):
+    """Raise ValueError unless every whole line of ``journal`` (if it exists) is a JSON
+    object: Optuna takes a last line that is not one for a write cut short, and would
+    append after it, leaving a journal that no run can read again."""
+    try:
+        with open(journal, "rb") as f:
+            for line in f:
+                if line.endswith(b"\n") and not isinstance(json.loads(line), dict):
+                    raise ValueError(f"a line that is no log entry: {line[:40]!r}")
+    except FileNotFoundError:
+        return
 
 
 def _first_line(error) -> str:

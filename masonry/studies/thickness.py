@@ -123,7 +123,7 @@ def minimum_thickness(params: Params, rtol=THICKNESS_RTOL,
         raise MasonryError(f"the arch stands already at t/R = {lo:g}, the thinnest the "
                            f"search tries: its minimum thickness is below that")
     while hi / lo - 1 > rtol:
-        mid = float(np.sqrt(lo * hi))
+        mid = float(lo * np.sqrt(hi / lo))  # not sqrt(lo * hi): that underflows first
         if not lo < mid < hi:  # the bracket is two neighbouring floats: it cannot shrink
             break
         if feasible(mid):
