@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from masonry.errors import ParameterError
-from masonry.runfolder import check_output_root
+from masonry.runfolder import check_output_root, check_study_folder
 from masonry.studies.optimize import SAMPLERS, Search
 
 from .sweep import (add_cluster_options, load_study, progress_bar, quiet_progress,
@@ -70,7 +70,6 @@ def handle(args, report):
                     args.sampler).checked()
     workers, scheduler = resolve_cluster(args)
     from masonry.studies.optimize import draw_best, optimise, publish_trials
-    from masonry.studies.sweep import check_study_folder
     stem = Path(args.study).stem
     check_study_folder(args.out, f"optimize_{stem}", args.study)
     out = Path(args.out)

@@ -11,7 +11,7 @@ from pathlib import Path
 from masonry.errors import ParameterError
 from masonry.parameters import read_toml
 from masonry.params import PRESETS, Params, names, validate
-from masonry.runfolder import check_output_root
+from masonry.runfolder import check_output_root, check_study_folder
 
 from . import run as run_command
 from .options import Parser, add_verbosity
@@ -356,8 +356,7 @@ def handle(args, report):
         raise ParameterError("workers", args.workers, "an integer >= 1")
     check_output_root(args.out)
     study = load_study(args.study)
-    from masonry.studies.sweep import (check_study_folder, execute, publish_summary,
-                                       summary_rows)
+    from masonry.studies.sweep import execute, publish_summary, summary_rows
 
     stem = Path(args.study).stem
     check_study_folder(args.out, f"sweep_{stem}", args.study)

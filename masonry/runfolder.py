@@ -500,3 +500,30 @@ def _round_trip(value):
     """``value`` as it reads back from ``run.json`` (tuples as lists, numpy values plain),
     for comparisons with a record."""
     return json.loads(strict_json(value))
+
+
+def source_file(path) -> str:
+    """The absolute path of the file a study's folder is named after, as its ``run.json``
+    records it (``study_file``): :func:`check_study_folder`."""
+    return str(Path(path).resolve())
+
+
+def check_study_folder(out_root, name: str, study_file) -> None:
+    """Refuse ``out_root/name`` (a study's folder, named after its file) to a study
+    file other than the one whose folder it is (``run.json``'s ``study_file``): two
+    studies of one file name in different folders would overwrite each other's.
+
+    Raises
+    ------
+    ParameterError
+        Named ``study``, with the folder and the other file.
+    """
+    try:
+        record = json.loads((Path(out_root) / name / "run.json").read_text())
+    except (OSError, ValueError):
+        return
+    other = record.get("study_file") if isinstance(record, dict) else None
+    if isinstance(other, str) and other != source_file(study_file):
+        raise ParameterError("study", str(study_file), f"a study file whose name no other "
+                             f"study's folder in {out_root} has: {name} is that of {other}; "
+                             f"rename this file or give another --out")

@@ -34,18 +34,18 @@ def tower(tmp_path_factory):
 
 
 BAD_READS = {
-    "no_support": dict(support=None),
-    "scene": dict(support="base", scene="dome"),
-    "assembly": dict(support="base", assembly="x"),
-    "support_int": dict(support=[3]),
-    "support_number": dict(support=3),
-    "support_below_text": dict(support_below="a"),
-    "support_below_nan": dict(support_below=float("nan")),
-    "support_below_bool": dict(support_below=True),
-    "ground_int": dict(ground=1),
-    "mu_text": dict(support="base", mu="high"),
-    "unknown": dict(support="base", colour=3),
-    "point_load": dict(support="base", point_loads="top:1,2"),
+    "no_support": {"support": None},
+    "scene": {"support": "base", "scene": "dome"},
+    "assembly": {"support": "base", "assembly": "x"},
+    "support_int": {"support": [3]},
+    "support_number": {"support": 3},
+    "support_below_text": {"support_below": "a"},
+    "support_below_nan": {"support_below": float("nan")},
+    "support_below_bool": {"support_below": True},
+    "ground_int": {"ground": 1},
+    "mu_text": {"support": "base", "mu": "high"},
+    "unknown": {"support": "base", "colour": 3},
+    "point_load": {"support": "base", "point_loads": "top:1,2"},
 }
 
 
@@ -68,10 +68,10 @@ def test_one_support_pattern_is_one_string_not_its_letters(tower):
     assert structure.source["supports"] == 1
 
 
-BAD_BUILDS = [dict(n=True), dict(n=4.5), dict(n="4"), dict(n=np.float64(4.5)),
-              dict(mu=np.nan), dict(mu="0.7"), dict(scene="moon"), dict(preset="7"),
-              dict(colour=1), dict(lateral="east"), dict(crown_load=-1.0),
-              dict(friction_cone="polygon:\u00b2"), dict(crown_load=1e308)]
+BAD_BUILDS = [{"n": True}, {"n": 4.5}, {"n": "4"}, {"n": np.float64(4.5)},
+              {"mu": np.nan}, {"mu": "0.7"}, {"scene": "moon"}, {"preset": "7"},
+              {"colour": 1}, {"lateral": "east"}, {"crown_load": -1.0},
+              {"friction_cone": "polygon:\u00b2"}, {"crown_load": 1e308}]
 
 
 @pytest.mark.parametrize("inputs", BAD_BUILDS, ids=lambda d: "-".join(map(str, d)))

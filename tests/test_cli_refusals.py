@@ -7,13 +7,13 @@ import json
 import types
 
 import pytest
+from masonry_cli.app import make_parser
+from masonry_cli.main import main
 
 from masonry.params import Params, validate
 from masonry.runfolder import alone
 from masonry.studies import thickness
 from masonry.tolerances import MIN_SEARCH_RTOL
-from masonry_cli.app import make_parser
-from masonry_cli.main import main
 
 WALL_STUDY = ('[base]\nscene = "wall"\nwall-courses = 3\nwall-length = 12\nfast = true\n'
               '[grid]\nmu = [0.5, 0.7]\n')
@@ -191,7 +191,7 @@ def test_a_domes_own_bricks_analysed_back_without_the_printable_body(tmp_path, c
     assert main(["run", *dome, "--no-printable", "--out", str(tmp_path / "run"), "-q"]) == 0
     run = json.loads(next(tmp_path.glob("run/*/run.json")).read_text())
     bricks = next(tmp_path.glob("run/*/bricks.obj"))
-    code, out, err = call(["analyze", str(bricks), "--support", "*_ground_*", "--fast",
+    code, _out, err = call(["analyze", str(bricks), "--support", "*_ground_*", "--fast",
                            "--no-plots", "--out", str(tmp_path / "analyze"), "-q"])
     assert code == 0 and "Traceback" not in err, err
     assert len(err.strip().splitlines()) == 1 and "printable body skipped" in err, err

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from masonry.errors import MasonryError, ParameterError
-from masonry.runfolder import alone
+from masonry.runfolder import alone, source_file
 
 log = logging.getLogger(__name__)
 
@@ -450,7 +450,7 @@ def publish_trials(search: Search, rows, out_root, name: str, journal, label="",
     """The optimisation's folder ``out_root/name``: ``trials.csv``, ``convergence.png``
     and ``run.json`` (the search, the trials' counts, the best trials with their inputs,
     values and run folders, the journal's path, the study's file if given:
-    :func:`~masonry.studies.sweep.check_study_folder`), published by the run-folder
+    :func:`~masonry.runfolder.check_study_folder`), published by the run-folder
     protocol and always written again (it sums up every trial of the journal).
 
     Returns
@@ -478,7 +478,7 @@ def publish_trials(search: Search, rows, out_root, name: str, journal, label="",
               "best": best, "journal": str(journal),
               "versions": {**versions(), "optuna": optuna.__version__}}
     if study_file is not None:
-        record["study_file"] = str(Path(study_file).resolve())
+        record["study_file"] = source_file(study_file)
 
     def write(folder):
         folder.write("trials.csv", summary_csv(search.study, rows, trial_columns(search)))

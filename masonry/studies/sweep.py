@@ -23,7 +23,6 @@ import traceback
 import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -33,7 +32,7 @@ from masonry.errors import ParameterError
 from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run, versions
 from masonry.studies.stages import run_stages, stage_params
-from masonry.runfolder import Publication
+from masonry.runfolder import Publication, source_file
 from masonry.forking import use_one_blas_thread
 
 log = logging.getLogger(__name__)
@@ -652,32 +651,11 @@ def summary_pngs(study: Study, rows, label="") -> dict:
     return out
 
 
-def check_study_folder(out_root, name: str, study_file) -> None:
-    """Refuse ``out_root/name`` (a study's folder, named after its file) to a study
-    file other than the one whose folder it is (``run.json``'s ``study_file``): two
-    studies of one file name in different folders would overwrite each other's.
-
-    Raises
-    ------
-    ParameterError
-        Named ``study``, with the folder and the other file.
-    """
-    try:
-        record = json.loads((Path(out_root) / name / "run.json").read_text())
-    except (OSError, ValueError):
-        return
-    other = record.get("study_file") if isinstance(record, dict) else None
-    if isinstance(other, str) and other != str(Path(study_file).resolve()):
-        raise ParameterError("study", str(study_file), f"a study file whose name no other "
-                             f"study's folder in {out_root} has: {name} is that of {other}; "
-                             f"rename this file or give another --out")
-
-
 def publish_summary(study: Study, rows, out_root, name: str, label="",
                     study_file=None) -> dict:
     """The study's folder ``out_root/name``: ``summary.csv``, ``summary.parquet`` (with
     pyarrow), the summary plots and ``run.json`` (with ``study_file``, the study's file
-    if given: :func:`check_study_folder`), published by the run-folder protocol
+    if given: :func:`~masonry.runfolder.check_study_folder`), published by the run-folder protocol
     (:class:`masonry.runfolder.Publication`). It is always written again: it sums up this
     run's variants, and a variant that ran before is reused, so nothing it held is lost.
 
@@ -691,7 +669,7 @@ def publish_summary(study: Study, rows, out_root, name: str, label="",
     record = {**identity, "complete": True, "outputs": {"plots": True}, "variants": counts,
               "versions": versions()}
     if study_file is not None:
-        record["study_file"] = str(Path(study_file).resolve())
+        record["study_file"] = source_file(study_file)
 
     def write(folder):
         folder.write("summary.csv", summary_csv(study, rows))
