@@ -76,7 +76,8 @@ def test_a_second_optimisation_of_a_study_at_once_is_refused(tmp_path):
 
 
 def test_a_scheduler_that_does_not_answer_is_refused_before_the_journal(tmp_path):
-    dask = pytest.importorskip("dask")
+    pytest.importorskip("dask.distributed")  # its config first: set() restores to it
+    import dask
     study = tmp_path / "study.toml"
     study.write_text(WALL_STUDY)
     out = tmp_path / "out"
