@@ -24,6 +24,7 @@ from masonry.forking import use_one_blas_thread
 from . import (analyze, arch_thickness, bench, build, optimize, run, stages, structures,
                sweep)
 from .options import Parser, describe_error, option_names, typed_values
+from .streams import silence_stdout
 
 SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, optimize, bench,
                stages)
@@ -71,7 +72,13 @@ def main(argv=None) -> int:
     use_one_blas_thread()
 
     def report(line):
-        print(line)
+        if not stdout_gone:
+            try:
+                print(line, flush=True)
+            except BrokenPipeError:  # its reader left ('| head -1'): the work goes on
+                stdout_gone.append(silence_stdout())
+
+    stdout_gone = []
 
     previous = _on_sigterm(_terminate)
     try:

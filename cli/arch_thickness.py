@@ -2,7 +2,7 @@
 feasibility, beside the thrust line's value."""
 
 from masonry.params import Params, validate
-from masonry.rbe.solvers import BACKENDS
+from masonry.rbe.solvers import RBE, names
 from masonry.scenes.arch import arch_radius
 from masonry.runfolder import RunFolder, check_output_root
 from masonry.tolerances import THICKNESS_RTOL
@@ -24,8 +24,9 @@ def register(subparsers):
     add_scene_options(parser, kinds=("arch",), skip=("arch_thickness",))
     g = parser.add_argument_group("analysis")
     add_material_options(g)
-    g.add_argument("--solver", choices=tuple(BACKENDS),
-                   help=f"QP solver (default: the balanced preset's): {', '.join(BACKENDS)}")
+    solvers = names(RBE)  # the bisection solves the equilibrium only: no collapse LPs
+    g.add_argument("--solver", choices=solvers,
+                   help=f"QP solver (default: the balanced preset's): {', '.join(solvers)}")
     g.add_argument("--rtol", type=float, default=THICKNESS_RTOL,
                    help="relative width of the final bisection bracket (default %(default)g)")
     parser.add_argument("--out", default="exports", metavar="DIR",

@@ -9,6 +9,8 @@ without it.
 import os
 import sys
 
+from masonry_cli.streams import silence_stdout
+
 BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
 """BLAS runs on one thread in the command (:func:`masonry.forking.use_one_blas_thread`,
 which limits the libraries loaded when it runs): these say so to the libraries that load
@@ -23,7 +25,10 @@ def main(argv=None) -> int:
     if argv == ["--version"]:
         from masonry import __version__
 
-        print(f"masonry {__version__}")
+        try:
+            print(f"masonry {__version__}", flush=True)
+        except BrokenPipeError:
+            silence_stdout()
         return 0
     try:
         from masonry_cli import app

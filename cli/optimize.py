@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 
 from masonry.errors import ParameterError
-from masonry.runfolder import check_output_root
+from masonry.runfolder import check_output_root, check_study_folder
 from masonry.studies.optimize import SAMPLERS, Search
 
 from .sweep import (add_cluster_options, load_study, progress_bar, quiet_progress,
@@ -71,9 +71,9 @@ def handle(args, report):
     workers, scheduler = resolve_cluster(args)
     from masonry.studies.optimize import draw_best, optimise, publish_trials
     stem = Path(args.study).stem
+    check_study_folder(args.out, f"optimize_{stem}", args.study)
     out = Path(args.out)
     journal = out / f"optimize_{stem}.journal"
-    out.mkdir(parents=True, exist_ok=True)
     show = sys.stderr.isatty() and not args.quiet and not args.verbose
     with quiet_progress(show):
         rows = optimise(search, out, journal, stem, workers, scheduler,
@@ -83,7 +83,8 @@ def handle(args, report):
     for row in [] if args.no_plots else draw_best(search, rows, out):
         if row["status"] == "failed":
             log.warning("the best variant's plots failed: %s", row["error"])
-    record = publish_trials(search, rows, out, f"optimize_{stem}", journal, stem)
+    record = publish_trials(search, rows, out, f"optimize_{stem}", journal, stem,
+                            args.study)
     counts = record["trials"]
     report(f"{counts['finished']} trials: {counts['computed']} computed, {counts['reused']} "
            f"reused, {counts['failed']} failed; {counts['constraints_met']} meet the "

@@ -307,10 +307,11 @@ def add_output_options(parser):
     g = parser.add_argument_group("output")
     g.add_argument("--out", default="exports", metavar="DIR",
                    help="output root; the run folder is DIR/<structure id> (default exports)")
-    g.add_argument("--no-plots", dest="plots", action="store_false", help="skip all plots")
-    g.add_argument("--no-printable", dest="printable", action="store_false",
+    g.add_argument("--no-plots", dest="plots", action="store_false", default=None,
+                   help="skip all plots")
+    g.add_argument("--no-printable", dest="printable", action="store_false", default=None,
                    help="skip the printable body (dome.stl, dome.obj)")
-    g.add_argument("--no-html", dest="html", action="store_false",
+    g.add_argument("--no-html", dest="html", action="store_false", default=None,
                    help="skip dome.html (the bricks in 3D, for a browser)")
     g.add_argument("--print-size", dest="print_size", type=float, metavar="MM",
                    help=f"also write dome.3mf for a slicer, in millimetres, its largest "

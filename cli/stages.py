@@ -80,11 +80,13 @@ def _refuse_inapplicable(args):
                                      "files are the assembly laid block by block, read, "
                                      "not built")
         return
-    for name in ("support", "support_below", "ground"):
-        if getattr(args, name) not in (None, False, []):
-            raise ParameterError(name, getattr(args, name),
-                                 "FILE... beside it: it chooses the supports of blocks read "
-                                 "from files; a dome or wall stands on its ground slab")
+    given = {"support": bool(args.support), "support_below": args.support_below is not None,
+             "ground": args.ground}  # a height of 0 is given too
+    name = next((name for name, is_given in given.items() if is_given), None)
+    if name is not None:
+        raise ParameterError(name, getattr(args, name),
+                             "FILE... beside it: it chooses the supports of blocks read "
+                             "from files; a dome or wall stands on its ground slab")
 
 
 def handle(args, report):

@@ -11,7 +11,7 @@ from pathlib import Path
 from masonry.errors import ParameterError
 from masonry.parameters import read_toml
 from masonry.params import PRESETS, Params, names, validate
-from masonry.runfolder import check_output_root
+from masonry.runfolder import check_output_root, check_study_folder
 
 from . import run as run_command
 from .options import Parser, add_verbosity
@@ -147,8 +147,8 @@ def load_study(path, draws=True):
     for key, value, ok, expected in (
             ("sample.count", count, isinstance(count, int) and not isinstance(count, bool)
              and 0 <= count <= MAX_VARIANTS, f"an integer 1 to {MAX_VARIANTS}"),
-            ("sample.seed", seed, isinstance(seed, int) and not isinstance(seed, bool),
-             "an integer")):
+            ("sample.seed", seed, isinstance(seed, int) and not isinstance(seed, bool)
+             and seed >= 0, "an integer >= 0")):
         if not ok:
             refuse(key, value, expected)
     stages = _stage_outputs(outputs, refuse)
@@ -251,7 +251,7 @@ def _stage_outputs(outputs, refuse) -> dict:
             refuse(f"outputs.{key}", outputs[key], "with outputs.stages only")
         return {}
     plans = _stage_plans()
-    if by not in plans:
+    if not isinstance(by, str) or by not in plans:
         refuse("outputs.stages", by, '"course", "brick" or "block" (the stage plan of '
                                      "'masonry stages --by')")
     if by == "brick" and course is not None and not (
@@ -358,6 +358,8 @@ def handle(args, report):
     study = load_study(args.study)
     from masonry.studies.sweep import execute, publish_summary, summary_rows
 
+    stem = Path(args.study).stem
+    check_study_folder(args.out, f"sweep_{stem}", args.study)
     total = len(study.variants())  # validates the study before any run
     workers, scheduler = resolve_cluster(args)
     show = sys.stderr.isatty() and not args.quiet and not args.verbose
@@ -373,8 +375,7 @@ def handle(args, report):
             if show:
                 sys.stderr.write("\n")
     rows = summary_rows(study, results)
-    stem = Path(args.study).stem
-    record = publish_summary(study, rows, args.out, f"sweep_{stem}", stem)
+    record = publish_summary(study, rows, args.out, f"sweep_{stem}", stem, args.study)
     counts = record["variants"]
     report(f"{total} variants: {counts['computed']} computed, {counts['reused']} reused, "
            f"{counts['failed']} failed")

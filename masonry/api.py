@@ -17,9 +17,14 @@ one of the command line's questions with the same code and the same defaults.
 
 import dataclasses
 import functools
+import math
+import numbers
+import os
+from collections.abc import Iterable
 
-from masonry.errors import ParameterError
-from masonry.export.csv import HEADERS, column_types, forces_columns
+from masonry.errors import MasonryError, NoForcesError, ParameterError
+from masonry.export.csv import HEADERS, column_types, forces_columns, missing_values
+from masonry.parameters import plain
 from masonry.params import (Params, from_preset, names, section_default, structure_id,
                             validate)
 from masonry.pipeline import Timer, build_model, centering_of, collapse_of, run, solve
@@ -97,12 +102,19 @@ class Structure:
 
         Raises
         ------
-        ValueError
-            The solve returned no forces (verdict ``not solved``).
+        masonry.errors.NoForcesError
+            The solve returned no forces: verdict ``not solved``, or ``infeasible`` under
+            ``friction="net"`` (no forces balance the blocks; ``"auto"`` or ``"plus"``
+            give the forces of least tension).
         """
         import pandas  # a notebook's library, imported by the calls that return a frame
 
         result = self.solve()
+        if result.x is None:
+            hint = ("; friction='auto' or 'plus' give the forces of least tension"
+                    if result.verdict == "infeasible" else "")
+            raise NoForcesError(f"no forces: the equilibrium is {result.verdict} "
+                                f"({result.friction}: {result.status}){hint}")
         forces = result.per_interface()
         resultants = interface_resultants(self.interfaces, result.layout, result.x)
         columns = forces_columns(self.blocks, self.interfaces, forces, resultants)
@@ -241,8 +253,8 @@ def read(*paths, support=(), support_below=None, ground=False, **inputs) -> Stru
     ----------
     *paths : str or Path
         The files; every closed convex body is a block.
-    support : sequence of str
-        Name patterns of the fixed blocks (``pier_*``).
+    support : str or sequence of str
+        Name patterns of the fixed blocks (``pier_*``); None or empty: none.
     support_below : float, optional
         Every block reaching below this height (metres) is fixed.
     ground : bool
@@ -255,13 +267,36 @@ def read(*paths, support=(), support_below=None, ground=False, **inputs) -> Stru
     masonry.scenes.imported.AssemblyError
         A file or block that cannot be read, no support, overlapping blocks.
     masonry.errors.ParameterError
-        An input out of its range.
+        An input out of its range or of the wrong type, or a ``scene`` (the blocks are
+        the scene).
     """
+    supports = _checked_supports(paths, support, support_below, ground, inputs)
     validate(Params.of(scene="assembly", assembly="-", **inputs))  # before any file is read
-    scene, source = load_assembly(paths, supports=tuple(support),
-                                  support_below=support_below, ground=ground)
+    scene, source = load_assembly(paths, supports=supports,
+                                  support_below=plain(support_below), ground=ground)
     params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **inputs))
     return Structure(params, scene, analysis_model(scene, params.analysis.boundary), source)
+
+
+def _checked_supports(paths, support, support_below, ground, inputs) -> tuple:
+    """The support patterns of :func:`read` as a tuple (one string is one pattern, None
+    none), its other arguments checked before any file is read."""
+    for name in ("scene", "assembly"):
+        if name in inputs:
+            raise ParameterError(name, inputs[name], "no scene: blocks read from files are "
+                                 "an assembly (masonry.build builds a scene)")
+    if not paths or not all(isinstance(p, str | os.PathLike) for p in paths):
+        raise ParameterError("paths", paths, "one or more mesh file paths (str or Path)")
+    support = () if support is None else (support,) if isinstance(support, str) else support
+    if not isinstance(support, Iterable) or not all(isinstance(s, str) for s in support):
+        raise ParameterError("support", support, "block name patterns (strings)")
+    if support_below is not None and (isinstance(support_below, bool) or not isinstance(
+            support_below, numbers.Real) or not math.isfinite(support_below)):
+        raise ParameterError("support_below", support_below, "a height in metres (a "
+                             "finite number) or None")
+    if not isinstance(ground, bool):
+        raise ParameterError("ground", ground, "true or false")
+    return tuple(support)
 
 
 def read_table(path):
@@ -269,7 +304,7 @@ def read_table(path):
     ``stages.csv``, a sweep's ``summary.csv``, ...) as a pandas DataFrame with every
     column's type, also when the file holds only its header (nothing in tension): integer
     ids and counts, text names, booleans ``True``/``False``, floats for the rest (their
-    names carry the unit).
+    names carry the unit; an empty cell or ``nan`` is NaN).
 
     Parameters
     ----------
@@ -278,10 +313,23 @@ def read_table(path):
     Returns
     -------
     pandas.DataFrame
+
+    Raises
+    ------
+    masonry.errors.MasonryError
+        The file cannot be read, or is not such a table (empty, binary, a cell not of its
+        column's type).
     """
     import pandas
 
-    with open(path, encoding="utf-8") as f:
-        names = f.readline().strip().split(",")
-    return pandas.read_csv(path, dtype=column_types(names), keep_default_na=False,
-                           na_values=[""])
+    try:
+        with open(path, encoding="utf-8") as f:
+            names = f.readline().strip().split(",")
+        if not all(name.isprintable() and name for name in names):
+            raise ValueError("no header of column names")
+        return pandas.read_csv(path, dtype=column_types(names), keep_default_na=False,
+                               na_values=missing_values(names))
+    except (OSError, UnicodeDecodeError, ValueError) as error:  # pandas' errors included
+        reason = str(error).strip().splitlines()[0] if str(error).strip() else "unreadable"
+        raise MasonryError(f"{path}: expected a CSV table that masonry writes ({reason})") \
+            from None

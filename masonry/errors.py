@@ -28,3 +28,8 @@ class ParameterError(MasonryError, ValueError):
         self.expected = expected
         self.related = tuple(related)
         self.where = where
+
+
+class NoForcesError(MasonryError, ValueError):
+    """A result asked for its forces has none: its equilibrium was not solved, or the
+    friction-net program found no forces that balance the blocks (infeasible)."""

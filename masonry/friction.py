@@ -77,7 +77,9 @@ class FrictionCone:
             return cls(CIRCLE, 0)
         if kind == SQUARE and not colon:
             return cls(SQUARE, 4)
-        if kind == POLYGON and count.isdigit() and MIN_SIDES <= int(count) <= MAX_SIDES:
+        # ASCII digits only: str.isdigit also takes '\u00b2', which int() refuses
+        if (kind == POLYGON and count.isascii() and count.isdigit()
+                and MIN_SIDES <= int(count) <= MAX_SIDES):
             return cls(POLYGON, int(count))
         raise FrictionModelError(expected)
 

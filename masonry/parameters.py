@@ -11,6 +11,7 @@ declarations (:mod:`masonry.params` composes them); nothing lists a parameter tw
 
 import dataclasses
 import math
+import numbers
 import os
 import tomllib
 from dataclasses import dataclass
@@ -129,6 +130,15 @@ def defaults(group) -> dict:
 def values(group) -> dict:
     """Field name -> value of a declared dataclass instance, in declaration order."""
     return {name: getattr(group, name) for name in declarations(group)}
+
+
+def plain(value):
+    """``value`` with a number of another library as Python's own: a numpy integer as
+    an ``int``, a numpy float as a ``float`` (numbers of ``numbers.Integral`` and
+    ``numbers.Real``), so that it validates and prints as one. A boolean stays one."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        return value
+    return int(value) if isinstance(value, numbers.Integral) else float(value)
 
 
 def check_fields(group):

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from masonry.errors import ParameterError
 from masonry.outputs import Outputs
-from masonry.parameters import (check_fields, declarations, defaults, read_toml, text_of,
+from masonry.parameters import (check_fields, declarations, defaults, plain, read_toml, text_of,
                                 values)
 from masonry.rbe.loads import LOAD_OPTIONS, Lateral, live_load
 from masonry.rbe.settings import Analysis
@@ -87,7 +87,7 @@ class Params:
                 inputs.setdefault("quick", True)
         parts = {"geometry": {}, "analysis": {}, "load": {}, "outputs": {}}
         for name, value in inputs.items():
-            parts[_part_of(name, kind, value)][name] = value
+            parts[_part_of(name, kind, value)][name] = plain(value)
         load = {"point_loads": ()} | parts["load"]
         return cls(kind, kind.geometry(**parts["geometry"]), Analysis(**parts["analysis"]),
                    live_load(**load) if any(v not in (None, ()) for v in load.values())

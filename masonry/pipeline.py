@@ -410,6 +410,8 @@ def write_run(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer):
     """Every file of a run and, last, its ``run.json`` (``record``, completed)."""
     write_exports(folder, made, record, timer)
     record["outputs"]["3dm"] = (folder.tmp / "bricks.3dm").exists()
+    if record["outputs"]["printable"] and not (folder.tmp / "dome.stl").exists():
+        record["outputs"]["printable"] = False  # skipped: run.json's printable says why
     record["coordinates"] = _held(record["coordinates"], folder)
     record["timings_s"] = timer.seconds
     record["versions"] = versions()

@@ -32,7 +32,7 @@ import uuid
 from contextlib import contextmanager
 from pathlib import Path
 
-from masonry.errors import ParameterError
+from masonry.errors import MasonryError, ParameterError
 
 try:
     import fcntl
@@ -189,6 +189,34 @@ def locked(folder):
     fd = os.open(folder, os.O_RDONLY)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX)
+        yield
+    finally:
+        os.close(fd)  # closing releases the lock
+
+
+@contextmanager
+def alone(path):
+    """Hold ``path`` (a file, created empty with its folder if missing) for the block,
+    or refuse at once if another process holds it: a file that one process at a time
+    may append to (an optimisation's journal). A POSIX advisory lock, released when the
+    process ends however it ends; nothing on systems without one.
+
+    Raises
+    ------
+    MasonryError
+        Another process holds ``path``.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        if fcntl is not None:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                raise MasonryError(f"{path} is in use by another process (another "
+                                   f"'masonry optimize' of this study into this --out): "
+                                   f"wait for it to end, or give another --out") from None
         yield
     finally:
         os.close(fd)  # closing releases the lock
@@ -472,3 +500,30 @@ def _round_trip(value):
     """``value`` as it reads back from ``run.json`` (tuples as lists, numpy values plain),
     for comparisons with a record."""
     return json.loads(strict_json(value))
+
+
+def source_file(path) -> str:
+    """The absolute path of the file a study's folder is named after, as its ``run.json``
+    records it (``study_file``): :func:`check_study_folder`."""
+    return str(Path(path).resolve())
+
+
+def check_study_folder(out_root, name: str, study_file) -> None:
+    """Refuse ``out_root/name`` (a study's folder, named after its file) to a study
+    file other than the one whose folder it is (``run.json``'s ``study_file``): two
+    studies of one file name in different folders would overwrite each other's.
+
+    Raises
+    ------
+    ParameterError
+        Named ``study``, with the folder and the other file.
+    """
+    try:
+        record = json.loads((Path(out_root) / name / "run.json").read_text())
+    except (OSError, ValueError):
+        return
+    other = record.get("study_file") if isinstance(record, dict) else None
+    if isinstance(other, str) and other != source_file(study_file):
+        raise ParameterError("study", str(study_file), f"a study file whose name no other "
+                             f"study's folder in {out_root} has: {name} is that of {other}; "
+                             f"rename this file or give another --out")

@@ -132,6 +132,12 @@ MIN_LIVE_LOAD_N = 1e-9
 (the dead load's weight over the load) passes 1e13 for a 0.1 m brick and overflows to
 infinity below about 1e-300 N; no structure is asked about a nanonewton."""
 
+MAX_LIVE_LOAD_N = 1e12
+"""Newtons. A point or crown load larger than this is refused: the squares of forces of
+1e154 N and more overflow, and long before that the blocks' own weight (a brick's is tens
+of newtons) falls below the solvers' relative accuracy beside the load. 1e12 N is the
+weight of a hundred million tonnes."""
+
 # ---------------------------------------------------------------------- model (dome/)
 UNIT_SLACK = 1e-9
 """Brick units. Positions along the flattened section (pattern cells, joints, the
@@ -257,6 +263,16 @@ THICKNESS_RTOL = 1e-4
 """Default relative width of the final bracket of the arch's minimum-thickness
 bisection (:func:`masonry.studies.thickness.minimum_thickness`, ``masonry
 arch-thickness --rtol``)."""
+
+MIN_SEARCH_RTOL = 1e-15
+"""The least relative width a search by bisection takes (``masonry arch-thickness
+--rtol``): a few units in the last place of a float64 (2.2e-16); a bracket narrower than
+that cannot shrink, and the search would never end."""
+
+MIN_THICKNESS_BLOCKS = 4
+"""The fewest voussoirs whose minimum thickness is searched: an arch needs four hinges
+to move, and one of three voussoirs has only four joints, so it stands at every
+thickness (its thrust line fits any)."""
 
 THICKNESS_LIMIT_FRACTION = 0.99
 """The thickest arch the bisection starts from is at most this fraction of the

@@ -108,7 +108,9 @@ LISTED = [
     ["--scene", "dome", "--lateral", "all", "--friction-law", "non-associative"],
     ["--pattern", "plain"], ["--pattern", ""], ["--scene", "wall", "--pattern", "none"],
     ["--scene", "arch", "--pattern", "herringbone"], ["--p", "1"],
-    ["--pattern", "none", "--p", "0"],
+    ["--pattern", "none", "--p", "0"], ["--friction-cone", "polygon:\u00b2"],
+    ["--crown-load", "1e308"], ["--crown-load", "1e13"],
+    ["--scene", "dome", "--point-load", "*:1e13,0,0"],
 ]
 RUN_ONLY = [["--scene", "arch", "--boundary", "cyclic"], ["--scene", "wall", "--dome"],
             ["--friction", "none"], ["--solver", "gurobi"]]
@@ -133,6 +135,9 @@ OTHER_COMMANDS = [
     ["stages", "--n", "1000000"], ["stages", "--scene", "arch", "--by", "course"],
     ["stages", "--scene", "dome", "--lateral", "all"], ["stages", "--lateral", "30"],
     ["stages", "--scene", "dome", "--lateral", "north"],
+    ["arch-thickness", "--blocks", "2"], ["arch-thickness", "--blocks", "3"],
+    ["arch-thickness", "--blocks", "4", "--rtol", "1e-17"],
+    ["arch-thickness", "--solver", "highs-ipm"], ["stages", "--support-below", "0"],
 ]
 
 
@@ -228,6 +233,8 @@ STUDIES = {
     "empty_list": "[grid]\nmu = []\n", "preset": "[base]\npreset = 7\n",
     "pattern": '[grid]\npattern = ["herringbone", "plain"]\n',
     "pattern_p1": '[base]\np = 1\n[grid]\npattern = ["none", "herringbone"]\n',
+    "stages_list": '[grid]\nmu = [0.7]\n[outputs]\nstages = ["course"]\n',
+    "seed_negative": "[sample]\nmu = [0.5, 0.7]\ncount = 2\nseed = -1\n",
     "latin1": None,
 }
 

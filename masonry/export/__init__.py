@@ -17,7 +17,7 @@ import numpy as np
 
 from masonry.blocks import whole_of_web
 from masonry.export import csv, html, obj, rhino, stl, summaries, threemf, vtu
-from masonry.printable import printable_blocks, printable_body
+from masonry.printable import PrintableError, printable_blocks, printable_body
 from masonry.rbe.equilibrium import VariableLayout
 from masonry.rbe.resultants import interface_resultants
 from masonry.tolerances import TENSION_REPORTED_REL
@@ -277,11 +277,19 @@ def _collapse_files(made: RunOutputs) -> Export:
 
 
 def _printable_files(made: RunOutputs) -> Export:
-    blocks, vertices, copies = printable_blocks(made.scene, made.params.analysis.boundary,
-                                                made.outputs.cad_offset)
-    body, report = printable_body(blocks, vertices, copies=copies)
-    data = stl.stl_bytes(body)
-    report["readback"] = stl.readback_check(data, report["volume_m3"])
+    """The printable body's files; none, with a warning and the reason in run.json's
+    ``printable.skipped``, when the blocks make no body that passes its checks (blocks
+    read from a file may touch at slivers): the body is an extra, the analysis goes on."""
+    try:
+        blocks, vertices, copies = printable_blocks(made.scene, made.params.analysis.boundary,
+                                                    made.outputs.cad_offset)
+        body, report = printable_body(blocks, vertices, copies=copies)
+        data = stl.stl_bytes(body)
+        report["readback"] = stl.readback_check(data, report["volume_m3"])
+    except PrintableError as error:
+        reason = str(error).splitlines()[0]
+        log.warning("printable body skipped (dome.stl, dome.obj): %s", reason)
+        return Export({}, {"skipped": reason})
     files = {"dome.stl": data, "dome.obj": stl.obj_body_bytes(body)}
     size = made.outputs.print_size
     if size is not None:

@@ -18,10 +18,10 @@ INTEGER_COLUMNS = ("id", "rank", "brick", "block", "block_a", "block_b", "course
                    "course_a", "course_b", "vertex", "vertices", "stage", "bricks", "step",
                    "variant", "interfaces", "stages", "stages_standing",
                    "first_unsupported_stage", "first_unsupported_course",
-                   "first_unsupported_brick", "trial")
+                   "first_unsupported_brick", "trial", "loose")
 TEXT_COLUMNS = ("name", "name_a", "name_b", "class", "kind", "laid", "status", "error",
                 "friction_used", "friction_model", "structure_id")
-BOOLEAN_COLUMNS = ("feasible", "loose", "stands", "constraints_met", "best")
+BOOLEAN_COLUMNS = ("feasible", "stands", "constraints_met", "best")
 """The columns of masonry's CSV files that are not floats, by type: :func:`column_types`."""
 
 
@@ -37,6 +37,15 @@ def column_types(names) -> dict:
     :func:`masonry.read_table` does it."""
     return {name: "Int64" if name in INTEGER_COLUMNS else "str" if name in TEXT_COLUMNS
             else "boolean" if name in BOOLEAN_COLUMNS else "float64" for name in names}
+
+
+def missing_values(names) -> dict:
+    """The cells of masonry's CSV columns ``names`` that read as missing (pandas
+    ``na_values``): an empty cell in every column, and ``nan`` in a float column (what
+    :func:`~masonry.export._text.format_floats` prints for NaN: a point of application
+    that does not exist). A name's ``nan`` stays text."""
+    return {name: ["", "nan"] if dtype == "float64" else [""]
+            for name, dtype in column_types(names).items()}
 
 
 def _table(columns) -> bytes:

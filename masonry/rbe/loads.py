@@ -26,7 +26,7 @@ import numpy as np
 from masonry.blocks import BLOCK_CLASSES
 from masonry.errors import ParameterError
 from masonry.parameters import text_of
-from masonry.tolerances import MIN_LIVE_LOAD_N, G
+from masonry.tolerances import MAX_LIVE_LOAD_N, MIN_LIVE_LOAD_N, G
 
 PATTERN = BLOCK_CLASSES.index("pattern")
 
@@ -233,6 +233,8 @@ def parse_point_load(spec: str) -> tuple:
         raise ParameterError("point_loads", spec, f"a force of at least {MIN_LIVE_LOAD_N:g} "
                                                   "N (a smaller one has no finite load "
                                                   "factor)")
+    if max(abs(v) for v in force) > MAX_LIVE_LOAD_N:
+        raise ParameterError("point_loads", spec, f"forces of at most {MAX_LIVE_LOAD_N:g} N")
     return pattern, force
 
 
@@ -335,6 +337,9 @@ def live_load(lateral=None, point_loads=(), crown_load=None):
             raise ParameterError("crown_load", crown_load,
                                  f">= {MIN_LIVE_LOAD_N:g} (newtons, downward; a smaller "
                                  f"load has no finite load factor)")
+        if crown_load > MAX_LIVE_LOAD_N:
+            raise ParameterError("crown_load", crown_load,
+                                 f"at most {MAX_LIVE_LOAD_N:g} (newtons)")
         given.append(("crown_load", crown_load, CrownLoad(float(crown_load))))
     if len(given) > 1:
         raise ParameterError(*given[1][:2], "one live load per run: --lateral, --point-load "

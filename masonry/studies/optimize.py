@@ -27,7 +27,8 @@ from pathlib import Path
 
 import numpy as np
 
-from masonry.errors import ParameterError
+from masonry.errors import MasonryError, ParameterError
+from masonry.runfolder import alone, source_file
 
 log = logging.getLogger(__name__)
 
@@ -85,7 +86,7 @@ class Search:
         ParameterError
             Named ``maximize`` (or ``minimize``) for a missing objective, a column that
             is no number of the summary (as ``summary.csv`` names it) or a column given
-            twice; ``trials``, ``batch`` or ``sampler`` out of range; ``study`` for a
+            twice; ``trials``, ``batch``, ``seed`` or ``sampler`` out of range; ``study`` for a
             study without search space or with a choice that is not a number, string or
             boolean.
         """
@@ -108,6 +109,8 @@ class Search:
         for name, value, ok, expected in (
                 ("trials", self.trials, self.trials >= 1, "an integer >= 1"),
                 ("batch", self.batch, self.batch >= 1, "an integer >= 1"),
+                ("seed", self.seed, isinstance(self.seed, int) and self.seed >= 0,
+                 "an integer >= 0"),
                 ("sampler", self.sampler, self.sampler in SAMPLERS,
                  f"one of {', '.join(SAMPLERS)}")):
             if not ok:
@@ -198,6 +201,11 @@ def open_study(search: Search, journal, label: str):
     Returns
     -------
     optuna.Study
+
+    Raises
+    ------
+    MasonryError
+        ``journal`` is not an Optuna journal (corrupt, another file).
     """
     import optuna
     from optuna.storages import JournalStorage
@@ -205,15 +213,41 @@ def open_study(search: Search, journal, label: str):
     from optuna.trial import TrialState
 
     _quiet_optuna()
-    storage = JournalStorage(JournalFileBackend(str(journal)))
-    study = optuna.create_study(
-        study_name=search.journal_name(label), storage=storage, load_if_exists=True,
-        directions=[direction for _, direction in search.objectives])
+    try:
+        _check_entries(journal)
+        storage = JournalStorage(JournalFileBackend(str(journal)))
+        storage.get_all_studies()  # replayed through before anything is written to it
+        study = optuna.create_study(
+            study_name=search.journal_name(label), storage=storage, load_if_exists=True,
+            directions=[direction for _, direction in search.objectives])
+    except (ValueError, KeyError, TypeError, IndexError, AssertionError) as error:
+        # JSON, UTF-8 or a log entry Optuna cannot replay: not a journal it wrote
+        raise MasonryError(f"{journal}: expected the Optuna journal of an optimisation "
+                           f"({type(error).__name__}: {_first_line(error)}); move it "
+                           f"away to start again") from None
     for trial in study.get_trials(deepcopy=False, states=(TrialState.RUNNING,)):
         study.tell(trial.number, state=TrialState.FAIL)
         study.enqueue_trial(trial.params)
         log.info("trial %d was not finished: queued again", trial.number)
     return study
+
+
+def _check_entries(journal):
+    """Raise ValueError unless every whole line of ``journal`` (if it exists) is a JSON
+    object: Optuna takes a last line that is not one for a write cut short, and would
+    append after it, leaving a journal that no run can read again."""
+    try:
+        with open(journal, "rb") as f:
+            for line in f:
+                if line.endswith(b"\n") and not isinstance(json.loads(line), dict):
+                    raise ValueError(f"a line that is no log entry: {line[:40]!r}")
+    except FileNotFoundError:
+        return
+
+
+def _first_line(error) -> str:
+    lines = str(error).strip().splitlines()
+    return lines[0] if lines else "unreadable"
 
 
 def evaluated(study) -> list:
@@ -252,11 +286,12 @@ def optimise(search: Search, out_root, journal, label, workers=1, scheduler=None
 
     if scheduler is not None:
         check_scheduler_address(scheduler)
-    study = open_study(search, journal, label)
     options = search.study.options()
-    done = evaluated(study)
-    failed = sum(t.state == TrialState.FAIL for t in done)
-    with Runner(out_root, options, workers, scheduler) as runner:
+    # the workers first: a scheduler that does not answer is refused before the journal
+    with Runner(out_root, options, workers, scheduler) as runner, alone(journal):
+        study = open_study(search, journal, label)
+        done = evaluated(study)
+        failed = sum(t.state == TrialState.FAIL for t in done)
         while len(done) < min(search.trials, search.size() or search.trials):
             size = min(search.batch - len(done) % search.batch, search.trials - len(done))
             study.sampler = _sampler(search, len(done) // search.batch)
@@ -410,11 +445,13 @@ def trial_columns(search: Search) -> list:
     return ["trial", *search.inputs, *results, "constraints_met", "best"]
 
 
-def publish_trials(search: Search, rows, out_root, name: str, journal, label="") -> dict:
+def publish_trials(search: Search, rows, out_root, name: str, journal, label="",
+                   study_file=None) -> dict:
     """The optimisation's folder ``out_root/name``: ``trials.csv``, ``convergence.png``
     and ``run.json`` (the search, the trials' counts, the best trials with their inputs,
-    values and run folders, the journal's path), published by the run-folder protocol
-    and always written again (it sums up every trial of the journal).
+    values and run folders, the journal's path, the study's file if given:
+    :func:`~masonry.runfolder.check_study_folder`), published by the run-folder
+    protocol and always written again (it sums up every trial of the journal).
 
     Returns
     -------
@@ -440,6 +477,8 @@ def publish_trials(search: Search, rows, out_root, name: str, journal, label="")
                          "constraints_met": sum(bool(r["constraints_met"]) for r in rows)},
               "best": best, "journal": str(journal),
               "versions": {**versions(), "optuna": optuna.__version__}}
+    if study_file is not None:
+        record["study_file"] = source_file(study_file)
 
     def write(folder):
         folder.write("trials.csv", summary_csv(search.study, rows, trial_columns(search)))

@@ -32,7 +32,7 @@ from masonry.errors import ParameterError
 from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run, versions
 from masonry.studies.stages import run_stages, stage_params
-from masonry.runfolder import Publication
+from masonry.runfolder import Publication, source_file
 from masonry.forking import use_one_blas_thread
 
 log = logging.getLogger(__name__)
@@ -651,9 +651,11 @@ def summary_pngs(study: Study, rows, label="") -> dict:
     return out
 
 
-def publish_summary(study: Study, rows, out_root, name: str, label="") -> dict:
+def publish_summary(study: Study, rows, out_root, name: str, label="",
+                    study_file=None) -> dict:
     """The study's folder ``out_root/name``: ``summary.csv``, ``summary.parquet`` (with
-    pyarrow), the summary plots and ``run.json``, published by the run-folder protocol
+    pyarrow), the summary plots and ``run.json`` (with ``study_file``, the study's file
+    if given: :func:`~masonry.runfolder.check_study_folder`), published by the run-folder protocol
     (:class:`masonry.runfolder.Publication`). It is always written again: it sums up this
     run's variants, and a variant that ran before is reused, so nothing it held is lost.
 
@@ -666,6 +668,8 @@ def publish_summary(study: Study, rows, out_root, name: str, label="") -> dict:
     identity = {"study": dataclasses.asdict(study)}
     record = {**identity, "complete": True, "outputs": {"plots": True}, "variants": counts,
               "versions": versions()}
+    if study_file is not None:
+        record["study_file"] = source_file(study_file)
 
     def write(folder):
         folder.write("summary.csv", summary_csv(study, rows))

@@ -14,11 +14,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonry.interfaces import detect
-from masonry.errors import ParameterError
+from masonry.errors import MasonryError, ParameterError
 from masonry.params import Params, validate
 from masonry.rbe.solve import solve_rbe
 from masonry.scenes.arch import arch_radius, build_arch
-from masonry.tolerances import THICKNESS_BRACKET, THICKNESS_LIMIT_FRACTION, THICKNESS_RTOL
+from masonry.tolerances import (MIN_SEARCH_RTOL, MIN_THICKNESS_BLOCKS, THICKNESS_BRACKET,
+                                THICKNESS_LIMIT_FRACTION, THICKNESS_RTOL)
 
 log = logging.getLogger(__name__)
 
@@ -66,8 +67,9 @@ def minimum_thickness(params: Params, rtol=THICKNESS_RTOL,
     ignored), by bisection on :func:`is_feasible`.
 
     Bisection is geometric (on log t) and stops when the feasible and infeasible
-    thicknesses differ by less than ``rtol`` of the feasible one; it assumes one
-    threshold (thicker arches stand, thinner ones fall).
+    thicknesses differ by less than ``rtol`` of the feasible one, or when the bracket
+    no longer shrinks (floats next to each other); it assumes one threshold (thicker
+    arches stand, thinner ones fall).
 
     Parameters
     ----------
@@ -84,13 +86,22 @@ def minimum_thickness(params: Params, rtol=THICKNESS_RTOL,
     Raises
     ------
     ParameterError
-        ``rtol`` is not in (0, 1); or the upper end is infeasible (the arch slides at
-        every thickness: named ``mu``).
-    ValueError
-        The lower end of ``bracket`` is feasible (lower it).
+        ``rtol`` is not in [:data:`~masonry.tolerances.MIN_SEARCH_RTOL`, 1); fewer than
+        :data:`~masonry.tolerances.MIN_THICKNESS_BLOCKS` voussoirs (they stand at every
+        thickness: named ``arch_blocks``); or the upper end is infeasible (the arch slides
+        at every thickness: named ``mu``).
+    MasonryError
+        The lower end of ``bracket`` is feasible: the minimum lies below it.
     """
-    if not (isinstance(rtol, float | int) and 0 < rtol < 1):
-        raise ParameterError("rtol", rtol, "a relative width between 0 and 1 (exclusive)")
+    if not (isinstance(rtol, float | int) and not isinstance(rtol, bool)
+            and MIN_SEARCH_RTOL <= rtol < 1):
+        raise ParameterError("rtol", rtol, f"a relative width from {MIN_SEARCH_RTOL:g} "
+                             f"(machine precision) to 1 (exclusive)")
+    if params.geometry.arch_blocks < MIN_THICKNESS_BLOCKS:
+        raise ParameterError("arch_blocks", params.geometry.arch_blocks,
+                             f"at least {MIN_THICKNESS_BLOCKS} voussoirs: an arch of fewer "
+                             f"has too few joints for the four hinges of a mechanism and "
+                             f"stands at every thickness")
     start = time.perf_counter()
     arch = params.geometry
     radius, _ = arch_radius(arch.arch_shape, arch.arch_span, arch.arch_rise)
@@ -109,9 +120,12 @@ def minimum_thickness(params: Params, rtol=THICKNESS_RTOL,
                              f"a friction coefficient at which the arch stands: it falls "
                              f"even at t/R = {hi:g}, so its voussoirs slide")
     if feasible(lo):
-        raise ValueError(f"the arch stands already at t/R = {lo:g}: lower the bracket")
+        raise MasonryError(f"the arch stands already at t/R = {lo:g}, the thinnest the "
+                           f"search tries: its minimum thickness is below that")
     while hi / lo - 1 > rtol:
-        mid = float(np.sqrt(lo * hi))
+        mid = float(lo * np.sqrt(hi / lo))  # not sqrt(lo * hi): that underflows first
+        if not lo < mid < hi:  # the bracket is two neighbouring floats: it cannot shrink
+            break
         if feasible(mid):
             hi = mid
         else:
