@@ -1,13 +1,16 @@
 """Entry point of the ``masonry`` command. ``main(argv)`` returns the exit code.
 
-The command itself is :mod:`masonry_cli.app`. It is imported here, inside ``main``, so
-that Ctrl-C while numpy, scipy and the solvers load (a second or two) ends as an
-interruption like any other, with exit code 130 and no traceback. ``--version`` answers
-without it.
+The command itself is :mod:`masonry_cli.app`. It is imported here, inside ``main`` and
+after SIGTERM's handler is installed, so that Ctrl-C or ``kill`` while numpy, scipy and
+the solvers load (a second or two), or while the command's options are built, ends as an
+interruption like any other: one line, exit code 130 or 143, no traceback. ``--version``
+answers without it.
 """
 
 import os
 import sys
+
+from .interrupts import heard, interrupted
 
 BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
 """BLAS runs on one thread in the command (:func:`masonry.forking.use_one_blas_thread`,
@@ -26,11 +29,12 @@ def main(argv=None) -> int:
         print(f"masonry {__version__}")
         return 0
     try:
-        from masonry_cli import app
-    except KeyboardInterrupt:
-        print("masonry: interrupted while starting", file=sys.stderr)
-        return 130
-    return app.main(argv)
+        with heard():
+            from masonry_cli import app
+
+            return app.main(argv)
+    except KeyboardInterrupt as interrupt:  # before the command's own handling, or after
+        return interrupted(interrupt)
 
 
 if __name__ == "__main__":

@@ -9,6 +9,7 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from masonry.errors import ParameterError
+from masonry.optional import optional_import
 from masonry.parameters import read_toml
 from masonry.params import PRESETS, Params, names, validate
 from masonry.runfolder import check_output_root
@@ -61,13 +62,10 @@ def resolve_cluster(args):
     workers, scheduler = args.workers, args.scheduler
     if workers < 1:
         raise ParameterError("workers", workers, "an integer >= 1")
-    if workers > 1 or scheduler:
-        try:
-            import dask.distributed  # noqa: F401
-        except ImportError:
-            log.warning("Dask is not installed: running serially. For workers or a "
-                        "cluster: pip install 'masonry[dask]'")
-            return 1, None
+    if (workers > 1 or scheduler) and optional_import("dask.distributed") is None:
+        log.warning("Dask is not installed: running serially. For workers or a "
+                    "cluster: pip install 'masonry[dask]'")
+        return 1, None
     if scheduler is not None:
         from masonry.studies.sweep import check_scheduler_address
 

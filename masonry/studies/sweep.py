@@ -34,6 +34,7 @@ from masonry.pipeline import run, versions
 from masonry.studies.stages import run_stages, stage_params
 from masonry.runfolder import Publication
 from masonry.forking import use_one_blas_thread
+from masonry.optional import optional_import, raise_interrupt
 
 log = logging.getLogger(__name__)
 
@@ -276,6 +277,7 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
         staged = None if stages is None else run_stages(
             stage_params(params, "boundary" in inputs), out_root, **stages)
     except Exception as error:  # a variant's failure is data, not the study's end
+        raise_interrupt(error)  # an interrupt an extension's loader made an ImportError
         row["error"] = f"{type(error).__name__}: {error}"
         log.debug("variant failed: %s", traceback.format_exc())
     else:
@@ -548,10 +550,8 @@ def summary_csv(study: Study, rows, columns=None) -> bytes:
 def summary_parquet(study: Study, rows):
     """Parquet bytes of :func:`summary_rows` (same columns as :func:`summary_csv`), or
     None when pyarrow is not installed."""
-    try:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-    except ImportError:
+    pa, pq = optional_import("pyarrow"), optional_import("pyarrow.parquet")
+    if pa is None or pq is None:
         return None
     columns = study.columns
     table = pa.table({HEADERS.get(c, c): [None if r.get(c) is None else str(r.get(c))
