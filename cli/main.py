@@ -3,14 +3,13 @@
 The command itself is :mod:`masonry_cli.app`. It is imported here, inside ``main`` and
 after SIGTERM's handler is installed, so that Ctrl-C or ``kill`` while numpy, scipy and
 the solvers load (a second or two), or while the command's options are built, ends as an
-interruption like any other: one line, exit code 130 or 143, no traceback. ``--version``
-answers without it.
+interruption like any other: one line, exit code 130 or 143, no traceback. This module
+imports nothing else before ``main`` runs (what loads before it, Python's start and the
+launcher's import of this module, is out of its reach). ``--version`` answers without it.
 """
 
 import os
 import sys
-
-from .interrupts import heard, interrupted
 
 BLAS_THREADS = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "BLIS_NUM_THREADS")
 """BLAS runs on one thread in the command (:func:`masonry.forking.use_one_blas_thread`,
@@ -29,11 +28,15 @@ def main(argv=None) -> int:
         print(f"masonry {__version__}")
         return 0
     try:
-        with heard():
-            from masonry_cli import app
+        from . import interrupts
+
+        with interrupts.heard():
+            from . import app
 
             return app.main(argv)
     except KeyboardInterrupt as interrupt:  # before the command's own handling, or after
+        from .interrupts import interrupted  # loaded again if the interrupt stopped it
+
         return interrupted(interrupt)
 
 
