@@ -35,6 +35,7 @@ from masonry.studies.stages import run_stages, stage_params
 from masonry.runfolder import Publication
 from masonry.forking import use_one_blas_thread
 from masonry.optional import optional_import, raise_interrupt
+from masonry.studies.workers import WORKER_LOG_LEVEL, quiet_shutdown
 
 log = logging.getLogger(__name__)
 
@@ -371,7 +372,8 @@ class Runner:
     workers : int
         1 and no ``scheduler``: serially, in this process. More: on a Dask
         ``LocalCluster`` of ``workers`` single-threaded processes (which ignore Ctrl-C:
-        this process stops them).
+        this process stops them); :func:`masonry.studies.workers.local_workers` says
+        how many.
     scheduler : str, optional
         The address of a running Dask scheduler (``tcp://host:port``), used instead of a
         local cluster. A worker lost while it runs a variant (killed, its machine gone) is
@@ -399,7 +401,8 @@ class Runner:
                 warnings.filterwarnings("ignore", message="Port .* is already in use")
                 self.cluster = LocalCluster(
                     n_workers=self.workers, threads_per_worker=1, processes=True,
-                    host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR)
+                    host="127.0.0.1", dashboard_address=None,
+                    silence_logs=WORKER_LOG_LEVEL)
         try:
             self.client = Client(self.cluster if self.cluster is not None
                                  else self.scheduler)
@@ -412,10 +415,11 @@ class Runner:
         return self
 
     def __exit__(self, *exc):
-        if self.client is not None:
-            self.client.close()
-        if self.cluster is not None:
-            self.cluster.close()
+        with quiet_shutdown():  # the client first: the cluster's end is then no surprise
+            if self.client is not None:
+                self.client.close()
+            if self.cluster is not None:
+                self.cluster.close()
         return False
 
     def map(self, variants: list):
