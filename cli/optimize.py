@@ -66,8 +66,7 @@ def handle(args, report):
     seed = args.seed if args.seed is not None else study.seed
     search = Search(study, tuple(args.objectives), args.trials, seed, args.batch,
                     args.sampler).checked()
-    asked = args.workers is not None or args.scheduler is not None
-    workers, scheduler = resolve_cluster(args, [] if asked else search.estimated_bricks())
+    workers, scheduler = resolve_cluster(args, search.estimated_bricks)
     from masonry.studies.optimize import draw_best, optimise, publish_trials
     stem = Path(args.study).stem
     out = Path(args.out)

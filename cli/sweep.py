@@ -58,8 +58,8 @@ def check_workers(args):
 
 def resolve_cluster(args, bricks):
     """``(workers, scheduler)`` from ``--workers`` and ``--scheduler``, checked; without
-    ``--workers``, serially or one worker per core as the study's estimated ``bricks``
-    (one per variant) say (:func:`masonry.studies.workers.local_workers`); serially
+    either, serially or one worker per core as the study's estimated blocks say
+    (``bricks()``, one per variant: :func:`masonry.studies.workers.local_workers`); serially
     (1, None), with a warning, when Dask is not installed. Dask loads here: call it once
     the study is read.
 
@@ -71,8 +71,9 @@ def resolve_cluster(args, bricks):
     from masonry.studies.workers import local_workers
 
     check_workers(args)
-    scheduler = args.scheduler
-    workers = 1 if scheduler else local_workers(bricks, args.workers)
+    workers, scheduler = args.workers, args.scheduler
+    if workers is None:
+        workers = 1 if scheduler else local_workers(bricks())
     if (workers > 1 or scheduler) and optional_import("dask.distributed") is None:
         log.warning("Dask is not installed: running serially. For workers or a "
                     "cluster: pip install 'masonry[dask]'")
@@ -369,9 +370,8 @@ def handle(args, report):
 
     variants = study.variants()
     total = len(variants)
-    asked = args.workers is not None or args.scheduler is not None
     workers, scheduler = resolve_cluster(
-        args, [] if asked else [estimated_bricks(inputs) for inputs in variants])
+        args, lambda: [estimated_bricks(inputs) for inputs in variants])
     show = sys.stderr.isatty() and not args.quiet and not args.verbose
     results, failed = [], 0
     with quiet_progress(show):
