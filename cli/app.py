@@ -10,7 +10,6 @@ previous output is untouched.
 
 import logging
 import os
-import signal
 import sys
 import tempfile
 import time
@@ -23,15 +22,12 @@ from masonry.forking import use_one_blas_thread
 
 from . import (analyze, arch_thickness, bench, build, optimize, run, stages, structures,
                sweep)
+from .interrupts import interrupt_behind, interrupted
 from .options import Parser, describe_error, option_names, typed_values
 from .streams import silence_stdout
 
 SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, optimize, bench,
                stages)
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM (``kill``, ``timeout``), handled like Ctrl-C: runs unwind and clean up."""
 
 
 def make_parser(argv=None):
@@ -80,22 +76,21 @@ def main(argv=None) -> int:
 
     stdout_gone = []
 
-    previous = _on_sigterm(_terminate)
-    try:
+    try:  # inside masonry_cli.main's interrupts.heard(): SIGTERM raises Terminated
         return args.handler(args, report)
     except MasonryError as error:
         print(f"masonry: error: {describe_error(error, args)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as interrupt:
-        print("masonry: interrupted; the previous output is untouched", file=sys.stderr)
-        return 143 if isinstance(interrupt, Terminated) else 130
+        return interrupted(interrupt)
     except Exception as error:  # anything unexpected: one line, the traceback in a log
+        interrupt = interrupt_behind(error)
+        if interrupt is not None:  # raised as another error by an extension's loader
+            return interrupted(interrupt)
         log_file = write_failure_log(argv)
         print(f"masonry: internal error: {type(error).__name__}: {_first_line(error)}; the "
               f"previous output is untouched; details in {log_file}", file=sys.stderr)
         return 1
-    finally:
-        _on_sigterm(previous)
 
 
 class _StderrHandler(logging.StreamHandler):
@@ -112,21 +107,6 @@ def _log_to_stderr(level):
     handler.setFormatter(logging.Formatter("masonry: %(message)s"))
     root.addHandler(handler)
     root.setLevel(level)
-
-
-def _terminate(signum, frame):
-    raise Terminated()
-
-
-def _on_sigterm(handler):
-    """Install ``handler`` for SIGTERM; returns the previous one (None off the main
-    thread, where signals cannot be handled)."""
-    if handler is None:
-        return None
-    try:
-        return signal.signal(signal.SIGTERM, handler)
-    except ValueError:
-        return None
 
 
 def _first_line(error) -> str:

@@ -1,9 +1,11 @@
 """Entry point of the ``masonry`` command. ``main(argv)`` returns the exit code.
 
-The command itself is :mod:`masonry_cli.app`. It is imported here, inside ``main``, so
-that Ctrl-C while numpy, scipy and the solvers load (a second or two) ends as an
-interruption like any other, with exit code 130 and no traceback. ``--version`` answers
-without it.
+The command itself is :mod:`masonry_cli.app`. It is imported here, inside ``main`` and
+after SIGTERM's handler is installed, so that Ctrl-C or ``kill`` while numpy, scipy and
+the solvers load (a second or two), or while the command's options are built, ends as an
+interruption like any other: one line, exit code 130 or 143, no traceback. This module
+imports nothing else before ``main`` runs (what loads before it, Python's start and the
+launcher's import of this module, is out of its reach). ``--version`` answers without it.
 """
 
 import os
@@ -31,11 +33,16 @@ def main(argv=None) -> int:
             silence_stdout()
         return 0
     try:
-        from masonry_cli import app
-    except KeyboardInterrupt:
-        print("masonry: interrupted while starting", file=sys.stderr)
-        return 130
-    return app.main(argv)
+        from . import interrupts
+
+        with interrupts.heard():
+            from . import app
+
+            return app.main(argv)
+    except KeyboardInterrupt as interrupt:  # before the command's own handling, or after
+        from .interrupts import interrupted  # loaded again if the interrupt stopped it
+
+        return interrupted(interrupt)
 
 
 if __name__ == "__main__":

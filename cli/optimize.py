@@ -10,8 +10,8 @@ from masonry.errors import ParameterError
 from masonry.runfolder import check_output_root, check_study_folder
 from masonry.studies.optimize import SAMPLERS, Search
 
-from .sweep import (add_cluster_options, load_study, progress_bar, quiet_progress,
-                    resolve_cluster)
+from .sweep import (add_cluster_options, check_workers, load_study, progress_bar,
+                    quiet_progress, resolve_cluster)
 
 log = logging.getLogger("masonry")
 
@@ -61,14 +61,13 @@ def register(subparsers):
 
 
 def handle(args, report):
-    if args.workers < 1:
-        raise ParameterError("workers", args.workers, "an integer >= 1")
+    check_workers(args)
     check_output_root(args.out)
     study = load_study(args.study, draws=False)
     seed = args.seed if args.seed is not None else study.seed
     search = Search(study, tuple(args.objectives), args.trials, seed, args.batch,
                     args.sampler).checked()
-    workers, scheduler = resolve_cluster(args)
+    workers, scheduler = resolve_cluster(args, search.estimated_bricks)
     from masonry.studies.optimize import draw_best, optimise, publish_trials
     stem = Path(args.study).stem
     check_study_folder(args.out, f"optimize_{stem}", args.study)

@@ -3,12 +3,12 @@
 import dataclasses
 import logging
 import math
-import os
 import sys
 from contextlib import contextmanager
 from pathlib import Path
 
 from masonry.errors import ParameterError
+from masonry.optional import optional_import
 from masonry.parameters import read_toml
 from masonry.params import PRESETS, Params, names, validate
 from masonry.runfolder import check_output_root, check_study_folder
@@ -36,9 +36,11 @@ def register(subparsers):
 def add_cluster_options(parser):
     """Where the variants run and go: ``--workers``, ``--scheduler``, ``--out``, and the
     verbosity options (sweeps and optimisations)."""
-    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1,
-                        help="local Dask worker processes (default: one per core); 1 runs "
-                             "serially without Dask")
+    parser.add_argument("--workers", type=int, default=None,
+                        help="local Dask worker processes; 1 runs serially without Dask. "
+                             "Default: serially when the variants are few or small (their "
+                             "estimated blocks add up to fewer than 5,000), else one per "
+                             "core")
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (its "
                              "workers must reach --out)")
@@ -48,8 +50,16 @@ def add_cluster_options(parser):
     add_verbosity(parser)
 
 
-def resolve_cluster(args):
-    """``(workers, scheduler)`` from ``--workers`` and ``--scheduler``, checked; serially
+def check_workers(args):
+    """Refuse ``--workers`` below 1."""
+    if args.workers is not None and args.workers < 1:
+        raise ParameterError("workers", args.workers, "an integer >= 1")
+
+
+def resolve_cluster(args, bricks):
+    """``(workers, scheduler)`` from ``--workers`` and ``--scheduler``, checked; without
+    either, serially or one worker per core as the study's estimated blocks say
+    (``bricks()``, one per variant: :func:`masonry.studies.workers.local_workers`); serially
     (1, None), with a warning, when Dask is not installed. Dask loads here: call it once
     the study is read.
 
@@ -58,16 +68,16 @@ def resolve_cluster(args):
     ParameterError
         For ``--workers`` below 1 or a scheduler address Dask cannot parse.
     """
+    from masonry.studies.workers import local_workers
+
+    check_workers(args)
     workers, scheduler = args.workers, args.scheduler
-    if workers < 1:
-        raise ParameterError("workers", workers, "an integer >= 1")
-    if workers > 1 or scheduler:
-        try:
-            import dask.distributed  # noqa: F401
-        except ImportError:
-            log.warning("Dask is not installed: running serially. For workers or a "
-                        "cluster: pip install 'masonry[dask]'")
-            return 1, None
+    if workers is None:
+        workers = 1 if scheduler else local_workers(bricks())
+    if (workers > 1 or scheduler) and optional_import("dask.distributed") is None:
+        log.warning("Dask is not installed: running serially. For workers or a "
+                    "cluster: pip install 'masonry[dask]'")
+        return 1, None
     if scheduler is not None:
         from masonry.studies.sweep import check_scheduler_address
 
@@ -352,16 +362,18 @@ def quiet_progress(show: bool):
 
 
 def handle(args, report):
-    if args.workers < 1:
-        raise ParameterError("workers", args.workers, "an integer >= 1")
+    check_workers(args)
     check_output_root(args.out)
     study = load_study(args.study)
     from masonry.studies.sweep import execute, publish_summary, summary_rows
+    from masonry.studies.workers import estimated_bricks
 
     stem = Path(args.study).stem
     check_study_folder(args.out, f"sweep_{stem}", args.study)
-    total = len(study.variants())  # validates the study before any run
-    workers, scheduler = resolve_cluster(args)
+    variants = study.variants()  # validates the study before any run
+    total = len(variants)
+    workers, scheduler = resolve_cluster(
+        args, lambda: [estimated_bricks(inputs) for inputs in variants])
     show = sys.stderr.isatty() and not args.quiet and not args.verbose
     results, failed = [], 0
     with quiet_progress(show):

@@ -246,10 +246,13 @@ class Forked:
 
     def __init__(self, calls):
         self.calls, self.process = list(calls), None
+        self.exitcode = None  # the process's, once closed (-N: ended by signal N)
 
     @property
     def started(self) -> bool:
-        return self.process is not None and self.process.pid is not None
+        """Whether the process started (it may have ended since)."""
+        return self.process is not None and (self.exitcode is not None
+                                             or self.process.pid is not None)
 
     def start(self) -> "Forked":
         context = multiprocessing.get_context("fork")
@@ -258,16 +261,19 @@ class Forked:
                                        args=(self.calls, self.receiver, sender, os.getpid()))
         try:
             # a signal during the fork would reach its handler inside the fork's own
-            # callbacks, which swallow the handler's exception: it waits for the fork
+            # callbacks, which drop the handler's exception: this thread takes it once
+            # forked (another thread may take it meanwhile: the command makes a dropped
+            # interrupt arrive again, masonry_cli.interrupts)
             signal.pthread_sigmask(signal.SIG_BLOCK, HELD_SIGNALS)
             try:
                 self.process.start()
             finally:
                 signal.pthread_sigmask(signal.SIG_UNBLOCK, HELD_SIGNALS)
-            sender.close()
         except BaseException:  # interrupted as it started
             self.close(cancel=True)
             raise
+        finally:  # closed here: a finalizer would drop an interrupt raised as it closes
+            sender.close()
         return self
 
     def result(self):
@@ -289,10 +295,12 @@ class Forked:
         """Wait for the process to end, or end it first (``cancel``)."""
         if self.process is None:
             return
-        if self.process.pid is not None:  # started
+        if self.exitcode is None and self.process.pid is not None:  # started, not closed
             if cancel:
                 self.process.terminate()
             self.process.join()
+            self.exitcode = self.process.exitcode
+            self.process.close()  # its pipes closed here, not by a finalizer (as above)
         self.receiver.close()
 
     def __enter__(self):

@@ -53,9 +53,13 @@ def test_what_cannot_come_back_is_a_runtime_error_that_says_why(call, message):
 
 def test_a_cancelled_process_is_gone():
     forked = forking.Forked([lambda: time.sleep(60)]).start()
-    process = forked.process
+    pid = forked.process.pid
     forked.close(cancel=True)
-    assert not process.is_alive() and process.exitcode == -signal.SIGTERM
+    assert forked.exitcode == -signal.SIGTERM
+    with pytest.raises(ChildProcessError):  # reaped: no zombie left
+        os.waitpid(pid, os.WNOHANG)
+    forked.close()  # a second close changes nothing
+    assert forked.started
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG")

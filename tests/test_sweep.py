@@ -5,6 +5,8 @@ import json
 
 import pytest
 
+from masonry import forking
+from masonry.studies import workers
 from masonry_cli.main import main
 
 STUDY = """
@@ -37,12 +39,15 @@ def study(tmp_path):
     return path
 
 
-def test_local_cluster_gives_the_serial_summary(tmp_path, study):
+def test_local_cluster_gives_the_serial_summary(tmp_path, study, capfd):
     pytest.importorskip("dask.distributed")
     assert main(["sweep", str(study), "--workers", "1", "--out", str(tmp_path / "a"),
                  "-q"]) == 0
+    capfd.readouterr()
     assert main(["sweep", str(study), "--workers", "2", "--out", str(tmp_path / "b"),
                  "-q"]) == 0
+    err = capfd.readouterr().err  # the workers' stderr too: their file descriptor
+    assert "Traceback" not in err and "CommClosedError" not in err, err
     serial, parallel = _summary(tmp_path / "a"), _summary(tmp_path / "b")
     assert len(serial) == 4 and all(r["status"] == "computed" for r in serial)
     assert _results(parallel) == _results(serial)
@@ -244,3 +249,63 @@ def test_stages_that_masonry_stages_refuses_stop_the_study_first(tmp_path, capsy
     assert main(["sweep", str(path), "--workers", "1", "--out", str(tmp_path / "x")]) == 2
     assert "bad.toml: outputs.stages = 'course'" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+def test_few_or_small_variants_run_serially_and_a_large_study_on_every_core(monkeypatch):
+    monkeypatch.setattr(forking, "cores", lambda: 4)
+    line = workers.DASK_MIN_BRICKS
+    assert workers.local_workers([90.0] * 4) == 1  # four walls of 90 bricks
+    assert workers.local_workers([line / 2, line / 2 - 1]) == 1
+    assert workers.local_workers([line / 2, line / 2]) == 4
+    assert workers.local_workers([2.0 * line]) == 1  # one variant: nothing to share
+    assert workers.local_workers([90.0] * 4, workers=2) == 2  # asked for: Dask
+    assert workers.local_workers([2.0 * line] * 8, workers=1) == 1
+    monkeypatch.setattr(forking, "cores", lambda: 1)
+    assert workers.local_workers([line] * 8) == 1
+
+
+def test_a_variant_is_estimated_at_its_blocks():
+    # an arch has exactly its voussoirs
+    assert workers.estimated_bricks({"scene": "arch", "arch_blocks": 12}) == 12
+    assert workers.estimated_bricks({"scene": "arch", "arch_blocks": 31}) == 31
+
+
+def test_a_sweep_without_workers_runs_small_studies_serially(tmp_path, study,
+                                                             monkeypatch):
+    import masonry.studies.sweep as sweep
+
+    asked = []
+    execute = sweep.execute
+
+    def recorded(study, out_root, workers=1, scheduler=None):
+        asked.append((workers, scheduler))
+        return execute(study, out_root, workers, scheduler)
+
+    monkeypatch.setattr(sweep, "execute", recorded)
+    monkeypatch.setattr(forking, "cores", lambda: 4)
+    assert main(["sweep", str(study), "--out", str(tmp_path), "-q"]) == 0
+    assert asked == [(1, None)]
+
+
+def test_benign_closed_connections_are_dropped_as_dask_stops_and_nothing_else(capsys):
+    import logging
+
+    pytest.importorskip("dask.distributed")
+    from distributed.comm.core import CommClosedError
+
+    log, dask = logging.getLogger("distributed.client"), logging.getLogger("distributed")
+    handler = logging.StreamHandler()  # on sys.stderr: capsys's
+    dask.addHandler(handler)
+    try:
+        with workers.quiet_shutdown(), pytest.raises(CommClosedError):
+            try:
+                raise CommClosedError("in <TCP (closed) Client->Scheduler>: Stream is closed")
+            except CommClosedError:
+                log.exception("Failed to reconnect to scheduler")
+                log.error("a real failure")
+                handler.flush()
+                raise
+    finally:
+        dask.removeHandler(handler)
+    err = capsys.readouterr().err
+    assert "a real failure" in err and "CommClosedError" not in err

@@ -18,6 +18,7 @@ import tempfile
 import numpy as np
 
 from masonry.blocks import BLOCK_CLASSES, Blocks
+from masonry.optional import optional_import
 
 # layer colours (RGBA), one per block class, in BLOCK_CLASSES order
 _LAYER_COLOURS = ((128, 128, 128, 255), (200, 120, 80, 255), (200, 40, 40, 255),
@@ -37,12 +38,9 @@ MISSING = ("bricks.3dm not written: rhino3dm, a dependency of masonry, is not in
 
 def available() -> bool:
     """Whether rhino3dm can be imported (an install without its dependencies, or a
-    platform without its wheels, has none)."""
-    try:
-        import rhino3dm  # noqa: F401
-    except ImportError:
-        return False
-    return True
+    platform without its wheels, has none); an interrupt during its import is raised,
+    not taken for its absence (:func:`masonry.optional.optional_import`)."""
+    return optional_import("rhino3dm") is not None
 
 
 def block_user_text(blocks: Blocks, model=None, forces=None) -> dict:
@@ -98,10 +96,9 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, is_copy=None) -> b
     ImportError
         When rhino3dm is not installed (:data:`MISSING`).
     """
-    try:
-        import rhino3dm
-    except ImportError as error:
-        raise ImportError(MISSING) from error
+    rhino3dm = optional_import("rhino3dm")
+    if rhino3dm is None:
+        raise ImportError(MISSING)
 
     vertices = blocks.vertices if vertices is None else np.asarray(vertices, dtype=float)
     user_text = {} if user_text is None else user_text

@@ -147,6 +147,17 @@ class Search:
         return {name: float(f"{value:.10g}") if isinstance(value, float) else value
                 for name, value in ((k, trial.params.get(k)) for k in self.inputs)}
 
+    def estimated_bricks(self) -> list:
+        """Every trial's estimated blocks, for choosing where the trials run
+        (:func:`masonry.studies.workers.local_workers`): each that of the variant at
+        every choice's first and every range's lower end."""
+        from masonry.studies.workers import estimated_bricks
+
+        first = {**self.study.base, **{k: v[0] for k, v in self.study.grid.items()},
+                 **{k: low for k, (low, high) in self.study.sample.items()}}
+        trials = min(self.trials, self.size() or self.trials)
+        return [estimated_bricks(first)] * trials
+
     def size(self):
         """How many variants the search space holds, or None when a range is of floats."""
         if any(not (isinstance(lo, int) and isinstance(hi, int))

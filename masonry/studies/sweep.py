@@ -34,6 +34,8 @@ from masonry.pipeline import run, versions
 from masonry.studies.stages import run_stages, stage_params
 from masonry.runfolder import Publication, source_file
 from masonry.forking import use_one_blas_thread
+from masonry.optional import optional_import, raise_interrupt
+from masonry.studies.workers import WORKER_LOG_LEVEL, quiet_shutdown
 
 log = logging.getLogger(__name__)
 
@@ -276,6 +278,7 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
         staged = None if stages is None else run_stages(
             stage_params(params, "boundary" in inputs), out_root, **stages)
     except Exception as error:  # a variant's failure is data, not the study's end
+        raise_interrupt(error)  # an interrupt an extension's loader made an ImportError
         row["error"] = f"{type(error).__name__}: {error}"
         log.debug("variant failed: %s", traceback.format_exc())
     else:
@@ -369,7 +372,8 @@ class Runner:
     workers : int
         1 and no ``scheduler``: serially, in this process. More: on a Dask
         ``LocalCluster`` of ``workers`` single-threaded processes (which ignore Ctrl-C:
-        this process stops them).
+        this process stops them); :func:`masonry.studies.workers.local_workers` says
+        how many.
     scheduler : str, optional
         The address of a running Dask scheduler (``tcp://host:port``), used instead of a
         local cluster. A worker lost while it runs a variant (killed, its machine gone) is
@@ -397,7 +401,8 @@ class Runner:
                 warnings.filterwarnings("ignore", message="Port .* is already in use")
                 self.cluster = LocalCluster(
                     n_workers=self.workers, threads_per_worker=1, processes=True,
-                    host="127.0.0.1", dashboard_address=None, silence_logs=logging.ERROR)
+                    host="127.0.0.1", dashboard_address=None,
+                    silence_logs=WORKER_LOG_LEVEL)
         try:
             self.client = Client(self.cluster if self.cluster is not None
                                  else self.scheduler)
@@ -410,10 +415,11 @@ class Runner:
         return self
 
     def __exit__(self, *exc):
-        if self.client is not None:
-            self.client.close()
-        if self.cluster is not None:
-            self.cluster.close()
+        with quiet_shutdown():  # the client first: the cluster's end is then no surprise
+            if self.client is not None:
+                self.client.close()
+            if self.cluster is not None:
+                self.cluster.close()
         return False
 
     def map(self, variants: list):
@@ -548,10 +554,8 @@ def summary_csv(study: Study, rows, columns=None) -> bytes:
 def summary_parquet(study: Study, rows):
     """Parquet bytes of :func:`summary_rows` (same columns as :func:`summary_csv`), or
     None when pyarrow is not installed."""
-    try:
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-    except ImportError:
+    pa, pq = optional_import("pyarrow"), optional_import("pyarrow.parquet")
+    if pa is None or pq is None:
         return None
     columns = study.columns
     table = pa.table({HEADERS.get(c, c): [None if r.get(c) is None else str(r.get(c))

@@ -4,10 +4,10 @@ symbolic analysis of :class:`masonry.rbe.solvers.cholesky.BlockCholesky`."""
 import numpy as np
 import scipy.sparse as sp
 
-try:  # wheels for Linux and macOS only (pyproject.toml); elsewhere AMD orders every graph
-    import pymetis
-except ImportError:
-    pymetis = None
+from masonry.optional import optional_import
+
+# wheels for Linux and macOS only (pyproject.toml); elsewhere AMD orders every graph
+pymetis = optional_import("pymetis")
 
 
 def has_metis() -> bool:
