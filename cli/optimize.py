@@ -6,7 +6,6 @@ import logging
 import sys
 from pathlib import Path
 
-from masonry.errors import ParameterError
 from masonry.runfolder import check_output_root, check_study_folder
 from masonry.studies.optimize import SAMPLERS, Search
 
