@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 
 from masonry.blocks import Blocks, tangent_basis
-from masonry.rbe.equilibrium import VariableLayout, assemble
-from masonry.tolerances import G
 from masonry.interfaces import INTERFACE_KINDS, Interfaces
+from masonry.params import Params, validate
+from masonry.rbe.equilibrium import VariableLayout, assemble
 from masonry.rbe.result import RESULT_KEYS, interface_forces
-from masonry.rbe.solve import solve_rbe
-from masonry.tolerances import Tolerances
+from masonry.rbe.solve import RBEProblem, solve_rbe
+from masonry.tolerances import G, Tolerances
 
 MU = 0.7
 DENSITY = 2000.0
@@ -316,3 +316,23 @@ def test_rejects_unknown_options():
         solve_rbe(blocks, interfaces, friction="cone")
     with pytest.raises(ValueError):
         solve_rbe(blocks, interfaces, solver="gurobi")
+
+
+@pytest.mark.parametrize("thickness, stands", [(0.4, True), (0.1, False)])
+def test_friction_plus_alone_says_cannot_stand_only_where_the_structure_cannot(
+        thickness, stands):
+    """A semicircular arch of 8 voussoirs (R = 2 m) stands at t/R = 0.2 and not at 0.05,
+    below Heyman's minimum of about 0.107. Asked for friction+ alone, the optimum carries
+    some tension either way (it trades compression for a little tension), so its MoI is
+    no verdict: friction-net decides, and the MoI stays the thesis's measure."""
+    from masonry.pipeline import build_model
+
+    params = validate(Params.of(scene="arch", arch_blocks=8, arch_span=4,
+                                arch_thickness=thickness, arch_depth=0.5))
+    model = build_model(params)[1]
+    result = RBEProblem(model.blocks, model.interfaces, **model.assembly).solve(
+        friction="plus")
+    assert result.friction == "plus" and result.moi > 0
+    assert result.verdict == ("feasible" if stands else "infeasible")
+    assert result.feasible is stands
+    assert any(a["friction"] == "net" for a in result.attempts)
