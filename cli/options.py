@@ -301,6 +301,10 @@ def add_material_options(group):
     group.add_argument("--tensile-kpa", dest="tensile_kpa", type=float, metavar="KPA",
                        help="the mortar's tensile strength at every joint, kPa (n >= -t A; "
                             "cut off at cohesion/mu; default 0)")
+    group.add_argument("--adhesion-tension-ratio", dest="adhesion_tension_ratio", type=float,
+                       metavar="R", help="t_c / c of the least adhesion a structure needs "
+                                         "(c = a, t_c = R a; 0 to 100; default 0.5, "
+                                         "0: no tension)")
 
 
 def add_output_options(parser):
@@ -471,6 +475,22 @@ def centering_line(total_N, fraction, held, count, where) -> str:
             f"largest {largest} ({where})")
 
 
+def adhesion_line(adhesion) -> str:
+    """The line about the least adhesion (docs/model.md 6.12) of a record's ``adhesion``:
+    ``a*``, the cohesion and tensile strength it stands for, and the joints that use most
+    (``joints``: dicts with ``blocks`` and ``adhesion_kPa``, most first)."""
+    if adhesion["a_kPa"] is None:
+        return f"least adhesion: none found ({adhesion['reason']})"
+    a, ratio = adhesion["a_kPa"], adhesion["ratio"]
+    if a == 0:
+        return "least adhesion: 0 kPa, the structure stands with dry joints"
+    joints = ", ".join(f"{' | '.join(j['blocks'])} ({j['adhesion_kPa']:.3g} kPa)"
+                       for j in adhesion["joints"])
+    return (f"least adhesion: mortar must hold {a:.4g} kPa (c = {a:.4g}, t_c = {ratio:g} x "
+            f"{a:.4g} kPa) for it to stand without centering; the joints that need most: "
+            f"{joints} (RBE/adhesion.csv)")
+
+
 def verdict_meaning(record, verdict) -> str:
     """The line saying what an RBE verdict means for the scene and boundary that ran."""
     rbe = record["rbe"]
@@ -525,6 +545,9 @@ def rbe_summary(record, report) -> int:
     if centering is not None:
         report(centering_line(centering["total_N"], centering["fraction"], centering["held"],
                               centering["held_count"], "RBE/centering.csv"))
+    adhesion = record.get("adhesion")
+    if adhesion is not None:
+        report(adhesion_line(adhesion))
     if verdict == "infeasible" and record["params"].get("friction") == "net":
         report("friction-net has no equilibrium for this structure, so it has no measure "
                "of infeasibility: --friction auto (or plus) gives its MoI and forces")

@@ -27,7 +27,8 @@ from masonry.export.csv import HEADERS, column_types, forces_columns, missing_va
 from masonry.parameters import plain
 from masonry.params import (Params, from_preset, names, section_default, structure_id,
                             validate)
-from masonry.pipeline import Timer, build_model, centering_of, collapse_of, run, solve
+from masonry.pipeline import (Timer, adhesion_of, build_model, centering_of, collapse_of, run,
+                              solve)
 from masonry.rbe.boundary import analysis_model
 from masonry.rbe.loads import LOAD_OPTIONS
 from masonry.rbe.resultants import interface_resultants
@@ -133,6 +134,21 @@ class Structure:
             (:meth:`~masonry.rbe.centering.CenteringResult.held_forces`).
         """
         return centering_of(self.model, self.params)
+
+    def least_adhesion(self):
+        """The least adhesion (docs/model.md 6.12): the least uniform strength ``a`` of
+        mortar (cohesion ``c = a``, tensile strength ``t_c = r a``, ``r`` the analysis's
+        ``adhesion_tension_ratio``) with which the structure stands without centering,
+        by one conic program; 0 when it stands with dry joints.
+
+        Returns
+        -------
+        masonry.rbe.adhesion.AdhesionResult
+            ``a_kPa`` (None, with ``reason``, when no value passed its check), per
+            interface the adhesion it uses (``interface_kPa``) and the joints that need
+            most (:meth:`~masonry.rbe.adhesion.AdhesionResult.joints`).
+        """
+        return adhesion_of(self.model, self.params)
 
     def collapse(self, **load):
         """The collapse load factor of a live load and its mechanism (docs/model.md 6.8).

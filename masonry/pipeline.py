@@ -25,6 +25,7 @@ from masonry.blocks import BLOCK_CLASSES
 from masonry.export import EXPORTERS, RunOutputs, rhino
 from masonry.params import (FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, geometry_key, structure_id,
                             validate)
+from masonry.rbe.adhesion import AdhesionResult, least_adhesion, stands_dry
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.centering import CenteringResult, centering_force
 from masonry.rbe.collapse import (CollapseResult, collapse_load, collapse_on_half,
@@ -363,7 +364,7 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     out = params.outputs
     # bricks.3dm whenever rhino3dm is there: a folder written without it is not up to
     # date once it is
-    wanted = {"analyse": analyse, "centering": analyse, "3dm": rhino.available(),
+    wanted = {"analyse": analyse, "centering": analyse, "adhesion": analyse, "3dm": rhino.available(),
               **{name: getattr(out, name) for name in FILE_OUTPUTS}}
     job = Publication(out_root, structure_id(params), {"params": identity(params)}, wanted,
                       force=force, identify=_identify)
@@ -380,12 +381,17 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     if result is not None and not result.feasible:
         with timer.stage("centering"):
             centering = centering_of(model, params)
+    adhesion = None
+    if result is not None:
+        with timer.stage("adhesion"):
+            adhesion = adhesion_of(model, params, result)
     if result is not None and params.load is not None:
         with timer.stage("collapse"):
             collapse = collapse_of(model, params, result)
-    record.update(results_record(result, collapse, centering, scene.blocks.block_name))
+    record.update(results_record(result, collapse, centering, scene.blocks.block_name,
+                                 adhesion))
     made = RunOutputs(params, scene, model, result, collapse=collapse, centering=centering,
-                      title=structure_id(params))
+                      adhesion=adhesion, title=structure_id(params))
     folder = job.publish(lambda folder: write_run(folder, made, record, timer))
     if cached == "computed":  # only a model whose run completed is cached
         write_cache(params, out_root, scene, model)
@@ -393,14 +399,17 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
 
 
 def results_record(result: RBEResult | None, collapse: CollapseResult | None,
-                   centering: CenteringResult | None = None, names=None) -> dict:
-    """run.json's ``rbe``, ``collapse`` and ``centering`` (the blocks named by ``names``,
-    per block of the model), where the run has them."""
+                   centering: CenteringResult | None = None, names=None,
+                   adhesion: AdhesionResult | None = None) -> dict:
+    """run.json's ``rbe``, ``collapse``, ``centering`` and ``adhesion`` (the blocks named
+    by ``names``, per block of the model), where the run has them."""
     out = {}
     if result is not None:
         out["rbe"] = {**result.to_dict(), "attempts": list(result.attempts)}
     if centering is not None:
         out["centering"] = centering.to_dict(names)
+    if adhesion is not None:
+        out["adhesion"] = adhesion.to_dict(names)
     if collapse is not None:
         out["collapse"] = collapse.to_dict()
     return out
@@ -454,7 +463,7 @@ def run_record(params: Params, scene: Scene, model: Model, outputs: dict, cached
         "structure_id": structure_id(params),
         "scene": params.scene,
         "params": params.record(),
-        "outputs": {name: outputs[name] for name in ("analyse", "centering",
+        "outputs": {name: outputs[name] for name in ("analyse", "centering", "adhesion",
                                                      *WRITTEN_OUTPUTS, "quick")},
         **model_record(scene, params.analysis.density),
         "coordinates": coordinates_record(scene, params.outputs.cad_offset),
@@ -531,6 +540,18 @@ def centering_of(model: Model, params: Params) -> CenteringResult:
     analysis = params.analysis
     return centering_force(model, mu=analysis.mu, density=analysis.density,
                            cone=analysis.cone, **mortar(analysis))
+
+
+def adhesion_of(model: Model, params: Params, rbe: RBEResult | None = None) -> AdhesionResult:
+    """The least adhesion of a run's model (docs/model.md 6.12) under the run's friction
+    model, with its tension ratio: 0 without a program where the run has dry joints and
+    its verdict is feasible (``rbe``), else the program's."""
+    analysis = params.analysis
+    law = analysis.law
+    if rbe is not None and rbe.feasible and law.is_dry:
+        return stands_dry(model.interfaces, law, analysis.adhesion_tension_ratio)
+    return least_adhesion(model, mu=analysis.mu, density=analysis.density, cone=analysis.cone,
+                          ratio=analysis.adhesion_tension_ratio)
 
 
 def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> CollapseResult:

@@ -331,6 +331,12 @@ held directly or through the one it rests on) its interior point spreads forces 
 bricks above 1e-9 of the weight, 83 above 1e-3 of their own, carrying all but 4e-5 of the
 total); a thousandth of a brick's weight is no support anyone gives."""
 
+ADHESION_REPORTED_REL = 1e-3
+"""A joint needs adhesion (docs/model.md 6.12, :mod:`masonry.rbe.adhesion`) when it uses
+more than this fraction of the least adhesion ``a*`` at the optimum: below it, the
+interior point's spread over joints that dry friction could carry as well (as
+:data:`CENTERING_REPORTED_REL` for supports)."""
+
 # ---------------------------------------------------------------------- mirror symmetry
 MIRROR_ANGLE_DEG = 1e-9
 """Degrees within which a load's azimuth lies in a mirror plane

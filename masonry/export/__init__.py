@@ -43,6 +43,8 @@ class RunOutputs:
         one.
     centering : masonry.rbe.centering.CenteringResult or None
         The centering force (docs/model.md 6.10) of a structure that cannot stand.
+    adhesion : masonry.rbe.adhesion.AdhesionResult or None
+        The least adhesion (docs/model.md 6.12).
     title : str
         The run's name in figures (its structure id).
     """
@@ -53,6 +55,7 @@ class RunOutputs:
     result: object = None
     collapse: object = None
     centering: object = None
+    adhesion: object = None
     title: str = ""
 
     @property
@@ -253,6 +256,10 @@ def _rbe_files(made: RunOutputs) -> Export:
     centering = made.centering
     if centering is not None and centering.total_N is not None:
         files["RBE/centering.csv"] = csv.held_csv(made.scene.blocks, centering.held_forces())
+    adhesion = made.adhesion
+    if adhesion is not None and adhesion.a_kPa is not None:
+        files["RBE/adhesion.csv"] = csv.adhesion_csv(made.model.blocks, made.model.interfaces,
+                                                     adhesion.interface_kPa)
     if made.forces is not None:
         files.update(force_tables(made.model.blocks, made.model.interfaces, made.result,
                                   made.forces, _resultants(made)))

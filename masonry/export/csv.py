@@ -1,10 +1,11 @@
 """CSV tables: brick vertex locations, interfaces and their forces, the blocks a temporary
-support must hold (docs/model.md 5, 6.10, 7)."""
+support must hold, the adhesion every joint uses (docs/model.md 5, 6.10, 6.12, 7)."""
 
 import numpy as np
 
 from masonry.blocks import BLOCK_CLASSES, Blocks
 from masonry.export._text import format_floats
+from masonry.interfaces import INTERFACE_KINDS
 from masonry.tolerances import TENSION_REPORTED_REL
 
 TENSION_TOP_COUNT = 20
@@ -16,7 +17,7 @@ HEADERS = {"moi": "moi_N", "objective": "objective_N2"}
 
 INTEGER_COLUMNS = ("id", "rank", "brick", "block", "block_a", "block_b", "course",
                    "course_a", "course_b", "vertex", "vertices", "stage", "bricks", "step",
-                   "variant", "interfaces", "stages", "stages_standing",
+                   "variant", "interfaces", "stages", "stages_standing", "interface",
                    "first_unsupported_stage", "first_unsupported_course",
                    "first_unsupported_brick", "trial", "loose")
 TEXT_COLUMNS = ("name", "name_a", "name_b", "class", "kind", "laid", "status", "error",
@@ -98,8 +99,6 @@ def _xyz(name, values, unit=""):
 
 
 def _interface_columns(blocks: Blocks, interfaces) -> list:
-    from masonry.interfaces import INTERFACE_KINDS
-
     a, b = interfaces.pair[:, 0], interfaces.pair[:, 1]
     kind = np.array(INTERFACE_KINDS, dtype=object)[interfaces.kind]
     return [("id", np.arange(len(interfaces))), ("block_a", a), ("block_b", b),
@@ -174,8 +173,6 @@ def tension_top_csv(blocks: Blocks, interfaces, forces: dict, resultants: dict,
     ``top`` (:func:`tension_top`): rank, the interface's columns of ``forces.csv``
     (blocks, their names and courses, kind, centre), its tension, compression, normal
     force and eccentricity. Only the header when nothing is in tension."""
-    from masonry.interfaces import INTERFACE_KINDS
-
     top = np.asarray(top, dtype=np.int64)
     a, b = interfaces.pair[top, 0], interfaces.pair[top, 1]
     return _table([("rank", np.arange(1, len(top) + 1)), ("id", top),
@@ -236,3 +233,22 @@ def held_csv(blocks: Blocks, held) -> bytes:
     return _table([("block", block), ("name", blocks.block_name[block]), ("class", classes),
                    ("course", np.where(course > 0, course.astype(str), "")),
                    ("support_N", size), *_xyz("force", force, "N")])
+
+
+def adhesion_csv(blocks: Blocks, interfaces, used_kPa) -> bytes:
+    """``RBE/adhesion.csv``: the adhesion every interface uses at the least adhesion's
+    optimum (docs/model.md 6.12), one row per interface in id order: ``interface``,
+    ``block_a``, ``block_b``, ``name_a``, ``name_b``, ``kind``, ``adhesion_kPa``.
+
+    Parameters
+    ----------
+    blocks : Blocks
+        The blocks the interfaces join (a model's).
+    used_kPa : (K,) float
+        :attr:`~masonry.rbe.adhesion.AdhesionResult.interface_kPa`.
+    """
+    a, b = interfaces.pair[:, 0], interfaces.pair[:, 1]
+    kind = np.array(INTERFACE_KINDS, dtype=object)[interfaces.kind]
+    return _table([("interface", np.arange(len(interfaces))), ("block_a", a), ("block_b", b),
+                   ("name_a", blocks.block_name[a]), ("name_b", blocks.block_name[b]),
+                   ("kind", kind), ("adhesion_kPa", np.asarray(used_kPa, dtype=float))])

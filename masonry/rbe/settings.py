@@ -8,6 +8,7 @@ from masonry.friction import FrictionCone, FrictionModelError
 from masonry.parameters import check_fields, declare
 from masonry.errors import ParameterError
 from masonry.rbe.accuracy import ACCURACY
+from masonry.rbe.adhesion import TENSION_RATIO
 from masonry.rbe.solvers import BACKENDS, RBE, names
 
 FRICTIONS = ("net", "plus", "auto")
@@ -27,7 +28,9 @@ class Analysis:
     are free), ``friction_law`` of the collapse load factor (associated: the cone
     program; non-associative: joints that slide without dilating, an estimate),
     ``cohesion_kpa`` and ``tensile_kpa`` the mortar's cohesion and tensile strength at
-    every joint (kPa; 0: dry joints; :mod:`masonry.contact`).
+    every joint (kPa; 0: dry joints; :mod:`masonry.contact`),
+    ``adhesion_tension_ratio`` the ratio ``t_c / c`` of the least adhesion
+    (:mod:`masonry.rbe.adhesion`).
     """
 
     mu: float = declare(0.7, "friction coefficient", low=0.01, high=10.0, tag="mu",
@@ -56,6 +59,10 @@ class Analysis:
     tensile_kpa: float = declare(0.0, "kPa, the mortar's tensile strength at every joint",
                                  low=0.0, high=1e6, tag="ten",
                                  expected="0 to 1e+06 (kPa; cut off at cohesion/mu)")
+    adhesion_tension_ratio: float = declare(
+        TENSION_RATIO, "t_c / c of the least adhesion", low=0.0, high=100.0, tag="atr",
+        expected="0 to 100 (the least adhesion's tensile strength over its cohesion; "
+                 "0.5 by default, 0: no tension)")
 
     def checked(self) -> "Analysis":
         """This analysis validated, the friction model in its canonical spelling; raises

@@ -41,12 +41,13 @@ log = logging.getLogger(__name__)
 
 SUMMARY_COLUMNS = ("variant", "status", "error", "feasible", "friction_used",
                    "friction_model", "moi", "moi_factor", "centering_N",
-                   "centering_fraction", "objective", "weight_N", "bricks", "interfaces",
+                   "centering_fraction", "adhesion_kPa", "objective", "weight_N", "bricks", "interfaces",
                    "residual_eq", "load_factor", "load_azimuth_deg", "time_s",
                    "structure_id")
 """Result columns of the summary; the swept inputs come first. ``centering_N``,
 ``centering_fraction``: the run's centering force (docs/model.md 6.10), 0 where the
-structure stands. ``load_factor`` (and the lateral load's azimuth, the worst one for
+structure stands; ``adhesion_kPa``: its least adhesion (docs/model.md 6.12), empty where
+none was found. ``load_factor`` (and the lateral load's azimuth, the worst one for
 ``lateral = "all"``) when the study gives a live load (``lateral``, ``point-load`` or
 ``crown-load``, docs/model.md 6.8). A study of stages adds :data:`STAGE_SUMMARY_COLUMNS`."""
 
@@ -303,6 +304,7 @@ def run_summary(record) -> dict:
         moi=rbe.get("moi"), moi_factor=rbe.get("moi_factor"),
         centering_N=0.0 if stands else centering.get("total_N"),
         centering_fraction=0.0 if stands else centering.get("fraction"),
+        adhesion_kPa=(record.get("adhesion") or {}).get("a_kPa"),
         objective=rbe.get("objective"), weight_N=record.get("weight_N"),
         bricks=record["counts"]["bricks"],
         interfaces=sum(record["counts"].get("interfaces", {}).values()),
