@@ -364,7 +364,8 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     out = params.outputs
     # bricks.3dm whenever rhino3dm is there: a folder written without it is not up to
     # date once it is
-    wanted = {"analyse": analyse, "centering": analyse, "adhesion": analyse, "3dm": rhino.available(),
+    wanted = {"analyse": analyse, "centering": analyse, "adhesion": analyse,
+              "3dm": rhino.available(),
               **{name: getattr(out, name) for name in FILE_OUTPUTS}}
     job = Publication(out_root, structure_id(params), {"params": identity(params)}, wanted,
                       force=force, identify=_identify)

@@ -41,7 +41,8 @@ log = logging.getLogger(__name__)
 
 SUMMARY_COLUMNS = ("variant", "status", "error", "feasible", "friction_used",
                    "friction_model", "moi", "moi_factor", "centering_N",
-                   "centering_fraction", "adhesion_kPa", "objective", "weight_N", "bricks", "interfaces",
+                   "centering_fraction", "adhesion_kPa", "objective", "weight_N", "bricks",
+                   "interfaces",
                    "residual_eq", "load_factor", "load_azimuth_deg", "time_s",
                    "structure_id")
 """Result columns of the summary; the swept inputs come first. ``centering_N``,
