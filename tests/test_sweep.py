@@ -39,6 +39,7 @@ def study(tmp_path):
     return path
 
 
+@pytest.mark.slow
 def test_local_cluster_gives_the_serial_summary(tmp_path, study, capfd):
     pytest.importorskip("dask.distributed")
     assert main(["sweep", str(study), "--workers", "1", "--out", str(tmp_path / "a"),
@@ -174,6 +175,7 @@ def _assert_stage_columns(row, expected):
     assert numbers == pytest.approx({k: expected[k] for k in STAGE_NUMBERS}, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_a_sweep_of_course_stages_gives_the_columns_of_masonry_stages(tmp_path):
     """The small dome by course at mu 0.1 (stages 5-11 need support) and 0.7 (all
     stand): the summary's stage columns equal those ``masonry stages`` writes for the
