@@ -14,6 +14,7 @@ def run_folders(root):
     return [p for p in root.iterdir() if not p.name.startswith(".")]
 
 
+@pytest.mark.slow
 def test_build_writes_the_run_folder(tmp_path, capsys):
     assert main(["build", "--preset", "1", "--fast", "--out", str(tmp_path), "-q"]) == 0
     (folder,) = run_folders(tmp_path)

@@ -432,6 +432,7 @@ def command_lines(draw):
 @settings(max_examples=400, deadline=None, derandomize=True, database=None,
           suppress_health_check=list(HealthCheck))
 @given(command_lines())
+@pytest.mark.slow
 def test_fuzz_command_line(argv):
     with tempfile.TemporaryDirectory() as tmp, pytest.MonkeyPatch.context() as patch:
         patch.setattr("masonry.pipeline.run", stub_pipeline)  # imported by the command
@@ -464,6 +465,7 @@ def toml_value(value) -> str:
                     TOML_VALUES, max_size=4).map(
         lambda d: "".join(f"{k} = {toml_value(v)}\n" for k, v in d.items()).encode()),
     st.binary(max_size=40)))
+@pytest.mark.slow
 def test_fuzz_parameter_files(content):
     with tempfile.TemporaryDirectory() as tmp, pytest.MonkeyPatch.context() as patch:
         patch.setattr("masonry.pipeline.run", stub_pipeline)
@@ -488,6 +490,7 @@ STUDY_KEYS = ["mu", "density", "friction", "stretch", "dome", "preset", "count",
                                                        for k, v in table.items())
                                for name, table in tables.items()).encode()),
     st.binary(max_size=40)))
+@pytest.mark.slow
 def test_fuzz_study_files(content):
     rows = {"status": "computed", "error": ""}
     with tempfile.TemporaryDirectory() as tmp, pytest.MonkeyPatch.context() as patch:

@@ -300,6 +300,7 @@ def test_crown_load_on_the_cyclic_section_equals_the_full_dome():
 
 @pytest.mark.parametrize("method, cone", [("interior", "circle"), ("clarabel", "circle"),
                                           ("highs-simplex", "polygon:16")])
+@pytest.mark.slow
 def test_worst_lateral_searches_the_symmetry_directions_with_one_model(method, cone):
     dome = build_model(validate(Params.of(scene="dome", **SMALL_DOME)))[1]
     azimuths = lateral_azimuths(6)
@@ -377,6 +378,7 @@ def test_highs_refuses_coulombs_cone():
 
 @pytest.mark.parametrize("azimuth", [0.0, 45.0])
 @pytest.mark.parametrize("cone", ["polygon:16", "square"])
+@pytest.mark.slow
 def test_interior_point_lp_finds_the_simplex_optimum_on_a_dome(azimuth, cone):
     """The own interior point method against HiGHS's dual simplex (an exact vertex
     solution) on the 72-brick dome, without falling back to Clarabel."""
@@ -503,6 +505,7 @@ def test_run_reports_the_non_associative_estimate_beside_the_associated_factor(t
         capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_the_dome_symmetry_leaves_azimuths_from_a_web_to_its_corner():
     """The worst lateral factor over 0..180/n (structures' search) is the worst over the
     whole circle: rotation by 360/n and the mirror in a web's mid-plane map every
@@ -562,6 +565,7 @@ def _no_constants(name):
     raise AssertionError(f"{name} is not JSON")
 
 
+@pytest.mark.slow
 def test_run_json_is_strict_json_with_null_where_a_value_is_missing(tmp_path):
     """A collapse without a factor (the live load is carried at any factor) and a
     friction-net solve without a point: run.json has null, never NaN or Infinity, which

@@ -107,6 +107,7 @@ def _results(root, name="sweep_study"):
         return [{k: r[k] for k in RESULTS} for r in csv.DictReader(f)]
 
 
+@pytest.mark.slow
 def test_a_sweep_on_the_cluster_equals_the_serial_one(cluster, serial, tmp_path):
     study, expected = serial
     assert main(["sweep", str(study), "--scheduler", cluster.address, "--out",
@@ -131,6 +132,7 @@ def test_an_optimisation_on_the_cluster_equals_the_serial_one(cluster, serial, t
     assert [r["status"] for r in second] == ["computed"] * 6
 
 
+@pytest.mark.slow
 def test_a_worker_killed_mid_study_loses_nothing(cluster, serial, tmp_path):
     from masonry.studies.sweep import execute, publish_summary, summary_rows
 

@@ -142,6 +142,7 @@ def test_friction_coefficient_extremes(mu, boundary):
         assert result.feasible and result.moi_factor <= 1e-9
 
 
+@pytest.mark.slow
 def test_friction_lowers_the_measure_of_infeasibility_strictly():
     moi = [analyse(mu=mu, boundary="free")[2].moi_factor for mu in (0.05, 0.3, 1.0, 5.0)]
     assert all(a > b for a, b in zip(moi, moi[1:])), moi

@@ -276,6 +276,7 @@ def test_the_own_solvers_of_the_cone_find_clarabels_optimum(boundary):
 
 
 @pytest.mark.parametrize("azimuth", [0.0, 30.0])
+@pytest.mark.slow
 def test_the_collapse_lp_of_the_cone_finds_clarabels_optimum(azimuth):
     """The collapse load factor with Coulomb's cone: the own interior point method
     (Nesterov-Todd scaling on the Newton system) against Clarabel's second-order cone

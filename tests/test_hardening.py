@@ -64,6 +64,7 @@ def test_run_after_build_adds_the_forces_and_keeps_the_plots(tmp_path):
     assert (tmp_path / WALL_ID / "00_pattern.png").is_file()
 
 
+@pytest.mark.slow
 def test_sweep_and_run_never_strip_each_other(tmp_path):
     study = tmp_path / "study.toml"
     study.write_text('[base]\npreset = "wall"\nwall-courses = 3\nwall-length = 12\n'
@@ -87,6 +88,7 @@ def test_sweep_and_run_never_strip_each_other(tmp_path):
     assert snapshot(other / WALL_ID) == richer
 
 
+@pytest.mark.slow
 def test_two_commands_at_once_into_one_root(tmp_path):
     # build and run of the same input race to publish the same folder: whichever ends
     # last, the folder holds the run's forces and the build's plots, and nothing is left
@@ -121,6 +123,7 @@ def test_leftovers_of_dead_runs_are_removed_and_live_ones_kept(tmp_path):
     assert (tmp_path / WALL_ID / "run.json").read_text() == "{}" and not aside.exists()
 
 
+@pytest.mark.slow
 def test_sigterm_during_the_exports_leaves_the_previous_run(tmp_path):
     args = ["--preset", "1", "--fast", "--no-printable", "--out", str(tmp_path), "-q"]
     assert main(["build", *args]) == 0

@@ -134,6 +134,7 @@ def test_a_crown_load_on_the_half_web_is_the_whole_domes(dome, section):
     assert down.load_factor is None and down.dead_load_feasible
 
 
+@pytest.mark.slow
 def test_the_search_on_halves_finds_every_azimuths_factor(dome):
     """--lateral all with the mirror planes: every azimuth's factor as on the whole, with
     fewer solves (0, 15 and 30 degrees: 0 and 30 on halves)."""

@@ -43,6 +43,7 @@ def arches(tmp_path):
     return path
 
 
+@pytest.mark.slow
 def test_the_optimum_an_exhaustive_sweep_finds_in_fewer_trials(tmp_path, arches, capsys):
     assert main(["sweep", str(arches), "--workers", "1", "--out", str(tmp_path), "-q"]) == 0
     grid = _read(tmp_path / "sweep_arches" / "summary.csv")
@@ -69,6 +70,7 @@ def test_the_optimum_an_exhaustive_sweep_finds_in_fewer_trials(tmp_path, arches,
         assert (tmp_path / "optimize_arches" / "convergence.png").stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_every_variant_once_then_the_search_stops(tmp_path, arches):
     assert _optimize(arches, tmp_path, "--minimize", "weight_N", "--trials", "40") == 0
     trials = _read(tmp_path / "optimize_arches" / "trials.csv")
@@ -103,6 +105,7 @@ def test_two_objectives_give_the_pareto_front_of_the_trials(tmp_path):
                                                    ["weight_N", "minimize"]]
 
 
+@pytest.mark.slow
 def test_an_interrupted_optimisation_resumes_to_the_same_trials(tmp_path, monkeypatch):
     import masonry.studies.sweep as sweep
 
@@ -156,6 +159,7 @@ def test_bad_input_is_one_line_before_any_work(tmp_path, capsys, options, study,
     assert not (tmp_path / "x").exists()
 
 
+@pytest.mark.slow
 def test_the_first_course_that_needs_support_is_latest_where_none_does(tmp_path):
     """The small dome's course stages (a section laid cyclic) at mu 0.1, 0.3 and 0.7:
     at 0.3 and 0.7 every stage stands (first_unsupported_course empty, read as

@@ -235,6 +235,7 @@ def test_lines_that_end_far_below_the_top_are_reported(tmp_path, capsys):
 
 
 # ---------------------------------------------------------------------------- commands
+@pytest.mark.slow
 def test_build_writes_a_plain_dome(tmp_path, capsys):
     assert main(["build", "--preset", "1", "--pattern", "none", "--fast", "--no-printable",
                  "--out", str(tmp_path), "-q"]) == 0

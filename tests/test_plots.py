@@ -1,9 +1,12 @@
 """Figures: units and colour scales chosen by the data, and the thrust line's points."""
 
+import os
+
 import matplotlib
 import numpy as np
 import pytest
 
+from masonry import forking
 from masonry.export.csv import tension_top
 from masonry.pipeline import build_model
 from masonry.params import Params, from_preset, validate
@@ -141,3 +144,45 @@ def test_the_azimuth_search_is_drawn_on_polar_axes():
     worst = worst_lateral(build_model(params)[1], n_webs=6, period_deg=60.0)
     assert len(worst.azimuths) >= 24
     assert azimuths_png(worst).startswith(b"\x89PNG")
+
+
+
+def _font_file_offsets():
+    """{descriptor: offset} of the font files this process holds open."""
+    offsets = {}
+    for name in os.listdir("/proc/self/fd"):
+        try:
+            target = os.readlink(f"/proc/self/fd/{name}")
+        except OSError:  # closed meanwhile (the listing's own descriptor)
+            continue
+        if target.endswith((".ttf", ".otf")):
+            offsets[int(name)] = os.lseek(int(name), 0, os.SEEK_CUR)
+    return offsets
+
+
+def _arrow_marker():
+    """The mechanism plot's arrow marker's outline: glyphs loaded through the font of
+    mathtext's cached parse."""
+    from matplotlib.textpath import TextPath
+
+    return TextPath((0, 0), r"$\rightarrow$", size=8).vertices
+
+
+@pytest.mark.skipif(not forking.can_fork() or not os.path.isdir("/proc/self/fd"),
+                    reason="needs fork and /proc")
+def test_a_forked_process_draws_without_moving_the_font_files_of_the_one_that_forked_it():
+    """Two processes that read glyphs through one open font file move each other's file
+    offset, and a glyph loads from the wrong bytes ("failed to load glyph"): the process
+    that forks keeps its offsets whatever the forked one draws, here an arrow marker it
+    drew before the fork (mathtext keeps that parse's fonts)."""
+    from matplotlib.textpath import TextPath
+
+    import masonry.plots  # noqa: F401 (what the run's forked exporters import first)
+
+    arrow = _arrow_marker()
+    TextPath((0, 0), r"$\mathrm{abc}$", size=8)  # the font's file read elsewhere
+    before = _font_file_offsets()
+    assert before, "no font file open: the test reads no glyph"
+    with forking.Forked([_arrow_marker]) as forked:
+        assert np.array_equal(forked.result(), arrow)
+    assert _font_file_offsets() == before

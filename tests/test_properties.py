@@ -77,6 +77,7 @@ def deepest_overlap(corners, pairs):
        p=st.integers(1, 20), cut=st.floats(0.0, 0.9), unit=log_uniform(1e-3, 1e2),
        mu=st.floats(0.05, 5.0), density=log_uniform(2.0, 2.0e6),
        boundary=st.sampled_from(["free", "cyclic"]))
+@pytest.mark.slow
 def test_any_parameters(stretch, n, r, p, cut, unit, mu, density, boundary):
     try:
         params = validate(Params.of(stretch=stretch, n=n, r=r, p=p, cut=cut, unit=unit, mu=mu,

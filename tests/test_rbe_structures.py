@@ -52,6 +52,7 @@ def test_straight_wall():
     assert result.residual_eq <= RESIDUAL and result.friction_violation <= RESIDUAL
 
 
+@pytest.mark.slow
 def test_friction_test_structure_1_1():
     """Thesis 3.3.6 / table 4.3: the free-standing section of preset 1 is infeasible at
     mu 0.7 and its MoI falls as mu grows."""
@@ -88,6 +89,7 @@ def test_golden_interface_counts_and_moi_factor(preset):
     assert square <= golden["moi_factor"]
 
 
+@pytest.mark.slow
 def test_infeasible_structure_is_reported_infeasible_by_net():
     """friction-net alone on structure 1.1 gives no solution and no fake optimum; the LP
     check agrees."""

@@ -217,6 +217,7 @@ def test_the_printable_body_is_one_watertight_body():
 
 
 # ---------------------------------------------------------------------- commands
+@pytest.mark.slow
 def test_run_writes_the_dome_of_revolution(tmp_path):
     args = ["run", "--scene", "sector", "--boundary", "cyclic", "--radius", "20", "--p", "3",
             "--cut", "0.3", "--fast", "--no-printable", "--out", str(tmp_path), "-q"]

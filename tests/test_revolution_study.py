@@ -87,6 +87,7 @@ def test_a_flank_holds_a_brick_on_a_steeper_bed(flank):
         assert result.feasible is stands
 
 
+@pytest.mark.slow
 def test_the_study_measures_every_dome_and_goes_on_where_it_stopped(tmp_path, monkeypatch):
     domes = rs.domes(**TINY)
     rs.study(tmp_path, domes)

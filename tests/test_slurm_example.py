@@ -41,6 +41,7 @@ def _summary(root):
                                    "structure_id")} for r in csv.DictReader(f)]
 
 
+@pytest.mark.slow
 def test_the_slurm_example_runs_a_study_through_sbatch(tmp_path):
     bin = tmp_path / "bin"
     bin.mkdir()

@@ -429,6 +429,7 @@ def test_interior_point_vertex_blocks_are_the_inverse(method, name):
                                np.linalg.inv(stiffness), rtol=0, atol=1e-12)
 
 
+@pytest.mark.slow
 def test_newton_matrices_equal_the_sparse_products():
     """``A J A^T`` by interface (every vertex changed: the first matrix, a new one) and by
     vertex update (a third changed), against the dense product."""
@@ -481,18 +482,26 @@ def test_newton_columns_and_vertex_sums_are_the_equilibrium_matrix():
                                    atol=1e-12 * np.abs(dense).sum(axis=1).max())
 
 
+def _largest_difference(a, b) -> float:
+    """The largest absolute entry of ``a - b``, two sparse matrices of one shape (kept
+    sparse: the pyramid's friction rows of a small section are gigabytes dense)."""
+    assert a.shape == b.shape
+    difference = sp.csr_array(a - b)
+    return float(abs(difference).max()) if difference.nnz else 0.0
+
+
 @pytest.mark.parametrize("name", ["circle", "polygon:16", "square"])
 def test_standard_form_is_the_equilibrium_system(name):
     m = small("free")
     system = assemble(m.blocks, m.interfaces, mu=0.45, cone=name)
     form = standard_form(system)
     for method in ("net", "plus"):
-        rows = form.matrix(method, 0.45).toarray()
+        rows = sp.csr_array(form.matrix(method, 0.45))
         n_eq, n_fr = form.n_eq, form.n_friction
-        np.testing.assert_array_equal(rows[:n_eq], system.A_eq.toarray())
+        assert _largest_difference(rows[:n_eq], system.A_eq) == 0
         if system.cone.is_polyhedral:
-            np.testing.assert_allclose(rows[n_eq:n_eq + n_fr],
-                                       system.A_fr[method].toarray(), rtol=0, atol=1e-15)
+            assert _largest_difference(rows[n_eq:n_eq + n_fr],
+                                       system.A_fr[method]) <= 1e-15
         else:
             # -(mu (c - t), f1, f2) per vertex: the slack of the second-order cone
             x = np.random.default_rng(1).normal(size=system.layout.n_columns)
@@ -520,6 +529,7 @@ def solved(boundary, solver, accuracy="accurate", cone=None):
     ("clarabel-cvxpy", None), ("newton", None), ("interior", None),
     ("osqp", "polygon:16"), ("osqp-cvxpy", "polygon:16"), ("newton", "polygon:16"),
     ("interior", "polygon:16"), ("clarabel-cvxpy", "polygon:16")])
+@pytest.mark.slow
 def test_every_solver_finds_the_same_feasible_optimum(solver, cone):
     # H is positive definite: the minimiser is unique, every path must find the one of
     # Clarabel (an independent interior point implementation), with Coulomb's cone (the
@@ -737,6 +747,7 @@ def test_a_feasible_load_path_verdict_resumes_newton(monkeypatch, caplog):
     np.testing.assert_allclose(result.x, reference.x, rtol=0, atol=1e-6 * scale(reference))
 
 
+@pytest.mark.slow
 def test_newton_hands_a_damped_out_dome_to_the_load_path_lp(monkeypatch):
     # preset 2's dome with p = 3 at mu 0.05 under the square pyramid (the trajectory
     # this hand-over rule was measured on): Newton's steps sit at the damping ceiling
@@ -763,6 +774,7 @@ def test_newton_hands_a_damped_out_dome_to_the_load_path_lp(monkeypatch):
     assert _most_work(system, A.T @ certificate) <= tol * gain / np.abs(b).sum()
 
 
+@pytest.mark.slow
 def test_a_feasible_dome_at_the_damping_ceiling_pays_no_load_path_lp():
     # preset 3's dome at mu 0.2 under the square pyramid (with Coulomb's cone it stands
     # at mu 0.2 by a margin of 0.2 %, and Newton wanders): Newton's damping reaches its
@@ -790,6 +802,7 @@ def _alongside(monkeypatch, on):
 
 
 @pytest.mark.skipif(not forking.can_fork(), reason="friction+ alongside needs fork")
+@pytest.mark.slow
 def test_friction_plus_alongside_is_the_one_solved_after(monkeypatch, caplog):
     """preset 2's dome with p = 3 at mu 0.05: Newton hands friction-net over to the
     load-path LP, friction+ starts on the second core, and its result is the one this
@@ -815,6 +828,7 @@ def test_friction_plus_alongside_is_the_one_solved_after(monkeypatch, caplog):
 
 @pytest.mark.skipif(not forking.can_fork(), reason="friction+ alongside needs fork")
 @pytest.mark.parametrize("where", ["in the forked process", "at the fork"])
+@pytest.mark.slow
 def test_friction_plus_alongside_failing_is_solved_here(monkeypatch, caplog, where):
     m = model("2", scene="dome", p=3)
     _alongside(monkeypatch, False)
@@ -877,6 +891,7 @@ def test_a_solve_given_one_core_solves_friction_plus_here(monkeypatch):
 # ---------------------------------------------------------------------- reuse
 @pytest.mark.parametrize("solver, cone", [("newton", None), ("osqp", "polygon:16"),
                                           ("clarabel", None), ("clarabel", "square")])
+@pytest.mark.slow
 def test_reuse_between_friction_coefficients_changes_nothing(solver, cone):
     # and between friction models: the kept solver objects are rebuilt for another
     # model's rows

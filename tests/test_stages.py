@@ -530,6 +530,7 @@ def test_whole_brick_plan_lays_every_course_brick_by_brick():
 
 
 @pytest.mark.parametrize("mu, order", [(0.7, "pattern-first"), (0.4, "along")])
+@pytest.mark.slow
 def test_stages_solved_in_sequence_equal_stages_solved_alone(mu, order):
     # every brick stage of a small dome, each from the last one's work (warm starts,
     # the whole model's matrices and ordering, the local certificate) and each alone:

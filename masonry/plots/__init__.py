@@ -11,10 +11,22 @@ Every function returns PNG bytes or ``{relative path: png bytes}`` so the run fo
 writer is the one place that touches the disk.
 """
 
+import os
+
 import matplotlib
+from matplotlib import mathtext
 
 # before any module of the package imports pyplot: runs draw without a display
 matplotlib.use("Agg")
+
+# A run draws its plots in a forked copy of itself beside this process (masonry.forking).
+# A FreeType font reads its file through an open file, and a forked copy shares that
+# file's offset: when both processes read glyphs through fonts made before the fork, each
+# moves the other's offset and a glyph loads from the wrong bytes ("failed to load
+# glyph"). matplotlib forgets its fonts in the child; mathtext's parses (the arrow
+# markers) keep theirs, so the child forgets those too and opens its own.
+if hasattr(os, "register_at_fork"):  # not on Windows, which does not fork
+    os.register_at_fork(after_in_child=mathtext.MathTextParser._parse_cached.cache_clear)
 
 from masonry.plots.azimuths import azimuths_png  # noqa: E402
 from masonry.plots.colours import (  # noqa: E402
