@@ -11,6 +11,8 @@ turns the triangle soups that :mod:`masonry.scenes.mesh_files` reads into checke
 - A file that names no blocks (STL, PLY, an OBJ of neither objects nor groups): one
   block per connected body, named after the file (``wall_0007``), or after the file
   alone when it holds one body, so one file per block works too.
+- COMPAS JSON (an assembly, a block model, a list of meshes): one block per mesh, with
+  the supports the file flags (:mod:`masonry.scenes.compas_json`).
 
 Every block must be a closed convex solid. A block that is open, non-manifold, inside
 out, flat, or concave beyond :data:`~masonry.tolerances.CONVEXITY_REL` raises
@@ -56,12 +58,14 @@ or sector's bricks of a whole dome carry ``w<web>_`` before them)."""
 
 # ---------------------------------------------------------------------- public API
 def read_blocks(paths, tol: Tolerances | None = None) -> Blocks:
-    """Convex blocks from mesh files, in file order; no block is a support yet.
+    """Convex blocks from mesh files, in file order; the supports are those a COMPAS
+    file flags (``is_support``), no block of another format.
 
     Parameters
     ----------
     paths : sequence of str or Path
-        OBJ, STL or PLY files (see the module docstring for how each splits into blocks).
+        OBJ, STL, PLY or COMPAS JSON files (see the module docstring for how each splits
+        into blocks).
     tol : Tolerances, optional
         ``length`` merges duplicate vertices, ``contact`` decides which hull triangles
         are coplanar (one face). Default ``Tolerances.for_points`` of all the vertices.
@@ -85,10 +89,11 @@ def read_blocks(paths, tol: Tolerances | None = None) -> Blocks:
     if tol is None:
         tol = Tolerances.for_points(points)
     parts = []
-    for path, soup in zip(paths, soups):
+    for k, (path, soup) in enumerate(zip(paths, soups)):
         soup = _merged(soup, tol.length)
         if soup.split_bodies:
             soup = _bodies(soup, path.stem)
+        soups[k] = soup
         parts.append(_convex_blocks(soup, path, tol))
     blocks = concatenate(parts)
     names = _unique_names(blocks.block_name)
@@ -96,7 +101,7 @@ def read_blocks(paths, tol: Tolerances | None = None) -> Blocks:
     return Blocks.from_arrays(
         blocks.vertices, blocks.vertex_offsets, blocks.face_vertices, blocks.face_offsets,
         blocks.face_block, block_class=block_class, block_course=block_course,
-        block_is_support=np.zeros(blocks.n_blocks, bool), block_name=names)
+        block_is_support=np.concatenate([s.supports for s in soups]), block_name=names)
 
 
 def select_supports(blocks: Blocks, names=(), below=None, tol: Tolerances | None = None):
@@ -219,6 +224,7 @@ def load_assembly(paths, *, supports=(), support_below=None, ground=False):
     paths : sequence of str or Path
         Mesh files, see :func:`read_blocks`.
     supports, support_below : see :func:`select_supports`
+        Either replaces the supports a COMPAS file flags; without them, those are kept.
     ground : bool
         Add a ground slab under the lowest blocks (:func:`with_ground`).
 
@@ -241,6 +247,8 @@ def load_assembly(paths, *, supports=(), support_below=None, ground=False):
     start = time.perf_counter()
     blocks = read_blocks(paths)
     tol = Tolerances.for_points(blocks.vertices)
+    if supports or support_below is not None:  # the user's choice, not the file's
+        blocks = dataclasses.replace(blocks, block_is_support=np.zeros(blocks.n_blocks, bool))
     if ground:
         blocks = with_ground(blocks, tol)
     is_support = select_supports(blocks, supports, support_below, tol)
@@ -297,7 +305,7 @@ def _merged(soup: TriangleSoup, distance) -> TriangleSoup:
     triangles, keep = merge_vertices(triangles, pairs, len(vertices))
     used, triangles = np.unique(triangles, return_inverse=True)
     return TriangleSoup(soup.block_name, vertices[used], triangles.reshape(-1, 3),
-                        soup.triangle_block[keep], soup.split_bodies)
+                        soup.triangle_block[keep], soup.split_bodies, soup.block_is_support)
 
 
 def _bodies(soup: TriangleSoup, stem) -> TriangleSoup:

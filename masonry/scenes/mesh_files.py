@@ -1,13 +1,16 @@
 """Mesh files read as triangle soups: the first step of an imported assembly (docs/model.md 4.6).
 
-This module only reads: it turns one OBJ, STL or PLY file into a :class:`TriangleSoup`,
-the file's triangles with the block each belongs to, coordinates exactly as written.
+This module only reads: it turns one OBJ, STL, PLY or COMPAS JSON file into a
+:class:`TriangleSoup`, the file's triangles with the block each belongs to, coordinates
+exactly as written.
 How a file's triangles make blocks:
 
 - OBJ: one block per object (``o``); a file without objects, one block per group
   (``g``); a file with neither, one soup to split into its connected bodies. Polygons
   are cut into fans.
 - STL (binary or ASCII) and PLY: one soup to split into its connected bodies.
+- JSON: a COMPAS assembly, block model or list of meshes, one block per mesh, with the
+  file's supports (:mod:`masonry.scenes.compas_json`).
 
 Merging vertices, splitting a soup into bodies and checking that every block is a
 closed convex solid come after (:mod:`masonry.scenes.imported`), once the tolerances
@@ -23,58 +26,16 @@ measurements, and ``masonry bench --readers`` repeats them).
 
 import io
 import warnings
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from masonry.errors import MasonryError
+from masonry.scenes.compas_json import read_compas_json
+from masonry.scenes.soup import AssemblyError, TriangleSoup, fan
 from masonry.tolerances import MAX_COORDINATE_M
 
-FORMATS = (".obj", ".stl", ".ply")
+FORMATS = (".obj", ".stl", ".ply", ".json")
 """File suffixes :func:`read_mesh` reads (case-insensitive)."""
-
-
-class AssemblyError(MasonryError, ValueError):
-    """A mesh file cannot be read, or one of its blocks is not a closed convex solid
-    (:mod:`masonry.scenes.imported`). The message names the file and, for a bad block,
-    the block."""
-
-
-@dataclass(frozen=True)
-class TriangleSoup:
-    """Triangles of named blocks, as a file holds them (struct of arrays).
-
-    Attributes
-    ----------
-    block_name : list of str
-        (B,) names as read; an empty string where the file gives none.
-    vertices : (V, 3) float64, metres
-        As written in the file (float32 files widened exactly).
-    triangles : (T, 3) int64
-        Corners, indices into ``vertices``, in file order.
-    triangle_block : (T,) int64
-        Block of every triangle, index into ``block_name``.
-    split_bodies : bool
-        The file names no blocks: the soup's connected bodies are its blocks (then
-        ``block_name`` holds one name, the one the file gives its only object or group,
-        or an empty string).
-    """
-
-    block_name: list = field(default_factory=list)
-    vertices: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
-    triangles: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), np.int64))
-    triangle_block: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    split_bodies: bool = False
-
-    def __post_init__(self):
-        object.__setattr__(self, "block_name", list(self.block_name))
-        object.__setattr__(self, "vertices",
-                           np.asarray(self.vertices, dtype=float).reshape(-1, 3))
-        object.__setattr__(self, "triangles",
-                           np.asarray(self.triangles, dtype=np.int64).reshape(-1, 3))
-        object.__setattr__(self, "triangle_block",
-                           np.asarray(self.triangle_block, dtype=np.int64))
 
 
 def read_mesh(path) -> TriangleSoup:
@@ -83,7 +44,7 @@ def read_mesh(path) -> TriangleSoup:
     Parameters
     ----------
     path : str or Path
-        An OBJ, STL or PLY file (by its suffix, case-insensitive).
+        An OBJ, STL, PLY or COMPAS JSON file (by its suffix, case-insensitive).
 
     Returns
     -------
@@ -199,7 +160,7 @@ def _obj_blocks(vertices, faces, face_object, face_group, objects, groups) -> Tr
     """
     counts = np.array([len(f) for f in faces])
     flat = np.fromiter((i for f in faces for i in f), dtype=np.int64, count=int(counts.sum()))
-    triangles, face = _fan(flat, counts)
+    triangles, face = fan(flat, counts)
     if len(set(face_object)) >= 2:
         names, key = objects, face_object
     elif len(set(face_group)) >= 2:
@@ -215,17 +176,6 @@ def _obj_blocks(vertices, faces, face_object, face_group, objects, groups) -> Tr
         key = np.where(key < 0, len(names) - 1, key)
     used, key = np.unique(key, return_inverse=True)
     return TriangleSoup([names[i] for i in used], vertices, triangles, key[face])
-
-
-def _fan(flat, counts):
-    """Polygons (flat indices, (n,) vertex counts) -> fan triangles (T, 3) and their
-    polygon (T,)."""
-    ntri = counts - 2
-    face = np.repeat(np.arange(len(counts)), ntri)
-    start = np.cumsum(counts) - counts
-    k = np.arange(len(face)) - np.repeat(np.cumsum(ntri) - ntri, ntri)
-    s = start[face]
-    return np.stack([flat[s], flat[s + k + 1], flat[s + k + 2]], axis=1), face
 
 
 # ---------------------------------------------------------------------- STL, PLY
@@ -288,5 +238,6 @@ def _one_soup(corners) -> TriangleSoup:
                         np.zeros(len(corners) // 3), split_bodies=True)
 
 
-READERS = {".obj": _read_obj, ".stl": _read_stl, ".ply": _read_ply}
+READERS = {".obj": _read_obj, ".stl": _read_stl, ".ply": _read_ply,
+           ".json": read_compas_json}
 """Suffix -> reader of a file's bytes (one per entry of :data:`FORMATS`)."""
