@@ -16,7 +16,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from masonry.blocks import whole_of_web
-from masonry.export import csv, html, obj, rhino, stl, summaries, threemf, vtu
+from masonry.export import (compas_json, csv, html, obj, rhino, stl, summaries, threemf,
+                            vtu)
 from masonry.printable import PrintableError, printable_blocks, printable_body
 from masonry.rbe.equilibrium import VariableLayout
 from masonry.rbe.resultants import interface_resultants
@@ -266,6 +267,21 @@ def _rbe_files(made: RunOutputs) -> Export:
     return Export(files)
 
 
+def _is_whole(made: RunOutputs) -> bool:
+    """Whether the run's analysis model is its whole structure, each block bearing its
+    own forces (no neighbour images, cyclic routing or half model): what a COMPAS
+    assembly can hold."""
+    model = made.model
+    return (made.result is not None and model.blocks.n_blocks == made.scene.blocks.n_blocks
+            and all(value is None for value in model.assembly.values()))
+
+
+def _compas_files(made: RunOutputs) -> Export:
+    model = made.model
+    return Export({"assembly.json": compas_json.assembly_json(
+        model.blocks, model.interfaces, made.result.x, made.result.to_dict(), made.title)})
+
+
 def _collapse_files(made: RunOutputs) -> Export:
     result = made.collapse
     files = {"collapse/00_collapse.txt": summaries.collapse_text(result)}
@@ -399,6 +415,7 @@ EXPORTERS = (
     Exporter("html", "html", _html_files, wanted=lambda made: made.outputs.html),
     Exporter("collapse", "exports", _collapse_files,
              wanted=lambda made: made.collapse is not None),
+    Exporter("compas", "exports", _compas_files, wanted=_is_whole),
     Exporter("model", "exports", _model_files),
 )
 """Every exporter, in the order a run takes them."""
