@@ -1,0 +1,205 @@
+"""COMPAS JSON in and out: the ecosystem's samples read (fixtures/compas/), bad files
+refused, and assembly.json loaded by the real compas_assembly and by masonry."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import masonry
+from masonry.scenes.imported import read_blocks
+from masonry.scenes.mesh_files import AssemblyError
+from masonry_cli.main import main
+
+SAMPLES = Path(__file__).parent.parent / "fixtures" / "compas"
+
+# sample, support names (None: the file's is_support), mu of its package's examples, verdict
+CONVEX = [
+    ("compas_assembly/two-blocks_assembly.json", None, 0.84, "feasible"),
+    ("compas_assembly/stack_assembly.json", None, 0.84, "infeasible"),
+    ("compas_assembly/arch_assembly.json", None, 0.84, "feasible"),
+    ("compas_assembly/wall_assembly.json", None, 0.84, "feasible"),
+    ("compas_dem/dem_crossvault.json", None, 0.5, "feasible"),
+    ("compas_dem/barrel_vault_model.json", None, 0.5, "feasible"),
+    ("compas_cra/cubes.json", ["node_0"], 0.84, "feasible"),
+    *[(f"compas_cra/{name}.json", ["node_0", "node_1"], 0.84, "feasible")
+      for name in ("type-a", "type-b", "type-c", "type-d", "A", "H")],
+]
+
+
+def _file_counts(path):
+    """Blocks, supports and interface pairs as the file itself holds them (plain json)."""
+    data = json.loads(path.read_text())["data"]
+    if "elements" in data:
+        elements = data["elements"].values()
+        return len(elements), sum(e["data"]["is_support"] for e in elements), None
+    graph = data["graph"]["data"]
+    nodes = graph["node"]
+    pairs = {frozenset((u, v)) for u, nb in graph["edge"].items() for v, a in nb.items()
+             if a.get("interfaces")}
+    return len(nodes), sum(bool(n.get("is_support")) for n in nodes.values()), pairs
+
+
+@pytest.mark.parametrize("name", [c[0] for c in CONVEX])
+def test_sample_counts_are_the_files(name):
+    path = SAMPLES / name
+    blocks = read_blocks([path])
+    n_blocks, n_supports, pairs = _file_counts(path)
+    assert blocks.n_blocks == n_blocks
+    assert int(blocks.block_is_support.sum()) == n_supports
+    if pairs:  # the file's interfaces: masonry finds the same pairs of blocks in contact
+        structure = masonry.read(path)
+        found = {frozenset(str(blocks.block_name[i])[len("node_"):] for i in pair)
+                 for pair in structure.model.interfaces.pair}
+        assert found == pairs
+
+
+@pytest.mark.parametrize("name, support, mu, verdict", CONVEX)
+def test_sample_verdict(name, support, mu, verdict):
+    structure = masonry.read(SAMPLES / name, support=support, mu=mu)
+    assert structure.solve().verdict == verdict
+
+
+def test_non_convex_sample_refused_by_name(tmp_path, capsys):
+    code = main(["analyze", str(SAMPLES / "compas_cra" / "concave-short.json"),
+                 "--support", "node_0", "--out", str(tmp_path)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1
+    assert "concave-short.json" in err[0] and "'node_1' is not convex" in err[0]
+    assert not any(tmp_path.iterdir())
+
+
+def _two_blocks():
+    return json.loads((SAMPLES / "compas_assembly" / "two-blocks_assembly.json").read_text())
+
+
+def _node(doc, key="1"):
+    return doc["data"]["graph"]["data"]["node"][key]
+
+
+def _bad_two_blocks(edit):
+    doc = _two_blocks()
+    edit(doc)
+    return json.dumps(doc)
+
+
+def _set(container, key, value):
+    container[key] = value
+
+
+BAD = {
+    "not json": ("{'dtype': ", "not a JSON file"),
+    "wrong dtype": (_bad_two_blocks(lambda d: _set(d, "dtype", "compas.geometry/Box")),
+                    "dtype 'compas.geometry/Box'"),
+    "block without faces": (_bad_two_blocks(
+        lambda d: _set(_node(d)["block"]["data"], "face", {})), "node '1': the block has no"),
+    "face of two vertices": (_bad_two_blocks(
+        lambda d: _set(_node(d)["block"]["data"]["face"], "0", [0, 1])),
+        "node '1': face '0' is [0, 1]"),
+    "NaN coordinate": (_bad_two_blocks(
+        lambda d: _set(_node(d)["block"]["data"]["vertex"]["3"], "z", float("nan"))),
+        "node '1': vertex '3' has coordinates"),
+    "support not a boolean": (_bad_two_blocks(lambda d: _set(_node(d, "0"), "is_support", 1)),
+                              "node '0': is_support is 1, expected true or false"),
+    "edge to no node": (_bad_two_blocks(
+        lambda d: _set(d["data"]["graph"]["data"]["edge"]["0"], "7", {"interfaces": None})),
+        "edge (0, 7): node '7' does not exist"),
+}
+
+
+def _model_with_bad_guid():
+    doc = json.loads((SAMPLES / "compas_dem" / "dem_crossvault.json").read_text())
+    doc["data"]["graph"]["node"]["3"]["element"] = "no-such-guid"
+    return json.dumps(doc)
+
+
+BAD["guid pointing nowhere"] = (_model_with_bad_guid(),
+                                "graph node '3': element \"no-such-guid\" points to no element")
+
+
+@pytest.mark.parametrize("case", sorted(BAD))
+def test_bad_file_one_line_exit_2(case, tmp_path, capsys):
+    text, expected = BAD[case]
+    path = tmp_path / "bad.json"
+    path.write_text(text)
+    out = tmp_path / "out"
+    code = main(["analyze", str(path), "--support", "node_0", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert str(path) in err[0] and expected in err[0], err[0]
+    assert not out.exists()
+    with pytest.raises(AssemblyError, match="bad.json"):
+        masonry.read(path, support="node_0")
+
+
+def test_support_options_replace_the_files():
+    path = SAMPLES / "compas_assembly" / "wall_assembly.json"
+    assert masonry.read(path).scene.blocks.block_is_support.sum() == 10
+    chosen = masonry.read(path, support="node_0").scene.blocks
+    assert list(chosen.block_name[chosen.block_is_support]) == ["node_0"]
+
+
+# ---------------------------------------------------------------------- round trip
+@pytest.fixture(scope="module")
+def dome_run(tmp_path_factory):
+    out = tmp_path_factory.mktemp("dome")
+    code = main(["run", "--scene", "dome", "--n", "6", "--r", "0", "--p", "3", "--cut", "0.5",
+                 "--no-plots", "--no-printable", "--no-html", "--out", str(out)])
+    assert code == 0
+    folder = next(p for p in out.iterdir() if not p.name.startswith("."))
+    return folder, json.loads((folder / "run.json").read_text())
+
+
+def test_round_trip_masonry_reads_its_assembly_json(dome_run):
+    folder, record = dome_run
+    path = folder / "assembly.json"
+    document = json.loads(path.read_text())
+    assert document["data"]["attributes"]["masonry"]["verdict"] == record["rbe"]["verdict"]
+    back = masonry.read(path)
+    result = back.solve()
+    assert result.verdict == record["rbe"]["verdict"] == "feasible"
+    # the same forces: per interface point, as written (c_np, c_nn, c_u, c_v)
+    written = {}
+    for u, neighbours in document["data"]["graph"]["data"]["edge"].items():
+        for v, attributes in neighbours.items():
+            for interface in attributes["interfaces"]:
+                rows = [[f[k] for k in ("c_np", "c_nn", "c_u", "c_v")]
+                        for f in interface["data"]["forces"]]
+                written[(int(u), int(v))] = np.array(rows)
+    interfaces = back.model.interfaces
+    assert len(interfaces) == len(written)
+    x = result.x.reshape(-1, 4)
+    scale = np.abs(x).max()
+    for k, (u, v) in enumerate(interfaces.pair):
+        rows = x[interfaces.offsets[k]:interfaces.offsets[k + 1]]
+        mine = written[(int(u), int(v))]
+        # the same normal forces at the same polygon (its start may differ)
+        assert np.isclose(mine[:, 0].sum(), rows[:, 0].sum(), rtol=1e-6, atol=1e-6 * scale)
+    total = sum(m[:, 0].sum() for m in written.values())
+    assert np.isclose(total, x[:, 0].sum(), rtol=1e-6)
+
+
+def test_round_trip_compas_assembly_loads_it(dome_run):
+    compas = pytest.importorskip("compas")
+    pytest.importorskip("compas_assembly")
+    from compas_assembly.datastructures import Assembly, Block, Interface
+
+    folder, record = dome_run
+    names = [line.split()[1] for line in (folder / "bricks.obj").read_text().splitlines()
+             if line.startswith("o ")]
+    assembly = compas.json_load(str(folder / "assembly.json"))
+    assert isinstance(assembly, Assembly)
+    graph = assembly.graph
+    assert graph.number_of_nodes() == len(names)
+    interfaces = [i for edge in graph.edges() for i in graph.edge_attribute(edge, "interfaces")]
+    assert len(interfaces) == sum(record["counts"]["interfaces"].values())
+    assert all(isinstance(graph.node_attribute(n, "block"), Block) for n in graph.nodes())
+    assert all(isinstance(i, Interface) for i in interfaces)
+    supports = {graph.node_attribute(n, "block").name for n in graph.nodes()
+                if graph.node_attribute(n, "is_support")}
+    assert supports == {name for name in names if "_ground_" in name} != set()
+    # the frame's normal is x cross y, unit; forces per polygon point
+    for interface in interfaces:
+        assert len(interface.forces) == len(interface.points)
+        assert np.isclose(np.linalg.norm(interface.frame.normal), 1.0, atol=1e-9)
