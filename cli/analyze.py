@@ -7,8 +7,8 @@ from .options import (add_analysis_options, add_live_load_options, add_output_op
 
 
 NAME = "analyze"
-HELP = ("any assembly of convex blocks from OBJ, STL or PLY files: interfaces, rigid "
-        "block equilibrium, exports")
+HELP = ("any assembly of convex blocks from OBJ, STL, PLY or COMPAS JSON files: "
+        "interfaces, rigid block equilibrium, exports")
 """The subcommand's name and its line in ``masonry --help``."""
 
 
@@ -16,8 +16,10 @@ def register(subparsers):
     parser = subparsers.add_parser(NAME, help=HELP)
     parser.add_argument("files", nargs="+", metavar="FILE",
                         help="OBJ (one block per object or group), STL or PLY (one block "
-                             "per connected body); several files add up")
-    g = parser.add_argument_group("supports (at least one)")
+                             "per connected body), COMPAS JSON (one block per mesh, its "
+                             "is_support); several files add up")
+    g = parser.add_argument_group("supports (at least one; --support and --support-below "
+                                  "replace a COMPAS file's)")
     g.add_argument("--support", action="append", default=[], metavar="NAME_OR_PATTERN",
                    help="blocks fixed in place, by name or shell pattern ('pier_*'); "
                         "repeat for more")

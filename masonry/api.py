@@ -263,14 +263,16 @@ def build(preset=None, **inputs) -> Structure:
 
 
 def read(*paths, support=(), support_below=None, ground=False, **inputs) -> Structure:
-    """A structure of blocks read from mesh files (OBJ, STL, PLY; docs/assemblies.md).
+    """A structure of blocks read from mesh files (OBJ, STL, PLY, COMPAS JSON;
+    docs/assemblies.md).
 
     Parameters
     ----------
     *paths : str or Path
         The files; every closed convex body is a block.
     support : str or sequence of str
-        Name patterns of the fixed blocks (``pier_*``); None or empty: none.
+        Name patterns of the fixed blocks (``pier_*``); None or empty: none (a COMPAS
+        file's ``is_support`` blocks). With ``support_below``, replaces a COMPAS file's.
     support_below : float, optional
         Every block reaching below this height (metres) is fixed.
     ground : bool
