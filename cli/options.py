@@ -231,8 +231,9 @@ def add_live_load_options(parser):
     g.add_argument("--lateral", metavar="AZIMUTH|all",
                    help="horizontal body force lambda x each block's weight, at AZIMUTH "
                         "degrees from +x toward +y; 'all' searches 24 azimuths and the "
-                        "dome's symmetry directions for the worst (not on a cyclic "
-                        "section: use --scene dome)")
+                        "dome's symmetry directions for the worst and refines it "
+                        "between them (Brent's method, to 1e-7 of lambda; not on a "
+                        "cyclic section: use --scene dome)")
     g.add_argument("--point-load", dest="point_loads", action="append",
                    metavar="NAME_OR_PATTERN:FX,FY,FZ",
                    help="force in newtons at the centre of the top face of every block "
@@ -251,16 +252,16 @@ def collapse_summary(record, report) -> int:
     """The lines about the collapse load factor of a run record; returns the exit code:
     3 when the factor asked for has no verdict (:data:`~masonry.rbe.collapse_result.
     VERDICTS`), else 0."""
-    from masonry.export.summaries import mechanism_words  # the exporters: when reporting
+    from masonry.export.summaries import mechanism_words, search_words  # when reporting
 
     c = record["collapse"]
     live = c["live_load"]
-    what = (f"lateral at {c['azimuth_deg']:g} deg" if live["kind"] == "lateral"
+    what = (f"lateral at {c['azimuth_deg']:.6g} deg" if live["kind"] == "lateral"
             and c["azimuth_deg"] is not None else f"{live['kind']} load")
     if live["kind"] == "point":
         what += f" on {live['blocks']} block{'s' * (live['blocks'] != 1)}"
     if c.get("azimuths"):
-        what += f" (worst of {len(c['azimuths'])} azimuths)"
+        what += f" ({search_words(c)})"
     if c["friction_law"] != "associated" and c["associated_factor"] is not None:
         what += (f", {c['friction_law']} friction (associated: "
                  f"{c['associated_factor']:.4g})")

@@ -322,6 +322,12 @@ FACTOR_TIE_REL = 1e-6
 reports the first azimuth (a symmetric structure's 0 and 180 degrees differ by the LP's
 rounding only)."""
 
+AZIMUTH_REFINE_REL = 1e-7
+"""An azimuth search (``--lateral all``) refines its least sample until the least factor
+it found is within this (relative) of the least over every azimuth between its samples
+(:mod:`masonry.rbe.azimuth_refine`): below the 1e-6 the collapse program's factor is
+compared to, above its gaps (1e-8)."""
+
 CENTERING_REPORTED_REL = 1e-3
 """A block needs a temporary support when the centering force on it (docs/model.md 6.10,
 :mod:`masonry.rbe.centering`) exceeds this fraction of its own weight. Clarabel solves

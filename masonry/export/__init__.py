@@ -286,7 +286,7 @@ def _collapse_files(made: RunOutputs) -> Export:
     result = made.collapse
     files = {"collapse/00_collapse.txt": summaries.collapse_text(result)}
     if result.azimuths:
-        files["collapse/azimuths.csv"] = csv.azimuths_csv(result.azimuths)
+        files["collapse/azimuths.csv"] = csv.azimuths_csv(result.azimuths + result.refined)
     if result.forces is not None and result.load_factor is not None:
         blocks, interfaces = made.model.blocks, made.model.interfaces
         flags = {name: getattr(result, name) for name in ("opens", "slides", "hinge")}

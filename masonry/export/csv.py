@@ -202,8 +202,8 @@ def mechanism_csv(blocks: Blocks, mechanism) -> bytes:
 
 
 def azimuths_csv(azimuths) -> bytes:
-    """``collapse/azimuths.csv``: the lateral load factor of every azimuth searched
-    (empty factor: none)."""
+    """``collapse/azimuths.csv``: the lateral load factor of every azimuth searched, the
+    samples then the refinement's (empty factor: none)."""
     lines = ["azimuth_deg,load_factor"]
     lines += [f"{a:.10g}," + ("" if f is None else f"{f:.10g}") for a, f in azimuths]
     return ("\n".join(lines) + "\n").encode()

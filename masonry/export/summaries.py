@@ -123,7 +123,8 @@ def collapse_text(result) -> str:
         f"dead load stands:   {d['dead_load_feasible']}",
         f"live load:          {live['kind']}, "
         + ", ".join(f"{k} {_readable(v)}" for k, v in live.items() if k != "kind"),
-        f"azimuth:            {d['azimuth_deg']}",
+        f"azimuth:            {d['azimuth_deg']}" + (f" ({search_words(d)})"
+                                                       if d.get("azimuths") else ""),
         f"mu:                 {d['mu']:g}",
         f"friction model:     {result.cone.describe()}",
         f"contact law:        {result.contact_law}",
@@ -141,6 +142,15 @@ def collapse_text(result) -> str:
     if d["note"]:
         lines.append(f"note:               {d['note']}")
     return "\n".join(lines) + "\n"
+
+
+def search_words(record: dict) -> str:
+    """How an azimuth search found its least factor (``record``:
+    :meth:`CollapseResult.to_dict` after ``--lateral all``)."""
+    refined = record.get("refined") or ()
+    return (f"the least of {len(record['azimuths'])} azimuths"
+            + (f" and {len(refined)} more solved between them by Brent's method"
+               if refined else ""))
 
 
 def mechanism_words(record: dict) -> str:

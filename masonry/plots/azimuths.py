@@ -1,5 +1,5 @@
 """The lateral load factor against the load's azimuth (``--lateral all``) on polar axes,
-the worst azimuth marked."""
+the azimuths the search refined between its samples and the least it found marked."""
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -9,7 +9,9 @@ from masonry.plots.common import png_bytes
 
 def azimuths_png(collapse, title="") -> bytes:
     """``collapse/azimuths.png``: the lateral load factor against the load's azimuth
-    (``--lateral all``) on polar axes, the worst marked, the radius from a little below
+    (``--lateral all``) on polar axes: the samples joined by a line, the azimuths
+    solved between them by the refinement as dots, the least marked, the radius from a
+    little below
     the smallest factor (the title says where); ``title`` is the line under the
     figure's own."""
     angle = np.array([a for a, _ in collapse.azimuths])
@@ -19,9 +21,13 @@ def azimuths_png(collapse, title="") -> bytes:
     fig, ax = plt.subplots(figsize=(5.5, 5.5), subplot_kw={"projection": "polar"})
     ax.plot(theta, np.append(factor[order], factor[order][0]), "-o", color="C0",
             markersize=3, linewidth=1)
+    refined = [(a, f) for a, f in collapse.refined if f is not None]
+    if refined:
+        ax.plot(np.radians([a for a, _ in refined]), [f for _, f in refined], ".",
+                color="0.4", markersize=3, label="refined between the samples")
     worst = np.radians(collapse.azimuth_deg)
     ax.plot([worst], [collapse.load_factor], "o", color="#d62728", markersize=8,
-            label=f"worst: {collapse.load_factor:.4g} at {collapse.azimuth_deg:g} deg")
+            label=f"least: {collapse.load_factor:.7g} at {collapse.azimuth_deg:.6g} deg")
     # the radius starts below the smallest factor: from 0, factors within a few per
     # cent of each other would look like a circle
     low, high = np.nanmin(factor), np.nanmax(factor)

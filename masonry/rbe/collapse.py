@@ -45,6 +45,7 @@ import scipy.sparse as sp
 from masonry import forking
 from masonry.contact import ContactLaw
 from masonry.friction import FrictionCone
+from masonry.rbe.azimuth_refine import refine_least, search_factor
 from masonry.rbe.collapse_result import (ANISOTROPIC_NOTE, ASSOCIATED_NOTE, RESULT_KEYS,
                                          UNBOUNDED_NOTE, CollapseResult)
 from masonry.rbe.equilibrium import assemble, friction_edges
@@ -528,8 +529,11 @@ def lateral_azimuths(n_webs=None, count=24) -> np.ndarray:
 def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle",
                   n_webs=None, period_deg=None, mirrors=(), dead_load_feasible=None,
                   time_limit=600.0, method=None, cores=None, cohesion=0.0,
-                  tensile=0.0) -> CollapseResult:
-    """The smallest lateral load factor over ``azimuths`` (``--lateral all``).
+                  tensile=0.0, refine=True) -> CollapseResult:
+    """The smallest lateral load factor over ``azimuths`` (``--lateral all``) and, with
+    ``refine``, between them: Brent's method on every bracket between two of them (less
+    than 180 degrees apart) where a smaller factor may lie
+    (:func:`~masonry.rbe.azimuth_refine.refine_least`).
 
     One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: the interior point
     method and Clarabel keep their symbolic factorization, HiGHS's simplex restarts from
@@ -544,7 +548,9 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
     map onto each other have the same factor and each is solved once; one that lies in a
     mirror plane is solved on the model's half in it (:mod:`masonry.rbe.mirror`), and
     reported, if it is the worst, on the whole. Returns the worst azimuth's result with
-    every azimuth's factor in ``azimuths`` ((azimuth, factor or None) pairs).
+    every azimuth's factor in ``azimuths`` ((azimuth, factor or None) pairs) and those
+    the refinement solved in ``refined``; of factors tied with the least
+    (:data:`~masonry.tolerances.FACTOR_TIE_REL`) a sample's is reported first.
     """
     azimuths = lateral_azimuths(n_webs) if azimuths is None else np.asarray(azimuths, float)
     start = time.perf_counter()
@@ -567,14 +573,21 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
             break
     log.info("lateral search: %d azimuths, %d solved", len(results), len(solved))
     factors = [(float(a), r.load_factor) for a, r in zip(azimuths, results)]
-    found = [r for r in results if r.load_factor is not None]
+    refined = {}
+    if refine and len(results) == len(keys) and results[-1].dead_load_feasible:
+        samples = [(a, search_factor(r)) for a, r in zip(azimuths, results)]
+        orbit = functools.partial(symmetric_key, period_deg=period_deg, mirrors=mirrors)
+        refine_least(samples, lambda a: search_factor(refined.setdefault(
+            a, cases.solve(a, dead_load_feasible=True))), key=orbit)
+    sampled = [r for r in results if r.load_factor is not None]
+    found = sampled + [r for r in refined.values() if r.load_factor is not None]
     worst = results[-1]
     if found:
-        least = min(r.load_factor for r in found)
-        worst = next(r for r in found
-                     if r.load_factor <= least + FACTOR_TIE_REL * abs(least))
-    return dataclasses.replace(cases.on_the_whole(worst), azimuths=tuple(factors),
-                               time_s=time.perf_counter() - start)
+        least = min(found, key=lambda r: r.load_factor)
+        worst = next((r for r in sampled if r.load_factor
+                      <= least.load_factor + FACTOR_TIE_REL * abs(least.load_factor)), least)
+    return dataclasses.replace(cases.on_the_whole(worst), azimuths=tuple(factors), refined=tuple(
+        (float(a), r.load_factor) for a, r in refined.items()), time_s=time.perf_counter() - start)
 
 
 def symmetric_key(azimuth_deg, period_deg=None, mirrors=()) -> float:
@@ -615,6 +628,8 @@ class _LateralCases:
     def solve(self, azimuth, *, dead_load_feasible=None) -> CollapseResult:
         """The factor at ``azimuth`` (on a half: the half's result, its azimuth set)."""
         plane = in_plane(azimuth, self.mirrors)
+        if plane is not None and plane not in self.halves:  # a refinement's azimuth
+            self.halves[plane] = half_model(self.model, plane)
         problem = self._program(plane)
         if plane is None:
             return problem.solve_lateral(azimuth, dead_load_feasible=dead_load_feasible)

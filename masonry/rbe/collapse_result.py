@@ -91,7 +91,10 @@ class CollapseResult:
         point's mechanism moves many joints by little (see ``MOTION_TOL``): these say
         which joints carry it.
     azimuths : tuple of (float, float or None)
-        After :func:`worst_lateral`: every azimuth searched and its factor.
+        After :func:`worst_lateral`: every azimuth sampled and its factor.
+    refined : tuple of (float, float or None)
+        After :func:`worst_lateral`: the azimuths its refinement between the samples
+        solved, in the order solved, and their factors.
     friction_law : str
         ``associated`` (the LP of docs/model.md 6.8) or ``non-associative`` (see
         :func:`fixed_capacity_factor`).
@@ -125,6 +128,7 @@ class CollapseResult:
     gap: np.ndarray | None = None
     slip: np.ndarray | None = None
     azimuths: tuple = field(default=())
+    refined: tuple = field(default=())
     friction_law: str = "associated"
     associated_factor: float | None = None
     cone: FrictionCone = FrictionCone("circle")
@@ -205,7 +209,8 @@ class CollapseResult:
 
     def to_dict(self) -> dict:
         """Plain values for run.json: :data:`RESULT_KEYS`, ``live_load`` and, after a
-        search, every azimuth's factor."""
+        search, every azimuth's factor (``azimuths`` the samples, ``refined`` the
+        refinement's)."""
         out = {}
         for key in RESULT_KEYS:
             value = getattr(self, key)
@@ -213,6 +218,7 @@ class CollapseResult:
         out["live_load"] = self.live.description
         if self.azimuths:
             out["azimuths"] = [{"azimuth_deg": a, "load_factor": f} for a, f in self.azimuths]
+            out["refined"] = [{"azimuth_deg": a, "load_factor": f} for a, f in self.refined]
         return out
 
 
