@@ -49,7 +49,7 @@ from masonry.contact import ContactLaw
 from masonry.friction import FrictionCone
 from masonry.rbe.collapse import friction_columns
 from masonry.rbe.equilibrium import EquilibriumSystem, assemble
-from masonry.rbe.solvers.direct_clarabel import solve_cone_program
+from masonry.rbe.solvers.direct_clarabel import CENTERING_SETTINGS, solve_cone_program
 from masonry.rbe.solvers.program import SECOND_ORDER
 from masonry.tolerances import ACCEPT_RESIDUAL, CENTERING_REPORTED_REL, G
 
@@ -215,7 +215,8 @@ def solve_centering(system: EquilibriumSystem, *, time_limit=600.0) -> Centering
     n = A.shape[1]
     q = np.zeros(n)
     q[n - free:] = 1.0
-    status, z, iterations = solve_cone_program(q, A, b, rows, h, cones, time_limit)
+    status, z, iterations = solve_cone_program(q, A, b, rows, h, cones, time_limit,
+                                               CENTERING_SETTINGS)
     common = dict(weight_N=system.total_weight, block=system.free_block,
                   block_weight=system.block_weight[system.free_block],
                   iterations=iterations, mu=system.mu, cone=system.cone, law=system.law)

@@ -122,6 +122,12 @@ PROGRAM_SETTINGS = {"tol_gap_abs": 1e-8, "tol_gap_rel": 1e-8, "tol_feas": 1e-8}
 """Clarabel's tolerances for the collapse program (its defaults; scaled rows of order
 one); tighter gaps end "almost solved" on the full domes (docs/collapse.md)."""
 
+CENTERING_SETTINGS = {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1e-10}
+"""Clarabel's tolerances for the centering force (:mod:`masonry.rbe.centering`), solved
+once: at the collapse program's 1e-8 its total stopped 1e-3 of the mean block weight
+above the optimum on preset 1's free web (an independent SOCP, docs/model.md 6.10), at
+1e-10 within 1e-6, for four or five more iterations."""
+
 PROGRAM_STATUS = {"Solved": OPTIMAL, "AlmostSolved": OPTIMAL,
                   "PrimalInfeasible": INFEASIBLE, "DualInfeasible": UNBOUNDED}
 """Clarabel's verdicts on a collapse program; other statuses keep Clarabel's words. An
@@ -210,11 +216,12 @@ class ClarabelProgram(HeldProgram):
             self.solver.update(q=self.q, A=self.A)
 
 
-def solve_cone_program(q, A, b, G, h, cones, time_limit) -> tuple:
+def solve_cone_program(q, A, b, G, h, cones, time_limit, tolerances=None) -> tuple:
     """``minimize q . z`` subject to ``A z = b`` and ``h - G z`` in ``cones`` (the
     ``(kind, dimension, count)`` of :attr:`~masonry.rbe.solvers.program.Columns.cones`),
-    with the collapse program's settings (:data:`PROGRAM_SETTINGS`): a program stated
-    once and solved once (the centering force, :mod:`masonry.rbe.centering`).
+    with Clarabel's ``tolerances`` (default the collapse program's,
+    :data:`PROGRAM_SETTINGS`): a program stated once and solved once (the centering
+    force, :mod:`masonry.rbe.centering`, with :data:`CENTERING_SETTINGS`).
 
     Returns
     -------
@@ -227,7 +234,7 @@ def solve_cone_program(q, A, b, G, h, cones, time_limit) -> tuple:
     settings = clarabel.DefaultSettings()
     settings.verbose = False
     settings.time_limit = float(time_limit)
-    for name, value in PROGRAM_SETTINGS.items():
+    for name, value in (PROGRAM_SETTINGS if tolerances is None else tolerances).items():
         setattr(settings, name, value)
     n = len(q)
     solver = clarabel.DefaultSolver(
