@@ -8,6 +8,7 @@ from masonry.params import Params, from_preset, validate
 from masonry.rbe.accuracy import ACCURACY
 from masonry.rbe.solvers import RBE, names as solver_names
 from masonry.runfolder import RunFolder, check_output_root
+from masonry.scenes.polygonal import MIN_PATTERN_P
 
 from .options import add_verbosity
 
@@ -82,8 +83,8 @@ LP, and the search would outweigh the rest of the bench)."""
 def handle(args, report):
     if args.repeats < 1:
         raise ParameterError("repeats", args.repeats, "an integer >= 1")
-    if args.p is not None and args.p < 1:
-        raise ParameterError("p", args.p, "an integer >= 1")
+    if args.p is not None and args.p < MIN_PATTERN_P:  # the presets lay the pattern
+        raise ParameterError("p", args.p, f"an integer >= {MIN_PATTERN_P}")
     if args.collapse and args.friction_models is not None:
         raise ParameterError("friction_models", args.friction_models,
                              "one bench at a time: not with --collapse")

@@ -53,7 +53,7 @@ class PolygonalDome:
                      names_geometry=True)
     p: int = declare(10, "pattern bricks per rhombus side", kind="int",
                      check=lambda v: v >= 1, tag="p", head=True, names_geometry=True,
-                     expected="an integer >= 1 (>= 2 with the herringbone pattern)")
+                     expected="an integer >= 2 (>= 1 with --pattern none)")
     cut: float = declare(0.1, "fraction of the height cut off", check=lambda v: 0 <= v < 1,
                          expected="0 <= cut < 1", tag="c", head=True, names_geometry=True)
     unit: float = declare(0.1, "m, the brick unit", low=1e-3, high=1e2, tag="u", head=True,
