@@ -77,13 +77,15 @@ def lateral_record(model, params, count=3, cone="circle") -> dict:
     the friction model ``cone``. (The thesis's square pyramid is not symmetric under
     the mirror in a web's mid-plane unless the joints' axes are: its search is a
     reproduction, not a bound.) With Coulomb's cone the azimuths in the dome's mirror
-    planes are solved on its halves (docs/model.md 6.11)."""
+    planes are solved on its halves (docs/model.md 6.11). The least of the ``count``
+    azimuths, not refined between them as ``--lateral all`` refines its samples: the
+    tables of docs/structures.md were measured so."""
     start = time.perf_counter()
     n = params.geometry.n
     worst = worst_lateral(model, symmetric_azimuths(n, count), mu=params.analysis.mu,
                           density=params.analysis.density, cone=cone, n_webs=n,
                           mirrors=params.kind.symmetry(params.geometry).mirrors,
-                          dead_load_feasible=True)
+                          dead_load_feasible=True, refine=False)
     out = {"lateral_factor": worst.load_factor, "lateral_azimuth": worst.azimuth_deg,
            "hinge_webs": "", "hinge_courses": "", "sliding": worst.main_sliding,
            "lateral_s": round(time.perf_counter() - start, 1)}
