@@ -390,7 +390,9 @@ def test_run_reports_the_refined_least_of_an_azimuth_search(tmp_path, capsys):
     args = [f"--{key}={value}" for key, value in SMALL_DOME.items()]
     assert main(["run", "--scene", "dome", *args, "--mu", "5", "--lateral", "all",
                  "--no-printable", "--out", str(out)]) == 0
-    collapse = json.loads((out / "run.json").read_text())["collapse"]
+    (record,) = out.glob("*/run.json")
+    folder = record.parent
+    collapse = json.loads(record.read_text())["collapse"]
     azimuth, factor = collapse["azimuth_deg"], collapse["load_factor"]
     sampled = {row["azimuth_deg"]: row["load_factor"] for row in collapse["azimuths"]}
     assert factor < sampled[30.0] - 1e-4
@@ -398,10 +400,10 @@ def test_run_reports_the_refined_least_of_an_azimuth_search(tmp_path, capsys):
     dome = build_model(validate(Params.of(scene="dome", **SMALL_DOME)))[1]
     alone = collapse_load(dome, lateral(dome, azimuth), mu=5.0)
     assert factor == pytest.approx(alone.load_factor, rel=1e-6)
-    table = masonry.read_table(out / "collapse" / "azimuths.csv")
+    table = masonry.read_table(folder / "collapse" / "azimuths.csv")
     assert len(table) == len(sampled) + len(collapse["refined"])
     assert table["load_factor"].min() == pytest.approx(factor, rel=1e-9)
-    assert (out / "collapse" / "azimuths.png").exists()
+    assert (folder / "collapse" / "azimuths.png").exists()
     printed = capsys.readouterr().out
     assert f"lateral at {azimuth:.6g} deg (the least of {len(sampled)} azimuths and " \
            f"{len(collapse['refined'])} more solved between them" in printed
