@@ -28,8 +28,8 @@ from masonry.params import (FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, geometry_key,
 from masonry.rbe.adhesion import AdhesionResult, least_adhesion, stands_dry
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.centering import CenteringResult, centering_force
-from masonry.rbe.collapse import (CollapseResult, collapse_load, collapse_on_half,
-                                   worst_lateral)
+from masonry.rbe.collapse import CollapseResult, collapse_load, collapse_on_half
+from masonry.rbe.lateral_search import worst_lateral
 from masonry.rbe.loads import Lateral
 from masonry.rbe.mirror import (equilibrium_on_the_whole, half_model, states_exactly,
                                  symmetric_plane)

@@ -19,8 +19,8 @@ from masonry.params import ParameterError, Params, from_preset, validate
 from masonry.rbe.azimuth_refine import floor_between
 from masonry.rbe.boundary import Model
 from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
-                                  collapse_load, fixed_capacity_factor, lateral_azimuths,
-                                  symmetric_key, worst_lateral)
+                                  collapse_load, fixed_capacity_factor)
+from masonry.rbe.lateral_search import lateral_azimuths, symmetric_key, worst_lateral
 from masonry.rbe.loads import crown_load, lateral, point_loads
 from masonry.rbe.solvers.interior_lp import LoadFactorOptions
 from masonry.scenes.arch import arch_profile

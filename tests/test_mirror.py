@@ -11,7 +11,8 @@ import pytest
 
 from masonry.params import Params, from_preset, validate
 from masonry.pipeline import Timer, build_model, collapse_of, solve
-from masonry.rbe.collapse import collapse_load, collapse_on_half, worst_lateral
+from masonry.rbe.collapse import collapse_load, collapse_on_half
+from masonry.rbe.lateral_search import worst_lateral
 from masonry.rbe.loads import CrownLoad, Lateral, crown_load, lateral
 from masonry.rbe.mirror import MirrorError, half_model
 from masonry.rbe.solve import RBEProblem

@@ -14,7 +14,8 @@ from masonry.plots import (COLOUR_PERCENTILE, VIEWS, azimuths_png, colour_scale,
                            mechanism_pngs)
 from masonry.plots.failure import _rank_labels
 from masonry.scenes import build
-from masonry.rbe.collapse import collapse_load, worst_lateral
+from masonry.rbe.collapse import collapse_load
+from masonry.rbe.lateral_search import worst_lateral
 from masonry.rbe.loads import lateral, point_loads
 from masonry.tolerances import TENSION_REPORTED_REL
 from test_collapse import DENSITY, SMALL_DOME, column

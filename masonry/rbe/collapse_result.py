@@ -91,9 +91,9 @@ class CollapseResult:
         point's mechanism moves many joints by little (see ``MOTION_TOL``): these say
         which joints carry it.
     azimuths : tuple of (float, float or None)
-        After :func:`worst_lateral`: every azimuth sampled and its factor.
+        After :func:`~masonry.rbe.lateral_search.worst_lateral`: every azimuth sampled and its factor.
     refined : tuple of (float, float or None)
-        After :func:`worst_lateral`: the azimuths its refinement between the samples
+        After :func:`~masonry.rbe.lateral_search.worst_lateral`: the azimuths its refinement between the samples
         solved, in the order solved, and their factors.
     friction_law : str
         ``associated`` (the LP of docs/model.md 6.8) or ``non-associative`` (see

@@ -12,7 +12,7 @@ and :class:`masonry.rbe.collapse.CollapseLP`; default the process's,
   the load-path LP decides friction-net.
 
 The collapse search's azimuths two at once (:func:`masonry.forking.two_at_once`) are
-decided by :func:`masonry.rbe.collapse.worst_lateral`, the command line's one BLAS thread
+decided by :func:`masonry.rbe.lateral_search.worst_lateral`, the command line's one BLAS thread
 for the whole process by :func:`masonry.forking.use_one_blas_thread`.
 """
 

@@ -31,7 +31,8 @@ from masonry.dome.levels import Dimensions
 from masonry.params import Params, from_preset, validate
 from masonry.pipeline import build_model
 from masonry.scenes import build
-from masonry.rbe.collapse import CollapseLP, collapse_on_half, lateral_azimuths, worst_lateral
+from masonry.rbe.collapse import CollapseLP, collapse_on_half
+from masonry.rbe.lateral_search import lateral_azimuths, worst_lateral
 from masonry.rbe.loads import Lateral, lateral
 from masonry.rbe.mirror import half_model
 from masonry.rbe.solve import ACCURACY, RBEProblem
@@ -372,7 +373,7 @@ def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None
         half for a load along a web's mid-plane (0 degrees) and one along the plane
         ``180 / n`` degrees on (a corner plane of the polygonal dome).
     search : bool
-        Also a row for ``--lateral all`` (:func:`~masonry.rbe.collapse.worst_lateral`,
+        Also a row for ``--lateral all`` (:func:`~masonry.rbe.lateral_search.worst_lateral`,
         as ``masonry run`` makes it) against independent one-azimuth LPs on the whole at
         the same azimuths.
     """

@@ -15,7 +15,7 @@ import numpy as np
 
 from masonry.export._text import format_float
 from masonry.export.csv import header
-from masonry.rbe.collapse import worst_lateral
+from masonry.rbe.lateral_search import worst_lateral
 from masonry.rbe.equilibrium import VariableLayout
 from masonry.params import from_preset
 from masonry.pipeline import build_model
