@@ -284,3 +284,14 @@ def test_bad_inputs_are_refused_by_name(tmp_path, capsys, args, named):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and named in err[0]
     assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize("p", [1, 2, 10])
+def test_the_default_start_nodes_are_at_least_three_bricks_apart(p):
+    """Two pattern bricks and a regular brick (6 units) fit between any two start nodes
+    of the default count, a multiple of four, whatever p asks: radius 20 units at p 1
+    asks 2 (p + 1) = 4 units, less than 6."""
+    g = validate(Params.of(scene="revolution", radius=20, p=p)).geometry
+    count = default_spirals(g)
+    assert count % 4 == 0 and 2 * np.pi * 20 / count >= 6
+    assert build(validate(Params.of(scene="revolution", radius=20, p=p))).blocks.n_blocks

@@ -127,11 +127,18 @@ def profile_of(g: RevolutionDome) -> Profile:
 
 
 # --------------------------------------------------------------------------- pattern
+NODE_SPACING_MIN = 6
+"""Fewest units between start nodes on the springing ring: two pattern bricks and a
+regular brick."""
+
+
 def default_spirals(g: RevolutionDome) -> int:
-    """Start nodes at least ``2 (p + 1)`` units apart around the springing ring, a
-    multiple of four (at least four), so that the lines can end twice at every other
-    node and keep the dome's symmetry."""
-    return max(4, 4 * int(2 * np.pi * g.radius / (8 * (g.p + 1))))
+    """Start nodes at least ``2 (p + 1)`` units apart around the springing ring, and at
+    least :data:`NODE_SPACING_MIN` (the least :func:`check_revolution` takes), a multiple
+    of four (at least four), so that the lines can end twice at every other node and
+    keep the dome's symmetry."""
+    spacing = max(2 * (g.p + 1), NODE_SPACING_MIN)
+    return max(4, 4 * int(2 * np.pi * g.radius / (4 * spacing)))
 
 
 @dataclass(frozen=True)
@@ -562,8 +569,9 @@ def check_revolution(g: RevolutionDome, pattern=None) -> None:
         raise ParameterError("cut", g.cut, "a dome at least three courses high; lower cut",
                              related=("radius", "stretch"))
     spirals = g.spirals or default_spirals(g)
-    if 2 * np.pi * g.radius / spirals < 6 and g.pattern == "herringbone":
-        raise ParameterError("spirals", spirals, f"at most {int(2 * np.pi * g.radius / 6)} "
+    if 2 * np.pi * g.radius / spirals < NODE_SPACING_MIN and g.pattern == "herringbone":
+        raise ParameterError("spirals", spirals, f"at most "
+                             f"{int(2 * np.pi * g.radius / NODE_SPACING_MIN)} "
                              f"start nodes on a springing ring of radius {g.radius:g} units "
                              "(two pattern bricks and a regular brick between nodes)",
                              related=("radius", "p"))
