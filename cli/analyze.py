@@ -39,12 +39,14 @@ def handle(args, report):
     # the inputs are checked before any file is read: a placeholder name until then
     given = given_inputs(args)
     check_print_size(args, validate(Params.of(scene="assembly", assembly="-", **given)))
+    from masonry.api import assembly_inputs
     from masonry.pipeline import run  # the whole pipeline: once the options are read
     from masonry.scenes.imported import load_assembly
 
     scene, source = load_assembly(args.files, supports=args.support,
                                   support_below=args.support_below, ground=args.ground)
-    params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **given))
+    inputs = assembly_inputs(scene.blocks, source, given)  # the options win over a Problem's
+    params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **inputs))
     record = run(params, args.out, analyse=True, force=args.force, scene=scene,
                  source=source)
     report(f"read {scene.blocks.n_blocks} blocks ({source['supports']} supports) from "

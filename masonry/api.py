@@ -30,12 +30,13 @@ from masonry.params import (Params, from_preset, names, section_default, structu
 from masonry.pipeline import (Timer, adhesion_of, build_model, centering_of, collapse_of, run,
                               solve)
 from masonry.rbe.boundary import analysis_model
-from masonry.rbe.loads import LOAD_OPTIONS
+from masonry.rbe.loads import LOAD_OPTIONS, point_load_spec
 from masonry.rbe.resultants import interface_resultants
 from masonry.scenes import check_size
-from masonry.scenes.imported import load_assembly
+from masonry.scenes.imported import AssemblyError, load_assembly
 from masonry.studies.plans import make_plan
 from masonry.studies.stages import STAGE_COLUMNS, analyse_stages, check_live_load
+from masonry.tolerances import Tolerances
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -278,7 +279,8 @@ def read(*paths, support=(), support_below=None, ground=False, **inputs) -> Stru
     ground : bool
         Add a ground slab (a support) under the lowest blocks.
     **inputs
-        Analysis, live-load and output inputs (``mu``, ``density``, ``lateral`` ...).
+        Analysis, live-load and output inputs (``mu``, ``density``, ``lateral`` ...);
+        they win over a compas_dem Problem's (:func:`assembly_inputs`).
 
     Raises
     ------
@@ -292,8 +294,45 @@ def read(*paths, support=(), support_below=None, ground=False, **inputs) -> Stru
     validate(Params.of(scene="assembly", assembly="-", **inputs))  # before any file is read
     scene, source = load_assembly(paths, supports=supports,
                                   support_below=plain(support_below), ground=ground)
+    inputs = assembly_inputs(scene.blocks, source, inputs)
     params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **inputs))
     return Structure(params, scene, analysis_model(scene, params.analysis.boundary), source)
+
+
+def assembly_inputs(blocks, source: dict, given: dict) -> dict:
+    """The analysis inputs of read blocks: a compas_dem Problem's (``source["problem"]``,
+    :func:`masonry.scenes.imported.load_assembly`), then ``given`` (the caller's) over
+    them; a live load given drops the Problem's point loads.
+
+    Raises
+    ------
+    masonry.scenes.imported.AssemblyError
+        A point load of the Problem that masonry cannot state, naming the file and load.
+    """
+    problem = (source or {}).get("problem")
+    given = {k: v for k, v in given.items() if v is not None and not (
+        isinstance(v, (list, tuple)) and not v)}
+    if problem is None:
+        return given
+    stated = {"mu": problem["mu"], "density": problem["density"],
+              "cohesion_kpa": _kilo(problem["cohesion_Pa"]),
+              "tensile_kpa": _kilo(problem["tensile_Pa"])}
+    if not any(name in given for name in LOAD_OPTIONS):
+        tol = Tolerances.for_points(blocks.vertices)
+        specs = []
+        for load in problem["point_loads"]:
+            try:
+                specs.append(point_load_spec(blocks, load["block"], load["force"],
+                                             load["point"], tol.length))
+            except ValueError as error:
+                raise AssemblyError(f"{problem['file']}: {load['where']}: {error}; not "
+                                    "supported") from None
+        stated["point_loads"] = tuple(specs)
+    return {**{k: v for k, v in stated.items() if v is not None and v != ()}, **given}
+
+
+def _kilo(pascals):
+    return None if pascals is None else pascals / 1000.0
 
 
 def _checked_supports(paths, support, support_below, ground, inputs) -> tuple:

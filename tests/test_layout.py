@@ -28,6 +28,8 @@ STAGES = (
     ("masonry.studies",),
     # the package's __init__ hands out the Python interface (imported when first used)
     ("masonry.api", "masonry"),
+    # adapters that let other tools call masonry (imported only by their users)
+    ("masonry.interop",),
 )
 
 

@@ -177,6 +177,32 @@ def point_loads(blocks, specs) -> LiveLoad:
                                       blocks=len(np.unique(chosen))))
 
 
+def point_load_spec(blocks, block: int, force, point=None, length_tol: float = 0.0) -> str:
+    """The ``'NAME:FX,FY,FZ'`` spec of a force ``force`` ((3,) N) at ``point`` ((3,) m;
+    None: the block's centroid) on block ``block``, when it is one: its line of action
+    passes within ``length_tol`` (m) of the centre of the block's top face, where
+    :func:`point_loads` applies it (the same force, the same moment about any point).
+
+    Raises
+    ------
+    ValueError
+        The line of action misses that centre (by how much), or the block is a support.
+    """
+    name = str(blocks.block_name[block])
+    if blocks.block_is_support[block]:
+        raise ValueError(f"block {name} is a support: a load on it changes nothing")
+    force = np.asarray(force, dtype=float)
+    at = blocks.block_centroid[block] if point is None else np.asarray(point, dtype=float)
+    lever = blocks.face_centre[top_faces(blocks)[block]] - at
+    norm = float(np.linalg.norm(force))
+    miss = float(np.linalg.norm(np.cross(lever, force))) / norm if norm else 0.0
+    if miss > length_tol:
+        raise ValueError(f"its line of action misses the centre of block {name}'s top face "
+                         f"by {miss:.3g} m, where masonry applies point loads")
+    escaped = "".join(f"[{c}]" if c in "*?[" else c for c in name)  # a name, not a pattern
+    return f"{escaped}:{','.join(repr(float(v)) for v in force)}"
+
+
 def top_course(blocks) -> np.ndarray:
     """(m,) int: the free blocks whose top lies in the highest course (a pattern brick
     spans its course and the next, docs/model.md 2)."""

@@ -9,7 +9,9 @@ a key to ``x``, ``y``, ``z``; its ``data.face`` maps a key to a list of vertex k
 - compas_dem's ``BlockModel``: its ``elements`` (keyed by guid), each with its mesh
   ``geometry`` and ``is_support``, in the order of the model graph's nodes, which name
   them by guid;
-- a plain list of meshes (``compas.datastructures/Mesh`` or compas_assembly ``Block``).
+- a plain list of meshes (``compas.datastructures/Mesh`` or compas_assembly ``Block``);
+- compas_dem's ``Problem`` saved with its ``BlockModel``: the model's blocks, and the
+  analysis inputs the problem states (:mod:`masonry.scenes.compas_problem`).
 
 compas 1 files (``value`` in place of ``data``) are read too. Parsed with the standard
 ``json`` module: the COMPAS packages are not needed to read.
@@ -29,6 +31,7 @@ from numbers import Real
 
 import numpy as np
 
+from masonry.scenes.compas_problem import PROBLEM_DTYPE, problem_inputs, problem_model
 from masonry.scenes.soup import AssemblyError, TriangleSoup, fan
 
 ASSEMBLY_DTYPES = ("compas_assembly.datastructures/Assembly",
@@ -60,20 +63,28 @@ def read_compas_json(data: bytes) -> TriangleSoup:
         document = json.loads(data)
     except (UnicodeDecodeError, json.JSONDecodeError) as error:
         raise AssemblyError(f"not a JSON file ({error})") from None
+    problem = None
     if isinstance(document, list):
         entries = [(f"mesh {i}", f"mesh_{i}", mesh, False) for i, mesh in enumerate(document)]
     elif isinstance(document, dict) and document.get("dtype") in ASSEMBLY_DTYPES:
         entries = _assembly_entries(_data(document, "the file"))
     elif isinstance(document, dict) and document.get("dtype") == BLOCK_MODEL_DTYPE:
         entries = _model_entries(_data(document, "the file"))
+    elif isinstance(document, dict) and document.get("dtype") == PROBLEM_DTYPE:
+        model = _data(problem_model(document, _data), "the problem's model")
+        entries = _model_entries(model)
+        problem = problem_inputs(document, _data, [e[4] for e in entries],
+                                 [_material(model, e[5]) for e in entries])
+        fixed = set(problem.fixed)
+        entries = [(*e[:3], e[3] or i in fixed) for i, e in enumerate(entries)]
     else:
         dtype = document.get("dtype") if isinstance(document, dict) else type(document)
         raise AssemblyError(
             f"dtype {dtype!r}: masonry reads a COMPAS {' or '.join(ASSEMBLY_DTYPES)}, "
-            f"{BLOCK_MODEL_DTYPE} or a list of meshes")
+            f"{BLOCK_MODEL_DTYPE}, {PROBLEM_DTYPE} or a list of meshes")
     if not entries:
         raise AssemblyError("no block in the file")
-    meshes = [_mesh(where, mesh) for where, _, mesh, _ in entries]
+    meshes = [_mesh(where, mesh) for where, _, mesh, *_ in entries]
     names = _names([e[1] for e in entries], [m[2] for m in meshes])
     counts = np.array([len(m[0]) for m in meshes])
     start = np.concatenate([[0], np.cumsum(counts)[:-1]])
@@ -83,7 +94,8 @@ def read_compas_json(data: bytes) -> TriangleSoup:
     sizes = np.array([len(f) for f in faces])
     triangles, face = fan(np.concatenate(faces), sizes)
     return TriangleSoup(names, np.concatenate([m[0] for m in meshes]), triangles,
-                        face_block[face], block_is_support=[e[3] for e in entries])
+                        face_block[face], block_is_support=[e[3] for e in entries],
+                        problem=problem)
 
 
 def _data(obj, where: str) -> dict:
@@ -137,20 +149,21 @@ def _assembly_entries(data: dict) -> list:
 
 
 def _model_entries(data: dict) -> list:
-    """``(where, fallback name, mesh, is_support)`` of every element of a BlockModel, in
-    the order of its graph's nodes; its tree's and materials' guids checked too."""
+    """``(where, fallback name, mesh, is_support, node key, material guid)`` of every
+    element of a BlockModel, in the order of its graph's nodes; its tree's and materials'
+    guids checked too."""
     elements = _dict(data, "elements", "the block model")
     materials = data.get("materials") or {}
     graph = data.get("graph") or {}
     nodes = graph.get("node") if isinstance(graph, dict) else None
-    order = (list(elements) if not nodes
-             else [(_guid(node, "element", elements, f"graph node {key!r}"))
+    order = (list(enumerate(elements)) if not nodes
+             else [(key, _guid(node, "element", elements, f"graph node {key!r}"))
                    for key, node in nodes.items()])
     tree = (data.get("tree") or {}).get("root") or {}
     for child in tree.get("children") or []:
         _guid(child, "element", elements, "tree node")
     entries = []
-    for i, guid in enumerate(order):
+    for i, (key, guid) in enumerate(order):
         where = f"element {guid!r}"
         element = _data(elements[guid], where)
         material = element.get("material")
@@ -162,8 +175,13 @@ def _model_entries(data: dict) -> list:
         name = element.get("name")
         named = mesh if name in GENERIC_NAMES or not isinstance(mesh, dict) \
             else {**mesh, "name": name}
-        entries.append((where, f"element_{i}", named, support))
+        entries.append((where, f"element_{i}", named, support, str(key), material))
     return entries
+
+
+def _material(model: dict, guid) -> dict | None:
+    """The data of the material ``guid`` of a BlockModel (checked to exist), or None."""
+    return None if guid is None else _data(model["materials"][guid], f"material {guid!r}")
 
 
 def _guid(node, key: str, targets: dict, where: str) -> str:

@@ -84,7 +84,12 @@ def read_blocks(paths, tol: Tolerances | None = None) -> Blocks:
     paths = [Path(p) for p in paths]
     if not paths:
         raise AssemblyError("no mesh file given")
-    soups = [read_mesh(p) for p in paths]
+    return _blocks_of(paths, [read_mesh(p) for p in paths], tol)[0]
+
+
+def _blocks_of(paths, soups, tol: Tolerances | None) -> tuple:
+    """:func:`read_blocks` of the files' soups, and the first block of every file ((n,)
+    int)."""
     points = np.concatenate([s.vertices for s in soups])
     if tol is None:
         tol = Tolerances.for_points(points)
@@ -98,10 +103,12 @@ def read_blocks(paths, tol: Tolerances | None = None) -> Blocks:
     blocks = concatenate(parts)
     names = _unique_names(blocks.block_name)
     block_class, block_course = _classes_from_names(names)
+    first = np.cumsum([0] + [part.n_blocks for part in parts[:-1]])
     return Blocks.from_arrays(
         blocks.vertices, blocks.vertex_offsets, blocks.face_vertices, blocks.face_offsets,
         blocks.face_block, block_class=block_class, block_course=block_course,
-        block_is_support=np.concatenate([s.supports for s in soups]), block_name=names)
+        block_is_support=np.concatenate([s.supports for s in soups]),
+        block_name=names), first
 
 
 def select_supports(blocks: Blocks, names=(), below=None, tol: Tolerances | None = None):
@@ -245,7 +252,11 @@ def load_assembly(paths, *, supports=(), support_below=None, ground=False):
         (:func:`overlapping_pairs`).
     """
     start = time.perf_counter()
-    blocks = read_blocks(paths)
+    if not paths:
+        raise AssemblyError("no mesh file given")
+    soups = [read_mesh(p) for p in paths]
+    blocks, first = _blocks_of([Path(p) for p in paths], list(soups), None)
+    problem = _problem_record(paths, soups, first)
     tol = Tolerances.for_points(blocks.vertices)
     if supports or support_below is not None:  # the user's choice, not the file's
         blocks = dataclasses.replace(blocks, block_is_support=np.zeros(blocks.n_blocks, bool))
@@ -265,9 +276,30 @@ def load_assembly(paths, *, supports=(), support_below=None, ground=False):
               "support_below": support_below, "ground": bool(ground),
               "supports": int(is_support.sum()),
               "read_s": round(time.perf_counter() - start, 4)}
+    if problem is not None:
+        source["problem"] = problem
     log.info("read %d blocks (%d supports) in %.3g s", blocks.n_blocks, source["supports"],
              source["read_s"])
     return Scene(Assembly, geometry, blocks), source
+
+
+def _problem_record(paths, soups, first) -> dict | None:
+    """The inputs of the one compas_dem Problem among the files (as run.json records
+    them: ``file``, ``mu``, ``cohesion_Pa``, ``tensile_Pa``, ``density``, ``fixed`` and
+    ``point_loads``, blocks as indices of the read blocks), or None."""
+    stated = [(path, soup.problem, int(f)) for path, soup, f in zip(paths, soups, first)
+              if soup.problem is not None]
+    if len(stated) > 1:
+        raise AssemblyError(f"{stated[1][0]}: a second compas_dem Problem (with "
+                            f"{stated[0][0]}); masonry analyses one problem at a time")
+    if not stated:
+        return None
+    path, problem, offset = stated[0]
+    record = dataclasses.asdict(problem)
+    record["fixed"] = [offset + b for b in problem.fixed]
+    record["point_loads"] = [{**load, "block": offset + load["block"]}
+                             for load in problem.point_loads]
+    return {"file": str(path), **record}
 
 
 def _refuse_overlaps(blocks: Blocks, paths):

@@ -36,6 +36,8 @@ class TriangleSoup:
     block_is_support : (B,) bool or None
         The supports the file flags (a COMPAS assembly's ``is_support``); None: the
         format has no such flag.
+    problem : masonry.scenes.compas_problem.ProblemInputs or None
+        The analysis inputs a compas_dem Problem states; None for other files.
     """
 
     block_name: list = field(default_factory=list)
@@ -44,6 +46,7 @@ class TriangleSoup:
     triangle_block: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     split_bodies: bool = False
     block_is_support: np.ndarray | None = None
+    problem: object = None
 
     def __post_init__(self):
         object.__setattr__(self, "block_name", list(self.block_name))
