@@ -29,6 +29,13 @@ import numpy as np
 from masonry.errors import MasonryError
 from masonry.friction import FrictionCone
 
+TENSION_RATIO = 0.5
+"""The default ratio ``t_c / c`` of the least adhesion's tensile strength to its cohesion
+(docs/model.md 6.12, :mod:`masonry.rbe.adhesion`): EN 1996-1-1 gives masonry's flexural
+(bond) strength and its initial shear strength in about that ratio (f_xk1 about 0.1 MPa
+for general purpose mortar against f_vk0 0.1 to 0.3 MPa); 0 is the conservative choice,
+no tension at all."""
+
 
 class ContactLawError(MasonryError, ValueError):
     """A strength that is negative or not finite, or a friction coefficient that is not

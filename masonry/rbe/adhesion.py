@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from masonry.contact import ContactLaw
+from masonry.contact import TENSION_RATIO, ContactLaw
 from masonry.errors import MasonryError
 from masonry.interfaces import INTERFACE_KINDS
 from masonry.rbe.collapse import friction_columns
@@ -51,12 +51,6 @@ log = logging.getLogger(__name__)
 
 SOLVER = "clarabel"
 """The solver of the program (module docstring)."""
-
-TENSION_RATIO = 0.5
-"""The default ratio ``t_c / c`` of the adhesion's tensile strength to its cohesion
-(docs/model.md 6.12): EN 1996-1-1 gives masonry's flexural (bond) strength and its
-initial shear strength in about that ratio (f_xk1 about 0.1 MPa for general purpose
-mortar against f_vk0 0.1 to 0.3 MPa); 0 is the conservative choice, no tension at all."""
 
 RESULT_KEYS = ("a_kPa", "ratio", "friction_model", "mu", "status", "solver",
                "iterations", "time_s", "residual_eq", "law_violation", "reason")

@@ -3,12 +3,11 @@ law and model, the boundary of a section, and the solvers' accuracy."""
 
 from dataclasses import dataclass
 
-from masonry.contact import ContactLaw
+from masonry.contact import TENSION_RATIO, ContactLaw
+from masonry.errors import ParameterError
 from masonry.friction import FrictionCone, FrictionModelError
 from masonry.parameters import check_fields, declare
-from masonry.errors import ParameterError
 from masonry.rbe.accuracy import ACCURACY
-from masonry.rbe.adhesion import TENSION_RATIO
 from masonry.rbe.solvers import BACKENDS, RBE, names
 
 FRICTIONS = ("net", "plus", "auto")
