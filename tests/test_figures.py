@@ -252,7 +252,7 @@ def test_thrust_line_chains_follow_one_column_of_blocks():
 def test_the_azimuths_radius_starts_near_the_smallest_factor(figures):
     factors = [0.79, 0.80, 0.82, 0.81, 0.795, 0.80]
     collapse = SimpleNamespace(azimuths=[(30.0 * k, f) for k, f in enumerate(factors)],
-                               azimuth_deg=0.0, load_factor=0.79)
+                               azimuth_deg=0.0, load_factor=0.79, refined=())
     azimuths.azimuths_png(collapse)
     low, high = figures[0].ylim
     assert 0.7 < low < 0.79 and 0.82 < high < 0.85

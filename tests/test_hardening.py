@@ -57,9 +57,9 @@ def test_run_after_build_adds_the_forces_and_keeps_the_plots(tmp_path):
     assert main(["run", *WALL, "--out", str(tmp_path), "--no-plots", "--no-printable",
                  "-q"]) == 0
     record = json.loads((tmp_path / WALL_ID / "run.json").read_text())
-    assert record["outputs"] == {"analyse": True, "centering": True, "plots": True,
-                                 "printable": False, "html": True, "quick": True,
-                                 "3dm": True}
+    assert record["outputs"] == {"analyse": True, "centering": True, "adhesion": True,
+                                 "plots": True, "printable": False, "html": True,
+                                 "quick": True, "3dm": True}
     assert (tmp_path / WALL_ID / "RBE" / "forces.csv").is_file()
     assert (tmp_path / WALL_ID / "00_pattern.png").is_file()
 

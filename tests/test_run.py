@@ -263,7 +263,7 @@ def test_the_output_bench_times_every_exporter_a_run_writes(tmp_path, capsys):
     # every exporter a run of it writes, in the registry's order
     assert [row["exporter"] for row in rows] == [
         "rbe", "force_plots", "printable", "structure_plots", "interface_plots", "rhino",
-        "html", "model"]
+        "html", "compas", "model"]
     assert all(row["seconds"] > 0 and row["cpu_seconds"] >= 0 for row in rows)
     plots = [row for row in rows if row["exporter"] == "force_plots"]
     assert plots and plots[0]["files"] >= 2 and plots[0]["bricks"] == 16
