@@ -6,6 +6,7 @@ from masonry.params import structure_id
 from masonry.pipeline import model_record
 from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
 from masonry.studies.plans import StagePlan
+from masonry.tolerances import ADHESION_TIE_REL
 
 STAGE_SUMMARY_COLUMNS = ("stages", "stages_standing", "first_unsupported_stage",
                          "first_unsupported_course", "first_unsupported_brick",
@@ -39,8 +40,8 @@ def stage_extremes(rows) -> dict:
         every stage stands); ``load_factor_min`` and ``load_factor_min_stage`` over the
         stages with a load factor (None without a lateral load or where no stage stands);
         ``adhesion_max_kPa`` over the stages with a least adhesion (0 when every stage
-        stands dry, None when no stage has one), its ``adhesion_max_stage`` and
-        ``adhesion_max_course`` (None where it is 0 or None).
+        stands dry, None when no stage has one), and the ``adhesion_max_stage`` and
+        ``adhesion_max_course`` of :func:`adhesion_peak` (None where it is 0 or None).
     """
     solved = [row for row in rows if row["centering_N"] is not None]
     out = {"centering_max_N": None, "centering_max_fraction": None,
@@ -56,14 +57,24 @@ def stage_extremes(rows) -> dict:
     if factors:
         low = min(factors, key=lambda row: row["load_factor"])
         out.update(load_factor_min=low["load_factor"], load_factor_min_stage=low["stage"])
-    held = [row for row in rows if row["adhesion_kPa"] is not None]
-    if held:
-        top = max(held, key=lambda row: row["adhesion_kPa"])
+    top = adhesion_peak(rows)
+    if top is not None:
         peak = top["adhesion_kPa"] > 0
-        out.update(adhesion_max_kPa=top["adhesion_kPa"],
+        out.update(adhesion_max_kPa=max(row["adhesion_kPa"] for row in rows
+                                        if row["adhesion_kPa"] is not None),
                    adhesion_max_stage=top["stage"] if peak else None,
                    adhesion_max_course=top["course"] if peak else None)
     return out
+
+
+def adhesion_peak(rows) -> dict | None:
+    """The row of the first stage whose least adhesion reaches the largest within
+    :data:`~masonry.tolerances.ADHESION_TIE_REL` (None when no stage has one)."""
+    held = [row for row in rows if row["adhesion_kPa"] is not None]
+    if not held:
+        return None
+    top = max(row["adhesion_kPa"] for row in held)
+    return next(row for row in held if row["adhesion_kPa"] >= top * (1 - ADHESION_TIE_REL))
 
 
 def stage_record(params, scene, model, plan: StagePlan, rows, cached, source) -> dict:
@@ -113,8 +124,7 @@ def _adhesion_record(scene, rows, ratio) -> dict:
     the stage where it peaks, the later laid first (None where it is 0 or None);
     ``adhesion_unsolved``: the stages without a value and the first one's reason (None
     when every stage has one)."""
-    peak = max((row for row in rows if row["adhesion_kPa"] is not None),
-               key=lambda row: row["adhesion_kPa"], default=None)
+    peak = adhesion_peak(rows)
     joint = None if peak is None or not peak["adhesion_kPa"] else peak["adhesion_joint"]
     missing = [row for row in rows if row["adhesion_kPa"] is None]
     return {"adhesion_tension_ratio": ratio,
@@ -143,8 +153,7 @@ def stage_summary(record) -> dict:
     None when every stage stands; the largest centering force (N, and its fraction of
     that stage's weight), the smallest lateral load factor and the largest least
     adhesion (kPa, and the course where it peaks) over the stages
-    (:func:`stage_extremes`). A record written before the stages' least adhesion leaves
-    its columns empty."""
+    (:func:`stage_extremes`)."""
     stages = record["stages"]
     first = stages["first_unsupported"] or {}
     return {"stages": stages["count"], "stages_standing": stages["standing"],
@@ -154,5 +163,5 @@ def stage_summary(record) -> dict:
             "centering_max_N": stages["centering_max_N"],
             "centering_max_fraction": stages["centering_max_fraction"],
             "stages_load_factor_min": stages["load_factor_min"],
-            "adhesion_max_kPa": stages.get("adhesion_max_kPa"),
-            "adhesion_max_course": stages.get("adhesion_max_course")}
+            "adhesion_max_kPa": stages["adhesion_max_kPa"],
+            "adhesion_max_course": stages["adhesion_max_course"]}
