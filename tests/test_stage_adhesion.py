@@ -139,8 +139,9 @@ def drawn(monkeypatch):
 def test_the_figure_shows_the_curve_the_references_and_a_legend_below(drawn, top, scale):
     """The axis in kPa, linear where the values are of fresh mortar's order and
     logarithmic beyond (so both show); the curve and both reference lines inside it;
-    the legend below the axes, clear of them."""
-    values = [0.0, 0.0, top / 4, np.nan, top, 0.0]
+    the legend below the axes, clear of them; the largest labelled at the first stage
+    within the solver's accuracy of it (stage 3, as the record names it)."""
+    values = [0.0, 0.0, top * (1 - 1e-5), np.nan, top, 0.0]
     stage_figures.stage_adhesion_png(range(1, 7), values,
                                      [True, True, False, False, False, True], ratio=0.5)
     (fig,) = drawn
@@ -156,3 +157,5 @@ def test_the_figure_shows_the_curve_the_references_and_a_legend_below(drawn, top
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
     assert labels[:2] == ["stands dry (3)", "needs adhesion (2)"]
     assert any("no value" in label for label in labels)
+    (label,) = ax.texts
+    assert label.xy[0] == 3 and label.get_text() == f"{top:.4g} kPa"

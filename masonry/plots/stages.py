@@ -1,6 +1,7 @@
 """Construction stages: the chart of every stage's centering force (and collapse load
-factor), which stand and which need support, and the structure views of one stage, its
-bricks coloured by the support force they need and the bricks just laid outlined."""
+factor), which stand and which need support; the chart of every stage's least adhesion;
+and the structure views of one stage, its bricks coloured by the support force they need
+and the bricks just laid outlined."""
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -15,6 +16,7 @@ from masonry.plots.common import (CLASS_COLOURS, ELEVATIONS, NO_FILL, add_points
                                   add_polygons, draw_outline, legend_below, png_bytes,
                                   view_axes, views_of, visible_faces)
 from masonry.plots.faces import face_array
+from masonry.tolerances import ADHESION_TIE_REL
 
 OUTLINE_COLOUR = "#ff00ff"
 """Edge colour of the outlined blocks of :func:`marked_structure_pngs`."""
@@ -189,9 +191,10 @@ def stage_adhesion_png(stage, adhesion_kPa, feasible, title="", xlabel="stage",
         ax.scatter(stage[missing], np.zeros(int(missing.sum())), marker="x", s=24,
                    color="#d62728", zorder=2,
                    label=f"no value: a block held by nothing ({int(missing.sum())})")
-    if held.any():
-        top = stage[held][np.argmax(value[held])]
-        ax.annotate(f"{np.max(value[held]):.4g} kPa", (top, np.max(value[held])),
+    if held.any():  # at the first stage that reaches the largest (the record's)
+        top = np.max(value[held])
+        first = np.argmax(held & (value >= top * (1 - ADHESION_TIE_REL)))
+        ax.annotate(f"{top:.4g} kPa", (stage[first], value[first]),
                     textcoords="offset points", xytext=(0, 6), ha="center", fontsize=8)
     low, high = FRESH_MORTAR_KPA
     for level in FRESH_MORTAR_KPA:
