@@ -162,17 +162,19 @@ def _loose(first) -> str:
 
 def _adhesion_line(stages, by) -> str:
     """The least adhesion over the stages (docs/model.md 6.12): the largest, where it
-    peaks and what it means; '' for a record written before the stages computed it."""
+    peaks and what it means, or the stages that have none; '' for a record written
+    before the stages computed it."""
     if "adhesion_max_kPa" not in stages:
         return ""
     top, missing = stages["adhesion_max_kPa"], stages["adhesion_unsolved"]
-    gap = "" if missing is None else (
-        f"; no value at {missing['count']} stage{'' if missing['count'] == 1 else 's'}, "
-        f"from stage {missing['first_stage']} ({missing['reason']})")
-    if top is None:
-        return f"least adhesion: no stage has a value{gap}"
+    if missing is not None:
+        count = missing["count"]
+        return (f"least adhesion: none builds it in this order: {count} "
+                f"stage{' has' if count == 1 else 's have'} no value, from stage "
+                f"{missing['first_stage']} ({missing['reason']}; stages.csv, column "
+                f"adhesion_kPa)")
     if top == 0:
-        return f"least adhesion: 0 kPa, every stage stands with dry joints{gap}"
+        return "least adhesion: 0 kPa, every stage stands with dry joints"
     course = stages["adhesion_max_course"]
     where = f"stage {stages['adhesion_max_stage']}" + (
         "" if course is None else f", course {course}")
@@ -180,5 +182,4 @@ def _adhesion_line(stages, by) -> str:
     return (f"least adhesion: {top:.4g} kPa at most ({where}, brick {brick} on {other}): "
             f"mortar holding {top:.4g} kPa of cohesion (and {stages['adhesion_tension_ratio']:g}"
             f" x that in tension) within the time a {'stage' if by == 'block' else 'course'}"
-            f" takes to lay builds it without centering (stages.csv, column adhesion_kPa)"
-            f"{gap}")
+            f" takes to lay builds it without centering (stages.csv, column adhesion_kPa)")

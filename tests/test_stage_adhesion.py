@@ -121,6 +121,25 @@ def test_the_run_folder_reports_every_stage_s_adhesion(tmp_path, capsys, arch_st
     assert f"least adhesion: {top['adhesion_kPa']:.4g} kPa at most (stage 7, brick " in out
 
 
+def test_without_tension_no_adhesion_holds_a_stage_that_tips(tmp_path, capsys):
+    """With a tension ratio of 0 the arch's stages 3 to 7 have no value: their half
+    arches tip about a joint (tests/test_stages.py's statics), and a cohesion without
+    tension adds no resistance to opening. So no adhesion builds the arch in this order:
+    the record's largest is none, and the summary says why."""
+    assert main(["stages", "--scene", "arch", "--adhesion-tension-ratio", "0",
+                 "--no-plots", "--out", str(tmp_path)]) == 0
+    (folder,) = tmp_path.glob("*_stages_*")
+    table = masonry.read_table(folder / "stages.csv").set_index("stage")
+    assert table["adhesion_kPa"].isna().tolist() == [False] * 2 + [True] * 5 + [False]
+    stages = json.loads((folder / "run.json").read_text())["stages"]
+    assert stages["adhesion_max_kPa"] is None and stages["adhesion_max_stage"] is None
+    assert stages["adhesion_unsolved"]["count"] == 5
+    assert stages["adhesion_unsolved"]["first_stage"] == 3
+    assert "infeasible" in stages["adhesion_unsolved"]["reason"]
+    assert "least adhesion: none builds it in this order: 5 stages have no value, " \
+           "from stage 3" in capsys.readouterr().out
+
+
 @pytest.fixture
 def drawn(monkeypatch):
     """The axes of the figures :func:`stage_adhesion_png` draws, drawn, not saved."""

@@ -39,9 +39,10 @@ def stage_extremes(rows) -> dict:
         ``centering_fraction``: of its own weight), ``centering_max_stage`` (None when
         every stage stands); ``load_factor_min`` and ``load_factor_min_stage`` over the
         stages with a load factor (None without a lateral load or where no stage stands);
-        ``adhesion_max_kPa`` over the stages with a least adhesion (0 when every stage
-        stands dry, None when no stage has one), and the ``adhesion_max_stage`` and
-        ``adhesion_max_course`` of :func:`adhesion_peak` (None where it is 0 or None).
+        ``adhesion_max_kPa``, the largest least adhesion over the stages (0 when every
+        stage stands dry, None when a stage has none: no adhesion builds it in this
+        order), and the ``adhesion_max_stage`` and ``adhesion_max_course`` of
+        :func:`adhesion_peak` (None where it is 0 or None).
     """
     solved = [row for row in rows if row["centering_N"] is not None]
     out = {"centering_max_N": None, "centering_max_fraction": None,
@@ -60,8 +61,7 @@ def stage_extremes(rows) -> dict:
     top = adhesion_peak(rows)
     if top is not None:
         peak = top["adhesion_kPa"] > 0
-        out.update(adhesion_max_kPa=max(row["adhesion_kPa"] for row in rows
-                                        if row["adhesion_kPa"] is not None),
+        out.update(adhesion_max_kPa=max(row["adhesion_kPa"] for row in rows),
                    adhesion_max_stage=top["stage"] if peak else None,
                    adhesion_max_course=top["course"] if peak else None)
     return out
@@ -69,12 +69,12 @@ def stage_extremes(rows) -> dict:
 
 def adhesion_peak(rows) -> dict | None:
     """The row of the first stage whose least adhesion reaches the largest within
-    :data:`~masonry.tolerances.ADHESION_TIE_REL` (None when no stage has one)."""
-    held = [row for row in rows if row["adhesion_kPa"] is not None]
-    if not held:
+    :data:`~masonry.tolerances.ADHESION_TIE_REL`; None when a stage has none (no
+    adhesion builds the structure in this order: there is no largest)."""
+    if any(row["adhesion_kPa"] is None for row in rows):
         return None
-    top = max(row["adhesion_kPa"] for row in held)
-    return next(row for row in held if row["adhesion_kPa"] >= top * (1 - ADHESION_TIE_REL))
+    top = max(row["adhesion_kPa"] for row in rows)
+    return next(row for row in rows if row["adhesion_kPa"] >= top * (1 - ADHESION_TIE_REL))
 
 
 def stage_record(params, scene, model, plan: StagePlan, rows, cached, source) -> dict:
