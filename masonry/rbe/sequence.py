@@ -37,6 +37,9 @@ within the solver's accuracy (tests/test_stages.py). What :class:`StageSequence`
   a solution (Newton, from the last stage's start), that point with supports on the
   local blocks alone is one of the part's program with the same total: the least, so
   the part's centering force. Otherwise the whole part's program is solved.
+- **The least adhesion** (docs/model.md 6.12) of a part: its program on the part's rows
+  and columns of the whole model's matrices (:meth:`StageSequence.adhesion`), one
+  Clarabel program per part; nothing carries over from the last part yet.
 """
 
 import dataclasses

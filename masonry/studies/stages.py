@@ -100,7 +100,8 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
         :data:`STAGE_COLUMNS` (``moi`` and ``centering_N`` in newtons; ``solve_s`` the
         stage's wall time: model, assembly and solves; ``load_factor`` None: no lateral
         load, or the stage does not stand), ``loose_blocks`` and ``held``: the scene
-        blocks a support must hold, largest first (see :func:`stage_centering`).
+        blocks a support must hold, largest first (see :func:`stage_centering`);
+        ``adhesion_reason`` and ``adhesion_joint`` (:func:`stage_adhesion`).
     """
     start = time.perf_counter()
     part = restrict(model, plan.is_present(stage))
