@@ -180,6 +180,7 @@ def test_the_first_course_that_needs_support_is_latest_where_none_does(tmp_path)
     assert int(best[0]["trial"]) == min(int(trials[mu]["trial"]) for mu in ("0.3", "0.7"))
 
 
+@pytest.mark.slow
 def test_the_least_adhesion_over_the_stages_is_least_where_every_stage_stands(tmp_path):
     """The small dome's course stages at mu 0.1 (courses 5 to 11 need support, so
     adhesion) and 0.7 (every stage stands dry: 0 kPa): minimizing ``adhesion_max_kPa``
