@@ -135,6 +135,9 @@ def handle(args, report):
         report(f"largest centering force: {stages['centering_max_N']:.4g} N "
                f"({stages['centering_max_fraction']:.3g} of the stage's weight) at stage "
                f"{stages['centering_max_stage']} (stages.csv, column centering_N)")
+    line = _adhesion_line(stages, record["plan"]["by"])
+    if line:
+        report(line)
     loose = [str(r["stage"]) for r in record.get("rows", ()) if r.get("loose")]
     if loose:
         report(f"stages with blocks joined to no support, so no MoI: {', '.join(loose[:10])}"
@@ -155,3 +158,28 @@ def _loose(first) -> str:
     if not first.get("loose"):
         return ""
     return f": {', '.join(first['loose'][:3])} touch nothing that joins them to a support"
+
+
+def _adhesion_line(stages, by) -> str:
+    """The least adhesion over the stages (docs/model.md 6.12): the largest, where it
+    peaks and what it means, or the stages that have none; '' for a record written
+    before the stages computed it."""
+    if "adhesion_max_kPa" not in stages:
+        return ""
+    top, missing = stages["adhesion_max_kPa"], stages["adhesion_unsolved"]
+    if missing is not None:
+        count = missing["count"]
+        return (f"least adhesion: none builds it in this order: {count} "
+                f"stage{' has' if count == 1 else 's have'} no value, from stage "
+                f"{missing['first_stage']} ({missing['reason']}; stages.csv, column "
+                f"adhesion_kPa)")
+    if top == 0:
+        return "least adhesion: 0 kPa, every stage stands with dry joints"
+    course = stages["adhesion_max_course"]
+    where = f"stage {stages['adhesion_max_stage']}" + (
+        "" if course is None else f", course {course}")
+    brick, other = stages["adhesion_max_joint"]
+    return (f"least adhesion: {top:.4g} kPa at most ({where}, brick {brick} on {other}): "
+            f"mortar holding {top:.4g} kPa of cohesion (and {stages['adhesion_tension_ratio']:g}"
+            f" x that in tension) within the time a {'stage' if by == 'block' else 'course'}"
+            f" takes to lay builds it without centering (stages.csv, column adhesion_kPa)")

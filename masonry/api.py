@@ -198,8 +198,9 @@ class Structure:
         -------
         pandas.DataFrame
             The columns of ``stages.csv``, one row per stage (docs/stages.md): blocks
-            laid, verdict, MoI factor, centering force, the load factor of the live load
-            if the structure has one.
+            laid, verdict, MoI factor, centering force, least adhesion
+            (``adhesion_kPa``, docs/model.md 6.12), the load factor of the live load if
+            the structure has one.
         """
         import pandas
 

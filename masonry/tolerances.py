@@ -343,6 +343,12 @@ more than this fraction of the least adhesion ``a*`` at the optimum: below it, t
 interior point's spread over joints that dry friction could carry as well (as
 :data:`CENTERING_REPORTED_REL` for supports)."""
 
+ADHESION_TIE_REL = 1e-4
+"""Least adhesions of two construction stages this close (relative) are the same: a stage
+study reports the first stage that reaches the largest. Clarabel solves each stage's
+program to about 1e-5 of ``a*`` (preset 1's course 61 laid brick by brick: eight stages
+held by the same first pattern brick, within 2.3e-5 of each other)."""
+
 # ---------------------------------------------------------------------- mirror symmetry
 MIRROR_ANGLE_DEG = 1e-9
 """Degrees within which a load's azimuth lies in a mirror plane

@@ -55,6 +55,11 @@ def test_collapse_and_stages_answer_as_the_command_line(arch, tmp_path):
     stages = masonry.build(scene="arch").stages(by="block", order="z")
     assert stages["feasible"].tolist() == [True, True] + [False] * 5 + [True]
     assert stages["bricks"].tolist() == list(range(2, 17, 2))
+    # the least adhesion of each stage: 0 where it stands dry, and as much as the
+    # structure-level a* of the stage's own model (tests/test_stage_adhesion.py)
+    adhesion = stages["adhesion_kPa"]
+    assert adhesion[stages["feasible"]].tolist() == [0.0, 0.0, 0.0]
+    assert (adhesion[~stages["feasible"]] > 0).all()
 
 
 def test_a_read_assembly_is_analysed_like_masonry_analyze(fixtures_dir):

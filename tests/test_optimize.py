@@ -180,6 +180,24 @@ def test_the_first_course_that_needs_support_is_latest_where_none_does(tmp_path)
     assert int(best[0]["trial"]) == min(int(trials[mu]["trial"]) for mu in ("0.3", "0.7"))
 
 
+@pytest.mark.slow
+def test_the_least_adhesion_over_the_stages_is_least_where_every_stage_stands(tmp_path):
+    """The small dome's course stages at mu 0.1 (courses 5 to 11 need support, so
+    adhesion) and 0.7 (every stage stands dry: 0 kPa): minimizing ``adhesion_max_kPa``
+    picks 0.7, and the trials' column reads back typed."""
+    import masonry
+
+    path = tmp_path / "stages.toml"
+    path.write_text('[base]\npreset = 1\nn = 4\np = 3\nr = 1\n[grid]\nmu = [0.1, 0.7]\n'
+                    '[outputs]\nstages = "course"\n')
+    assert _optimize(path, tmp_path, "--minimize", "adhesion_max_kPa", "--trials", "2") == 0
+    trials = masonry.read_table(tmp_path / "optimize_stages" / "trials.csv")
+    assert trials["adhesion_max_course"].dtype == "Int64"
+    by_mu = trials.set_index("mu")
+    assert by_mu.loc[0.1, "adhesion_max_kPa"] > 0 and by_mu.loc[0.7, "adhesion_max_kPa"] == 0
+    assert bool(by_mu.loc[0.7, "best"]) and not bool(by_mu.loc[0.1, "best"])
+
+
 def test_a_column_empty_when_every_stage_stands_measures_infinite():
     from masonry.studies.sweep import measure
 

@@ -550,6 +550,9 @@ def test_stages_solved_in_sequence_equal_stages_solved_alone(mu, order):
         if alone["moi"] is not None:
             assert ours["moi"] == pytest.approx(alone["moi"], abs=1e-6 * weight)
         assert ours["centering_N"] == pytest.approx(alone["centering_N"], abs=1e-6 * weight)
+        # the least adhesion: the same program on the whole model's matrices and alone
+        assert ours["adhesion_kPa"] == pytest.approx(alone["adhesion_kPa"], rel=1e-5)
+    assert max(r["adhesion_kPa"] for r in cold) > 0
 
 
 def test_stages_bench_rows_and_its_refusal(tmp_path, capsys):

@@ -155,16 +155,18 @@ def _expected(rows):
     """The sweep's stage columns from a stage study's stages.csv, by hand."""
     failing = [r for r in rows if r["feasible"] == "False"]
     top = max(rows, key=lambda r: float(r["centering_N"]))
+    adhesion = max(float(r["adhesion_kPa"]) for r in rows)
     return {"stages": str(len(rows)), "stages_standing": str(len(rows) - len(failing)),
             "first_unsupported_stage": failing[0]["stage"] if failing else "",
             "first_unsupported_course": failing[0]["course"] if failing else "",
             "centering_max_N": float(top["centering_N"]),
-            "centering_max_fraction": float(top["centering_fraction"])}
+            "centering_max_fraction": float(top["centering_fraction"]),
+            "adhesion_max_kPa": adhesion}
 
 
 STAGE_TEXT = ("stages", "stages_standing", "first_unsupported_stage",
               "first_unsupported_course")
-STAGE_NUMBERS = ("centering_max_N", "centering_max_fraction")
+STAGE_NUMBERS = ("centering_max_N", "centering_max_fraction", "adhesion_max_kPa")
 
 
 def _assert_stage_columns(row, expected):
@@ -193,6 +195,9 @@ def test_a_sweep_of_course_stages_gives_the_columns_of_masonry_stages(tmp_path):
     assert low["first_unsupported_course"] == "5" and float(low["centering_max_N"]) > 0
     assert high["stages_standing"] == "11" and high["first_unsupported_course"] == ""
     assert float(high["centering_max_N"]) == 0.0
+    # the least adhesion: some at mu 0.1, on a course that needs support; none at 0.7
+    assert float(low["adhesion_max_kPa"]) > 0 and int(low["adhesion_max_course"]) >= 5
+    assert float(high["adhesion_max_kPa"]) == 0.0 and high["adhesion_max_course"] == ""
     # the run of the variant itself: a free-standing web, its own centering force
     assert float(low["centering_N"]) > 0 and low["feasible"] == "False"
 

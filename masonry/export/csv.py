@@ -19,7 +19,7 @@ INTEGER_COLUMNS = ("id", "rank", "brick", "block", "block_a", "block_b", "course
                    "course_a", "course_b", "vertex", "vertices", "stage", "bricks", "step",
                    "variant", "interfaces", "stages", "stages_standing", "interface",
                    "first_unsupported_stage", "first_unsupported_course",
-                   "first_unsupported_brick", "trial", "loose")
+                   "first_unsupported_brick", "adhesion_max_course", "trial", "loose")
 TEXT_COLUMNS = ("name", "name_a", "name_b", "class", "kind", "laid", "status", "error",
                 "friction_used", "friction_model", "structure_id")
 BOOLEAN_COLUMNS = ("feasible", "stands", "constraints_met", "best")

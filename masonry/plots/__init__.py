@@ -40,15 +40,16 @@ from masonry.plots.forces import (  # noqa: E402
 from masonry.plots.mechanism import MECHANISM_SCALE, mechanism_pngs  # noqa: E402
 from masonry.plots.pattern import pattern_png  # noqa: E402
 from masonry.plots.stages import (  # noqa: E402
-    MARK_DECADES, OUTLINE_COLOUR, marked_structure_pngs, stage_chart_png)
+    FRESH_MORTAR_KPA, MARK_DECADES, OUTLINE_COLOUR, marked_structure_pngs,
+    stage_adhesion_png, stage_chart_png)
 from masonry.plots.structure import structure_pngs  # noqa: E402
 from masonry.plots.thrust import HINGE_ECCENTRICITY, thrust_line_png  # noqa: E402
 
 __all__ = [
     "ANGLE", "BAR_3D", "CLASS_COLOURS", "COLOUR_PERCENTILE", "DIVERGING", "ELEVATIONS",
-    "FORCE_LABELS", "FORCE_PLOTS", "HINGE_ECCENTRICITY", "HORIZONTAL_KINDS", "MARK_DECADES",
-    "MECHANISM_SCALE", "NO_FILL", "ONE_SIDED", "OUTLINE_COLOUR", "RANKED", "SEQUENTIAL",
+    "FORCE_LABELS", "FORCE_PLOTS", "FRESH_MORTAR_KPA", "HINGE_ECCENTRICITY",
+    "HORIZONTAL_KINDS", "MARK_DECADES", "MECHANISM_SCALE", "NO_FILL", "ONE_SIDED", "OUTLINE_COLOUR", "RANKED", "SEQUENTIAL",
     "VIEWS", "azimuths_png", "colour_scale", "convergence_png", "failure_png", "force_pngs",
     "force_unit", "interface_pngs", "marked_structure_pngs", "mechanism_pngs", "pattern_png",
-    "stage_chart_png", "structure_pngs", "thrust_line_png",
+    "stage_adhesion_png", "stage_chart_png", "structure_pngs", "thrust_line_png",
 ]

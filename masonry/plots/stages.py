@@ -1,13 +1,14 @@
 """Construction stages: the chart of every stage's centering force (and collapse load
-factor), which stand and which need support, and the structure views of one stage, its
-bricks coloured by the support force they need and the bricks just laid outlined."""
+factor), which stand and which need support; the chart of every stage's least adhesion;
+and the structure views of one stage, its bricks coloured by the support force they need
+and the bricks just laid outlined."""
 
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import LogNorm, to_rgba
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
-from matplotlib.ticker import MaxNLocator
+from matplotlib.ticker import FuncFormatter, MaxNLocator
 
 from masonry.blocks import BLOCK_CLASSES
 from masonry.plots.colours import bar_3d
@@ -15,6 +16,7 @@ from masonry.plots.common import (CLASS_COLOURS, ELEVATIONS, NO_FILL, add_points
                                   add_polygons, draw_outline, legend_below, png_bytes,
                                   view_axes, views_of, visible_faces)
 from masonry.plots.faces import face_array
+from masonry.tolerances import ADHESION_TIE_REL
 
 OUTLINE_COLOUR = "#ff00ff"
 """Edge colour of the outlined blocks of :func:`marked_structure_pngs`."""
@@ -138,6 +140,80 @@ def stage_chart_png(stage, centering, feasible, load_factor=None, title="",
     else:
         ax.legend(handles, labels, loc="best", fontsize=8)
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    return png_bytes(fig, 110)
+
+
+FRESH_MORTAR_KPA = (0.1, 1.0)
+"""Reference lines of :func:`stage_adhesion_png`, kPa: fresh lime or gypsum mortar holds
+of the order of 0.1 to a few kPa within minutes of laying (docs/model.md 6.12), orders of
+magnitude, not a measured mortar."""
+
+REFERENCE_COLOUR = "0.3"
+"""Colour of the reference lines of :func:`stage_adhesion_png`."""
+
+LINEAR_DECADES = 10.0
+""":func:`stage_adhesion_png`'s axis is linear up to this many times the upper
+reference line, symmetric-logarithmic beyond (linear below the lower line), so that the
+reference lines and a large ``a*`` show on one axis."""
+
+
+def stage_adhesion_png(stage, adhesion_kPa, feasible, title="", xlabel="stage",
+                       ratio=None) -> bytes:
+    """The least adhesion of every stage (docs/model.md 6.12) against the stage, kPa:
+    stages that stand dry in green (at 0), those that need adhesion in red (the
+    largest labelled), stages without a value as red crosses at 0, and dotted lines at
+    :data:`FRESH_MORTAR_KPA`; a logarithmic axis beyond :data:`LINEAR_DECADES`.
+
+    Parameters
+    ----------
+    stage : (N,) int
+    adhesion_kPa : (N,) float
+        ``a*`` per stage, kPa (NaN: no value).
+    feasible : (N,) bool
+        The stage stands with dry joints.
+    ratio : float, optional
+        The tension ratio ``t_c / c``, named in the axis label.
+    """
+    stage = np.asarray(stage)
+    value = np.asarray(adhesion_kPa, dtype=float)
+    feasible = np.asarray(feasible, dtype=bool)
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(stage, value, color="0.6", linewidth=0.8, zorder=1)
+    ax.scatter(stage[feasible], value[feasible], s=14, color="#2ca02c",
+               label=f"stands dry ({int(feasible.sum())})", zorder=2)
+    held = ~feasible & np.isfinite(value)
+    ax.scatter(stage[held], value[held], s=14, color="#d62728",
+               label=f"needs adhesion ({int(held.sum())})", zorder=2)
+    missing = ~np.isfinite(value)
+    if missing.any():
+        ax.scatter(stage[missing], np.zeros(int(missing.sum())), marker="x", s=24,
+                   color="#d62728", zorder=2,
+                   label=f"no value: a block held by nothing ({int(missing.sum())})")
+    if held.any():  # at the first stage that reaches the largest (the record's)
+        top = np.max(value[held])
+        first = np.argmax(held & (value >= top * (1 - ADHESION_TIE_REL)))
+        ax.annotate(f"{top:.4g} kPa", (stage[first], value[first]),
+                    textcoords="offset points", xytext=(0, 6), ha="center", fontsize=8)
+    low, high = FRESH_MORTAR_KPA
+    for level in FRESH_MORTAR_KPA:
+        ax.axhline(level, color=REFERENCE_COLOUR, linestyle=":", linewidth=1.0, zorder=0,
+                   label=f"{low:g} and {high:g} kPa: fresh mortar holds about {low:g} to a "
+                         f"few kPa within minutes" if level == low else None)
+    ax.set_xlabel(xlabel)
+    tension = "" if ratio is None else f", tensile strength {ratio:g} a*"
+    ax.set_ylabel(f"least adhesion a* [kPa]\n(cohesion a*{tension})")
+    top = max(float(np.nanmax(value, initial=0.0)), high)
+    if top > LINEAR_DECADES * high:  # beyond fresh mortar's range: its lines stay apart
+        ax.set_yscale("symlog", linthresh=low, linscale=0.5)
+        ax.set_ylim(-0.2 * low, 2.0 * top)
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    else:
+        ax.set_ylim(-0.03 * top, 1.12 * top)
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=8,
+              frameon=False)  # below the plot: the curve may fill any corner
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
     return png_bytes(fig, 110)

@@ -37,6 +37,9 @@ within the solver's accuracy (tests/test_stages.py). What :class:`StageSequence`
   a solution (Newton, from the last stage's start), that point with supports on the
   local blocks alone is one of the part's program with the same total: the least, so
   the part's centering force. Otherwise the whole part's program is solved.
+- **The least adhesion** (docs/model.md 6.12) of a part: its program on the part's rows
+  and columns of the whole model's matrices (:meth:`StageSequence.adhesion`), one
+  Clarabel program per part; nothing carries over from the last part yet.
 """
 
 import dataclasses
@@ -45,6 +48,7 @@ import time
 
 import numpy as np
 
+from masonry.rbe.adhesion import TENSION_RATIO, AdhesionResult, solve_adhesion
 from masonry.rbe.boundary import Model, kept_blocks
 from masonry.rbe.centering import CenteringResult, solve_centering
 from masonry.rbe.equilibrium import FRICTION_METHODS, EquilibriumSystem, VariableLayout, assemble
@@ -71,7 +75,8 @@ def part_system(whole: EquilibriumSystem, rows, interfaces) -> EquilibriumSystem
     block that is not kept is held fixed (a support: no rows, zero coefficients).
 
     ``free_block`` and ``block_weight`` stay the whole model's (``free_block`` indexes
-    the whole model's blocks), and so do the units."""
+    the whole model's blocks), and so do the units. ``whole`` has dry joints (a mortar's
+    shifted weight is not carried over)."""
     rows, interfaces = np.asarray(rows, bool), np.asarray(interfaces, bool)
     new_row = np.full(len(rows), -1)
     new_row[rows] = np.arange(int(rows.sum()))
@@ -84,9 +89,11 @@ def part_system(whole: EquilibriumSystem, rows, interfaces) -> EquilibriumSystem
     coefficients[(side_row < 0)[layout.vertex_interface]] = 0.0    # supports: zero already
     columns = np.repeat(vertices, VariableLayout.WIDTH)
     f_ext = whole.f_ext.reshape(-1, 6)[rows].ravel()
+    area = None if whole.vertex_area is None else whole.vertex_area[vertices]
     return dataclasses.replace(whole, layout=layout, free_block=whole.free_block[rows],
                                f_ext=f_ext, lower=whole.lower[columns], h=whole.h[columns],
-                               side_row=side_row, vertex_coefficients=coefficients)
+                               side_row=side_row, vertex_coefficients=coefficients,
+                               vertex_area=area)
 
 
 class StageSequence:
@@ -272,6 +279,19 @@ class StageSequence:
                   else self.model.block_source)
         return dataclasses.replace(reduced, weight_N=system.total_weight,
                                    block=source[reduced.block])
+
+    def adhesion(self, is_present, *, mu=0.7, density=2000.0, cone="circle",
+                 ratio=TENSION_RATIO) -> AdhesionResult:
+        """The least adhesion (docs/model.md 6.12) of the part whose scene blocks
+        ``is_present``: :func:`masonry.rbe.adhesion.solve_adhesion` on the part's rows and
+        columns of the whole model's matrices, one conic program per part (the part's
+        model is the one :func:`~masonry.rbe.boundary.restrict` gives, so is its ``a*``).
+        ``interface_pair`` indexes the whole model's blocks."""
+        keep = kept_blocks(self.model, is_present)
+        interfaces = keep[self.model.interfaces.pair].all(axis=1)
+        system = part_system(self.whole, keep[self.whole.free_block],
+                             interfaces).with_material(mu=mu, density=density, cone=cone)
+        return solve_adhesion(system, self.model.interfaces.subset(interfaces), ratio=ratio)
 
     def _touching(self, rows) -> np.ndarray:
         """(K,) bool: the interfaces with a side on the free blocks ``rows``."""

@@ -56,7 +56,9 @@ from masonry.errors import ParameterError
 from masonry.params import Params, validate
 from masonry.pipeline import build_model, collapse_of, geometry_code_digest
 from masonry.rbe.solve import ACCURACY, RBEProblem
-from masonry.studies.stages import BRICK_ORDERS, analyse_stages, make_plan
+from masonry.studies.orders import BRICK_ORDERS
+from masonry.studies.plans import make_plan
+from masonry.studies.stages import analyse_stages
 from masonry.tolerances import G
 
 log = logging.getLogger(__name__)

@@ -44,8 +44,8 @@ from masonry.export._text import format_float
 from masonry.export.csv import header, held_csv
 from masonry.export.summaries import parameters_text
 from masonry.params import FILE_OUTPUTS, structure_id, validate
-from masonry.pipeline import (Timer, identity, model_record, run_model, versions,
-                              write_cache)
+from masonry.pipeline import Timer, identity, run_model, versions, write_cache
+from masonry.rbe.adhesion import least_adhesion
 from masonry.rbe.boundary import Model, restrict
 from masonry.rbe.centering import centering_force
 from masonry.rbe.collapse import collapse_load
@@ -54,20 +54,23 @@ from masonry.rbe.sequence import StageSequence
 from masonry.rbe.solve import RBEProblem
 from masonry.runfolder import Publication, check_output_root
 from masonry.scenes import check_size
-from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
 from masonry.studies.plans import StagePlan, make_plan
+from masonry.studies.stage_records import first_unsupported, stage_record
 from masonry.tolerances import MAX_BRICKS
 
 log = logging.getLogger(__name__)
 
 STAGE_COLUMNS = ("stage", "course", "laid", "bricks", "feasible", "loose", "moi",
-                 "moi_factor", "centering_N", "centering_fraction", "load_factor", "solve_s")
+                 "moi_factor", "centering_N", "centering_fraction", "adhesion_kPa",
+                 "load_factor", "solve_s")
 """Columns of ``stages.csv``, one row per stage. ``laid``: the names of the blocks the
 stage lays, in a brick or block plan (a course plan's stage is its course). ``loose``: the
 laid blocks that touch nothing joining them to a support (:func:`loose_blocks`: the stage
 has no equilibrium at all, and no MoI). ``centering_N``, ``centering_fraction``: the
 centering force and its fraction of the stage's weight (:func:`stage_centering`; 0 for a
-stage that stands). ``load_factor``: the collapse load factor of the
+stage that stands). ``adhesion_kPa``: the least adhesion of the stage's model (docs/model.md
+6.12, :func:`stage_adhesion`; 0 for a stage that stands dry, empty where it has none).
+``load_factor``: the collapse load factor of the
 stage under the lateral load of ``params.lateral`` (:func:`stage_load_factor`); empty
 without one, or where the stage does not stand under its own weight."""
 
@@ -97,7 +100,8 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
         :data:`STAGE_COLUMNS` (``moi`` and ``centering_N`` in newtons; ``solve_s`` the
         stage's wall time: model, assembly and solves; ``load_factor`` None: no lateral
         load, or the stage does not stand), ``loose_blocks`` and ``held``: the scene
-        blocks a support must hold, largest first (see :func:`stage_centering`).
+        blocks a support must hold, largest first (see :func:`stage_centering`);
+        ``adhesion_reason`` and ``adhesion_joint`` (:func:`stage_adhesion`).
     """
     start = time.perf_counter()
     part = restrict(model, plan.is_present(stage))
@@ -132,8 +136,63 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
                                        mu=analysis.mu, density=analysis.density,
                                        accuracy=analysis.accuracy, cone=analysis.friction_cone)
     row.update(stage_centering(part, params, row["feasible"], centering))
+    row.update(stage_adhesion(part, params, plan, stage, row, sequence))
     row["solve_s"] = round(time.perf_counter() - start, 4)
     return row
+
+
+def stage_adhesion(part: Model, params, plan: StagePlan, stage: int, row,
+                   sequence: StageSequence | None = None) -> dict:
+    """The least adhesion of a stage (docs/model.md 6.12, :mod:`masonry.rbe.adhesion`):
+    the least uniform strength of mortar (cohesion ``a``, tensile strength ``r a``) with
+    which the stage's model stands.
+
+    Parameters
+    ----------
+    part : Model
+        The stage's model (:func:`masonry.rbe.boundary.restrict`).
+    params : masonry.params.Params
+        ``mu``, ``density``, the friction model and ``adhesion_tension_ratio``.
+    plan : StagePlan
+    stage : int
+    row : dict
+        The stage's ``feasible`` and ``loose`` (:func:`analyse_stage`).
+    sequence : StageSequence, optional
+        Solve the program on its matrices (:meth:`StageSequence.adhesion`); None: on
+        ``part``'s own.
+
+    Returns
+    -------
+    dict
+        ``adhesion_kPa``: 0 for a stage that stands dry (no program), None where the
+        stage has a block that no joint joins to a support or the program gives no
+        checked value; ``adhesion_reason`` why not ('' with a value);
+        ``adhesion_joint``: the two scene blocks of the joint that needs most, the later
+        laid first (None without a positive value).
+    """
+    if row["feasible"]:
+        return {"adhesion_kPa": 0.0, "adhesion_reason": "", "adhesion_joint": None}
+    if row["loose"] or len(part.interfaces) == 0:
+        return {"adhesion_kPa": None, "adhesion_joint": None,
+                "adhesion_reason": "a block touches nothing that joins it to a support: "
+                                   "no adhesion holds it"}
+    analysis = params.analysis
+    options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone,
+                   ratio=analysis.adhesion_tension_ratio)
+    if sequence is None:
+        result, source = least_adhesion(part, **options), part.block_source
+    else:
+        result = sequence.adhesion(plan.is_present(stage), **options)
+        source = sequence.model.block_source
+    if result.a_kPa is None:
+        log.warning("stage %d: no least adhesion (%s)", stage, result.reason)
+    joint = None
+    if result.a_kPa:
+        pair = result.interface_pair[result.needing[0]]
+        pair = pair if source is None else source[pair]
+        joint = [int(b) for b in pair[np.argsort(-plan.block_stage[pair], kind="stable")]]
+    return {"adhesion_kPa": result.a_kPa, "adhesion_reason": result.reason,
+            "adhesion_joint": joint}
 
 
 def stage_centering(part: Model, params, stands: bool, result=None) -> dict:
@@ -270,39 +329,6 @@ def _analysed(model: Model, params, plan: StagePlan, stage: int, sequence=None) 
     return row
 
 
-def first_unsupported(rows) -> dict | None:
-    """The row of the first stage that does not stand, None when every stage stands."""
-    return next((row for row in rows if not row["feasible"]), None)
-
-
-def stage_extremes(rows) -> dict:
-    """The largest centering force over the stages and the smallest collapse load factor.
-
-    Returns
-    -------
-    dict
-        ``centering_max_N`` (0 when every stage stands; None when no stage's centering
-        force was solved), ``centering_max_fraction`` (that stage's
-        ``centering_fraction``: of its own weight), ``centering_max_stage`` (None when
-        every stage stands); ``load_factor_min`` and ``load_factor_min_stage`` over the
-        stages with a load factor (None without a lateral load or where no stage stands).
-    """
-    solved = [row for row in rows if row["centering_N"] is not None]
-    out = {"centering_max_N": None, "centering_max_fraction": None,
-           "centering_max_stage": None, "load_factor_min": None,
-           "load_factor_min_stage": None}
-    if solved:
-        top = max(solved, key=lambda row: row["centering_N"])  # the first of equal ones
-        out.update(centering_max_N=top["centering_N"],
-                   centering_max_fraction=top["centering_fraction"],
-                   centering_max_stage=top["stage"] if top["centering_N"] > 0 else None)
-    factors = [row for row in rows if row["load_factor"] is not None]
-    if factors:
-        low = min(factors, key=lambda row: row["load_factor"])
-        out.update(load_factor_min=low["load_factor"], load_factor_min_stage=low["stage"])
-    return out
-
-
 def stage_params(params, boundary_given: bool):
     """The inputs of a stage study of ``params``: a stage of the dome, not of a
     free-standing web, so a section whose scene takes a cyclic boundary is analysed
@@ -405,7 +431,8 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
     out = params.outputs
     job = Publication(out_root, stages_folder_name(params, plan),
                       {"params": identity(params), "plan": _plan_identity(plan)},
-                      {"plots": out.plots, "quick": out.quick, "centering": True},
+                      {"plots": out.plots, "quick": out.quick, "centering": True,
+                       "adhesion": True},
                       force=force,
                       identify=_identify)
     reused = job.reusable()
@@ -415,7 +442,7 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
         out, plots=job.outputs()["plots"], quick=job.outputs()["quick"]))
     with timer.stage("stages"):
         rows = analyse_stages(model, params, plan)
-    record = _record(params, scene, model, plan, rows, cached, source)
+    record = stage_record(params, scene, model, plan, rows, cached, source)
     record["stages"]["wall_s"] = timer.seconds["stages"]
     folder = job.publish(lambda folder: _write(folder, params, scene, plan, rows, record,
                                                timer))
@@ -453,60 +480,10 @@ def _write(folder, params, scene, plan, rows, record, timer):
     folder.write_json("run.json", record)
 
 
-def _record(params, scene, model, plan, rows, cached, source) -> dict:
-    """run.json of a stage study, before timings."""
-    first = first_unsupported(rows)
-    held = [] if first is None else [
-        {"block": block, "name": str(scene.blocks.block_name[block]), "support_N": size,
-         "force_N": [float(v) for v in force]} for block, force, size in first["held"]]
-    record = {
-        "structure_id": structure_id(params),
-        "scene": params.scene,
-        "params": params.record(),
-        "outputs": {"plots": params.outputs.plots, "quick": params.outputs.quick,
-                    "centering": True},
-        "plan": {**plan.record(), "described": _described(plan)},
-        **model_record(scene, params.analysis.density),
-        "cache": {"geometry": cached},
-        "friction_model": params.analysis.cone.record(),
-        "stages": {
-            "count": plan.n_stages,
-            "standing": int(sum(bool(row["feasible"]) for row in rows)),
-            "first_unsupported": None if first is None else {
-                "stage": first["stage"], "course": first["course"],
-                "bricks": first["bricks"], "moi_factor": first["moi_factor"],
-                "brick": plan.brick_on_course(first["stage"]),
-                "centering_N": first["centering_N"],
-                "centering_fraction": first["centering_fraction"],
-                "laid": [str(name) for name in scene.blocks.block_name[
-                    plan.block_stage == first["stage"]]],
-                "loose": [str(scene.blocks.block_name[b]) for b in first["loose_blocks"]],
-                "held": held},
-            **stage_extremes(rows),
-            # every stage's solve, summed: more than the wall time when two run at once
-            "solve_s": round(sum(row["solve_s"] for row in rows), 4),
-        },
-    }
-    record["counts"]["interfaces"] = model.interfaces.counts()
-    if source is not None:
-        record["source"] = source
-    return record
-
-
-def _described(plan: StagePlan) -> str:
-    if plan.by == "course":
-        return "stage k: every brick starting on courses 1..k"
-    if plan.by == "brick" and plan.course is None:
-        return "every course brick by brick, from the first: " + BRICK_ORDERS[plan.order]
-    if plan.by == "brick":
-        return f"courses 1..{plan.course - 1}, then course {plan.course}: " + \
-            BRICK_ORDERS[plan.order]
-    return BLOCK_ORDERS[plan.order]
-
-
 def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
     """``stages.png`` (the centering force of every stage as a fraction of its weight,
-    which stages stand) and, when a stage needs support, ``first_unsupported/<view>.png``:
+    which stages stand), ``adhesion.png`` (the least adhesion of every stage, kPa) and,
+    when a stage needs support, ``first_unsupported/<view>.png``:
     that stage, its bricks coloured by the support force they need."""
     from masonry import plots  # matplotlib, imported only by the runs that draw
 
@@ -515,15 +492,19 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
             "block": f"block by block ({plan.order})"}[plan.by]
     title = f"{structure_id(params)}: {what}, {sum(bool(r['feasible']) for r in rows)} of " \
             f"{len(rows)} stages stand (mu {params.analysis.mu:g})"
+    xlabel = {"course": "stage (courses laid)",
+              "brick": f"stage (bricks of {bricks} laid, per web)"}.get(plan.by, "stage")
+    stage, feasible = [r["stage"] for r in rows], [bool(r["feasible"]) for r in rows]
     out = {"stages.png": plots.stage_chart_png(
-        [r["stage"] for r in rows],
-        [np.nan if r["centering_fraction"] is None else r["centering_fraction"]
-         for r in rows],
-        [bool(r["feasible"]) for r in rows],
+        stage, [np.nan if r["centering_fraction"] is None else r["centering_fraction"]
+                for r in rows], feasible,
         [np.nan if r["load_factor"] is None else r["load_factor"] for r in rows],
-        loose=[r["loose"] for r in rows], title=title,
-        xlabel={"course": "stage (courses laid)", "brick": f"stage (bricks of {bricks} "
-                f"laid, per web)"}.get(plan.by, "stage"))}
+        loose=[r["loose"] for r in rows], title=title, xlabel=xlabel),
+        "adhesion.png": plots.stage_adhesion_png(
+        stage, [np.nan if r["adhesion_kPa"] is None else r["adhesion_kPa"] for r in rows],
+        feasible, title=f"{structure_id(params)}: {what}, the least adhesion of every "
+                        f"stage (mu {params.analysis.mu:g})", xlabel=xlabel,
+        ratio=params.analysis.adhesion_tension_ratio)}
     first = first_unsupported(rows)
     if first is None:
         return out

@@ -31,6 +31,8 @@ from masonry.export.csv import HEADERS, TEXT_COLUMNS, header
 from masonry.errors import ParameterError
 from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run, versions
+from masonry.studies.stage_records import (STAGE_SUMMARY_COLUMNS, STANDS_THROUGHOUT,
+                                           stage_summary)
 from masonry.studies.stages import run_stages, stage_params
 from masonry.runfolder import Publication, source_file
 from masonry.forking import use_one_blas_thread
@@ -50,39 +52,8 @@ SUMMARY_COLUMNS = ("variant", "status", "error", "feasible", "friction_used",
 structure stands; ``adhesion_kPa``: its least adhesion (docs/model.md 6.12), empty where
 none was found. ``load_factor`` (and the lateral load's azimuth, the worst one for
 ``lateral = "all"``) when the study gives a live load (``lateral``, ``point-load`` or
-``crown-load``, docs/model.md 6.8). A study of stages adds :data:`STAGE_SUMMARY_COLUMNS`."""
-
-STAGE_SUMMARY_COLUMNS = ("stages", "stages_standing", "first_unsupported_stage",
-                         "first_unsupported_course", "first_unsupported_brick",
-                         "centering_max_N", "centering_max_fraction",
-                         "stages_load_factor_min")
-"""A stage study's columns in a sweep's summary (:func:`stage_summary`), after
-:data:`SUMMARY_COLUMNS` when the study asks for stages (``Study.stages``)."""
-
-
-def stage_summary(record) -> dict:
-    """A stage study's :data:`STAGE_SUMMARY_COLUMNS` from its ``run.json`` record
-    (:func:`masonry.studies.stages.run_stages`): the number of stages and of those that
-    stand; the first that needs support (stage, course, and for a brick plan the brick's
-    rank on its course), None when every stage stands; the largest centering force (N,
-    and its fraction of that stage's weight) and the smallest lateral load factor over
-    the stages (:func:`masonry.studies.stages.stage_extremes`)."""
-    stages = record["stages"]
-    first = stages["first_unsupported"] or {}
-    return {"stages": stages["count"], "stages_standing": stages["standing"],
-            "first_unsupported_stage": first.get("stage"),
-            "first_unsupported_course": first.get("course"),
-            "first_unsupported_brick": first.get("brick"),
-            "centering_max_N": stages["centering_max_N"],
-            "centering_max_fraction": stages["centering_max_fraction"],
-            "stages_load_factor_min": stages["load_factor_min"]}
-
-
-STANDS_THROUGHOUT = ("first_unsupported_stage", "first_unsupported_course",
-                     "first_unsupported_brick")
-"""Stage columns left empty when every stage stands; as a measure they are then
-infinite (:func:`measure`): no stage needs support."""
-
+``crown-load``, docs/model.md 6.8). A study of stages adds
+:data:`~masonry.studies.stage_records.STAGE_SUMMARY_COLUMNS`."""
 
 def measure(row: dict, column: str):
     """A result column of a variant's row as a number, for an optimisation: a boolean as
