@@ -9,6 +9,7 @@ import types
 import pytest
 from masonry_cli.app import make_parser
 from masonry_cli.main import main
+from test_cli_fuzz import call
 
 from masonry.params import Params, validate
 from masonry.runfolder import alone
@@ -20,15 +21,6 @@ WALL_STUDY = ('[base]\nscene = "wall"\nwall-courses = 3\nwall-length = 12\nfast 
 OPTIMIZE = ["--maximize", "bricks", "--trials", "2", "--workers", "1", "-q"]
 
 
-def call(argv):
-    """``main(argv)`` -> (exit code, stdout, stderr)."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = main(argv)
-        except SystemExit as exit_info:  # argparse
-            code = exit_info.code
-    return code, out.getvalue(), err.getvalue()
 
 
 def refused(argv, *words):
