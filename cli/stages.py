@@ -14,6 +14,7 @@ HELP = ("construction stages without centering: the rigid block equilibrium of e
 
 
 def register(subparsers):
+    from masonry.mortars import MORTAR_NAMES
     from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
 
     parser = subparsers.add_parser(NAME, help=HELP)
@@ -42,6 +43,21 @@ def register(subparsers):
                    help="add a ground slab (a support) under the lowest blocks")
     add_model_options(parser)
     add_analysis_options(parser)
+    g = parser.add_argument_group("mortar by age (docs/model.md 6.13)")
+    g.add_argument("--mortar", choices=MORTAR_NAMES,
+                   help="every joint has the strength of its age: lime or gypsum (a "
+                        "table of cohesion and tensile strength against the hours after "
+                        "laying; needs --laying-rate), or constant (--cohesion-kpa and "
+                        "--tensile-kpa at every age); default: --cohesion-kpa and "
+                        "--tensile-kpa at every joint")
+    g.add_argument("--laying-rate", dest="laying_rate", type=float,
+                   metavar="BRICKS_PER_HOUR",
+                   help="bricks per hour per mason: a stage laying n bricks of the scene "
+                        "takes n / (rate x masons) hours, which ages the joints made "
+                        "before it")
+    g.add_argument("--masons", type=int, metavar="N",
+                   help="masons laying side by side (default 1; a section's scene is one "
+                        "web: its mason's rate; a whole dome's webs: give the webs)")
     g = parser.add_argument_group("live load")
     g.add_argument("--lateral", metavar="AZIMUTH",
                    help="also the collapse load factor lambda of every stage that stands, "
@@ -110,13 +126,15 @@ def handle(args, report):
         params = stage_params(params, args.boundary is not None or args.dome)
     record = run_stages(params, args.out, by=by, order=args.order, course=args.course,
                         force=args.force, scene=scene, source=source,
-                        max_bricks=args.max_bricks)
+                        max_bricks=args.max_bricks, mortar=args.mortar,
+                        laying_rate=args.laying_rate, masons=args.masons)
     stages = record["stages"]
     state = "up to date, reused" if record.get("reused") else "written"
     report(f"{record['structure_id']}: {record['plan']['described']}")
     pattern_note(record, report)
-    report(f"{stages['standing']} of {stages['count']} stages stand without support "
-           f"(mu {params.analysis.mu:g}, friction {params.analysis.friction}); "
+    report(f"{_with_mortar(record)}{stages['standing']} of {stages['count']} stages stand "
+           f"without {'centering' if record.get('mortar') else 'support'} (mu "
+           f"{params.analysis.mu:g}, friction {params.analysis.friction}); "
            f"{_timing(stages)}")
     factors = [(r["load_factor"], r["stage"]) for r in record["rows"]
                if r.get("load_factor") is not None] if "rows" in record else []
@@ -125,6 +143,8 @@ def handle(args, report):
         report(f"lateral load factor at {params.load.azimuth_deg:g} deg: smallest {low:.4g} "
                f"(stage {at}), {factors[-1][0]:.4g} at stage {factors[-1][1]} (stages.csv)")
     first = stages["first_unsupported"]
+    if record.get("mortar"):
+        report(f"contact law: {record['mortar']['law']}")
     if first is not None:
         report(f"first stage that needs support: {first['stage']} ({first['bricks']} "
                f"bricks{_moi(first)}){_loose(first)}")
@@ -144,6 +164,13 @@ def handle(args, report):
                f"{', ...' if len(loose) > 10 else ''} (stages.csv, column loose)")
     report(f"{state}: {record['path']}")
     return 0
+
+
+def _with_mortar(record) -> str:
+    """``with lime mortar at 60 bricks per hour (1 mason): `` where the study aged its
+    joints, else ''."""
+    mortar = record.get("mortar")
+    return "" if mortar is None else f"with {mortar['text']}: "
 
 
 def _moi(first) -> str:

@@ -19,6 +19,10 @@ compression ``c~_i = n_i + s_i``, the law is the dry model in ``(c~, f)``
 t_c A_i`` where ``t_c < c / mu`` (the truncated cone). The equilibrium's right-hand side
 takes the shift (:class:`masonry.rbe.equilibrium.EquilibriumSystem`), so every solver
 states the same cones as for dry joints.
+
+The strengths may differ from vertex to vertex (mortar of different ages in a
+construction sequence, :mod:`masonry.mortars`): ``c`` and ``t_c`` are then arrays over
+the vertices, and so are the shift and the floor; the solvers see the same cones.
 """
 
 import math
@@ -52,21 +56,21 @@ class ContactLaw:
         The friction model (circle, polygon:K, square).
     mu : float
         Friction coefficient, > 0.
-    cohesion_Pa : float
-        ``c``, pascals, >= 0 (0: dry joints).
-    tensile_Pa : float
-        ``t_c``, pascals, >= 0.
+    cohesion_Pa : float or (IV,) float
+        ``c``, pascals, >= 0 (0: dry joints); an array: per interface vertex.
+    tensile_Pa : float or (IV,) float
+        ``t_c``, pascals, >= 0; an array: per interface vertex.
     """
 
     cone: FrictionCone = FrictionCone("circle")
     mu: float = 0.7
-    cohesion_Pa: float = 0.0
-    tensile_Pa: float = 0.0
+    cohesion_Pa: float | np.ndarray = 0.0
+    tensile_Pa: float | np.ndarray = 0.0
 
     @classmethod
     def of(cls, cone="circle", mu=0.7, cohesion_Pa=0.0, tensile_Pa=0.0) -> "ContactLaw":
         """The law of a friction model (name or :class:`FrictionCone`), ``mu`` and the
-        strengths, checked.
+        strengths (numbers, or arrays over the interface vertices), checked.
 
         Raises
         ------
@@ -75,31 +79,47 @@ class ContactLaw:
         """
         for name, value in (("mu", mu), ("cohesion_Pa", cohesion_Pa),
                             ("tensile_Pa", tensile_Pa)):
+            if isinstance(value, np.ndarray) and name != "mu":
+                bad = value[~(np.isfinite(value) & (value >= 0))] if value.dtype.kind in \
+                    "fiu" else value.ravel()
+                if value.ndim != 1 or len(bad):
+                    raise ContactLawError(f"{name} per vertex {bad[:1].tolist() or value.shape}"
+                                          f": expected finite numbers >= 0, one per vertex")
+                continue
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise ContactLawError(f"{name} {value!r}: expected a number")
             low_ok = value > 0 if name == "mu" else value >= 0
             if not (math.isfinite(value) and low_ok):
                 raise ContactLawError(f"{name} {value!r}: expected a finite number "
                                       f"{'> 0' if name == 'mu' else '>= 0'}")
-        return cls(FrictionCone.parse(cone), float(mu), float(cohesion_Pa),
-                   float(tensile_Pa))
+        return cls(FrictionCone.parse(cone), float(mu), as_strength(cohesion_Pa),
+                   as_strength(tensile_Pa))
 
     @property
     def is_dry(self) -> bool:
         """No cohesion: the friction model alone (a tensile strength without cohesion is
-        cut off at the cone's apex, 0)."""
-        return self.cohesion_Pa == 0.0
+        cut off at the cone's apex, 0); per vertex: no vertex has any."""
+        return not np.any(self.cohesion_Pa)
 
     @property
-    def cutoff_Pa(self) -> float:
-        """The tension a joint carries per unit area: ``min(t_c, c / mu)``."""
-        return min(self.tensile_Pa, self.cohesion_Pa / self.mu)
+    def is_per_vertex(self) -> bool:
+        """The strengths are arrays over the interface vertices."""
+        return np.ndim(self.cohesion_Pa) > 0 or np.ndim(self.tensile_Pa) > 0
+
+    @property
+    def cutoff_Pa(self) -> float | np.ndarray:
+        """The tension a joint carries per unit area: ``min(t_c, c / mu)`` (per vertex
+        where the strengths are)."""
+        if not self.is_per_vertex:
+            return min(self.tensile_Pa, self.cohesion_Pa / self.mu)
+        return np.minimum(self.tensile_Pa, np.asarray(self.cohesion_Pa) / self.mu)
 
     @property
     def is_truncated(self) -> bool:
-        """The cut-off lies before the cone's apex (``t_c < c / mu``): the solvers need
-        the lower bound ``c~ >= l``."""
-        return not self.is_dry and self.tensile_Pa < self.cohesion_Pa / self.mu
+        """The cut-off lies before the cone's apex (``t_c < c / mu``) somewhere: the
+        solvers need the lower bound ``c~ >= l``."""
+        return not self.is_dry and bool(np.any(
+            np.asarray(self.tensile_Pa) < np.asarray(self.cohesion_Pa) / self.mu))
 
     def shift(self, area) -> np.ndarray:
         """(IV,) float, newtons: ``s_i = c A_i / mu`` for tributary areas ``area``
@@ -114,10 +134,13 @@ class ContactLaw:
 
     def describe(self) -> str:
         """The law in one line, e.g. ``Coulomb circle, mu 0.7, cohesion 0.5 kPa,
-        tensile strength 0.25 kPa``."""
+        tensile strength 0.25 kPa`` (per vertex: the range of each strength)."""
         head = f"Coulomb {self.cone.name}, mu {self.mu:g}"
         if self.is_dry:
             return f"{head}, dry joints (no cohesion, no tension)"
+        if self.is_per_vertex:
+            return (f"{head}, per joint: cohesion {_range_kPa(self.cohesion_Pa)}, tensile "
+                    f"strength {_range_kPa(self.tensile_Pa)} (cut off at c/mu)")
         text = (f"{head}, cohesion {self.cohesion_Pa / 1e3:g} kPa, tensile strength "
                 f"{self.tensile_Pa / 1e3:g} kPa")
         if self.tensile_Pa > self.cohesion_Pa / self.mu:
@@ -129,10 +152,45 @@ class ContactLaw:
 
     def record(self) -> dict:
         """run.json's ``contact_law``: the model, ``mu``, the strengths and the
-        effective tension cut-off (pascals), and the one line."""
+        effective tension cut-off (pascals), and the one line; per vertex, each strength
+        is its least and its largest ``[min, max]``."""
+        if self.is_per_vertex:
+            return {"friction_model": self.cone.name, "mu": self.mu,
+                    **{name: _bounds(value) for name, value in (
+                        ("cohesion_Pa", self.cohesion_Pa), ("tensile_Pa", self.tensile_Pa),
+                        ("tension_cutoff_Pa", self.cutoff_Pa))},
+                    "per_vertex": True, "text": self.describe()}
         return {"friction_model": self.cone.name, "mu": self.mu,
                 "cohesion_Pa": self.cohesion_Pa, "tensile_Pa": self.tensile_Pa,
                 "tension_cutoff_Pa": self.cutoff_Pa, "text": self.describe()}
+
+
+def as_strength(value) -> float | np.ndarray:
+    """A strength (pascals) as a float, or as a read-only float array per vertex."""
+    if not isinstance(value, np.ndarray):
+        return float(value)
+    out = np.array(value, dtype=float)
+    out.flags.writeable = False
+    return out
+
+
+def same_strength(a, b) -> bool:
+    """Two strengths (floats or per-vertex arrays) are the same everywhere."""
+    if np.ndim(a) == 0 and np.ndim(b) == 0:
+        return float(a) == float(b)
+    return np.shape(a) == np.shape(b) and bool(np.array_equal(a, b))
+
+
+def _bounds(value) -> list:
+    """``[min, max]`` of a per-vertex strength (pascals), ``[0, 0]`` for no vertex."""
+    value = np.broadcast_to(np.asarray(value, dtype=float), (max(np.size(value), 1),))
+    return [float(value.min()), float(value.max())]
+
+
+def _range_kPa(value) -> str:
+    """A per-vertex strength's range in kPa, e.g. ``0.1 to 2 kPa``."""
+    low, high = _bounds(value)
+    return f"{low / 1e3:g} kPa" if low == high else f"{low / 1e3:g} to {high / 1e3:g} kPa"
 
 
 def tributary_area(interfaces) -> np.ndarray:

@@ -252,13 +252,3 @@ def test_a_run_with_mortar_records_its_law(tmp_path):
     assert record["rbe"]["contact_law"] == line
     assert line in (folder / "00_parameters.txt").read_text()
     assert line in (folder / "RBE" / "00_objective.txt").read_text()
-
-
-def test_stages_refuse_mortar_by_name(tmp_path, capsys):
-    """Construction stages solve dry joints only so far: mortar is refused in one line
-    naming the option, exit 2, nothing written."""
-    out = tmp_path / "out"
-    assert main(["stages", "--preset", "3", "--cohesion-kpa", "1", "--out", str(out)]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "cohesion" in err[0] and "stages" in err[0]
-    assert not out.exists() or not any(out.iterdir())

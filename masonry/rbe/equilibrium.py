@@ -48,7 +48,7 @@ from typing import ClassVar
 import numpy as np
 import scipy.sparse as sp
 
-from masonry.contact import ContactLaw, tributary_area
+from masonry.contact import ContactLaw, as_strength, same_strength, tributary_area
 from masonry.friction import FrictionCone
 from masonry.tolerances import COEFFICIENT_NOISE, G
 
@@ -186,9 +186,9 @@ class EquilibriumSystem:
         (:meth:`masonry.rbe.collapse.CollapseLP.scaled`); None: every row is kept.
     vertex_area : (IV,) float or None, m^2
         Every vertex's tributary area (:func:`masonry.contact.tributary_area`).
-    cohesion, tensile : float, Pa
+    cohesion, tensile : float or (IV,) float, Pa
         The mortar's cohesion and tensile strength (:class:`masonry.contact.ContactLaw`,
-        :attr:`law`); 0: dry joints.
+        :attr:`law`), at every vertex or per vertex; 0: dry joints.
     f_weight : (6 F,) float or None
         The self weight before the cohesion shift when there is one: ``f_ext`` is then
         ``f_weight - A_eq[:, c] s`` (:attr:`compression_shift`); None: ``f_ext`` is the
@@ -211,8 +211,8 @@ class EquilibriumSystem:
     cone: FrictionCone = FrictionCone("circle")
     row_kept: np.ndarray | None = None
     vertex_area: np.ndarray | None = None
-    cohesion: float = 0.0
-    tensile: float = 0.0
+    cohesion: float | np.ndarray = 0.0
+    tensile: float | np.ndarray = 0.0
     f_weight: np.ndarray | None = None
 
     def with_material(self, mu=None, density=None, cone=None, cohesion=None,
@@ -232,8 +232,8 @@ class EquilibriumSystem:
             Default unchanged.
         cone : FrictionCone or str, optional
             Friction model; default unchanged.
-        cohesion, tensile : float, Pa, optional
-            The mortar's strengths; default unchanged.
+        cohesion, tensile : float or (IV,) float, Pa, optional
+            The mortar's strengths, at every vertex or per vertex; default unchanged.
 
         Returns
         -------
@@ -251,9 +251,9 @@ class EquilibriumSystem:
                                       weight_ref=self.weight_ref * ratio,
                                       density=float(density))
         for name, value in (("cohesion", cohesion), ("tensile", tensile)):
-            if value is not None and float(value) != getattr(self, name):
-                out = dataclasses.replace(out, **{name: float(value)})
-        if out is not self and (out.cohesion or self.cohesion):
+            if value is not None and not same_strength(value, getattr(self, name)):
+                out = dataclasses.replace(out, **{name: as_strength(value)})
+        if out is not self and (np.any(out.cohesion) or np.any(self.cohesion)):
             out = out._with_mortar()
         if out is not self and "A_eq" in self.__dict__:  # the matrix depends on neither
             out.__dict__["A_eq"] = self.A_eq

@@ -40,6 +40,12 @@ within the solver's accuracy (tests/test_stages.py). What :class:`StageSequence`
 - **The least adhesion** (docs/model.md 6.12) of a part: its program on the part's rows
   and columns of the whole model's matrices (:meth:`StageSequence.adhesion`), one
   Clarabel program per part; nothing carries over from the last part yet.
+- **Mortar.** A part's strengths (``cohesion``, ``tensile``: one number, or an array
+  over the whole model's interface vertices, the joints' ages differing) are sliced
+  with its columns and shift its own ``f_ext`` (:meth:`EquilibriumSystem.with_material`);
+  the local certificate and the local centering force take the same slice, so both
+  state the part's law. The dual points are starts only: a shifted ``f_ext`` changes the
+  part's optimum, not what Newton accepts.
 """
 
 import dataclasses
@@ -67,6 +73,14 @@ acceptance tolerance."""
 
 CERTIFICATE = "local-certificate"
 """The local certificate's name in :attr:`RBEResult.attempts`."""
+
+
+def vertex_slice(strength, whole: EquilibriumSystem, interfaces):
+    """A strength (pascals: a number, or (IV,) over ``whole``'s vertices) for the
+    vertices of ``interfaces`` ((K,) bool), in :func:`part_system`'s order."""
+    if np.ndim(strength) == 0:
+        return strength
+    return np.asarray(strength)[np.asarray(interfaces, bool)[whole.layout.vertex_interface]]
 
 
 def part_system(whole: EquilibriumSystem, rows, interfaces) -> EquilibriumSystem:
@@ -132,7 +146,8 @@ class StageSequence:
         """Parts whose local certificate spared the friction-net solve."""
 
     def solve(self, is_present, local=None, within=None, *, mu=0.7, density=2000.0,
-              friction="auto", solver=None, accuracy="balanced", cone=None) -> RBEResult:
+              friction="auto", solver=None, accuracy="balanced", cone=None, cohesion=0.0,
+              tensile=0.0) -> RBEResult:
         """The RBE of the part of the model whose scene blocks ``is_present`` ((S,) bool,
         as :func:`~masonry.rbe.boundary.restrict` takes it).
 
@@ -148,6 +163,8 @@ class StageSequence:
             (:class:`~masonry.rbe.solvers.embedded.Embedded`). Default: the part's own.
         mu, density, friction, solver, accuracy, cone
             As :meth:`RBEProblem.solve`.
+        cohesion, tensile : float or (IV,) float, Pa
+            The mortar, at every joint or per vertex of the whole model's interfaces.
 
         Returns
         -------
@@ -162,19 +179,21 @@ class StageSequence:
         interfaces = keep[self.model.interfaces.pair].all(axis=1)
         rows = keep[self.whole.free_block]
         cone = friction_model(accuracy, cone)
-        system = part_system(self.whole, rows, interfaces).with_material(
-            mu=mu, density=density, cone=cone)
+        system = self._part(rows, interfaces, mu=mu, density=density, cone=cone,
+                            cohesion=cohesion, tensile=tensile)
         certificate = None
         if local is not None and friction == "auto" and solver is None:
             certificate = self._certificate(system, rows, interfaces,
-                                            kept_blocks(self.model, local) & keep, accuracy)
+                                            kept_blocks(self.model, local) & keep, accuracy,
+                                            cohesion, tensile)
         starts = {method: self._start(method, rows) for method in FRICTION_METHODS
                   if self._known[method][rows].any()}
         problem = RBEProblem.of_system(system, symbolic=self._symbolic(
             rows, rows if within is None else kept_blocks(self.model, within)[
                 self.whole.free_block] | rows), starts=starts)
         result = problem.solve(mu=mu, density=density, accuracy=accuracy, cone=cone,
-                               friction="plus" if certificate else friction, solver=solver)
+                               friction="plus" if certificate else friction, solver=solver,
+                               cohesion=system.cohesion, tensile=system.tensile)
         for method, y in problem.duals.items():
             self._duals[method][rows] = y.reshape(-1, 6)
             self._known[method][rows] = True
@@ -182,6 +201,12 @@ class StageSequence:
             self.certified += 1
             result = dataclasses.replace(result, attempts=(certificate, *result.attempts))
         return dataclasses.replace(result, time_s=time.perf_counter() - start)
+
+    def _part(self, rows, interfaces, *, cohesion, tensile, **material) -> EquilibriumSystem:
+        """:func:`part_system` with its material and its slice of the strengths."""
+        return part_system(self.whole, rows, interfaces).with_material(
+            cohesion=vertex_slice(cohesion, self.whole, interfaces),
+            tensile=vertex_slice(tensile, self.whole, interfaces), **material)
 
     def forget(self) -> None:
         """Drop the dual points: the next part starts from scratch (its matrices and
@@ -231,11 +256,12 @@ class StageSequence:
         return Embedded(self._within[1], (np.cumsum(self._within[0]) - 1)[rows])
 
     def centering(self, is_present, local, *, mu=0.7, density=2000.0, accuracy="balanced",
-                  cone=None) -> CenteringResult | None:
+                  cone=None, cohesion=0.0, tensile=0.0) -> CenteringResult | None:
         """The centering force of the part whose scene blocks ``is_present`` (see the
         module's notes: from the ``local`` blocks alone, checked on the whole part);
         None where that does not give it (the caller solves the part's own program).
-        ``weight_N`` is the part's; ``block`` the scene's blocks."""
+        ``weight_N`` is the part's; ``block`` the scene's blocks; the mortar as
+        :meth:`solve` takes it."""
         keep = kept_blocks(self.model, is_present)
         interfaces = keep[self.model.interfaces.pair].all(axis=1)
         rows = keep[self.whole.free_block]
@@ -243,16 +269,18 @@ class StageSequence:
         if not local_rows.any():
             return None
         cone = friction_model(accuracy, cone)
-        small = part_system(self.whole, local_rows, interfaces & self._touching(
-            local_rows)).with_material(mu=mu, density=density, cone=cone)
+        material = dict(mu=mu, density=density, cone=cone, cohesion=cohesion, tensile=tensile)
+        small = self._part(local_rows, interfaces & self._touching(local_rows), **material)
         reduced = solve_centering(small)
         if reduced.total_N is None:
             return None
-        system = part_system(self.whole, rows, interfaces).with_material(
-            mu=mu, density=density, cone=cone)
+        system = self._part(rows, interfaces, **material)
         load = np.zeros((int(rows.sum()), 6))
         load[(np.cumsum(rows) - 1)[local_rows], :3] = reduced.force / system.weight_ref
-        loaded = dataclasses.replace(system, f_ext=system.f_ext + load.ravel())
+        load = load.ravel()
+        loaded = dataclasses.replace(  # a mortar's shifted f_ext takes the loads as well
+            system, f_ext=system.f_ext + load,
+            f_weight=None if system.f_weight is None else system.f_weight + load)
         # the loads are at the limit of what the part carries (the least support), where
         # Newton creeps: a point within the acceptance tolerance is all the check needs
         preset = ACCURACY[accuracy]
@@ -298,16 +326,18 @@ class StageSequence:
         side = self.whole.side_row
         return ((side >= 0) & rows[np.maximum(side, 0)]).any(axis=1)
 
-    def _certificate(self, system, rows, interfaces, local, accuracy) -> dict | None:
+    def _certificate(self, system, rows, interfaces, local, accuracy, cohesion,
+                     tensile) -> dict | None:
         """Friction-net of the ``local`` blocks ((B,) bool) alone, the rest of the part
-        held fixed, by Clarabel: its record when it certifies infeasibility (the part
+        held fixed, under the part's law (``cohesion``, ``tensile`` as :meth:`solve`
+        takes them), by Clarabel: its record when it certifies infeasibility (the part
         cannot stand), else None."""
         local_rows = local[self.whole.free_block] & rows
         if not local_rows.any():
             return None
-        small = part_system(self.whole, local_rows,
-                            interfaces & self._touching(local_rows)).with_material(
-            mu=system.mu, density=system.density, cone=system.cone)
+        small = self._part(local_rows, interfaces & self._touching(local_rows),
+                           mu=system.mu, density=system.density, cone=system.cone,
+                           cohesion=cohesion, tensile=tensile)
         clarabel = BACKENDS["clarabel"]
         outcome = clarabel.solve_rbe(small, "net",
                                      ACCURACY[accuracy].options.get(clarabel.settings, {}),

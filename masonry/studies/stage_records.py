@@ -77,8 +77,12 @@ def adhesion_peak(rows) -> dict | None:
     return next(row for row in rows if row["adhesion_kPa"] >= top * (1 - ADHESION_TIE_REL))
 
 
-def stage_record(params, scene, model, plan: StagePlan, rows, cached, source) -> dict:
-    """run.json of a stage study, before timings."""
+def stage_record(params, scene, model, plan: StagePlan, rows, cached, source,
+                 laying=None) -> dict:
+    """run.json of a stage study, before timings; ``mortar``: the
+    :class:`~masonry.mortars.Laying` (its mortar's table and source, the rate, the
+    masons) and ``law``, the contact law in one line; None without one (``params``'
+    contact law at every joint, in ``params``)."""
     first = first_unsupported(rows)
     held = [] if first is None else [
         {"block": block, "name": str(scene.blocks.block_name[block]), "support_N": size,
@@ -93,6 +97,8 @@ def stage_record(params, scene, model, plan: StagePlan, rows, cached, source) ->
         **model_record(scene, params.analysis.density),
         "cache": {"geometry": cached},
         "friction_model": params.analysis.cone.record(),
+        "mortar": None if laying is None else {**laying.record(), "law": law_line(
+            params, laying)},
         "stages": {
             "count": plan.n_stages,
             "standing": int(sum(bool(row["feasible"]) for row in rows)),
@@ -116,6 +122,19 @@ def stage_record(params, scene, model, plan: StagePlan, rows, cached, source) ->
     if source is not None:
         record["source"] = source
     return record
+
+
+def law_line(params, laying) -> str:
+    """The contact law of a stage study in one line: ``params``' where every joint has
+    it, else the friction model and the mortar by age."""
+    law = params.analysis.law
+    if laying is None:
+        return law.describe()
+    head = f"Coulomb {law.cone.name}, mu {law.mu:g}"
+    if laying.rate_per_hour is None:
+        return f"{head}, {laying.describe()}"
+    return (f"{head}, per joint by its age: {laying.describe()}; "
+            f"{laying.mortar.describe()}")
 
 
 def _adhesion_record(scene, rows, ratio) -> dict:

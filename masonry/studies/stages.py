@@ -25,6 +25,12 @@ which carries the work consecutive stages share (matrices, ordering, dual points
 local infeasibility certificate on the course being laid) from one to the next; each
 stage alone (:func:`analyse_stage` without it) gives the same verdicts and measures
 within the solver's accuracy.
+
+With mortar (docs/model.md 6.13) a stage's joints have the strength of their age: a
+:class:`~masonry.mortars.Laying` (a mortar's table and a laying rate) gives every joint,
+made at the stage that laid the later of its two blocks, its age at the stage solved
+(:func:`joint_strength`), and the stage's verdict, MoI and centering force are those of
+that per-joint law.
 """
 
 import csv
@@ -43,10 +49,11 @@ from masonry.errors import ParameterError
 from masonry.export._text import format_float
 from masonry.export.csv import header, held_csv
 from masonry.export.summaries import parameters_text
+from masonry.mortars import MORTAR_NAMES, MORTARS, Laying, Mortar
 from masonry.params import FILE_OUTPUTS, structure_id, validate
 from masonry.pipeline import Timer, identity, run_model, versions, write_cache
 from masonry.rbe.adhesion import least_adhesion
-from masonry.rbe.boundary import Model, restrict
+from masonry.rbe.boundary import Model, kept_blocks, restrict
 from masonry.rbe.centering import centering_force
 from masonry.rbe.collapse import collapse_load
 from masonry.rbe.loads import Lateral
@@ -62,7 +69,7 @@ log = logging.getLogger(__name__)
 
 STAGE_COLUMNS = ("stage", "course", "laid", "bricks", "feasible", "loose", "moi",
                  "moi_factor", "centering_N", "centering_fraction", "adhesion_kPa",
-                 "load_factor", "solve_s")
+                 "load_factor", "time_h", "solve_s")
 """Columns of ``stages.csv``, one row per stage. ``laid``: the names of the blocks the
 stage lays, in a brick or block plan (a course plan's stage is its course). ``loose``: the
 laid blocks that touch nothing joining them to a support (:func:`loose_blocks`: the stage
@@ -72,11 +79,13 @@ stage that stands). ``adhesion_kPa``: the least adhesion of the stage's model (d
 6.12, :func:`stage_adhesion`; 0 for a stage that stands dry, empty where it has none).
 ``load_factor``: the collapse load factor of the
 stage under the lateral load of ``params.lateral`` (:func:`stage_load_factor`); empty
-without one, or where the stage does not stand under its own weight."""
+without one, or where the stage does not stand under its own weight. ``time_h``: with a mortar that ages
+(:func:`joint_strength`), the hours from the start of the first stage to the end of this
+one, which set its joints' ages; empty without a laying rate."""
 
 # ---------------------------------------------------------------------- one stage
 def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
-                  sequence: StageSequence | None = None) -> dict:
+                  sequence: StageSequence | None = None, laying: Laying | None = None) -> dict:
     """The rigid block equilibrium of one stage, and its centering force, as a row of
     ``stages.csv``.
 
@@ -93,6 +102,9 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
     sequence : StageSequence, optional
         Solve it from where the sequence's last stage ended (:func:`analyse_stages`);
         None: the stage alone, from scratch.
+    laying : Laying, optional
+        The joints' strength by age (:func:`joint_strength`); None: ``params``' contact
+        law at every joint.
 
     Returns
     -------
@@ -109,9 +121,15 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
     laid = (None if plan.by == "course" else
             " ".join(map(str, model.blocks.block_name[:len(plan.block_stage)][
                 plan.block_stage == stage])))
+    mortar, time_h = joint_strength(model, params, plan, stage, laying)
     row = {"stage": stage, "course": int(plan.stage_course[stage - 1]) or None, "laid": laid,
            "bricks": int((~part.blocks.block_is_support).sum()), "loose": len(loose),
-           "loose_blocks": loose.tolist(), "load_factor": None}
+           "loose_blocks": loose.tolist(), "load_factor": None, "time_h": time_h}
+    # the part's own slice of per-joint strengths (restrict keeps the model's order)
+    chosen = kept_blocks(model, plan.is_present(stage))[model.interfaces.pair].all(axis=1)
+    own = {name: value if np.ndim(value) == 0 else
+           value[np.repeat(chosen, model.interfaces.vertex_count)]
+           for name, value in mortar.items()}
     if len(loose) or len(part.interfaces) == 0:  # no equilibrium: nothing to solve
         row.update(feasible=False, moi=None, moi_factor=None)
     else:
@@ -121,28 +139,68 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
                        cone=analysis.friction_cone)
         if sequence is None:
             result = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
-                                side_rotation=part.side_rotation).solve(**options)
+                                side_rotation=part.side_rotation).solve(**options, **own)
         else:
             result = sequence.solve(plan.is_present(stage), plan.local(stage),
-                                    plan.is_present(plan.course_end(stage)), **options)
+                                    plan.is_present(plan.course_end(stage)), **options,
+                                    **mortar)
         row.update(feasible=result.feasible, moi=_number(result.moi),
                    moi_factor=_number(result.moi_factor))
         if result.feasible:
-            row["load_factor"] = stage_load_factor(part, params)
+            row["load_factor"] = stage_load_factor(part, params, own)
     centering = None
     if sequence is not None and not row["feasible"] and not len(loose):
         analysis = params.analysis
         centering = sequence.centering(plan.is_present(stage), plan.local(stage),
                                        mu=analysis.mu, density=analysis.density,
-                                       accuracy=analysis.accuracy, cone=analysis.friction_cone)
-    row.update(stage_centering(part, params, row["feasible"], centering))
-    row.update(stage_adhesion(part, params, plan, stage, row, sequence))
+                                       accuracy=analysis.accuracy, cone=analysis.friction_cone,
+                                       **mortar)
+    row.update(stage_centering(part, params, row["feasible"], centering, own))
+    dry = not any(np.any(value) for value in mortar.values())
+    row.update(stage_adhesion(part, params, plan, stage, row, sequence, dry))
     row["solve_s"] = round(time.perf_counter() - start, 4)
     return row
 
 
+def joint_strength(model: Model, params, plan: StagePlan, stage: int,
+                   laying: Laying | None = None) -> tuple:
+    """The strength of every joint of ``model`` at the end of ``stage`` (docs/model.md
+    6.13).
+
+    A joint is made at the stage that lays the later of its two blocks (a support, and
+    a block present from the start, at stage 0); at the end of stage ``k`` its age is
+    the time the stages after it took (:meth:`Laying.stage_hours`, the bricks of the
+    scene each stage lays), and its strength the mortar's at that age.
+
+    Returns
+    -------
+    tuple
+        ``({'cohesion': c, 'tensile': t_c}, time_h)``: pascals, floats where every joint
+        has the same strength (``params``' contact law without ``laying``), else (IV,)
+        arrays over ``model``'s interface vertices (a joint not yet made takes the
+        strength at age 0); ``time_h`` the hours to the end of ``stage``, None without
+        a laying rate.
+    """
+    if laying is None:
+        law = params.analysis.law
+        return {"cohesion": law.cohesion_Pa, "tensile": law.tensile_Pa}, None
+    if laying.rate_per_hour is None:
+        cohesion, tensile = laying.mortar.strength_kPa(0.0)
+        return {"cohesion": 1e3 * float(cohesion), "tensile": 1e3 * float(tensile)}, None
+    laid = plan.block_stage[plan.block_stage >= 1]
+    hours = laying.stage_hours(np.bincount(laid, minlength=plan.n_stages + 1)[1:])
+    source = (np.arange(model.blocks.n_blocks) if model.block_source is None
+              else model.block_source)
+    block_stage = np.maximum(plan.block_stage, 0)[source]  # images: their bricks'
+    made = block_stage[model.interfaces.pair].max(axis=1)
+    age = np.maximum(hours[stage] - hours[np.minimum(made, stage)], 0.0)
+    cohesion, tensile = laying.mortar.strength_kPa(
+        np.repeat(age, model.interfaces.vertex_count))
+    return {"cohesion": 1e3 * cohesion, "tensile": 1e3 * tensile}, float(hours[stage])
+
+
 def stage_adhesion(part: Model, params, plan: StagePlan, stage: int, row,
-                   sequence: StageSequence | None = None) -> dict:
+                   sequence: StageSequence | None = None, dry: bool = True) -> dict:
     """The least adhesion of a stage (docs/model.md 6.12, :mod:`masonry.rbe.adhesion`):
     the least uniform strength of mortar (cohesion ``a``, tensile strength ``r a``) with
     which the stage's model stands.
@@ -160,6 +218,9 @@ def stage_adhesion(part: Model, params, plan: StagePlan, stage: int, row,
     sequence : StageSequence, optional
         Solve the program on its matrices (:meth:`StageSequence.adhesion`); None: on
         ``part``'s own.
+    dry : bool
+        The stage was solved with dry joints: standing, it needs no adhesion (with
+        mortar a stage that stands may not stand dry, so the program decides).
 
     Returns
     -------
@@ -170,7 +231,7 @@ def stage_adhesion(part: Model, params, plan: StagePlan, stage: int, row,
         ``adhesion_joint``: the two scene blocks of the joint that needs most, the later
         laid first (None without a positive value).
     """
-    if row["feasible"]:
+    if row["feasible"] and dry:
         return {"adhesion_kPa": 0.0, "adhesion_reason": "", "adhesion_joint": None}
     if row["loose"] or len(part.interfaces) == 0:
         return {"adhesion_kPa": None, "adhesion_joint": None,
@@ -195,7 +256,7 @@ def stage_adhesion(part: Model, params, plan: StagePlan, stage: int, row,
             "adhesion_joint": joint}
 
 
-def stage_centering(part: Model, params, stands: bool, result=None) -> dict:
+def stage_centering(part: Model, params, stands: bool, result=None, mortar=None) -> dict:
     """The centering force of a stage (docs/model.md 6.10, :mod:`masonry.rbe.centering`): 0 for a
     stage that stands (its equilibrium needs none), else the least total force that
     supports at the laid blocks' centroids must give, loose blocks included (they must
@@ -212,6 +273,9 @@ def stage_centering(part: Model, params, stands: bool, result=None) -> dict:
     result : CenteringResult, optional
         The stage's centering force found already
         (:meth:`masonry.rbe.sequence.StageSequence.centering`, its blocks the scene's).
+    mortar : dict, optional
+        ``cohesion`` and ``tensile`` (Pa, numbers or per vertex of ``part``); default
+        ``params``' contact law.
 
     Returns
     -------
@@ -226,7 +290,7 @@ def stage_centering(part: Model, params, stands: bool, result=None) -> dict:
     if result is None:
         analysis = params.analysis
         result = centering_force(part, mu=analysis.mu, density=analysis.density,
-                                 cone=analysis.cone)
+                                 cone=analysis.cone, **(mortar or _law_mortar(params)))
         source = part.block_source
     return {"centering_N": result.total_N, "centering_fraction": result.fraction,
             "held": result.held_forces(source)}
@@ -250,7 +314,12 @@ def loose_blocks(part: Model) -> np.ndarray:
     return np.unique(source[loose])
 
 
-def stage_load_factor(part: Model, params) -> float | None:
+def _law_mortar(params) -> dict:
+    law = params.analysis.law
+    return {"cohesion": law.cohesion_Pa, "tensile": law.tensile_Pa}
+
+
+def stage_load_factor(part: Model, params, mortar=None) -> float | None:
     """The collapse load factor of a stage (docs/model.md 6.8) under the lateral load at
     ``params.lateral`` degrees, built on the stage's own blocks; None without a lateral
     load or without a factor (unbounded: the stage carries any lateral load).
@@ -262,6 +331,8 @@ def stage_load_factor(part: Model, params) -> float | None:
         weight.
     params : masonry.params.Params
         ``lateral`` (degrees, not ``'all'``), ``mu`` and ``density``.
+    mortar : dict, optional
+        As :func:`stage_centering` takes it.
     """
     if params.load is None:
         return None
@@ -269,7 +340,7 @@ def stage_load_factor(part: Model, params) -> float | None:
     live = params.load.on(part, analysis.density)
     result = collapse_load(part, live, mu=analysis.mu, density=analysis.density,
                            cone=analysis.cone, friction=analysis.friction_law,
-                           dead_load_feasible=True)
+                           dead_load_feasible=True, **(mortar or _law_mortar(params)))
     return result.load_factor
 
 
@@ -278,8 +349,10 @@ def _number(value):
 
 
 # ---------------------------------------------------------------------- every stage
-def analyse_stages(model: Model, params, plan: StagePlan, reuse: bool = True) -> list:
-    """:func:`analyse_stage` of stages ``1..N``, in order, logging ``stage k of N``.
+def analyse_stages(model: Model, params, plan: StagePlan, reuse: bool = True,
+                   laying: Laying | None = None) -> list:
+    """:func:`analyse_stage` of stages ``1..N`` (with ``laying``), in order, logging
+    ``stage k of N``.
 
     With ``reuse``, in runs of consecutive stages, each run solved by one
     :class:`StageSequence` from its first stage to its last; on a large model two runs at
@@ -288,12 +361,12 @@ def analyse_stages(model: Model, params, plan: StagePlan, reuse: bool = True) ->
     blocks = int((~model.blocks.block_is_support).sum())
     stages = range(1, plan.n_stages + 1)
     if not reuse:
-        return forking.two_at_once(functools.partial(_analysed, model, params, plan),
-                                   stages, blocks=blocks)
+        return forking.two_at_once(functools.partial(_analysed, model, params, plan,
+                                                     laying=laying), stages, blocks=blocks)
     sequence = StageSequence(model)  # made once, before any fork
     runs = _runs(plan, 2 * STAGE_RUNS if blocks >= forking.TWO_AT_ONCE_BLOCKS else 1)
     done = forking.two_at_once(functools.partial(_analysed_run, model, params, plan,
-                                                 sequence), runs, blocks=blocks)
+                                                 sequence, laying), runs, blocks=blocks)
     return [row for run in done for row in run]
 
 
@@ -313,13 +386,14 @@ def _runs(plan: StagePlan, count: int) -> list:
     return [range(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
 
 
-def _analysed_run(model, params, plan, sequence, stages) -> list:
+def _analysed_run(model, params, plan, sequence, laying, stages) -> list:
     sequence.forget()  # another run's last stage is no start for this one's first
-    return [_analysed(model, params, plan, stage, sequence) for stage in stages]
+    return [_analysed(model, params, plan, stage, sequence, laying) for stage in stages]
 
 
-def _analysed(model: Model, params, plan: StagePlan, stage: int, sequence=None) -> dict:
-    row = analyse_stage(model, params, plan, stage, sequence)
+def _analysed(model: Model, params, plan: StagePlan, stage: int, sequence=None,
+              laying=None) -> dict:
+    row = analyse_stage(model, params, plan, stage, sequence, laying)
     verdict = ("stands" if row["feasible"] else
                f"needs support ({row['loose']} blocks touch nothing that holds them)"
                if row["loose"] else "needs support")
@@ -352,22 +426,21 @@ def stages_csv(rows) -> bytes:
 
 
 # ---------------------------------------------------------------------- the run
-def stages_folder_name(params, plan: StagePlan) -> str:
-    """The run folder of a stage study: the structure id and the plan, so it never
-    replaces the folder of ``masonry run`` or of another plan."""
-    return f"{structure_id(params)}_stages_{plan.tag}"
+def stages_folder_name(params, plan: StagePlan, laying: Laying | None = None) -> str:
+    """The run folder of a stage study: the structure id, the plan and a mortar that
+    ages (its name and rate, e.g. ``_lime60``), so it never replaces the folder of
+    ``masonry run``, of another plan or of another mortar."""
+    name = f"{structure_id(params)}_stages_{plan.tag}"
+    if laying is not None and laying.mortar.name != "constant":
+        name += f"_{laying.mortar.name}{laying.rate_per_hour:g}"
+        name += "" if laying.masons == 1 else f"x{laying.masons}"
+    return name
 
 
 def check_live_load(params) -> None:
-    """Refuse the inputs a stage study does not take (:class:`ParameterError`): mortar
-    (the stages solve dry joints only so far), point and crown loads (they name blocks a
-    stage may not hold yet) and ``--lateral all`` (an azimuth search at every stage: one
-    azimuth per study)."""
-    analysis = params.analysis
-    for name in ("cohesion_kpa", "tensile_kpa"):
-        if getattr(analysis, name) != 0:
-            raise ParameterError(name, getattr(analysis, name), "0 for stages: construction "
-                                 "stages solve dry joints only so far")
+    """Refuse the inputs a stage study does not take (:class:`ParameterError`): point
+    and crown loads (they name blocks a stage may not hold yet) and ``--lateral all``
+    (an azimuth search at every stage: one azimuth per study)."""
     load = params.load
     if load is None:
         return
@@ -380,8 +453,47 @@ def check_live_load(params) -> None:
                                                "not offered: run one azimuth per study)")
 
 
+def stage_laying(params, mortar=None, laying_rate=None, masons=None) -> Laying | None:
+    """The :class:`~masonry.mortars.Laying` of a stage study's options, checked
+    (:class:`ParameterError` naming the option): ``mortar`` a name of
+    :data:`~masonry.mortars.MORTAR_NAMES` (``constant``: ``params``' cohesion and tensile
+    strength at every age), ``laying_rate`` bricks per hour per mason (needed by a mortar
+    that ages), ``masons`` >= 1 (default 1). None without ``mortar``: ``params``'
+    contact law at every joint."""
+    if mortar is None:
+        for name, value in (("laying_rate", laying_rate), ("masons", masons)):
+            if value is not None:
+                raise ParameterError(name, value, "--mortar NAME beside it (the rate ages "
+                                     "a mortar's joints)")
+        return None
+    if mortar not in MORTAR_NAMES:
+        raise ParameterError("mortar", mortar, f"one of {', '.join(MORTAR_NAMES)}")
+    analysis = params.analysis
+    if mortar != "constant":
+        for name in ("cohesion_kpa", "tensile_kpa"):
+            if getattr(analysis, name) != 0:
+                raise ParameterError(name, getattr(analysis, name), f"0 with --mortar "
+                                     f"{mortar}: its table gives the strengths (or "
+                                     f"--mortar constant)", related=("mortar",))
+    table = (MORTARS[mortar] if mortar != "constant" else
+             Mortar.constant(analysis.cohesion_kpa, analysis.tensile_kpa))
+    if laying_rate is None and mortar != "constant":
+        raise ParameterError("laying_rate", None, f"bricks per hour per mason with "
+                             f"--mortar {mortar} (its joints' age)", related=("mortar",))
+    if laying_rate is not None and not (isinstance(laying_rate, (int, float))
+                                        and np.isfinite(laying_rate) and laying_rate > 0):
+        raise ParameterError("laying_rate", laying_rate, "bricks per hour per mason, a "
+                             "finite number > 0 (a mason lays 30 to 100 an hour)")
+    if masons is not None and (isinstance(masons, bool) or not isinstance(masons, int)
+                               or masons < 1):
+        raise ParameterError("masons", masons, "an integer >= 1 (masons laying side by "
+                             "side)")
+    return Laying.of(table, laying_rate, 1 if masons is None else masons)
+
+
 def run_stages(params, out_root="exports", *, by="course", order=None, course=None,
-               force=False, scene=None, source=None, max_bricks=MAX_BRICKS) -> dict:
+               force=False, scene=None, source=None, max_bricks=MAX_BRICKS, mortar=None,
+               laying_rate=None, masons=None) -> dict:
     """Every construction stage of ``params`` (or of ``scene``) into its own run folder.
 
     The folder is published by the run-folder protocol
@@ -408,6 +520,9 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
     max_bricks : int
         A model estimated larger (:func:`masonry.scenes.check_size`) is refused before
         anything is built.
+    mortar, laying_rate, masons
+        The joints' strength by age (:func:`stage_laying`, docs/model.md 6.13); default
+        ``params``' contact law at every joint.
 
     Returns
     -------
@@ -417,6 +532,7 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
     """
     params = validate(params)
     check_live_load(params)
+    laying = stage_laying(params, mortar, laying_rate, masons)
     check_output_root(out_root)
     if scene is None:
         check_size(params, max_bricks)
@@ -429,8 +545,9 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
 
     scene, model, cached = run_model(params, out_root, timer, scene, check=check)
     out = params.outputs
-    job = Publication(out_root, stages_folder_name(params, plan),
-                      {"params": identity(params), "plan": _plan_identity(plan)},
+    job = Publication(out_root, stages_folder_name(params, plan, laying),
+                      {"params": identity(params), "plan": _plan_identity(plan),
+                       "mortar": None if laying is None else laying.record()},
                       {"plots": out.plots, "quick": out.quick, "centering": True,
                        "adhesion": True},
                       force=force,
@@ -441,8 +558,8 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
     params = dataclasses.replace(params, outputs=dataclasses.replace(
         out, plots=job.outputs()["plots"], quick=job.outputs()["quick"]))
     with timer.stage("stages"):
-        rows = analyse_stages(model, params, plan)
-    record = stage_record(params, scene, model, plan, rows, cached, source)
+        rows = analyse_stages(model, params, plan, laying=laying)
+    record = stage_record(params, scene, model, plan, rows, cached, source, laying)
     record["stages"]["wall_s"] = timer.seconds["stages"]
     folder = job.publish(lambda folder: _write(folder, params, scene, plan, rows, record,
                                                timer))
@@ -456,11 +573,13 @@ def _plan_identity(plan) -> dict:
 
 
 def _identify(record) -> dict:
-    plan = record["plan"]
+    plan, mortar = record["plan"], record.get("mortar")
     return {"params": {name: value for name, value in record["params"].items()
                        if name not in FILE_OUTPUTS},
             "plan": {"stages": plan.get("stages"),
-                     **{k: plan.get(k) for k in ("by", "order", "course")}}}
+                     **{k: plan.get(k) for k in ("by", "order", "course")}},
+            "mortar": None if mortar is None else
+            {k: v for k, v in mortar.items() if k != "law"}}
 
 
 def _write(folder, params, scene, plan, rows, record, timer):

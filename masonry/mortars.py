@@ -1,0 +1,181 @@
+"""Mortars whose strength grows with age after laying (docs/model.md 6.13), and the rate
+at which a construction lays its bricks.
+
+A :class:`Mortar` is a table of the cohesion and the tensile strength (kPa) against the
+hours after laying, non-decreasing in both; between rows the strength is interpolated
+linearly in time, before the first row it is the first row's and after the last the
+last row's. :data:`MORTARS` holds the named ones (``lime``, ``gypsum``: indicative orders
+of magnitude with their sources in docs/model.md 6.13); :meth:`Mortar.constant` is one
+strength at every age.
+
+A :class:`Laying` turns a construction's stages into hours: a stage that lays ``n``
+bricks of the scene takes ``n / (rate x masons)`` hours, and a joint made at stage ``j``
+is, at the end of stage ``k``, as old as the stages ``j+1..k`` took
+(:func:`masonry.studies.stages.joint_strength`).
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from masonry.errors import MasonryError
+
+
+class MortarError(MasonryError, ValueError):
+    """A mortar's table out of order or with negative or non-finite values, an unknown
+    mortar or a laying rate that is not positive."""
+
+
+@dataclass(frozen=True)
+class Mortar:
+    """A mortar's strength against its age.
+
+    Parameters
+    ----------
+    name : str
+    hours : (R,) float
+        Hours after laying, increasing, from 0.
+    cohesion_kPa, tensile_kPa : (R,) float
+        The strengths at those ages, non-decreasing, >= 0.
+    source : str
+        Where the orders of magnitude come from (one line).
+    """
+
+    name: str
+    hours: tuple
+    cohesion_kPa: tuple
+    tensile_kPa: tuple
+    source: str = ""
+
+    @classmethod
+    def of_table(cls, name: str, rows, source: str = "") -> "Mortar":
+        """The mortar of ``rows`` ``(hours, cohesion kPa, tensile kPa)``, checked.
+
+        Raises
+        ------
+        MortarError
+            One line naming the mortar and the first row at fault.
+        """
+        rows = [tuple(row) for row in rows]
+        if not rows or any(len(row) != 3 for row in rows):
+            raise MortarError(f"mortar {name!r}: expected rows (hours, cohesion kPa, "
+                              f"tensile kPa), at least one")
+        for index, row in enumerate(rows):
+            if not all(isinstance(v, (int, float)) and not isinstance(v, bool)
+                       and math.isfinite(v) and v >= 0 for v in row):
+                raise MortarError(f"mortar {name!r}: row {index + 1} {row}: expected "
+                                  f"finite numbers >= 0")
+        if rows[0][0] != 0:
+            raise MortarError(f"mortar {name!r}: row 1 at {rows[0][0]:g} h: expected the "
+                              f"table to start at 0 h (the strength when laid)")
+        for index, (before, row) in enumerate(zip(rows, rows[1:]), start=2):
+            if row[0] <= before[0] or row[1] < before[1] or row[2] < before[2]:
+                raise MortarError(f"mortar {name!r}: row {index} {row} out of order: "
+                                  f"expected hours increasing and strengths not "
+                                  f"decreasing after row {index - 1} {before}")
+        hours, cohesion, tensile = (tuple(float(v) for v in column) for column in zip(*rows))
+        return cls(name, hours, cohesion, tensile, source)
+
+    @classmethod
+    def constant(cls, cohesion_kPa: float, tensile_kPa: float) -> "Mortar":
+        """One strength at every age (``--cohesion-kpa``, ``--tensile-kpa``)."""
+        return cls.of_table("constant", [(0.0, cohesion_kPa, tensile_kPa)],
+                            "the strengths given")
+
+    def strength_kPa(self, age_h) -> tuple:
+        """``(cohesion, tensile)``, kPa, each shaped as ``age_h`` (hours, >= 0): the table
+        interpolated linearly, held at its ends."""
+        age = np.asarray(age_h, dtype=float)
+        return (np.interp(age, self.hours, self.cohesion_kPa),
+                np.interp(age, self.hours, self.tensile_kPa))
+
+    def describe(self) -> str:
+        """One line: the name and the strengths at the table's ends."""
+        if len(self.hours) == 1:
+            return (f"{self.name} mortar: cohesion {self.cohesion_kPa[0]:g} kPa, tensile "
+                    f"strength {self.tensile_kPa[0]:g} kPa at every age")
+        return (f"{self.name} mortar: cohesion {self.cohesion_kPa[0]:g} kPa when laid to "
+                f"{self.cohesion_kPa[-1]:g} kPa at {_age(self.hours[-1])}, tensile strength "
+                f"{self.tensile_kPa[0]:g} to {self.tensile_kPa[-1]:g} kPa")
+
+    def record(self) -> dict:
+        return {"name": self.name, "table": [list(row) for row in zip(
+            self.hours, self.cohesion_kPa, self.tensile_kPa)], "source": self.source}
+
+
+def _age(hours: float) -> str:
+    return f"{hours / 24:g} days" if hours >= 48 else f"{hours:g} h"
+
+
+MORTARS = {
+    "lime": Mortar.of_table("lime", [
+        (0.0, 0.1, 0.05), (1.0, 0.2, 0.1), (4.0, 0.5, 0.25), (24.0, 2.0, 1.0),
+        (168.0, 20.0, 10.0), (672.0, 100.0, 50.0)],
+        "fresh tack 0.1-1 kPa (the yield stress of fresh mortar, Banfill 1991); hardened "
+        "initial shear strength 0.1 MPa at 28 days (EN 1996-1-1 Table 3.4, weakest "
+        "mortars); tension half of it; rows between: a smooth guess, not measured"),
+    "gypsum": Mortar.of_table("gypsum", [
+        (0.0, 0.1, 0.05), (0.05, 1.0, 0.5), (0.25, 20.0, 10.0), (1.0, 100.0, 50.0),
+        (24.0, 300.0, 150.0)],
+        "a fast-setting gypsum plaster, setting within minutes (EN 13279-1 initial "
+        "setting time; the tile vaults of Guastavino 1893, Ochsendorf 2010, laid "
+        "without centering on it); hardened bond 0.1-0.3 MPa as EN 1996-1-1's initial "
+        "shear strength; tension half of it; rows between: a smooth guess, not measured"),
+}
+"""The named mortars (docs/model.md 6.13): indicative orders of magnitude, not
+measurements; ``constant`` is :meth:`Mortar.constant` of the run's strengths."""
+
+MORTAR_NAMES = ("constant", *MORTARS)
+
+
+@dataclass(frozen=True)
+class Laying:
+    """A mortar and the rate a construction lays its bricks at.
+
+    Parameters
+    ----------
+    mortar : Mortar
+    rate_per_hour : float or None
+        Bricks per hour per mason, > 0; None for a mortar of one strength at every age.
+    masons : int
+        Masons laying side by side, >= 1: a stage of ``n`` bricks of the scene takes
+        ``n / (rate x masons)`` hours.
+    """
+
+    mortar: Mortar
+    rate_per_hour: float | None = None
+    masons: int = 1
+
+    @classmethod
+    def of(cls, mortar: Mortar, rate_per_hour=None, masons=1) -> "Laying":
+        """Checked: a mortar that ages needs a rate, > 0; ``masons`` an integer >= 1."""
+        if rate_per_hour is None and len(mortar.hours) > 1:
+            raise MortarError(f"mortar {mortar.name!r}: a laying rate (bricks per hour "
+                              f"per mason) is needed to age its joints")
+        if rate_per_hour is not None and not (math.isfinite(rate_per_hour)
+                                              and rate_per_hour > 0):
+            raise MortarError(f"laying rate {rate_per_hour!r}: expected bricks per hour "
+                              f"per mason, a finite number > 0")
+        if isinstance(masons, bool) or not isinstance(masons, int) or masons < 1:
+            raise MortarError(f"masons {masons!r}: expected an integer >= 1")
+        return cls(mortar, None if rate_per_hour is None else float(rate_per_hour), masons)
+
+    def stage_hours(self, bricks_laid) -> np.ndarray:
+        """(N+1,) float: the hours from the start to the end of stages ``0..N``, for the
+        bricks each stage ``1..N`` lays ((N,) int); zeros without a rate."""
+        laid = np.concatenate([[0.0], np.asarray(bricks_laid, dtype=float)])
+        if self.rate_per_hour is None:
+            return np.zeros(len(laid))
+        return np.cumsum(laid) / (self.rate_per_hour * self.masons)
+
+    def describe(self) -> str:
+        """One line, e.g. ``lime mortar at 60 bricks per hour (1 mason)``."""
+        if self.rate_per_hour is None:
+            return self.mortar.describe()
+        crew = "1 mason" if self.masons == 1 else f"{self.masons} masons"
+        return f"{self.mortar.name} mortar at {self.rate_per_hour:g} bricks per hour ({crew})"
+
+    def record(self) -> dict:
+        return {"mortar": self.mortar.record(), "rate_bricks_per_hour": self.rate_per_hour,
+                "masons": self.masons, "text": self.describe()}
