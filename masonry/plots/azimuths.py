@@ -4,16 +4,16 @@ the azimuths the search refined between its samples and the least it found marke
 import matplotlib.pyplot as plt
 import numpy as np
 
-from masonry.plots.common import png_bytes
+from masonry.plots.common import PNG, figure_files
 
 
-def azimuths_png(collapse, title="") -> bytes:
+def azimuths_png(collapse, title="", render=PNG) -> dict:
     """``collapse/azimuths.png``: the lateral load factor against the load's azimuth
     (``--lateral all``) on polar axes: the samples joined by a line, the azimuths
     solved between them by the refinement as dots, the least marked, the radius from a
     little below
     the smallest factor (the title says where); ``title`` is the line under the
-    figure's own."""
+    figure's own. Returns its files by format (of ``render``)."""
     angle = np.array([a for a, _ in collapse.azimuths])
     factor = np.array([np.nan if f is None else f for _, f in collapse.azimuths])
     order = np.argsort(angle)  # the line breaks where an azimuth has no factor
@@ -39,4 +39,4 @@ def azimuths_png(collapse, title="") -> bytes:
     ax.set_title(f"lateral load factor against the load's azimuth (from +x toward +y)\n"
                  f"{'' if start == 0 else f'the radius from {start:.3g}, not 0; '}"
                  f"{title}", fontsize=9, pad=20)
-    return png_bytes(fig, 110)
+    return figure_files(fig, 110, render)

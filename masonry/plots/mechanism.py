@@ -7,8 +7,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from masonry.plots.colours import colour_bar, colour_scale
-from masonry.plots.common import (ELEVATIONS, NO_FILL, add_points, add_polygons,
-                                  legend_below, png_bytes, view_axes, views_of)
+from masonry.plots.common import (ELEVATIONS, NO_FILL, PNG, add_points, add_polygons,
+                                  as_files, figure_files, legend_below, view_axes, views_of)
 from masonry.plots.faces import face_array, interface_array, padded
 from masonry.rbe.collapse_result import vertex_displacements
 from masonry.tolerances import MECHANISM_MAIN
@@ -80,7 +80,8 @@ def _joint_handles(collapse) -> list:
     return handles
 
 
-def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="") -> dict:
+def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="",
+                   render=PNG) -> dict:
     """The collapse mechanism (docs/model.md 6.9) drawn exaggerated over the undeformed
     structure, in the views of its extent (``collapse/<view>_mechanism.png``; one view
     when ``fast``; :func:`~masonry.plots.common.views_of`):
@@ -97,6 +98,8 @@ def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="")
         centroid, largest vertex displacement 1) and the joints that carry it.
     title, subtitle : str
         The figure's title and the line under it.
+    render : masonry.plots.common.Render
+        The formats of each figure's files.
     """
     undeformed, deformed, value, bounds = _mechanism_faces(
         blocks, np.asarray(collapse.mechanism))
@@ -122,5 +125,6 @@ def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="")
         legend_below(fig, ax, shown)
         ax.set_title(f"{title}; displacement drawn at {MECHANISM_SCALE:g} x size\n"
                      f"{subtitle}", fontsize=9)
-        out[f"collapse/{view}_mechanism.png"] = png_bytes(fig, 60 if fast else 110)
+        out.update(as_files(f"collapse/{view}_mechanism.png",
+                            figure_files(fig, 60 if fast else 110, render)))
     return out

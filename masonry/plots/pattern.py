@@ -7,14 +7,15 @@ from matplotlib.collections import PolyCollection
 from matplotlib.patches import Patch
 
 from masonry.blocks import BLOCK_CLASSES, PATTERN
-from masonry.plots.common import CLASS_COLOURS, legend_below, png_bytes
+from masonry.plots.common import CLASS_COLOURS, PNG, figure_files, legend_below
 
 
-def pattern_png(scene, fast=False, title="") -> bytes:
+def pattern_png(scene, fast=False, title="", render=PNG) -> dict:
     """The flattened section (thesis figures 3.8-3.9): position along the wall (units)
     against course, pattern, regular and fill-in bricks in distinct colours (the legend
     under the axes names the classes present), the web's half width at every course in
-    blue; ``title`` is the line under the figure's own."""
+    blue; ``title`` is the line under the figure's own. Returns its files
+    (:func:`~masonry.plots.common.figure_files`: format -> bytes, of ``render``)."""
     layout, levels, unit = scene.layout, scene.levels, scene.unit
     height = np.where(layout.klass == PATTERN, 2, 1)
     # mitered ends reach the web's boundary (at the course's lower, wider edge)
@@ -52,4 +53,4 @@ def pattern_png(scene, fast=False, title="") -> bytes:
     what = scene.kind.pattern_caption(scene.geometry)
     counts = f"{pattern} pattern" if pattern else "no pattern bricks"
     ax.set_title(f"{what}: {len(layout)} bricks ({counts})\n{title}", fontsize=9)
-    return png_bytes(fig, 80 if fast else 130)
+    return figure_files(fig, 80 if fast else 130, render)

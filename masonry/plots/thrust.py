@@ -6,7 +6,7 @@ blocks); a joint with no neighbour in its column is a point alone."""
 import matplotlib.pyplot as plt
 import numpy as np
 
-from masonry.plots.common import HORIZONTAL_KINDS, png_bytes
+from masonry.plots.common import HORIZONTAL_KINDS, PNG, figure_files
 
 HINGE_ECCENTRICITY = 0.99
 """A joint whose resultant lies at least this far out (eccentricity, 1 = on the edge) is
@@ -100,10 +100,12 @@ def _draw_points(ax, point, runs) -> int:
     return len(alone)
 
 
-def thrust_line_png(interfaces, resultants, section, fast=False, title=""):
+def thrust_line_png(interfaces, resultants, section, fast=False, title="", render=PNG):
     """The thrust line: the resultants' points of application on the bed joints that
     cross the structure's mid-plane (an arch's plane; a dome web's meridian section at
-    its centre line, y = 0), in x-z, hinges marked. None when no bed joint crosses it.
+    its centre line, y = 0), in x-z, hinges marked: its files by format
+    (:func:`~masonry.plots.common.figure_files` of ``render``). None when no bed joint
+    crosses it.
 
     Parameters
     ----------
@@ -147,4 +149,4 @@ def thrust_line_png(interfaces, resultants, section, fast=False, title=""):
     ax.set_title(f"thrust line under self-weight through {len(index)} bed joints at "
                  f"{section.name}{chained}: {_count(hinge.sum(), 'hinge')}, "
                  f"{int(outside.sum())} outside\n{title}", fontsize=9)
-    return png_bytes(fig, 80 if fast else 150)
+    return figure_files(fig, 80 if fast else 150, render)

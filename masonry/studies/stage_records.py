@@ -88,6 +88,7 @@ def stage_record(params, scene, model, plan: StagePlan, rows, cached, source) ->
         "scene": params.scene,
         "params": params.record(),
         "outputs": {"plots": params.outputs.plots, "quick": params.outputs.quick,
+                    "figure_format": params.outputs.figure_format, "dpi": params.outputs.dpi,
                     "centering": True},
         "plan": {**plan.record(), "described": _described(plan)},
         **model_record(scene, params.analysis.density),
