@@ -4,6 +4,7 @@ the azimuths the search refined between its samples and the least it found marke
 import matplotlib.pyplot as plt
 import numpy as np
 
+from masonry.plots.colours import EMPHASIS
 from masonry.plots.common import PNG, figure_files
 
 
@@ -26,7 +27,7 @@ def azimuths_png(collapse, title="", render=PNG) -> dict:
         ax.plot(np.radians([a for a, _ in refined]), [f for _, f in refined], ".",
                 color="0.4", markersize=3, label="refined between the samples")
     worst = np.radians(collapse.azimuth_deg)
-    ax.plot([worst], [collapse.load_factor], "o", color="#d62728", markersize=8,
+    ax.plot([worst], [collapse.load_factor], "o", color=EMPHASIS, markersize=8,
             label=f"least: {collapse.load_factor:.7g} at {collapse.azimuth_deg:.6g} deg")
     # the radius starts below the smallest factor: from 0, factors within a few per
     # cent of each other would look like a circle

@@ -19,6 +19,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from masonry.blocks import CLASS_COLOURS  # noqa: F401 (the figures' name for it)
 from masonry.interfaces import INTERFACE_KINDS
+from masonry.plots.colours import WEB_OUTLINE
 from masonry.plots.faces import AWAY, facing
 
 # the thesis's four views (section 3.4): a 3D view from an angle (elevation, azimuth in
@@ -322,13 +323,13 @@ def add_points(ax, view, points, **style):
 
 def draw_outline(ax, view, scene):
     """The web's boundaries (its level table's half widths, both sides) and its base line
-    in blue; nothing for a scene without a level table, nor for a whole dome (one web's
-    outline would mark one web of many)."""
+    dashed (:data:`~masonry.plots.colours.WEB_OUTLINE`); nothing for a scene without a
+    level table, nor for a whole dome (one web's outline would mark one web of many)."""
     levels = scene.levels
     if levels is None or scene.dims is None or not scene.symmetry.unit:
         return
     for sign in (-1, 1):
         add_line(ax, view, np.column_stack([levels.x, sign * levels.y, levels.z]),
-                 color="b", linewidth=1)
+                 color=WEB_OUTLINE, linestyle="--", linewidth=1)
     add_line(ax, view, [[levels.x[0], -levels.y[0], 0.0], [levels.x[0], levels.y[0], 0.0]],
-             color="b", linewidth=1)
+             color=WEB_OUTLINE, linestyle="--", linewidth=1)

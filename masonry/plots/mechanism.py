@@ -6,7 +6,7 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from masonry.plots.colours import colour_bar, colour_scale
+from masonry.plots.colours import HINGE, SLIDING, colour_bar, colour_scale
 from masonry.plots.common import (ELEVATIONS, NO_FILL, PNG, add_points, add_polygons,
                                   as_files, figure_files, legend_below, view_axes, views_of)
 from masonry.plots.faces import face_array, interface_array, padded
@@ -70,11 +70,11 @@ def _joint_handles(collapse) -> list:
     share = f"\u2265 {MECHANISM_MAIN:.0%} of the largest"
     handles = [Patch(facecolor="none", edgecolor="0.6", label="undeformed")]
     if collapse.hinges:
-        handles.append(Patch(facecolor="red", edgecolor="red",
+        handles.append(Patch(facecolor=HINGE, edgecolor=HINGE,
                              label=f"hinges opening {share}: {collapse.main_hinges} of "
                                    f"{collapse.hinges}"))
     if collapse.sliding:
-        handles.append(Patch(facecolor="none", edgecolor="blue",
+        handles.append(Patch(facecolor="none", edgecolor=SLIDING,
                              label=f"sliding {share}: {collapse.main_sliding} of "
                                    f"{collapse.sliding}"))
     return handles
@@ -87,7 +87,8 @@ def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="",
     when ``fast``; :func:`~masonry.plots.common.views_of`):
     displaced blocks coloured by their largest vertex displacement, the undeformed ones as
     grey outlines, the hinges and sliding joints that carry the mechanism
-    (:data:`~masonry.tolerances.MECHANISM_MAIN`) filled red and outlined blue, at their
+    (:data:`~masonry.tolerances.MECHANISM_MAIN`) filled (:data:`~masonry.plots.colours.HINGE`) and outlined
+    (:data:`~masonry.plots.colours.SLIDING`), at their
     undeformed places (seen through the blocks).
 
     Parameters
@@ -107,8 +108,8 @@ def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="",
     colours = scale["cmap"](scale["norm"](value))
     handles = _joint_handles(collapse)
     joints = [(interface_array(interfaces, np.flatnonzero(mask)), face, edge, width)
-              for mask, face, edge, width in ((collapse.main_slides, NO_FILL, "blue", 0.6),
-                                              (collapse.main_hinge, "red", "red", 0.8))
+              for mask, face, edge, width in ((collapse.main_slides, NO_FILL, SLIDING, 0.8),
+                                              (collapse.main_hinge, HINGE, HINGE, 0.8))
               if mask.any()]
     out = {}
     for view in views_of(bounds, fast):

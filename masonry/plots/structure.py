@@ -87,7 +87,7 @@ def structure_pngs(scene, fast=False, title="", webs=None, interfaces=None,
             legend = legend_below(fig, ax, handles)
             count = int((mask & ~blocks.block_is_support).sum())
             shown = (f"{count} {scene.kind.block_word}" if mask.any()
-                     else "the web's outline (blue), before any brick is laid")
+                     else "the web's outline (dashed), before any brick is laid")
             ax.set_title(f"{stage[2:]}: {shown}\n{title}", fontsize=9)
             out.update(as_files(f"{view}/{stage}.png", figure_files(
                 fig, 60 if fast else 110, render, close=False)))
