@@ -5,7 +5,7 @@ import math
 import shlex
 
 from masonry.errors import ParameterError
-from masonry.outputs import Outputs
+from masonry.outputs import DPI_RANGE, FIGURE_FORMATS, Outputs
 from masonry.parameters import declarations, defaults, read_toml
 from masonry.params import (PRESETS, Params, applies, from_preset, load, names,
                             section_default, validate)
@@ -318,12 +318,27 @@ def add_output_options(parser):
                    help="skip the printable body (dome.stl, dome.obj)")
     g.add_argument("--no-html", dest="html", action="store_false", default=None,
                    help="skip dome.html (the bricks in 3D, for a browser)")
+    add_figure_options(g)
     g.add_argument("--print-size", dest="print_size", type=float, metavar="MM",
                    help=f"also write dome.3mf for a slicer, in millimetres, its largest "
                         f"dimension MM ({_range('print_size')}; default: no 3MF)")
     g.add_argument("--force", action="store_true",
                    help="recompute even if the run folder holds this input's results")
     add_verbosity(g)
+
+
+def add_figure_options(group):
+    """``--figure-format`` and ``--dpi``: the files every figure is written as."""
+    group.add_argument("--figure-format", dest="figure_format", action="append",
+                       metavar="|".join(FIGURE_FORMATS),
+                       help="the files of every figure: png (raster), svg or pdf (vector, "
+                            "text as text, for a paper); several separated by commas or "
+                            "the option repeated (default png)")
+    group.add_argument("--dpi", type=int, metavar="N",
+                       help=f"dots per inch of the PNG figures, {DPI_RANGE[0]} to "
+                            f"{DPI_RANGE[1]} (default: each figure's own, 110 for most, "
+                            f"130 to 150 for the pattern, the whole dome and the thrust "
+                            f"line; lower with --fast)")
 
 
 def add_verbosity(parser):

@@ -3,8 +3,9 @@
 from masonry.errors import ParameterError
 from masonry.params import Params, validate
 
-from .options import (add_analysis_options, add_model_options, add_verbosity,
-                      centering_line, given_inputs, params_from_args, pattern_note)
+from .options import (add_analysis_options, add_figure_options, add_model_options,
+                      add_verbosity, centering_line, given_inputs, params_from_args,
+                      pattern_note)
 
 
 NAME = "stages"
@@ -68,6 +69,7 @@ def register(subparsers):
     g.add_argument("--out", default="exports", metavar="DIR",
                    help="output root; the run folder is DIR/<structure id>_stages_<plan>")
     g.add_argument("--no-plots", dest="plots", action="store_false", help="skip all plots")
+    add_figure_options(g)
     g.add_argument("--force", action="store_true",
                    help="recompute even if the run folder holds this input's results")
     add_verbosity(g)

@@ -9,7 +9,8 @@ from pathlib import Path
 
 from masonry.errors import ParameterError
 from masonry.optional import optional_import
-from masonry.parameters import read_toml
+from masonry.outputs import Outputs, figure_formats
+from masonry.parameters import declarations, read_toml
 from masonry.params import PRESETS, Params, names, validate
 from masonry.runfolder import check_output_root, check_study_folder
 
@@ -94,7 +95,7 @@ def run_option_names() -> dict:
     parser = Parser(prog="masonry")
     run_command.register(parser.add_subparsers())
     run_parser = parser._subparsers._group_actions[0].choices["run"]
-    inputs = {"scene", "fast", "dome", *names()}
+    inputs = {"scene", "fast", "dome", *names()} - {*FIGURE_OUTPUTS}
     found = {}
     for action in run_parser._actions:
         is_input = action.dest in inputs and action.const is not False
@@ -112,6 +113,10 @@ NOT_AN_INPUT = {
                  "table (printable = false)",
     "html": "an input of each variant: dome.html is chosen in the [outputs] table "
             "(html = false)",
+    "figure_format": "an input of each variant: the figures' formats are chosen in the "
+                     "[outputs] table (figure_format = [\"png\", \"pdf\"])",
+    "dpi": "an input of each variant: the figures' resolution is chosen in the [outputs] "
+           "table (dpi = 300)",
     "out": "an input of each variant: the study's output root is masonry sweep's --out",
     "preset": "an input of [base] (preset = 3), not of another table",
     "params": "an input of each variant: a study names the inputs themselves",
@@ -184,7 +189,8 @@ def load_study(path, draws=True):
         grid=_fields(grid, "grid", names, where, lists=True),
         sample=_fields(sample, "sample", names, where), count=count, seed=seed,
         plots=outputs.get("plots", False), printable=outputs.get("printable", False),
-        html=outputs.get("html", False), constraints=constraints, **stages)
+        html=outputs.get("html", False), constraints=constraints, **stages,
+        **_figure_outputs(outputs, refuse))
     study = _checked_constraints(study, where)
     _check_variants(study, where, None if draws else _search_probes(study))
     return study
@@ -241,6 +247,25 @@ def _stage_plans() -> dict:
     return {"course": (), "brick": BRICK_ORDERS, "block": BLOCK_ORDERS}
 
 
+FIGURE_OUTPUTS = ("figure_format", "dpi")
+"""The ``[outputs]`` keys of the figures' files, checked by their declarations
+(:class:`masonry.outputs.Outputs`)."""
+
+
+def _figure_outputs(outputs, refuse) -> dict:
+    """``[outputs] figure_format`` (a name or a list of names) and ``dpi``, checked as
+    ``masonry run`` checks its options; returns :class:`Study`'s fields they give."""
+    given = {}
+    for key in FIGURE_OUTPUTS:
+        if key in outputs:
+            value = figure_formats(outputs[key]) if key == "figure_format" else outputs[key]
+            error = declarations(Outputs)[key].refusal(key, value)
+            if error is not None:
+                refuse(f"outputs.{key}", outputs[key], error.expected)
+            given[key] = value
+    return given
+
+
 def _stage_outputs(outputs, refuse) -> dict:
     """The ``[outputs]`` table checked: ``plots``, ``printable``, ``html`` (true or
     false) and a stage study's ``stages`` (``course``, ``brick`` or ``block``),
@@ -250,9 +275,9 @@ def _stage_outputs(outputs, refuse) -> dict:
         if key in ("plots", "printable", "html"):
             if not isinstance(value, bool):
                 refuse(f"outputs.{key}", value, "true or false")
-        elif key not in ("stages", "stages_course", "stages_order"):
-            refuse(f"outputs.{key}", value, "plots, printable, html, stages, "
-                                            "stages_course or stages_order")
+        elif key not in ("stages", "stages_course", "stages_order", *FIGURE_OUTPUTS):
+            refuse(f"outputs.{key}", value, "plots, printable, html, figure_format, dpi, "
+                                            "stages, stages_course or stages_order")
     by, course = outputs.get("stages"), outputs.get("stages_course")
     order = outputs.get("stages_order")
     if by is None:

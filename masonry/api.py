@@ -221,7 +221,8 @@ class Structure:
             The output root.
         **outputs
             What to write (docs/model.md 7): ``plots``, ``quick``, ``printable``,
-            ``print_size``, ``html``, ``cad_offset``.
+            ``print_size``, ``figure_format`` (``"png,pdf"`` or ``["png", "svg"]``),
+            ``dpi``, ``html``, ``cad_offset``.
 
         Returns
         -------
@@ -231,8 +232,8 @@ class Structure:
         unknown = set(outputs) - {n for n, part in names().items() if part == "outputs"}
         if unknown:
             name = sorted(unknown)[0]
-            raise ParameterError(name, outputs[name], "an output option: plots, quick, "
-                                 "printable, print_size, html or cad_offset")
+            raise ParameterError(name, outputs[name], "an output option: " + ", ".join(
+                n for n, part in names().items() if part == "outputs"))
         params = validate(self.params.replace(**outputs))
         return run(params, out, scene=self.scene, source=self.source)
 

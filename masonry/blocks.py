@@ -25,11 +25,13 @@ BLOCK_CLASSES = ("ground", "regular", "pattern", "fill_in", "block")
 CLASS_COLOURS = {
     "ground": "#9e9e9e",
     "regular": "#e8d5b0",
-    "pattern": "#d62728",
-    "fill_in": "#f2a541",
+    "pattern": "#0072b2",
+    "fill_in": "#e69f00",
     "block": "#c9b79c",
 }
-"""The colour of each block class in the figures and ``dome.html``."""
+"""The colour of each block class in the figures and ``dome.html`` (Okabe and Ito's
+colour-blind safe blue and orange for the pattern and fill-in bricks); no other concept of
+a figure takes these (:mod:`masonry.plots.colours`, docs/outputs.md)."""
 
 GROUND = BLOCK_CLASSES.index("ground")
 """``block_class`` code of a ground slab or support block."""

@@ -5,6 +5,31 @@ from dataclasses import dataclass
 
 from masonry.parameters import check_fields, declare
 
+FIGURE_FORMATS = ("png", "svg", "pdf")
+"""The files a figure can be written as: a raster PNG, or vector SVG and PDF (matplotlib's
+own backends) for a paper."""
+
+DPI_RANGE = (50, 600)
+"""Resolutions a raster figure may ask for: below 50 dpi a figure's labels do not read,
+600 dpi is what a printer prints (a 7 inch figure 4,200 pixels wide)."""
+
+
+def figure_formats(value):
+    """``value`` as a tuple of format names, in the order given, each once: a text
+    ``"png,pdf"`` or a list of names; anything else as it is (for the check to refuse)."""
+    if isinstance(value, str):
+        value = [value]
+    if isinstance(value, (list, tuple)) and all(isinstance(v, str) for v in value):
+        # several given (a repeated option), each perhaps of several
+        return tuple(dict.fromkeys(name.strip().lower() for v in value
+                                   for name in v.split(",")))
+    return value
+
+
+def _are_formats(value) -> bool:
+    return (isinstance(value, tuple) and len(value) > 0
+            and all(v in FIGURE_FORMATS for v in value))
+
 
 @dataclass(frozen=True)
 class Outputs:
@@ -12,7 +37,9 @@ class Outputs:
 
     ``plots`` the figures; ``quick`` draws them in one view at lower resolution;
     ``printable`` the printable body (``dome.stl``, ``dome.obj``); ``print_size`` also
-    writes it as ``dome.3mf`` of that size in millimetres; ``html`` the page
+    writes it as ``dome.3mf`` of that size in millimetres; ``figure_format`` the files each figure is
+    written as (:data:`FIGURE_FORMATS`); ``dpi`` a raster figure's resolution (None: each
+    figure's own, 110 dots per inch for most); ``html`` the page
     ``dome.html`` (the bricks in 3D in a browser); ``cad_offset`` moves every brick of the
     CAD files inward by that many units (thesis 3.4.1).
     """
@@ -24,9 +51,20 @@ class Outputs:
         None, "mm, largest dimension of dome.3mf (None: no 3MF)", low=1.0, high=1e4,
         optional=True, expected="1 to 10000 (millimetres, the largest dimension of "
                                 "dome.3mf: printers' beds are 100 to 1000 mm)")
+    figure_format: tuple = declare(
+        ("png",), "the files each figure is written as", kind="any", check=_are_formats,
+        expected=f"one or more of {', '.join(FIGURE_FORMATS)}, separated by commas")
+    dpi: int | None = declare(
+        None, "dots per inch of a PNG figure (None: each figure's own)", kind="int",
+        low=DPI_RANGE[0], high=DPI_RANGE[1], optional=True,
+        expected=f"an integer {DPI_RANGE[0]} to {DPI_RANGE[1]} (dots per inch)")
     html: bool = declare(True, "write dome.html, the bricks in 3D in a browser", kind="bool")
     cad_offset: float = declare(1.0, "units the CAD files move each brick inward", low=0.0,
                                 high=4.0, expected="0 to 4 (units)", tag="cad")
+
+    def __post_init__(self):
+        # "png,pdf" (a command line, the API) or ["png", "pdf"] (TOML) alike
+        object.__setattr__(self, "figure_format", figure_formats(self.figure_format))
 
     def checked(self) -> "Outputs":
         """These outputs validated; raises :class:`~masonry.errors.ParameterError`."""

@@ -465,7 +465,8 @@ def run_record(params: Params, scene: Scene, model: Model, outputs: dict, cached
         "scene": params.scene,
         "params": params.record(),
         "outputs": {name: outputs[name] for name in ("analyse", "centering", "adhesion",
-                                                     *WRITTEN_OUTPUTS, "quick")},
+                                                     *WRITTEN_OUTPUTS, "quick",
+                                                     "figure_format", "dpi")},
         **model_record(scene, params.analysis.density),
         "coordinates": coordinates_record(scene, params.outputs.cad_offset),
         "cache": {"geometry": cached},
@@ -658,4 +659,9 @@ def _merge(record: dict, key: str, part: dict):
     under one key)."""
     held = record.setdefault(key, {})
     for name, value in part.items():
-        held[name] = {**held[name], **value} if isinstance(held.get(name), dict) else value
+        if isinstance(held.get(name), dict):
+            held[name] = {**held[name], **value}
+        elif isinstance(held.get(name), list):  # the figures' files: sorted, all of them
+            held[name] = sorted(held[name] + value)
+        else:
+            held[name] = value

@@ -395,8 +395,10 @@ class Publication:
     wanted : dict
         The outputs asked for, as ``run.json`` records them under ``outputs``: names ->
         True/False (``plots``, ``printable``, ...), ``quick`` (figures in one view: they do
-        not stand for the full ones), and ``print_size`` (mm of ``dome.3mf`` or None: a
-        3MF of another size is not the one asked for).
+        not stand for the full ones), ``print_size`` (mm of ``dome.3mf`` or None: a
+        3MF of another size is not the one asked for), ``figure_format`` (the figures'
+        formats: a folder without one of them does not hold what is asked) and ``dpi``
+        (figures at another resolution are not the ones asked for).
     force : bool
         Recompute even when the folder holds what is asked for (it still only grows).
     identify : callable, optional
@@ -430,6 +432,10 @@ class Publication:
         grown = {name: (value or had.get(name) is True) if isinstance(value, bool) else value
                  for name, value in self.wanted.items() if name not in ("quick",
                                                                         "print_size")}
+        if "figure_format" in self.wanted:  # the figures in every format asked or held
+            held = figure_formats_of(had) if had.get("plots") is True else ()
+            grown["figure_format"] = tuple(dict.fromkeys((*self.wanted["figure_format"],
+                                                          *held)))
         full_plots = had.get("plots") is True and had.get("quick") is not True
         grown["quick"] = bool(self.wanted.get("quick")) and not full_plots
         size = self.wanted.get("print_size")
@@ -471,12 +477,24 @@ def covers(record: dict, wanted: dict) -> bool:
         if name == "quick":
             if not value and had.get("plots") is True and had.get("quick") is True:
                 return False
+        elif name == "figure_format":
+            if wanted.get("plots") and not set(value) <= set(figure_formats_of(had)):
+                return False
+        elif name == "dpi":  # figures at another resolution are not the ones asked
+            if wanted.get("plots") and had.get("plots") is True and had.get("dpi") != value:
+                return False
         elif name == "print_size":
             if value is not None and wanted.get("printable") and printed_size(record) != value:
                 return False
         elif value is True and had.get(name) is not True:
             return False
     return True
+
+
+def figure_formats_of(outputs: dict) -> tuple:
+    """The formats of the figures a record's ``outputs`` wrote (PNG before there were
+    others)."""
+    return tuple(outputs.get("figure_format") or ("png",)) if outputs.get("plots") else ()
 
 
 def printed_size(record) -> float | None:

@@ -36,7 +36,7 @@ def figures(monkeypatch):
     colours of each polygon collection)."""
     kept = []
 
-    def keep(fig, dpi, close=True):
+    def keep(fig, dpi, render=None, close=True):
         fig.canvas.draw()
         ax = fig.axes[0]
         polygons = [c for c in ax.collections if isinstance(c, PolyCollection)]
@@ -47,10 +47,10 @@ def figures(monkeypatch):
             data=None if extent is None else extent.transformed(ax.transData.inverted()),
             is_3d=hasattr(ax, "get_zlim"),
             colours=[c.get_facecolor().copy() for c in polygons]))
-        return b"\x89PNG kept"
+        return {"png": b"\x89PNG kept"}
 
     for module in (structure, mechanism, stages, azimuths, force_figures, pattern):
-        monkeypatch.setattr(module, "png_bytes", keep)
+        monkeypatch.setattr(module, "figure_files", keep)
     yield kept
     plt.close("all")
 

@@ -144,7 +144,7 @@ def test_the_azimuth_search_is_drawn_on_polar_axes():
     params = validate(Params.of(scene="dome", **SMALL_DOME))
     worst = worst_lateral(build_model(params)[1], n_webs=6, period_deg=60.0)
     assert len(worst.azimuths) >= 24
-    assert azimuths_png(worst).startswith(b"\x89PNG")
+    assert azimuths_png(worst)["png"].startswith(b"\x89PNG")
 
 
 

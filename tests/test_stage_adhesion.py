@@ -145,12 +145,12 @@ def drawn(monkeypatch):
     """The axes of the figures :func:`stage_adhesion_png` draws, drawn, not saved."""
     kept = []
 
-    def keep(fig, dpi, close=True):
+    def keep(fig, dpi, render=None, close=True):
         fig.canvas.draw()
         kept.append(fig)
-        return b"\x89PNG kept"
+        return {"png": b"\x89PNG kept"}
 
-    monkeypatch.setattr(stage_figures, "png_bytes", keep)
+    monkeypatch.setattr(stage_figures, "figure_files", keep)
     return kept
 
 

@@ -335,19 +335,22 @@ def _mechanism_plots(made: RunOutputs) -> dict:
     title = (f"collapse mechanism: lambda = {collapse.load_factor:.4g}, "
              f"{collapse.live.description['kind']} load"
              + ("" if collapse.azimuth_deg is None else f" at {collapse.azimuth_deg:g} deg"))
+    render = plots.Render.of(made.outputs)
     files = plots.mechanism_pngs(model.blocks, model.interfaces, collapse, title,
-                                 made.outputs.quick, made.figure_title)
+                                 made.outputs.quick, made.figure_title, render)
     if collapse.azimuths:
-        files["collapse/azimuths.png"] = plots.azimuths_png(collapse, made.figure_title)
+        files.update(plots.as_files("collapse/azimuths.png", plots.azimuths_png(
+            collapse, made.figure_title, render)))
     return files
 
 
-def _figures(pngs: dict) -> Export:
-    """The figures of ``pngs`` (path -> PNG bytes, or the reason (str) a figure was left
-    out); run.json's ``figures.skipped`` names those left out and why."""
-    files = {path: png for path, png in pngs.items() if not isinstance(png, str)}
-    skipped = {path: why for path, why in pngs.items() if isinstance(why, str)}
-    return Export(files, {"skipped": skipped} if skipped else None)
+def _figures(drawn: dict) -> Export:
+    """The figures of ``drawn`` (path -> bytes, or the reason (str) a figure was left out,
+    under its PNG's path); run.json's ``figures.files`` lists the files written,
+    ``figures.skipped`` names those left out and why."""
+    files = {path: data for path, data in drawn.items() if not isinstance(data, str)}
+    skipped = {path: why for path, why in drawn.items() if isinstance(why, str)}
+    return Export(files, {"files": sorted(files)} | ({"skipped": skipped} if skipped else {}))
 
 
 def _structure_plot_files(made: RunOutputs) -> Export:
@@ -356,10 +359,13 @@ def _structure_plot_files(made: RunOutputs) -> Export:
     from masonry import plots
 
     scene, model, fast, title = made.scene, made.model, made.outputs.quick, made.figure_title
+    render = plots.Render.of(made.outputs)
     files = {}
     if scene.layout is not None:
-        files["00_pattern.png"] = plots.pattern_png(scene, fast, title)
-    files.update(plots.structure_pngs(scene, fast, title, made.webs, model.interfaces))
+        files.update(plots.as_files("00_pattern.png", plots.pattern_png(scene, fast, title,
+                                                                        render)))
+    files.update(plots.structure_pngs(scene, fast, title, made.webs, model.interfaces,
+                                      render))
     return _figures(files)
 
 
@@ -368,7 +374,8 @@ def _interface_plot_files(made: RunOutputs) -> Export:
     from masonry import plots
 
     files = plots.interface_pngs(made.model.blocks, made.model.interfaces,
-                                 made.outputs.quick, made.figure_title)
+                                 made.outputs.quick, made.figure_title,
+                                 plots.Render.of(made.outputs))
     files.update(_mechanism_plots(made))
     return _figures(files)
 
@@ -378,19 +385,21 @@ def _force_plot_files(made: RunOutputs) -> Export:
     from masonry import plots
 
     scene, model, fast, title = made.scene, made.model, made.outputs.quick, made.figure_title
-    pngs = plots.force_pngs(model.blocks, model.interfaces, made.forces, fast, title,
-                            made.webs, noise=TENSION_REPORTED_REL * made.result.weight_N)
-    files = {f"RBE/{name}": png for name, png in pngs.items()}
+    render = plots.Render.of(made.outputs)
+    drawn = plots.force_pngs(model.blocks, model.interfaces, made.forces, fast, title,
+                             made.webs, noise=TENSION_REPORTED_REL * made.result.weight_N,
+                             render=render)
+    files = {f"RBE/{name}": data for name, data in drawn.items()}
     section = scene.kind.thrust_section(scene)
     if section is not None:
-        png = plots.thrust_line_png(model.interfaces, _resultants(made), section, fast,
-                                    title)
-        if png is not None:
-            files["RBE/thrust_line.png"] = png
+        thrust = plots.thrust_line_png(model.interfaces, _resultants(made), section, fast,
+                                       title, render)
+        if thrust is not None:
+            files.update(plots.as_files("RBE/thrust_line.png", thrust))
     top = csv.tension_top(made.forces, made.result.weight_N)
     if len(top):
-        files["RBE/where_it_fails.png"] = plots.failure_png(
-            model.blocks, model.interfaces, top, made.forces, fast, title)
+        files.update(plots.as_files("RBE/where_it_fails.png", plots.failure_png(
+            model.blocks, model.interfaces, top, made.forces, fast, title, render)))
     return _figures(files)
 
 

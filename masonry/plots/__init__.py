@@ -7,8 +7,9 @@ construction stages (:mod:`.stages`), and an optimisation's convergence
 (:mod:`.convergence`). They share the views, the drawing helpers
 (:mod:`.common`) and the colour scales (:mod:`.colours`).
 
-Every function returns PNG bytes or ``{relative path: png bytes}`` so the run folder
-writer is the one place that touches the disk.
+Every function returns a figure's files (``{format: bytes}``, :func:`.common.figure_files`)
+or ``{relative path: bytes}`` of several, in the formats a :class:`.common.Render` asks
+(PNG, SVG, PDF), so the run folder writer is the one place that touches the disk.
 """
 
 import os
@@ -32,7 +33,8 @@ from masonry.plots.azimuths import azimuths_png  # noqa: E402
 from masonry.plots.colours import (  # noqa: E402
     BAR_3D, COLOUR_PERCENTILE, DIVERGING, ONE_SIDED, SEQUENTIAL, colour_scale, force_unit)
 from masonry.plots.common import (  # noqa: E402
-    ANGLE, CLASS_COLOURS, ELEVATIONS, HORIZONTAL_KINDS, NO_FILL, VIEWS)
+    ANGLE, CLASS_COLOURS, ELEVATIONS, HORIZONTAL_KINDS, NO_FILL, PNG, VIEWS, Render, as_files,
+    figure_files)
 from masonry.plots.convergence import convergence_png  # noqa: E402
 from masonry.plots.failure import RANKED, failure_png  # noqa: E402
 from masonry.plots.forces import (  # noqa: E402
@@ -48,8 +50,9 @@ from masonry.plots.thrust import HINGE_ECCENTRICITY, thrust_line_png  # noqa: E4
 __all__ = [
     "ANGLE", "BAR_3D", "CLASS_COLOURS", "COLOUR_PERCENTILE", "DIVERGING", "ELEVATIONS",
     "FORCE_LABELS", "FORCE_PLOTS", "FRESH_MORTAR_KPA", "HINGE_ECCENTRICITY",
-    "HORIZONTAL_KINDS", "MARK_DECADES", "MECHANISM_SCALE", "NO_FILL", "ONE_SIDED", "OUTLINE_COLOUR", "RANKED", "SEQUENTIAL",
-    "VIEWS", "azimuths_png", "colour_scale", "convergence_png", "failure_png", "force_pngs",
+    "HORIZONTAL_KINDS", "MARK_DECADES", "MECHANISM_SCALE", "NO_FILL", "ONE_SIDED",
+    "OUTLINE_COLOUR", "PNG", "RANKED", "Render", "SEQUENTIAL", "VIEWS", "as_files",
+    "azimuths_png", "figure_files", "colour_scale", "convergence_png", "failure_png", "force_pngs",
     "force_unit", "interface_pngs", "marked_structure_pngs", "mechanism_pngs", "pattern_png",
     "stage_adhesion_png", "stage_chart_png", "structure_pngs", "thrust_line_png",
 ]

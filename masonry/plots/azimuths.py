@@ -4,16 +4,17 @@ the azimuths the search refined between its samples and the least it found marke
 import matplotlib.pyplot as plt
 import numpy as np
 
-from masonry.plots.common import png_bytes
+from masonry.plots.colours import EMPHASIS
+from masonry.plots.common import PNG, figure_files
 
 
-def azimuths_png(collapse, title="") -> bytes:
+def azimuths_png(collapse, title="", render=PNG) -> dict:
     """``collapse/azimuths.png``: the lateral load factor against the load's azimuth
     (``--lateral all``) on polar axes: the samples joined by a line, the azimuths
     solved between them by the refinement as dots, the least marked, the radius from a
     little below
     the smallest factor (the title says where); ``title`` is the line under the
-    figure's own."""
+    figure's own. Returns its files by format (of ``render``)."""
     angle = np.array([a for a, _ in collapse.azimuths])
     factor = np.array([np.nan if f is None else f for _, f in collapse.azimuths])
     order = np.argsort(angle)  # the line breaks where an azimuth has no factor
@@ -26,7 +27,7 @@ def azimuths_png(collapse, title="") -> bytes:
         ax.plot(np.radians([a for a, _ in refined]), [f for _, f in refined], ".",
                 color="0.4", markersize=3, label="refined between the samples")
     worst = np.radians(collapse.azimuth_deg)
-    ax.plot([worst], [collapse.load_factor], "o", color="#d62728", markersize=8,
+    ax.plot([worst], [collapse.load_factor], "o", color=EMPHASIS, markersize=8,
             label=f"least: {collapse.load_factor:.7g} at {collapse.azimuth_deg:.6g} deg")
     # the radius starts below the smallest factor: from 0, factors within a few per
     # cent of each other would look like a circle
@@ -39,4 +40,4 @@ def azimuths_png(collapse, title="") -> bytes:
     ax.set_title(f"lateral load factor against the load's azimuth (from +x toward +y)\n"
                  f"{'' if start == 0 else f'the radius from {start:.3g}, not 0; '}"
                  f"{title}", fontsize=9, pad=20)
-    return png_bytes(fig, 110)
+    return figure_files(fig, 110, render)

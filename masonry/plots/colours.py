@@ -11,6 +11,31 @@ import matplotlib
 import numpy as np
 from mpl_toolkits.axes_grid1 import make_axes_locatable
 
+STANDS = "#009e73"
+"""A stage (or structure) that stands: bluish green."""
+NEEDS_SUPPORT = "#d55e00"
+"""A stage that needs support (or adhesion): vermillion."""
+LOOSE = "#000000"
+"""A stage with a block that touches nothing that holds it: black crosses."""
+HINGE = "#cc79a7"
+"""A hinge (a joint whose resultant reaches its edge), in the mechanism and the thrust
+line alike: reddish purple."""
+SLIDING = "#56b4e9"
+"""A sliding joint of a mechanism: sky blue outlines."""
+TENSION = "#b2182b"
+"""Tension: the red end of the signed map (:data:`DIVERGING`), and a thrust line's point
+outside its joint (it needs tension)."""
+WEB_OUTLINE = "#000000"
+"""A web's boundary (its level table's half widths), dashed."""
+THRUST = "#000000"
+"""The thrust line."""
+EMPHASIS = "#000000"
+"""A value the figure points at (the least load factor of the azimuths, the load factor
+of the stages)."""
+# Each concept has one colour in every figure; the block classes' are
+# masonry.blocks.CLASS_COLOURS, compression and friction the signed map's blue end and
+# the magnitude map (viridis): docs/outputs.md lists them.
+
 BAR_3D = dict(shrink=0.6, pad=0.16, anchor=(0.0, 0.4))
 """A colour bar beside a 3D box (which sits inside its axes) of a 7 inch tall figure:
 shorter, a little low (clear of the title), and far enough out to clear the z axis's

@@ -1,6 +1,6 @@
 """What every figure shares: the block class colours (:data:`masonry.blocks.CLASS_COLOURS`),
 the four views and their axes, polygons, lines and markers drawn in any view, titles, and
-the PNG bytes a figure becomes.
+the files a figure becomes (PNG, SVG, PDF: :class:`Render`).
 
 A view is 3D (``01_angle``, from :data:`ANGLE`) or an elevation (:data:`ELEVATIONS`),
 drawn as a 2D projection at equal scale; the drawing helpers take the view's name and
@@ -8,6 +8,7 @@ draw in either.
 """
 
 import io
+from dataclasses import dataclass
 
 import matplotlib
 import matplotlib.pyplot as plt
@@ -18,6 +19,7 @@ from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
 from masonry.blocks import CLASS_COLOURS  # noqa: F401 (the figures' name for it)
 from masonry.interfaces import INTERFACE_KINDS
+from masonry.plots.colours import WEB_OUTLINE
 from masonry.plots.faces import AWAY, facing
 
 # the thesis's four views (section 3.4): a 3D view from an angle (elevation, azimuth in
@@ -42,6 +44,62 @@ PAD_INCHES = 0.1
 
 LEGEND_GAP_INCHES = 0.05
 """Space between a legend below the axes (:func:`legend_below`) and their labels."""
+
+
+@dataclass(frozen=True)
+class Render:
+    """How a figure is saved: the formats of its files (of
+    :data:`~masonry.outputs.FIGURE_FORMATS`) and a PNG's dots per inch (None: each
+    figure's own)."""
+
+    formats: tuple = ("png",)
+    dpi: int | None = None
+
+    @classmethod
+    def of(cls, outputs) -> "Render":
+        """The render a run's :class:`~masonry.outputs.Outputs` ask for."""
+        return cls(tuple(outputs.figure_format), outputs.dpi)
+
+
+PNG = Render()
+"""A PNG at each figure's own resolution."""
+
+VECTOR_STYLE = {"svg.fonttype": "none", "pdf.fonttype": 42, "svg.hashsalt": "masonry"}
+"""Vector figures keep their text as text (SVG: ``<text>`` in the reader's font; PDF:
+TrueType fonts, embedded), which a paper's editor can search and restyle; the salt makes
+the SVG's ids the same from run to run."""
+
+VECTOR_METADATA = {"svg": {"Date": None, "Creator": None},
+                   "pdf": {"CreationDate": None, "Creator": None, "Producer": None}}
+"""No date or tool version in a vector file: the same figure is the same bytes."""
+
+
+def figure_files(fig, dpi, render=PNG, close=True) -> dict:
+    """``fig`` in each format of ``render``: ``{format: bytes}``, cropped to what it draws
+    (with :data:`PAD_INCHES` around it). ``dpi`` is the figure's own PNG resolution,
+    ``render.dpi`` replaces it when set; the figure is closed unless ``close`` is False
+    (the next figure of the same view draws on it)."""
+    dpi = dpi if render.dpi is None else render.dpi
+    out = {}
+    for fmt in render.formats:
+        if fmt == "png":
+            out[fmt] = png_bytes(fig, dpi, close=False)
+            continue
+        buf = io.BytesIO()
+        with matplotlib.rc_context(VECTOR_STYLE):
+            fig.savefig(buf, format=fmt, dpi=dpi, bbox_inches="tight",
+                        pad_inches=PAD_INCHES, metadata=VECTOR_METADATA[fmt])
+        out[fmt] = buf.getvalue()
+    if close:
+        plt.close(fig)
+    return out
+
+
+def as_files(path, figure: dict) -> dict:
+    """``{path with each format's suffix: bytes}`` of a figure's :func:`figure_files`;
+    ``path`` names the figure by its PNG (``02_front/1_boundaries.png``)."""
+    stem = str(path).removesuffix(".png")
+    return {f"{stem}.{fmt}": data for fmt, data in figure.items()}
 
 
 def png_bytes(fig, dpi, close=True) -> bytes:
@@ -265,13 +323,13 @@ def add_points(ax, view, points, **style):
 
 def draw_outline(ax, view, scene):
     """The web's boundaries (its level table's half widths, both sides) and its base line
-    in blue; nothing for a scene without a level table, nor for a whole dome (one web's
-    outline would mark one web of many)."""
+    dashed (:data:`~masonry.plots.colours.WEB_OUTLINE`); nothing for a scene without a
+    level table, nor for a whole dome (one web's outline would mark one web of many)."""
     levels = scene.levels
     if levels is None or scene.dims is None or not scene.symmetry.unit:
         return
     for sign in (-1, 1):
         add_line(ax, view, np.column_stack([levels.x, sign * levels.y, levels.z]),
-                 color="b", linewidth=1)
+                 color=WEB_OUTLINE, linestyle="--", linewidth=1)
     add_line(ax, view, [[levels.x[0], -levels.y[0], 0.0], [levels.x[0], levels.y[0], 0.0]],
-             color="b", linewidth=1)
+             color=WEB_OUTLINE, linestyle="--", linewidth=1)

@@ -6,7 +6,7 @@ import numpy as np
 from mpl_toolkits.mplot3d import proj3d
 
 from masonry.plots.colours import bar_3d, force_unit
-from masonry.plots.common import add_polygons, axes_3d, png_bytes
+from masonry.plots.common import PNG, add_polygons, axes_3d, figure_files
 from masonry.plots.faces import interface_array
 
 RANKED = 10
@@ -50,11 +50,11 @@ def _label_ranks(ax, centres, bounds):
                       "linewidth": 0})
 
 
-def failure_png(blocks, interfaces, top, forces, fast=False, title="") -> bytes:
+def failure_png(blocks, interfaces, top, forces, fast=False, title="", render=PNG) -> dict:
     """Where it fails: every interface in light grey and the interfaces ``top`` (the
     rows of ``RBE/tension_top.csv``, largest tension first) coloured by tension, the
     first :data:`RANKED` numbered by their rank (neighbours share a label); ``title`` is the
-    line under the figure's own."""
+    line under the figure's own. Returns its files by format (of ``render``)."""
     fig, ax = axes_3d(blocks.bounds)
     add_polygons(ax, "01_angle", interface_array(interfaces, np.arange(len(interfaces))),
                  (0.6, 0.6, 0.6, 0.2), edgecolors="none")
@@ -71,4 +71,4 @@ def failure_png(blocks, interfaces, top, forces, fast=False, title="") -> bytes:
                 else ", numbered by rank")
     ax.set_title(f"where it fails: the {len(top)} interfaces with the largest tension\n"
                  f"{numbered[2:]} (RBE/tension_top.csv)\n{title}", fontsize=9)
-    return png_bytes(fig, 60 if fast else 130)
+    return figure_files(fig, 60 if fast else 130, render)

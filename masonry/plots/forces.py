@@ -10,8 +10,8 @@ import numpy as np
 
 from masonry.blocks import concatenate, rotated_web, rotation_z
 from masonry.plots.colours import colour_bar, colour_scale, one_value
-from masonry.plots.common import (HORIZONTAL_KINDS, add_polygons, axes_3d, png_bytes,
-                                  recolour, view_axes, views_of)
+from masonry.plots.common import (HORIZONTAL_KINDS, PNG, add_polygons, as_files, axes_3d,
+                                  figure_files, recolour, view_axes, views_of)
 from masonry.plots.faces import interface_array
 
 
@@ -26,15 +26,16 @@ class _ViewFigures:
     their ticks and the colour bar are made once, and a plot of the same polygons as the
     one before only recolours them (a fifth to a third of each figure's time)."""
 
-    def __init__(self, bounds, view, fast):
+    def __init__(self, bounds, view, fast, render):
         self.fig, self.ax = view_axes(bounds, view)
-        self.view, self.dpi = view, 60 if fast else 110
+        self.view, self.dpi, self.render = view, 60 if fast else 110, render
         self.polygons = self.collection = self.bar = None
 
     def png(self, polygons, values, title, quantity, signed=False, is_force=True,
-            subtitle="", unit="") -> bytes:
+            subtitle="", unit="") -> dict:
         """The interfaces ``polygons`` ((n, m, 3), :func:`interface_array`) coloured by
-        ``values`` (SI units, or ``unit`` for values that are not forces)."""
+        ``values`` (SI units, or ``unit`` for values that are not forces): its files by
+        format (:func:`~masonry.plots.common.figure_files`)."""
         scale = colour_scale(values, signed, is_force, unit)
         colours = scale["cmap"](scale["norm"](np.asarray(values, dtype=float)
                                               * scale["factor"]))
@@ -49,7 +50,7 @@ class _ViewFigures:
             self.polygons = polygons
         self.bar = colour_bar(self.fig, self.ax, scale, quantity, self.bar)
         self.ax.set_title(f"{title} ({len(polygons)} interfaces)\n{subtitle}", fontsize=9)
-        return png_bytes(self.fig, self.dpi, close=False)
+        return figure_files(self.fig, self.dpi, self.render, close=False)
 
     def __enter__(self):
         return self
@@ -66,11 +67,12 @@ def _groups(interfaces) -> dict:
             "all": np.arange(len(interfaces))}
 
 
-def interface_pngs(blocks, interfaces, fast=False, title="") -> dict:
+def interface_pngs(blocks, interfaces, fast=False, title="", render=PNG) -> dict:
     """Horizontal and vertical interfaces drawn as polygons (thesis figures 3.12-3.13),
     coloured by area; a group without interfaces has no plot, one whose interfaces all
     have the same area (one colour: an arch's joints) maps ``*/<name>.png`` to the reason
-    instead. ``title`` is the line under each figure's own."""
+    instead. ``title`` is the line under each figure's own; each figure in the formats
+    of ``render``."""
     out = {}
     groups = {f"interfaces_{name}": index
               for name, index in list(_groups(interfaces).items())[:2] if len(index)}
@@ -82,11 +84,11 @@ def interface_pngs(blocks, interfaces, fast=False, title="") -> dict:
             del groups[name]
     polygons = {name: interface_array(interfaces, index) for name, index in groups.items()}
     for view in views_of(blocks.bounds, fast):
-        with _ViewFigures(blocks.bounds, view, fast) as figures:
+        with _ViewFigures(blocks.bounds, view, fast, render) as figures:
             for name, index in groups.items():
-                out[f"{view}/{name}.png"] = figures.png(
+                out.update(as_files(f"{view}/{name}.png", figures.png(
                     polygons[name], interfaces.area[index] * 1e4, name.replace("_", " "),
-                    "area", is_force=False, subtitle=title, unit="cm^2")
+                    "area", is_force=False, subtitle=title, unit="cm^2")))
     return out
 
 
@@ -122,13 +124,13 @@ def _noise(values, noise) -> str | None:
 
 
 def force_pngs(blocks, interfaces, forces: dict, fast=False, title="", webs=None,
-               noise=0.0) -> dict:
+               noise=0.0, render=PNG) -> dict:
     """Force plots (sums over each interface's vertices), per view of the model's extent
     (``<view>/<name>.png``); with ``webs`` (a section that stands for the whole dome of
     ``webs`` webs) also the whole dome (``05_dome/<name>.png``). A selection without
     interfaces has no plot; one whose forces all lie within ``noise`` newtons of zero
     maps ``*/<name>.png`` to the reason instead. ``title`` is the line under each
-    figure's own."""
+    figure's own; each figure in the formats of ``render``."""
     select = _groups(interfaces)
     out, drawn = {}, []
     for name, key, group, heading, signed in FORCE_PLOTS:
@@ -141,16 +143,17 @@ def force_pngs(blocks, interfaces, forces: dict, fast=False, title="", webs=None
             else:
                 out[f"*/{name}.png"] = f"{heading}: {reason}"
     for view in views_of(blocks.bounds, fast):
-        with _ViewFigures(blocks.bounds, view, fast) as figures:
+        with _ViewFigures(blocks.bounds, view, fast, render) as figures:
             for name, key, polygons, values, heading, signed in drawn:
-                out[f"{view}/{name}.png"] = figures.png(
-                    polygons, values, heading, FORCE_LABELS[key], signed, subtitle=title)
+                out.update(as_files(f"{view}/{name}.png", figures.png(
+                    polygons, values, heading, FORCE_LABELS[key], signed, subtitle=title)))
     if webs:
-        out.update(_whole_dome_pngs(blocks, interfaces, forces, fast, title, webs, noise))
+        out.update(_whole_dome_pngs(blocks, interfaces, forces, fast, title, webs, noise,
+                                    render))
     return out
 
 
-def _whole_dome_pngs(blocks, interfaces, forces, fast, title, n, noise) -> dict:
+def _whole_dome_pngs(blocks, interfaces, forces, fast, title, n, noise, render) -> dict:
     """Normal force and tension on the whole dome: the section's interfaces (its boundary
     interfaces with the next web included) rotated ``n`` times, each copy with the
     section's forces (exact under the cyclic symmetry of docs/model.md 6.4); tension within
@@ -173,5 +176,6 @@ def _whole_dome_pngs(blocks, interfaces, forces, fast, title, n, noise) -> dict:
         colour_bar(fig, ax, scale, FORCE_LABELS[name])
         ax.set_title(f"the whole dome ({n} webs by rotation): {heading}\n"
                      f"{title}", fontsize=9)
-        out[f"05_dome/{name}.png"] = png_bytes(fig, 70 if fast else 130)
+        out.update(as_files(f"05_dome/{name}.png", figure_files(fig, 70 if fast else 130,
+                                                                render)))
     return out

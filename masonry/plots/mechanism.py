@@ -6,9 +6,9 @@ import numpy as np
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from masonry.plots.colours import colour_bar, colour_scale
-from masonry.plots.common import (ELEVATIONS, NO_FILL, add_points, add_polygons,
-                                  legend_below, png_bytes, view_axes, views_of)
+from masonry.plots.colours import HINGE, SLIDING, colour_bar, colour_scale
+from masonry.plots.common import (ELEVATIONS, NO_FILL, PNG, add_points, add_polygons,
+                                  as_files, figure_files, legend_below, view_axes, views_of)
 from masonry.plots.faces import face_array, interface_array, padded
 from masonry.rbe.collapse_result import vertex_displacements
 from masonry.tolerances import MECHANISM_MAIN
@@ -70,23 +70,25 @@ def _joint_handles(collapse) -> list:
     share = f"\u2265 {MECHANISM_MAIN:.0%} of the largest"
     handles = [Patch(facecolor="none", edgecolor="0.6", label="undeformed")]
     if collapse.hinges:
-        handles.append(Patch(facecolor="red", edgecolor="red",
+        handles.append(Patch(facecolor=HINGE, edgecolor=HINGE,
                              label=f"hinges opening {share}: {collapse.main_hinges} of "
                                    f"{collapse.hinges}"))
     if collapse.sliding:
-        handles.append(Patch(facecolor="none", edgecolor="blue",
+        handles.append(Patch(facecolor="none", edgecolor=SLIDING,
                              label=f"sliding {share}: {collapse.main_sliding} of "
                                    f"{collapse.sliding}"))
     return handles
 
 
-def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="") -> dict:
+def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="",
+                   render=PNG) -> dict:
     """The collapse mechanism (docs/model.md 6.9) drawn exaggerated over the undeformed
     structure, in the views of its extent (``collapse/<view>_mechanism.png``; one view
     when ``fast``; :func:`~masonry.plots.common.views_of`):
     displaced blocks coloured by their largest vertex displacement, the undeformed ones as
     grey outlines, the hinges and sliding joints that carry the mechanism
-    (:data:`~masonry.tolerances.MECHANISM_MAIN`) filled red and outlined blue, at their
+    (:data:`~masonry.tolerances.MECHANISM_MAIN`) filled (:data:`~masonry.plots.colours.HINGE`) and outlined
+    (:data:`~masonry.plots.colours.SLIDING`), at their
     undeformed places (seen through the blocks).
 
     Parameters
@@ -97,6 +99,8 @@ def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="")
         centroid, largest vertex displacement 1) and the joints that carry it.
     title, subtitle : str
         The figure's title and the line under it.
+    render : masonry.plots.common.Render
+        The formats of each figure's files.
     """
     undeformed, deformed, value, bounds = _mechanism_faces(
         blocks, np.asarray(collapse.mechanism))
@@ -104,8 +108,8 @@ def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="")
     colours = scale["cmap"](scale["norm"](value))
     handles = _joint_handles(collapse)
     joints = [(interface_array(interfaces, np.flatnonzero(mask)), face, edge, width)
-              for mask, face, edge, width in ((collapse.main_slides, NO_FILL, "blue", 0.6),
-                                              (collapse.main_hinge, "red", "red", 0.8))
+              for mask, face, edge, width in ((collapse.main_slides, NO_FILL, SLIDING, 0.8),
+                                              (collapse.main_hinge, HINGE, HINGE, 0.8))
               if mask.any()]
     out = {}
     for view in views_of(bounds, fast):
@@ -122,5 +126,6 @@ def mechanism_pngs(blocks, interfaces, collapse, title, fast=False, subtitle="")
         legend_below(fig, ax, shown)
         ax.set_title(f"{title}; displacement drawn at {MECHANISM_SCALE:g} x size\n"
                      f"{subtitle}", fontsize=9)
-        out[f"collapse/{view}_mechanism.png"] = png_bytes(fig, 60 if fast else 110)
+        out.update(as_files(f"collapse/{view}_mechanism.png",
+                            figure_files(fig, 60 if fast else 110, render)))
     return out

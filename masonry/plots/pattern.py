@@ -7,14 +7,16 @@ from matplotlib.collections import PolyCollection
 from matplotlib.patches import Patch
 
 from masonry.blocks import BLOCK_CLASSES, PATTERN
-from masonry.plots.common import CLASS_COLOURS, legend_below, png_bytes
+from masonry.plots.colours import WEB_OUTLINE
+from masonry.plots.common import CLASS_COLOURS, PNG, figure_files, legend_below
 
 
-def pattern_png(scene, fast=False, title="") -> bytes:
+def pattern_png(scene, fast=False, title="", render=PNG) -> dict:
     """The flattened section (thesis figures 3.8-3.9): position along the wall (units)
     against course, pattern, regular and fill-in bricks in distinct colours (the legend
     under the axes names the classes present), the web's half width at every course in
-    blue; ``title`` is the line under the figure's own."""
+    dashed (:data:`~masonry.plots.colours.WEB_OUTLINE`); ``title`` is the line under the figure's own. Returns its files
+    (:func:`~masonry.plots.common.figure_files`: format -> bytes, of ``render``)."""
     layout, levels, unit = scene.layout, scene.levels, scene.unit
     height = np.where(layout.klass == PATTERN, 2, 1)
     # mitered ends reach the web's boundary (at the course's lower, wider edge)
@@ -37,7 +39,7 @@ def pattern_png(scene, fast=False, title="") -> bytes:
                                          zorder=3 if on_top else 2), autolim=False)
     w = levels.y / unit
     z = np.arange(len(w))
-    ax.plot(w, z, "b-", -w, z, "b-", linewidth=1.2)
+    ax.plot(w, z, -w, z, color=WEB_OUTLINE, linestyle="--", linewidth=1.2)
     ax.set_xlabel(scene.kind.pattern_axis)
     ax.set_ylabel("course")
     # every brick (a sector's reach past the half width on one side) and the outline
@@ -52,4 +54,4 @@ def pattern_png(scene, fast=False, title="") -> bytes:
     what = scene.kind.pattern_caption(scene.geometry)
     counts = f"{pattern} pattern" if pattern else "no pattern bricks"
     ax.set_title(f"{what}: {len(layout)} bricks ({counts})\n{title}", fontsize=9)
-    return png_bytes(fig, 80 if fast else 130)
+    return figure_files(fig, 80 if fast else 130, render)

@@ -11,10 +11,10 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter, MaxNLocator
 
 from masonry.blocks import BLOCK_CLASSES
-from masonry.plots.colours import bar_3d
-from masonry.plots.common import (CLASS_COLOURS, ELEVATIONS, NO_FILL, add_points,
-                                  add_polygons, draw_outline, legend_below, png_bytes,
-                                  view_axes, views_of, visible_faces)
+from masonry.plots.colours import EMPHASIS, LOOSE, NEEDS_SUPPORT, STANDS, bar_3d
+from masonry.plots.common import (CLASS_COLOURS, ELEVATIONS, NO_FILL, PNG, add_points,
+                                  add_polygons, as_files, draw_outline, figure_files,
+                                  legend_below, view_axes, views_of, visible_faces)
 from masonry.plots.faces import face_array
 from masonry.tolerances import ADHESION_TIE_REL
 
@@ -28,15 +28,15 @@ below ``10**-MARK_DECADES`` of the largest keep their class colour."""
 
 def marked_structure_pngs(scene, is_present, value, title, value_label="value",
                           is_outlined=None, outline_label="outlined", fast=False,
-                          subtitle="") -> dict:
+                          subtitle="", render=PNG) -> dict:
     """The structure views of a part of ``scene`` (e.g. a construction stage): the blocks
     of ``is_present`` ((B,) bool), coloured by ``value`` ((B,) float >= 0, e.g. the
     support force a brick needs, newtons) on a logarithmic scale over
     :data:`MARK_DECADES` decades, in their class colours below it; the blocks of
     ``is_outlined`` ((B,) bool, e.g. the ones just laid) with thick :data:`OUTLINE_COLOUR`
     edges and a ring (legend ``outline_label``); the rest of the scene's blocks as faint
-    outlines. ``{view}.png`` per view of its extent, one view at lower resolution when
-    ``fast``;
+    outlines. ``{view}.png`` per view of its extent (and ``.svg``, ``.pdf`` as ``render``
+    asks), one view at lower resolution when ``fast``;
     ``title`` and ``subtitle`` are the figure's title and the line under it."""
     blocks = scene.blocks
     owner = blocks.face_block
@@ -81,16 +81,16 @@ def marked_structure_pngs(scene, is_present, value, title, value_label="value",
                                  label="laid, below the scale (class colours)"))
         legend_below(fig, ax, handles, fontsize=8)
         ax.set_title(f"{title}\n{subtitle}", fontsize=9)
-        out[f"{view}.png"] = png_bytes(fig, 60 if fast else 110)
+        out.update(as_files(f"{view}.png", figure_files(fig, 60 if fast else 110, render)))
     return out
 
 
 def stage_chart_png(stage, centering, feasible, load_factor=None, title="",
-                    xlabel="stage", loose=None) -> bytes:
+                    xlabel="stage", loose=None, render=PNG) -> dict:
     """The centering force as a fraction of the weight (and the collapse load factor,
     where given) against the construction stage: stages that stand in green (at 0),
-    those that need support in red, the first of them marked by a dashed line; stages
-    with loose blocks as red crosses.
+    those that need support in vermillion, the first of them marked by a dashed line;
+    stages with loose blocks as black crosses (:mod:`masonry.plots.colours`).
 
     Parameters
     ----------
@@ -101,6 +101,8 @@ def stage_chart_png(stage, centering, feasible, load_factor=None, title="",
     load_factor : (N,) float or None (NaN: not computed)
     loose : (N,) int or None
         Blocks per stage that touch nothing joining them to a support.
+    render : masonry.plots.common.Render
+        The formats of the files returned (format -> bytes).
     """
     stage = np.asarray(stage)
     centering = np.asarray(centering, dtype=float)
@@ -108,18 +110,18 @@ def stage_chart_png(stage, centering, feasible, load_factor=None, title="",
     loose = np.zeros(len(stage), int) if loose is None else np.asarray(loose)
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(stage, centering, color="0.6", linewidth=0.8, zorder=1)
-    ax.scatter(stage[feasible], centering[feasible], s=14, color="#2ca02c",
+    ax.scatter(stage[feasible], centering[feasible], s=14, color=STANDS,
                label=f"stands ({int(feasible.sum())})", zorder=2)
     held = ~feasible & (loose == 0)
-    ax.scatter(stage[held], centering[held], s=14, color="#d62728",
+    ax.scatter(stage[held], centering[held], s=14, color=NEEDS_SUPPORT,
                label=f"needs support ({int(held.sum())})", zorder=2)
     if loose.any():
         ax.scatter(stage[loose > 0], centering[loose > 0], marker="x", s=24,
-                   color="#d62728", zorder=2, label=f"a block touches nothing that holds "
+                   color=LOOSE, zorder=2, label=f"a block touches nothing that holds "
                    f"it ({int((loose > 0).sum())})")
     if not feasible.all():
         first = stage[np.argmin(feasible)]
-        ax.axvline(first, color="#d62728", linestyle="--", linewidth=0.8,
+        ax.axvline(first, color=NEEDS_SUPPORT, linestyle="--", linewidth=0.8,
                    label=f"first needs support: {first}")
     ax.set_xlabel(xlabel)
     ax.set_ylabel("centering force / weight (least support force)")
@@ -128,7 +130,7 @@ def stage_chart_png(stage, centering, feasible, load_factor=None, title="",
     handles, labels = ax.get_legend_handles_labels()
     if load_factor is not None and np.isfinite(np.asarray(load_factor, float)).any():
         right = ax.twinx()
-        right.plot(stage, np.asarray(load_factor, float), color="#1f77b4", marker=".",
+        right.plot(stage, np.asarray(load_factor, float), color=EMPHASIS, marker=".",
                    label="load factor")
         right.set_ylabel("collapse load factor")
         right.set_ylim(0, 1.1 * np.nanmax(np.asarray(load_factor, float)))
@@ -142,7 +144,7 @@ def stage_chart_png(stage, centering, feasible, load_factor=None, title="",
     ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
-    return png_bytes(fig, 110)
+    return figure_files(fig, 110, render)
 
 
 FRESH_MORTAR_KPA = (0.1, 1.0)
@@ -160,10 +162,10 @@ reference lines and a large ``a*`` show on one axis."""
 
 
 def stage_adhesion_png(stage, adhesion_kPa, feasible, title="", xlabel="stage",
-                       ratio=None) -> bytes:
+                       ratio=None, render=PNG) -> dict:
     """The least adhesion of every stage (docs/model.md 6.12) against the stage, kPa:
-    stages that stand dry in green (at 0), those that need adhesion in red (the
-    largest labelled), stages without a value as red crosses at 0, and dotted lines at
+    stages that stand dry in green (at 0), those that need adhesion in vermillion (the
+    largest labelled), stages without a value as black crosses at 0, and dotted lines at
     :data:`FRESH_MORTAR_KPA`; a logarithmic axis beyond :data:`LINEAR_DECADES`.
 
     Parameters
@@ -175,21 +177,23 @@ def stage_adhesion_png(stage, adhesion_kPa, feasible, title="", xlabel="stage",
         The stage stands with dry joints.
     ratio : float, optional
         The tension ratio ``t_c / c``, named in the axis label.
+    render : masonry.plots.common.Render
+        The formats of the files returned (format -> bytes).
     """
     stage = np.asarray(stage)
     value = np.asarray(adhesion_kPa, dtype=float)
     feasible = np.asarray(feasible, dtype=bool)
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(stage, value, color="0.6", linewidth=0.8, zorder=1)
-    ax.scatter(stage[feasible], value[feasible], s=14, color="#2ca02c",
+    ax.scatter(stage[feasible], value[feasible], s=14, color=STANDS,
                label=f"stands dry ({int(feasible.sum())})", zorder=2)
     held = ~feasible & np.isfinite(value)
-    ax.scatter(stage[held], value[held], s=14, color="#d62728",
+    ax.scatter(stage[held], value[held], s=14, color=NEEDS_SUPPORT,
                label=f"needs adhesion ({int(held.sum())})", zorder=2)
     missing = ~np.isfinite(value)
     if missing.any():
         ax.scatter(stage[missing], np.zeros(int(missing.sum())), marker="x", s=24,
-                   color="#d62728", zorder=2,
+                   color=LOOSE, zorder=2,
                    label=f"no value: a block held by nothing ({int(missing.sum())})")
     if held.any():  # at the first stage that reaches the largest (the record's)
         top = np.max(value[held])
@@ -216,4 +220,4 @@ def stage_adhesion_png(stage, adhesion_kPa, feasible, title="", xlabel="stage",
               frameon=False)  # below the plot: the curve may fill any corner
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
-    return png_bytes(fig, 110)
+    return figure_files(fig, 110, render)

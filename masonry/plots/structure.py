@@ -11,9 +11,9 @@ from matplotlib.colors import to_rgba
 from matplotlib.patches import Patch
 
 from masonry.blocks import BLOCK_CLASSES, PATTERN, concatenate, rotated_web
-from masonry.plots.common import (CLASS_COLOURS, add_polygons, axes_3d, draw_outline,
-                                  legend_below, png_bytes, view_axes, views_of,
-                                  visible_faces)
+from masonry.plots.common import (CLASS_COLOURS, PNG, add_polygons, as_files, axes_3d,
+                                  draw_outline, figure_files, legend_below, view_axes,
+                                  views_of, visible_faces)
 from masonry.plots.faces import face_array, hidden_faces
 
 SUPPORT_COLOUR = "#5f6b7a"
@@ -60,7 +60,8 @@ def _stages(scene) -> dict:
     return stages
 
 
-def structure_pngs(scene, fast=False, title="", webs=None, interfaces=None) -> dict:
+def structure_pngs(scene, fast=False, title="", webs=None, interfaces=None,
+                   render=PNG) -> dict:
     """Structure plots in the thesis's stages (figures 3.7, 3.10, 3.11): the web's
     boundaries (one web's outline: a section's only), the pattern bricks, the complete
     structure; in the views of the model's extent (:func:`~masonry.plots.common.views_of`,
@@ -68,7 +69,8 @@ def structure_pngs(scene, fast=False, title="", webs=None, interfaces=None) -> d
     for the whole dome) also the whole dome (``05_dome/3_structure.png``, the section
     rotated ``webs`` times). ``interfaces`` (the analysis model's, whose first blocks are
     the scene's) hide the faces they cover. ``title`` is the line under each figure's
-    own. A figure left out maps to the reason (str) instead of its bytes."""
+    own. Each figure is written in the formats of ``render`` (``<view>/<stage>.png``,
+    ``.svg``, ``.pdf``); a figure left out maps to the reason (str) instead of its bytes."""
     blocks = scene.blocks
     out = {}
     if not scene.symmetry.unit and (blocks.block_class == PATTERN).any():
@@ -85,20 +87,21 @@ def structure_pngs(scene, fast=False, title="", webs=None, interfaces=None) -> d
             legend = legend_below(fig, ax, handles)
             count = int((mask & ~blocks.block_is_support).sum())
             shown = (f"{count} {scene.kind.block_word}" if mask.any()
-                     else "the web's outline (blue), before any brick is laid")
+                     else "the web's outline (dashed), before any brick is laid")
             ax.set_title(f"{stage[2:]}: {shown}\n{title}", fontsize=9)
-            out[f"{view}/{stage}.png"] = png_bytes(fig, 60 if fast else 110, close=False)
+            out.update(as_files(f"{view}/{stage}.png", figure_files(
+                fig, 60 if fast else 110, render, close=False)))
             for artist in (drawn, legend):
                 if artist is not None:
                     artist.remove()
         plt.close(fig)
     if webs:
-        out["05_dome/3_structure.png"] = _whole_dome_png(blocks, interfaces, webs, fast,
-                                                         title)
+        out.update(as_files("05_dome/3_structure.png", _whole_dome_png(
+            blocks, interfaces, webs, fast, title, render)))
     return out
 
 
-def _whole_dome_png(blocks, interfaces, n, fast, title) -> bytes:
+def _whole_dome_png(blocks, interfaces, n, fast, title, render) -> dict:
     """The section's bricks rotated ``n`` times in the 3D view, the faces that touch the
     next web (its boundary interfaces) hidden too."""
     bricks = ~np.asarray(blocks.block_is_support, bool)
@@ -111,4 +114,4 @@ def _whole_dome_png(blocks, interfaces, n, fast, title) -> bytes:
     legend_below(fig, ax, handles)
     ax.set_title(f"the whole dome: the section rotated {n} times, {whole.n_blocks} "
                  f"bricks\n{title}", fontsize=9)
-    return png_bytes(fig, 70 if fast else 130)
+    return figure_files(fig, 70 if fast else 130, render)

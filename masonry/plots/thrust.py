@@ -6,7 +6,8 @@ blocks); a joint with no neighbour in its column is a point alone."""
 import matplotlib.pyplot as plt
 import numpy as np
 
-from masonry.plots.common import HORIZONTAL_KINDS, png_bytes
+from masonry.plots.colours import HINGE, TENSION, THRUST
+from masonry.plots.common import HORIZONTAL_KINDS, PNG, figure_files
 
 HINGE_ECCENTRICITY = 0.99
 """A joint whose resultant lies at least this far out (eccentricity, 1 = on the edge) is
@@ -88,22 +89,24 @@ def _draw_points(ax, point, runs) -> int:
     (:func:`chains`), alone (hollow) where a joint is in none; returns how many are
     alone."""
     alone = np.concatenate([run for run in runs if len(run) == 1] or [np.zeros(0, int)])
-    line = dict(color="#c0392b", markersize=2.5, linewidth=1.2)
+    line = dict(color=THRUST, markersize=2.5, linewidth=1.2)
     for k, run in enumerate(run for run in runs if len(run) > 1):
         ax.plot(point[run, 0], point[run, 2], "-o", **line,
                 label="point of application of the resultant (thrust line)" if k == 0
                 else None)
     if len(alone):
         ax.plot(point[alone, 0], point[alone, 2], "D", markerfacecolor="none",
-                markeredgecolor="#c0392b", markersize=4, linestyle="none",
+                markeredgecolor=THRUST, markersize=4, linestyle="none",
                 label="a joint's resultant, not in a chain of joints (no line)")
     return len(alone)
 
 
-def thrust_line_png(interfaces, resultants, section, fast=False, title=""):
+def thrust_line_png(interfaces, resultants, section, fast=False, title="", render=PNG):
     """The thrust line: the resultants' points of application on the bed joints that
     cross the structure's mid-plane (an arch's plane; a dome web's meridian section at
-    its centre line, y = 0), in x-z, hinges marked. None when no bed joint crosses it.
+    its centre line, y = 0), in x-z, hinges marked: its files by format
+    (:func:`~masonry.plots.common.figure_files` of ``render``). None when no bed joint
+    crosses it.
 
     Parameters
     ----------
@@ -135,9 +138,9 @@ def thrust_line_png(interfaces, resultants, section, fast=False, title=""):
     outside = e > 1 + 1e-6
     if hinge.any():
         ax.plot(point[hinge, 0], point[hinge, 2], "o", markerfacecolor="none", markersize=8,
-                color="k", label=f"hinge ({HINGE_ECCENTRICITY:g} <= eccentricity <= 1)")
+                markeredgewidth=1.5, color=HINGE, label=f"hinge ({HINGE_ECCENTRICITY:g} <= eccentricity <= 1)")
     if outside.any():
-        ax.plot(point[outside, 0], point[outside, 2], "x", markersize=7, color="k",
+        ax.plot(point[outside, 0], point[outside, 2], "x", markersize=7, color=TENSION,
                 label="outside its joint (needs tension)")
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
@@ -147,4 +150,4 @@ def thrust_line_png(interfaces, resultants, section, fast=False, title=""):
     ax.set_title(f"thrust line under self-weight through {len(index)} bed joints at "
                  f"{section.name}{chained}: {_count(hinge.sum(), 'hinge')}, "
                  f"{int(outside.sum())} outside\n{title}", fontsize=9)
-    return png_bytes(fig, 80 if fast else 150)
+    return figure_files(fig, 80 if fast else 150, render)

@@ -549,14 +549,16 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
                       {"params": identity(params), "plan": _plan_identity(plan),
                        "mortar": None if laying is None else laying.record()},
                       {"plots": out.plots, "quick": out.quick, "centering": True,
-                       "adhesion": True},
+                       "adhesion": True, "figure_format": out.figure_format,
+                       "dpi": out.dpi},
                       force=force,
                       identify=_identify)
     reused = job.reusable()
     if reused is not None:
         return reused
+    grown = job.outputs()
     params = dataclasses.replace(params, outputs=dataclasses.replace(
-        out, plots=job.outputs()["plots"], quick=job.outputs()["quick"]))
+        out, **{name: grown[name] for name in ("plots", "quick", "figure_format")}))
     with timer.stage("stages"):
         rows = analyse_stages(model, params, plan, laying=laying)
     record = stage_record(params, scene, model, plan, rows, cached, source, laying)
@@ -591,8 +593,10 @@ def _write(folder, params, scene, plan, rows, record, timer):
         folder.write("first_unsupported/held.csv", held_csv(scene.blocks, first["held"]))
     if params.outputs.plots:
         with timer.stage("plots"):
-            for name, png in stage_pngs(params, scene, plan, rows).items():
-                folder.write(name, png)
+            figures = stage_pngs(params, scene, plan, rows)
+            for name, data in figures.items():
+                folder.write(name, data)
+            record["figures"] = {"files": sorted(figures)}
     record["timings_s"] = timer.seconds
     record["versions"] = versions()
     record["complete"] = True
@@ -603,7 +607,8 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
     """``stages.png`` (the centering force of every stage as a fraction of its weight,
     which stages stand), ``adhesion.png`` (the least adhesion of every stage, kPa) and,
     when a stage needs support, ``first_unsupported/<view>.png``:
-    that stage, its bricks coloured by the support force they need."""
+    that stage, its bricks coloured by the support force they need; each figure in the
+    formats the outputs ask (``.png``, ``.svg``, ``.pdf``): path -> bytes."""
     from masonry import plots  # matplotlib, imported only by the runs that draw
 
     bricks = "every course" if plan.course is None else f"course {plan.course}"
@@ -614,16 +619,19 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
     xlabel = {"course": "stage (courses laid)",
               "brick": f"stage (bricks of {bricks} laid, per web)"}.get(plan.by, "stage")
     stage, feasible = [r["stage"] for r in rows], [bool(r["feasible"]) for r in rows]
+    render = plots.Render.of(params.outputs)
     out = {"stages.png": plots.stage_chart_png(
         stage, [np.nan if r["centering_fraction"] is None else r["centering_fraction"]
                 for r in rows], feasible,
         [np.nan if r["load_factor"] is None else r["load_factor"] for r in rows],
-        loose=[r["loose"] for r in rows], title=title, xlabel=xlabel),
+        loose=[r["loose"] for r in rows], title=title, xlabel=xlabel, render=render),
         "adhesion.png": plots.stage_adhesion_png(
         stage, [np.nan if r["adhesion_kPa"] is None else r["adhesion_kPa"] for r in rows],
         feasible, title=f"{structure_id(params)}: {what}, the least adhesion of every "
                         f"stage (mu {params.analysis.mu:g})", xlabel=xlabel,
-        ratio=params.analysis.adhesion_tension_ratio)}
+        ratio=params.analysis.adhesion_tension_ratio, render=render)}
+    out = {path: data for name, figure in out.items()
+           for path, data in plots.as_files(name, figure).items()}
     first = first_unsupported(rows)
     if first is None:
         return out
@@ -642,6 +650,7 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
         value_label="support force on the brick, at its centroid [N] (centering force)",
         is_outlined=plan.block_stage == first["stage"],
         outline_label=f"laid at stage {first['stage']}", fast=params.outputs.quick,
-        subtitle=f"{scene.kind.describe(params.analysis.boundary)} | {structure_id(params)}")
+        subtitle=f"{scene.kind.describe(params.analysis.boundary)} | {structure_id(params)}",
+        render=render)
     out.update({f"first_unsupported/{name}": png for name, png in views.items()})
     return out

@@ -128,6 +128,8 @@ class Study:
     plots: bool = False
     printable: bool = False
     html: bool = False
+    figure_format: tuple = ("png",)
+    dpi: int | None = None
     stages: str | None = None
     stages_course: int | None = None
     stages_order: str | None = None
@@ -152,7 +154,8 @@ class Study:
         stages = None if self.stages is None else {
             "by": self.stages, "course": self.stages_course, "order": self.stages_order}
         return dict(analyse=self.analyse, plots=self.plots, printable=self.printable,
-                    html=self.html, stages=stages)
+                    html=self.html, figure_format=self.figure_format, dpi=self.dpi,
+                    stages=stages)
 
     def variants(self) -> list:
         """One dict of inputs per variant (base, then grid point, then sample).
@@ -213,7 +216,7 @@ class Study:
 
 
 def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=False,
-                html=False, stages=None) -> dict:
+                html=False, stages=None, figure_format=("png",), dpi=None) -> dict:
     """Run one variant (and its stage study); never raises: a failure becomes a row with
     its error.
 
@@ -226,6 +229,8 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     analyse, plots, printable, html : bool
         What the run does and writes (:func:`masonry.pipeline.run`; ``plots``,
         ``printable`` and ``html`` unless the variant's inputs say otherwise).
+    figure_format, dpi :
+        The figures' formats and resolution (:class:`masonry.outputs.Outputs`).
     stages : dict or None
         ``by``, ``course`` and ``order`` of a stage study of the variant
         (:func:`masonry.studies.stages.run_stages`, in its own run folder; a section
@@ -246,7 +251,8 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     row = {"status": "failed", "error": ""}
     try:
         params = validate(Params.of(**{"plots": plots, "printable": printable,
-                                       "html": html, **inputs}))
+                                       "html": html, "figure_format": figure_format,
+                                       "dpi": dpi, **inputs}))
         record = run(params, out_root, analyse=analyse)
         staged = None if stages is None else run_stages(
             stage_params(params, "boundary" in inputs), out_root, **stages)
