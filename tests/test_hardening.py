@@ -281,4 +281,5 @@ def test_a_stage_study_without_plots_keeps_the_plots_of_one_with(tmp_path, capsy
     assert main([*args, "--no-plots", "--force"]) == 0  # recomputed, the plots kept
     assert set(snapshot(folder)) == set(before)
     assert json.loads((folder / "run.json").read_text())["outputs"] == {
-        "plots": True, "quick": False, "centering": True}
+        "plots": True, "quick": False, "figure_format": ["png"], "dpi": None,
+        "centering": True, "adhesion": True}

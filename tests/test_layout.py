@@ -14,8 +14,8 @@ ROOT = Path(masonry.__file__).parent
 # the pipeline's order: a module may import only from its own stage or earlier ones
 STAGES = (
     ("masonry.errors", "masonry.parameters", "masonry.tolerances", "masonry.optional",
-     "masonry.friction", "masonry.contact", "masonry.outputs", "masonry.runfolder",
-     "masonry.forking"),
+     "masonry.friction", "masonry.contact", "masonry.mortars", "masonry.outputs",
+     "masonry.runfolder", "masonry.forking"),
     ("masonry.blocks", "masonry.meshing"),
     ("masonry.dome",),
     ("masonry.scenes",),
