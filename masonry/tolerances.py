@@ -322,6 +322,11 @@ FACTOR_TIE_REL = 1e-6
 reports the first azimuth (a symmetric structure's 0 and 180 degrees differ by the LP's
 rounding only)."""
 
+AZIMUTH_NEAR_LEAST_REL = 1e-3
+"""An azimuth search refines the brackets with an end whose factor is within this
+(relative) of the least sampled (:mod:`masonry.rbe.azimuth_refine`): the least's
+neighbours and those of samples tied with it."""
+
 AZIMUTH_REFINE_REL = 1e-7
 """An azimuth search (``--lateral all``) refines its least sample until the least factor
 it found is within this (relative) of the least over every azimuth between its samples

@@ -12,9 +12,13 @@ samples bound it between them: the set lies in the half-planes ``p . u(theta_i) 
 so between ``theta_1`` and ``theta_2`` (less than 180 degrees apart) ``h`` is at most
 the corner of the two half-planes seen along ``u(theta)``; its inverse is a floor under
 the factor there (:func:`floor_between`). Every bracket whose floor lies below the least
-factor found is searched by Brent's method (:func:`scipy.optimize.minimize_scalar`,
-bounded), and then again on the brackets its points leave, until every floor is within
-:data:`~masonry.tolerances.AZIMUTH_REFINE_REL` of the least.
+factor found, and that has an end at or near the least
+(:data:`~masonry.tolerances.AZIMUTH_NEAR_LEAST_REL`), is searched by Brent's method
+(:func:`scipy.optimize.minimize_scalar`, bounded), and then again on the brackets its
+points leave, until every such floor is within
+:data:`~masonry.tolerances.AZIMUTH_REFINE_REL` of the least. Brackets away from the least
+are not searched: each point costs a collapse program on the whole model, and on a
+large dome the loose floors of far brackets would ask for hundreds.
 
 The azimuth tolerance follows from the factor's: the least of the branches
 ``D / (R cos(theta - phi))`` has its local minima where one branch has its own (two
@@ -29,7 +33,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from masonry.rbe.solvers.base import UNBOUNDED
-from masonry.tolerances import AZIMUTH_REFINE_REL
+from masonry.tolerances import AZIMUTH_NEAR_LEAST_REL, AZIMUTH_REFINE_REL
 
 __all__ = ["floor_between", "refine_least", "search_factor"]
 
@@ -42,6 +46,11 @@ XATOL_DEG = float(np.degrees(np.sqrt(2.0 * AZIMUTH_REFINE_REL)))
 ROUNDS = 4
 """Searches of the brackets left after the one before, at most: the first finds the
 local minimum in its bracket, the next the rare second one that bracket held."""
+
+MAX_SOLVES = 16
+"""Collapse programs a refinement solves at the most (each one on the whole model): the
+72-brick dome of the tests needs 7; a large dome's brackets would ask for more than a
+run should spend. Past it the least factor found is kept, and the log says so."""
 
 
 class _NoFactor(Exception):
@@ -88,8 +97,12 @@ def refine_least(samples, factor_at, key=None) -> list:
             log.info("lateral search: %d azimuths refined", len(new))
             return new
         for low, high, name in brackets:
+            if len(new) >= MAX_SOLVES:
+                log.warning("lateral search: refinement stopped after %d solves; the least "
+                            "factor found is kept", len(new))
+                return new
             searched.add(name)
-            new += _brent(low, high, points, factor_at)
+            new += _brent(low, high, points, factor_at, MAX_SOLVES - len(new))
     if _open_brackets(points, key, searched):
         log.warning("lateral search: brackets still open after %d rounds of Brent's "
                     "method; the least factor found is kept", ROUNDS)
@@ -112,18 +125,23 @@ def _open_brackets(points, key, searched) -> list:
             continue
         middle = 0.5 * (low + high) % 360.0
         name = (round(middle, 9) if key is None else key(middle), round(high - low, 9))
-        floor = floor_between(low, known[low], high, known[high % 360.0])
+        ends = (known[low], known[high % 360.0])
+        if min(ends) > least * (1.0 + AZIMUTH_NEAR_LEAST_REL):
+            continue  # not beside the least: its floor is a bound, not searched
+        floor = floor_between(low, ends[0], high, ends[1])
         if name not in searched and floor < least * (1.0 - AZIMUTH_REFINE_REL):
             out.setdefault(name, (low, high, name))
     return list(out.values())
 
 
-def _brent(low, high, points, factor_at) -> list:
-    """Brent's method on the bracket ``[low, high]`` (degrees); every point it solves
-    goes into ``points`` and the returned list."""
+def _brent(low, high, points, factor_at, budget) -> list:
+    """Brent's method on the bracket ``[low, high]`` (degrees), ``budget`` solves at the
+    most; every point it solves goes into ``points`` and the returned list."""
     new = []
 
     def factor(azimuth):
+        if len(new) >= budget:
+            raise _NoFactor
         value = factor_at(azimuth % 360.0)
         points[azimuth % 360.0] = value
         new.append((azimuth % 360.0, value))
@@ -135,6 +153,7 @@ def _brent(low, high, points, factor_at) -> list:
         minimize_scalar(factor, bounds=(low, high), method="bounded",
                         options={"xatol": XATOL_DEG})
     except _NoFactor:
-        log.warning("lateral search: no finite factor at %.6g deg; the bracket %.6g to %.6g deg "
-                    "is not searched further", new[-1][0], low, high % 360.0)
+        if len(new) < budget:
+            log.warning("lateral search: no finite factor at %.6g deg; the bracket %.6g to "
+                        "%.6g deg is not searched further", new[-1][0], low, high % 360.0)
     return new
