@@ -47,10 +47,11 @@ ROUNDS = 4
 """Searches of the brackets left after the one before, at most: the first finds the
 local minimum in its bracket, the next the rare second one that bracket held."""
 
-MAX_SOLVES = 16
-"""Collapse programs a refinement solves at the most (each one on the whole model): the
-72-brick dome of the tests needs 7; a large dome's brackets would ask for more than a
-run should spend. Past it the least factor found is kept, and the log says so."""
+MAX_SOLVES = 8
+"""Collapse programs a refinement solves at the most (each one on the whole model, off
+the mirror planes): the 72-brick dome of the tests needs 7; on a large dome each costs
+more than the sampled azimuths together, which the dome's symmetries solve on halves.
+Past it the least factor found is kept, and the log says so."""
 
 
 class _NoFactor(Exception):
