@@ -360,6 +360,7 @@ PLAUSIBLE = {
     "--mu": ["0.3", "0.7", "1", "0.05"], "--density": ["1500", "2000", "2.5e3"],
     "--cohesion-kpa": ["0", "0.5", "1", "300"], "--tensile-kpa": ["0", "0.25", "100"],
     "--adhesion-tension-ratio": ["0", "0.5", "1"],
+    "--figure-format": ["png", "svg", "pdf", "png,pdf", "tiff"], "--dpi": ["50", "110", "300"],
     "--span": ["1", "5", "10", "0.5"], "--thickness": ["0.05", "0.3", "0.6", "2"],
     "--rise": ["1", "2.5", "5", "8"], "--depth": ["0.2", "1", "3"],
     "--blocks": ["2", "3", "8", "16", "40"],
@@ -378,7 +379,7 @@ PLAUSIBLE = {
     "--helix": ["loxodrome", "clelia", "spiral"],
     "--pattern": ["herringbone", "none", "stripes"],
 }
-INTEGER_OPTIONS = {"--n", "--r", "--p", "--wall-courses", "--blocks", "--spirals"}
+INTEGER_OPTIONS = {"--n", "--r", "--p", "--wall-courses", "--blocks", "--spirals", "--dpi"}
 REVOLUTION = ["--radius", "--stretch", "--cut", "--unit", "--min-fill", "--p", "--spirals",
               "--helix-angle", "--helix", "--pattern"]
 SCENE_OPTIONS = {
@@ -407,7 +408,8 @@ def test_the_tables_cover_every_option_of_run():
 def value_of(option):
     plausible = st.sampled_from(PLAUSIBLE[option])
     if option in ("--shape", "--boundary", "--friction", "--accuracy", "--point-load",
-                  "--friction-law", "--friction-cone", "--helix", "--pattern"):
+                  "--friction-law", "--friction-cone", "--helix", "--pattern",
+                  "--figure-format"):
         return plausible
     wild = WILD_INTEGERS if option in INTEGER_OPTIONS else WILD_FLOATS
     return st.one_of(plausible, plausible, plausible, wild)

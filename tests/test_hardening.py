@@ -59,7 +59,8 @@ def test_run_after_build_adds_the_forces_and_keeps_the_plots(tmp_path):
     record = json.loads((tmp_path / WALL_ID / "run.json").read_text())
     assert record["outputs"] == {"analyse": True, "centering": True, "adhesion": True,
                                  "plots": True, "printable": False, "html": True,
-                                 "quick": True, "3dm": True}
+                                 "quick": True, "figure_format": ["png"], "dpi": None,
+                                 "3dm": True}
     assert (tmp_path / WALL_ID / "RBE" / "forces.csv").is_file()
     assert (tmp_path / WALL_ID / "00_pattern.png").is_file()
 

@@ -308,7 +308,10 @@ def test_benign_closed_connections_are_dropped_as_dask_stops_and_nothing_else(ca
 
     log, dask = logging.getLogger("distributed.client"), logging.getLogger("distributed")
     handler = logging.StreamHandler()  # on sys.stderr: capsys's
-    dask.addHandler(handler)
+    # only this handler hears them: an earlier test's cluster may have left its own, on a
+    # stream since closed
+    held = [(logger, logger.handlers[:], logger.propagate) for logger in (log, dask)]
+    log.handlers, dask.handlers, dask.propagate = [], [handler], False
     try:
         with workers.quiet_shutdown(), pytest.raises(CommClosedError):
             try:
@@ -319,6 +322,7 @@ def test_benign_closed_connections_are_dropped_as_dask_stops_and_nothing_else(ca
                 handler.flush()
                 raise
     finally:
-        dask.removeHandler(handler)
+        for logger, handlers, propagate in held:
+            logger.handlers, logger.propagate = handlers, propagate
     err = capsys.readouterr().err
     assert "a real failure" in err and "CommClosedError" not in err
