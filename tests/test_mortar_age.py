@@ -124,7 +124,8 @@ def test_a_constant_mortar_is_the_uniform_contact_law(arch):
         if not alone.feasible:
             assert row["moi_factor"] == pytest.approx(alone.moi_factor, rel=1e-3)
         verdicts.append(alone.feasible)
-    assert True in verdicts[2:7] and False in verdicts[2:7]  # the case decides something
+    # the case decides something: 100 kPa holds some of stages 3 to 7 and not others
+    assert 0 < sum(verdicts[2:7]) < len(verdicts[2:7])
 
 
 def test_per_vertex_strengths_equal_to_a_uniform_one_give_its_system():
