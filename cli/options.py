@@ -302,6 +302,14 @@ def add_material_options(group):
     group.add_argument("--tensile-kpa", dest="tensile_kpa", type=float, metavar="KPA",
                        help="the mortar's tensile strength at every joint, kPa (n >= -t A; "
                             "cut off at cohesion/mu; default 0)")
+    group.add_argument("--head-joint-ratio", dest="head_joint_ratio", type=float,
+                       metavar="R", help="head joints hold R times the bed joints' cohesion "
+                                         "and tensile strength (0 to 1; default 1; a "
+                                         "joint between two webs is a head joint)")
+    group.add_argument("--support-joint-ratio", dest="support_joint_ratio", type=float,
+                       metavar="R", help="joints with a support hold R times the bed "
+                                         "joints' strengths (default 1; 0: dry on the "
+                                         "supports)")
     group.add_argument("--adhesion-tension-ratio", dest="adhesion_tension_ratio", type=float,
                        metavar="R", help="t_c / c of the least adhesion a structure needs "
                                          "(c = a, t_c = R a; 0 to 100; default 0.5, "

@@ -235,13 +235,14 @@ def load(path, **overrides) -> Params:
                              related=error.related, where=str(path)) from None
 
 
-MORTAR_KEYS = ("cohesion_kpa", "tensile_kpa", "adhesion_tension_ratio")
+MORTAR_KEYS = ("cohesion_kpa", "tensile_kpa", "head_joint_ratio", "support_joint_ratio",
+               "adhesion_tension_ratio")
 """The keys of a parameter file's ``[mortar]`` table (the analysis's mortar inputs)."""
 
 
 def _mortar_table(table, path) -> dict:
-    """The inputs of a parameter file's ``[mortar]`` table (``cohesion_kpa``,
-    ``tensile_kpa``, ``adhesion_tension_ratio``), refused by key when it is not a table or names another key."""
+    """The inputs of a parameter file's ``[mortar]`` table (:data:`MORTAR_KEYS`), refused
+    by key when it is not a table or names another key."""
     if not isinstance(table, dict):
         raise ParameterError("mortar", table, f"a table of {' and '.join(MORTAR_KEYS)}",
                              where=str(path))

@@ -512,7 +512,7 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
         problem = RBEProblem(solved.blocks, solved.interfaces, **solved.assembly)
     options = dict(mu=analysis.mu, density=analysis.density, friction=analysis.friction,
                    solver=analysis.solver, accuracy=analysis.accuracy,
-                   cone=analysis.friction_cone, **mortar(analysis))
+                   cone=analysis.friction_cone, **mortar(analysis, model.interfaces))
     with timer.stage("solve"):
         result = problem.solve(**options)
         if half is None:
@@ -528,10 +528,11 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
         return dataclasses.replace(result, solved_on="whole, the half rejected")
 
 
-def mortar(analysis) -> dict:
-    """The analyses' keyword arguments of the run's mortar: cohesion and tensile
-    strength, pascals (:attr:`~masonry.rbe.settings.Analysis.law`)."""
-    law = analysis.law
+def mortar(analysis, interfaces) -> dict:
+    """The analyses' keyword arguments of the run's mortar at ``interfaces``: cohesion and
+    tensile strength, pascals, numbers or per vertex where the joint kinds differ
+    (:meth:`~masonry.rbe.settings.Analysis.law_on`)."""
+    law = analysis.law_on(interfaces)
     return dict(cohesion=law.cohesion_Pa, tensile=law.tensile_Pa)
 
 
@@ -541,7 +542,7 @@ def centering_of(model: Model, params: Params) -> CenteringResult:
     model. A run computes it when the structure cannot stand."""
     analysis = params.analysis
     return centering_force(model, mu=analysis.mu, density=analysis.density,
-                           cone=analysis.cone, **mortar(analysis))
+                           cone=analysis.cone, **mortar(analysis, model.interfaces))
 
 
 def adhesion_of(model: Model, params: Params, rbe: RBEResult | None = None) -> AdhesionResult:
@@ -553,7 +554,9 @@ def adhesion_of(model: Model, params: Params, rbe: RBEResult | None = None) -> A
     if rbe is not None and rbe.feasible and law.is_dry:
         return stands_dry(model.interfaces, law, analysis.adhesion_tension_ratio)
     return least_adhesion(model, mu=analysis.mu, density=analysis.density, cone=analysis.cone,
-                          ratio=analysis.adhesion_tension_ratio)
+                          ratio=analysis.adhesion_tension_ratio,
+                          head_ratio=analysis.head_joint_ratio,
+                          support_ratio=analysis.support_joint_ratio)
 
 
 def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> CollapseResult:
@@ -571,7 +574,7 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     if isinstance(load, Lateral) and load.azimuth_deg == "all":
         result = worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
                                mirrors=symmetry.mirrors, dead_load_feasible=known, **options,
-                               **mortar(analysis))
+                               **mortar(analysis, model.interfaces))
         return _checked_collapse(model, params, result, 1, known)
     plane = symmetric_plane(load, symmetry.mirrors)
     if (plane is not None and analysis.friction_law == "associated"
@@ -581,7 +584,7 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     else:
         result = collapse_load(model, load.on(model, analysis.density, copies=copies),
                                dead_load_feasible=known, friction=analysis.friction_law,
-                               **options, **mortar(analysis))
+                               **options, **mortar(analysis, model.interfaces))
     if isinstance(load, Lateral) and load.azimuth_deg != "all":
         result = dataclasses.replace(result, azimuth_deg=float(load.azimuth_deg))
     return _checked_collapse(model, params, result, copies, known)
@@ -602,7 +605,7 @@ def _checked_collapse(model, params, result, copies, known) -> CollapseResult:
     whole = collapse_load(model, load.on(model, analysis.density, copies=copies),
                           dead_load_feasible=known, friction=analysis.friction_law,
                           mu=analysis.mu, density=analysis.density, cone=analysis.cone,
-                          **mortar(analysis))
+                          **mortar(analysis, model.interfaces))
     return dataclasses.replace(whole, azimuth_deg=result.azimuth_deg,
                                azimuths=result.azimuths, solved_on="whole, the half rejected")
 

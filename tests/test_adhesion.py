@@ -18,8 +18,10 @@ from test_friction import tilted_block
 from test_rbe import cantilever, incline
 
 import masonry
+from masonry.interfaces import INTERFACE_KINDS
 from masonry.rbe.adhesion import AdhesionRatioError, least_adhesion
 from masonry.rbe.boundary import Model
+from masonry.rbe.settings import Analysis
 from masonry.rbe.solve import solve_rbe
 from masonry.studies.sweep import run_summary
 from masonry_cli.main import main
@@ -167,3 +169,63 @@ def test_a_run_reports_the_least_adhesion_beside_the_centering_force(tmp_path, c
     (standing,) = [f for f in out.glob("arch_*") if f != folder]
     assert json.loads((standing / "run.json").read_text())["adhesion"]["a_kPa"] == 0.0
     assert "least adhesion: 0 kPa" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("kind, head, support, share", [
+    ("support", 1.0, 0.5, 0.5), ("vertical", 0.5, 1.0, 0.5), ("boundary", 0.25, 2.0, 0.25),
+    ("horizontal", 0.5, 0.5, 1.0)])
+def test_a_joint_kind_holds_its_share_of_the_bed_joints_adhesion(kind, head, support, share):
+    """The block on a 55 degree slope with its one joint labelled ``kind``: that joint
+    holds ``share`` times ``a`` (head joints, a joint between webs: ``head``; a joint with
+    a support: ``support``; a bed joint: 1), so a* = p (sin a - mu cos a) / share, and the
+    joint uses the same kilopascals as a bed joint would. The RBE with the run's contact
+    law per joint (``law_on``) stands with bed cohesion a*(1 + 1e-3) and not a*(1 - 1e-3)."""
+    alpha = np.radians(55.0)
+    blocks, interfaces = incline(alpha, base=1.0, height=0.1)
+    interfaces = dataclasses.replace(interfaces, kind=np.array(
+        [INTERFACE_KINDS.index(kind)], dtype=np.int8))
+    needed = weight(blocks) / interfaces.area[0] * (np.sin(alpha) - MU * np.cos(alpha)) / 1e3
+    result = least_adhesion(Model(blocks, interfaces), mu=MU, density=DENSITY, ratio=0.0,
+                            head_ratio=head, support_ratio=support)
+    assert result.a_kPa == pytest.approx(needed / share, rel=1e-6)
+    assert result.interface_kPa[0] == pytest.approx(needed, rel=1e-5)
+    for margin, verdict in ((1 + 1e-3, "feasible"), (1 - 1e-3, "infeasible")):
+        law = Analysis(cohesion_kpa=margin * result.a_kPa, head_joint_ratio=head,
+                       support_joint_ratio=support).law_on(interfaces)
+        rbe = solve_rbe(blocks, interfaces, mu=MU, density=DENSITY,
+                        cohesion=law.cohesion_Pa, tensile=law.tensile_Pa)
+        assert rbe.verdict == verdict, margin
+
+
+@pytest.mark.parametrize("option, value", [("--head-joint-ratio", "1.5"),
+                                           ("--head-joint-ratio", "-0.1"),
+                                           ("--support-joint-ratio", "nan")])
+def test_a_bad_joint_ratio_is_one_line_and_exit_2(tmp_path, capsys, option, value):
+    out = tmp_path / "out"
+    code = main(["run", "--scene", "arch", option, value, "--no-plots", "--no-printable",
+                 "--out", str(out), "-q"])
+    error = capsys.readouterr().err.strip()
+    assert code == 2
+    assert len(error.splitlines()) == 1 and option in error and value in error
+    assert not out.exists()
+
+
+def test_the_arch_needs_more_where_its_springings_hold_less(tmp_path):
+    """The thin arch (t/R 0.08) with its joints on the supports at half the bed joints'
+    strength needs a larger a*, and no joint uses more than its kind holds: the
+    springings' joints at most a*/2. The run records the law in one line with the ratio."""
+    arch = masonry.build(scene="arch", arch_thickness=0.4)
+    weak = masonry.build(scene="arch", arch_thickness=0.4, support_joint_ratio=0.5)
+    full, half = arch.least_adhesion(), weak.least_adhesion()
+    assert half.a_kPa > full.a_kPa * (1 + 1e-3)
+    on_support = half.interface_kind == INTERFACE_KINDS.index("support")
+    assert on_support.any()
+    assert half.interface_kPa[on_support].max() <= 0.5 * half.a_kPa * (1 + 1e-5)
+    assert half.interface_kPa[~on_support].max() <= half.a_kPa * (1 + 1e-5)
+    out = tmp_path / "out"
+    assert main(["run", "--scene", "arch", "--cohesion-kpa", "1", "--support-joint-ratio",
+                 "0.5", "--no-plots", "--no-printable", "--out", str(out), "-q"]) == 0
+    (folder,) = out.glob("arch_*")
+    assert "_sj0.5" in folder.name
+    text = (folder / "00_parameters.txt").read_text()
+    assert "at bed joints; head joints x1, joints with a support x0.5" in text

@@ -360,6 +360,7 @@ PLAUSIBLE = {
     "--mu": ["0.3", "0.7", "1", "0.05"], "--density": ["1500", "2000", "2.5e3"],
     "--cohesion-kpa": ["0", "0.5", "1", "300"], "--tensile-kpa": ["0", "0.25", "100"],
     "--adhesion-tension-ratio": ["0", "0.5", "1"],
+    "--head-joint-ratio": ["0", "0.5", "1"], "--support-joint-ratio": ["0", "1", "2"],
     "--figure-format": ["png", "svg", "pdf", "png,pdf", "tiff"], "--dpi": ["50", "110", "300"],
     "--span": ["1", "5", "10", "0.5"], "--thickness": ["0.05", "0.3", "0.6", "2"],
     "--rise": ["1", "2.5", "5", "8"], "--depth": ["0.2", "1", "3"],
@@ -393,7 +394,8 @@ SCENE_OPTIONS = {
 }
 EVERY_SCENE = ["--mu", "--density", "--friction", "--accuracy", "--print-size", "--lateral",
                "--point-load", "--crown-load", "--friction-law", "--friction-cone",
-               "--cohesion-kpa", "--tensile-kpa", "--adhesion-tension-ratio"]
+               "--cohesion-kpa", "--tensile-kpa", "--head-joint-ratio",
+               "--support-joint-ratio", "--adhesion-tension-ratio"]
 
 
 def test_the_tables_cover_every_option_of_run():

@@ -10,6 +10,7 @@ while ``p sin(alpha) <= mu p cos(alpha) + c``, so it needs ``a* = p (sin(alpha) 
 cos(alpha))`` of cohesion (no tension).
 """
 
+import dataclasses
 import json
 
 import numpy as np
@@ -85,6 +86,18 @@ def test_the_slope_joint_holds_once_it_is_old_enough(rate, stands):
         assert rows[0]["centering_N"] == pytest.approx(
             1e3 * NEEDED_KPA * 0.2 / np.hypot(1.0, MU), rel=1e-4)
 
+
+
+@pytest.mark.parametrize("rate, stands", [(1.4, True), (1.6, False)])
+def test_a_joint_with_a_support_ages_at_its_share_of_the_mortar(rate, stands):
+    """With --support-joint-ratio 0.75 the slope's joint (a joint with a support) holds
+    0.75 x 0.3/rate kPa at stage 2, which reaches the 0.15 kPa it needs iff rate <= 1.5
+    bricks per hour."""
+    model, plan = slope_and_flat()
+    params = dataclasses.replace(ARCH, analysis=dataclasses.replace(
+        ARCH.analysis, support_joint_ratio=0.75))
+    row = analyse_stage(model, params, plan, 2, None, Laying.of(RAMP, rate))
+    assert row["feasible"] is stands
 
 def test_the_named_lime_table_decides_the_slope_at_its_stated_threshold():
     """With lime (docs/model.md 6.13) c = 0.1 kPa when laid, 0.2 kPa at 1 h, linear

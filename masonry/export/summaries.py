@@ -39,7 +39,7 @@ def parameters_text(params, structure_id: str) -> str:
     cone = analysis.cone
     lines += ["", *_lines(analysis, values(analysis), ANALYSIS_SHOWN),
               _line("friction_cone", cone.name, cone.describe()),
-              _line("contact_law", analysis.law.describe(), ""),
+              _line("contact_law", analysis.law_text(), ""),
               _line("accuracy", preset.name, f"solver preset; residual <= {preset.residual:g}"),
               _line("solver", solvers, "" if analysis.solver is None else "set by --solver"),
               ""]

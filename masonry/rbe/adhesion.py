@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from masonry.contact import TENSION_RATIO, ContactLaw
+from masonry.contact import TENSION_RATIO, ContactLaw, joint_factor
 from masonry.errors import MasonryError
 from masonry.interfaces import INTERFACE_KINDS
 from masonry.rbe.collapse import friction_columns
@@ -158,7 +158,7 @@ class AdhesionResult:
 
 
 def least_adhesion(model, *, mu=0.7, density=2000.0, cone="circle", ratio=TENSION_RATIO,
-                   time_limit=600.0) -> AdhesionResult:
+                   head_ratio=1.0, support_ratio=1.0, time_limit=600.0) -> AdhesionResult:
     """The least uniform adhesion with which ``model`` stands (module docstring).
 
     Parameters
@@ -171,6 +171,9 @@ def least_adhesion(model, *, mu=0.7, density=2000.0, cone="circle", ratio=TENSIO
         The friction model (:mod:`masonry.friction`).
     ratio : float
         ``t_c / c``, >= 0 (:data:`TENSION_RATIO`).
+    head_ratio, support_ratio : float
+        Head joints and joints with a support hold these fractions of ``a``
+        (:func:`masonry.contact.joint_factor`); ``a*`` is the bed joints'.
     time_limit : float, s
 
     Returns
@@ -189,11 +192,12 @@ def least_adhesion(model, *, mu=0.7, density=2000.0, cone="circle", ratio=TENSIO
     system = assemble(model.blocks, model.interfaces, mu=mu, density=density,
                       side_block=model.side_block, side_rotation=model.side_rotation,
                       cone=cone)
-    return solve_adhesion(system, model.interfaces, ratio=ratio, time_limit=time_limit)
+    return solve_adhesion(system, model.interfaces, ratio=ratio, head_ratio=head_ratio,
+                          support_ratio=support_ratio, time_limit=time_limit)
 
 
 def solve_adhesion(system: EquilibriumSystem, interfaces, *, ratio=TENSION_RATIO,
-                   time_limit=600.0) -> AdhesionResult:
+                   head_ratio=1.0, support_ratio=1.0, time_limit=600.0) -> AdhesionResult:
     """:func:`least_adhesion` on assembled matrices (their friction model and ``mu``;
     a mortar they carry is dropped: ``a`` is the program's)."""
     start = time.perf_counter()
@@ -202,7 +206,8 @@ def solve_adhesion(system: EquilibriumSystem, interfaces, *, ratio=TENSION_RATIO
     columns = friction_columns(system)
     area_ref = float(np.mean(system.vertex_area))
     area = system.vertex_area / area_ref
-    A, b, rows, h, cones = _program(system, columns, area, ratio)
+    held = area * joint_factor(interfaces, head_ratio, support_ratio)  # c_i A_i / a
+    A, b, rows, h, cones = _program(system, columns, held, ratio)
     q = np.zeros(A.shape[1])
     q[-1] = 1.0
     status, z, iterations = solve_cone_program(q, A, b, rows, h, cones, time_limit)
@@ -216,8 +221,8 @@ def solve_adhesion(system: EquilibriumSystem, interfaces, *, ratio=TENSION_RATIO
     # within the acceptance tolerance of standing dry is standing dry (checked at 0)
     a = float(z[-1]) if z[-1] > ACCEPT_RESIDUAL else 0.0
     x = columns.edges @ z[:-1]
-    x[system.layout.columns("c")] -= a * area / system.mu       # the physical n
-    residual, violation = _residuals(system, x, a * area, ratio)
+    x[system.layout.columns("c")] -= a * held / system.mu       # the physical n
+    residual, violation = _residuals(system, x, a * held, ratio)
     unit_kPa = system.weight_ref / area_ref / 1e3
     used = _interface_use(system, x, area, ratio) * unit_kPa
     common = dict(ratio=ratio, interface_pair=np.asarray(interfaces.pair),
@@ -254,7 +259,8 @@ def _unsolved(interfaces, law, ratio, reason, status="not solved", iterations=0,
 def _program(system, columns, area, ratio):
     """``(A, b, G, h, cones)`` over ``z = [g, a]`` (module docstring): the equilibrium
     rows with the shift's column, the friction model's cone rows, then one nonnegative
-    cone of the cut-off rows (where ``r < 1 / mu``) and ``a >= 0``."""
+    cone of the cut-off rows (where ``r < 1 / mu``) and ``a >= 0``. ``area``: each
+    vertex's strength per unit ``a``, the tributary area times its joint's factor."""
     layout, mu = system.layout, system.mu
     unit_shift = np.zeros(layout.n_columns)
     unit_shift[layout.columns("c")] = area / mu

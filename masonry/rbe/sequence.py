@@ -309,7 +309,7 @@ class StageSequence:
                                    block=source[reduced.block])
 
     def adhesion(self, is_present, *, mu=0.7, density=2000.0, cone="circle",
-                 ratio=TENSION_RATIO) -> AdhesionResult:
+                 ratio=TENSION_RATIO, head_ratio=1.0, support_ratio=1.0) -> AdhesionResult:
         """The least adhesion (docs/model.md 6.12) of the part whose scene blocks
         ``is_present``: :func:`masonry.rbe.adhesion.solve_adhesion` on the part's rows and
         columns of the whole model's matrices, one conic program per part (the part's
@@ -319,7 +319,8 @@ class StageSequence:
         interfaces = keep[self.model.interfaces.pair].all(axis=1)
         system = part_system(self.whole, keep[self.whole.free_block],
                              interfaces).with_material(mu=mu, density=density, cone=cone)
-        return solve_adhesion(system, self.model.interfaces.subset(interfaces), ratio=ratio)
+        return solve_adhesion(system, self.model.interfaces.subset(interfaces), ratio=ratio,
+                              head_ratio=head_ratio, support_ratio=support_ratio)
 
     def _touching(self, rows) -> np.ndarray:
         """(K,) bool: the interfaces with a side on the free blocks ``rows``."""

@@ -3,7 +3,9 @@ law and model, the boundary of a section, and the solvers' accuracy."""
 
 from dataclasses import dataclass
 
-from masonry.contact import TENSION_RATIO, ContactLaw
+import numpy as np
+
+from masonry.contact import TENSION_RATIO, ContactLaw, joint_factor
 from masonry.errors import ParameterError
 from masonry.friction import FrictionCone, FrictionModelError
 from masonry.parameters import check_fields, declare
@@ -28,6 +30,9 @@ class Analysis:
     program; non-associative: joints that slide without dilating, an estimate),
     ``cohesion_kpa`` and ``tensile_kpa`` the mortar's cohesion and tensile strength at
     every joint (kPa; 0: dry joints; :mod:`masonry.contact`),
+    ``head_joint_ratio`` and ``support_joint_ratio`` the strength of head joints and of
+    joints with a support as a fraction of the bed joints' (cohesion and tension alike,
+    also of a mortar by age and of the least adhesion; :func:`masonry.contact.joint_factor`),
     ``adhesion_tension_ratio`` the ratio ``t_c / c`` of the least adhesion
     (:mod:`masonry.rbe.adhesion`).
     """
@@ -58,6 +63,14 @@ class Analysis:
     tensile_kpa: float = declare(0.0, "kPa, the mortar's tensile strength at every joint",
                                  low=0.0, high=1e6, tag="ten",
                                  expected="0 to 1e+06 (kPa; cut off at cohesion/mu)")
+    head_joint_ratio: float = declare(
+        1.0, "head joints' strength over the bed joints'", low=0.0, high=1.0, tag="hj",
+        expected="0 to 1 (a fraction of the bed joints' cohesion and tensile strength; "
+                 "EN 1996-1-1 halves the shear strength of unfilled perpends)")
+    support_joint_ratio: float = declare(
+        1.0, "the strength of joints with a support over the bed joints'", low=0.0,
+        high=1e6, tag="sj", expected="0 to 1e+06 (a factor on the bed joints' cohesion "
+                                     "and tensile strength; 0: dry on its supports)")
     adhesion_tension_ratio: float = declare(
         TENSION_RATIO, "t_c / c of the least adhesion", low=0.0, high=100.0, tag="atr",
         expected="0 to 100 (the least adhesion's tensile strength over its cohesion; "
@@ -86,8 +99,28 @@ class Analysis:
 
     @property
     def law(self) -> ContactLaw:
-        """The contact law every analysis of the run asks (:mod:`masonry.contact`)."""
+        """The contact law every analysis of the run asks (:mod:`masonry.contact`), at
+        its bed joints; :meth:`law_on` gives every joint's."""
         return ContactLaw(self.cone, self.mu, 1e3 * self.cohesion_kpa, 1e3 * self.tensile_kpa)
+
+    def joint_factor(self, interfaces) -> float | np.ndarray:
+        """Every vertex's strength over the bed joints' (1.0, a float, where every joint
+        has the bed joints'; :func:`masonry.contact.joint_factor`)."""
+        return joint_factor(interfaces, self.head_joint_ratio, self.support_joint_ratio)
+
+    def law_on(self, interfaces) -> ContactLaw:
+        """The contact law of every joint of ``interfaces``: :attr:`law` scaled by
+        :meth:`joint_factor` (per vertex where the joint kinds differ)."""
+        return self.law.scaled(self.joint_factor(interfaces))
+
+    def law_text(self) -> str:
+        """The contact law in one line, with the joint kinds' ratios where they are not
+        1 and the joints have a mortar."""
+        text = self.law.describe()
+        if self.law.is_dry or (self.head_joint_ratio, self.support_joint_ratio) == (1, 1):
+            return text
+        return (f"{text} at bed joints; head joints x{self.head_joint_ratio:g}, joints "
+                f"with a support x{self.support_joint_ratio:g}")
 
     @property
     def cone(self) -> FrictionCone:

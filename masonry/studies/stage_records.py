@@ -130,7 +130,7 @@ def law_line(params, laying) -> str:
     it, else the friction model and the mortar by age."""
     law = params.analysis.law
     if laying is None:
-        return law.describe()
+        return params.analysis.law_text()
     head = f"Coulomb {law.cone.name}, mu {law.mu:g}"
     if laying.rate_per_hour is None:
         return f"{head}, {laying.describe()}"

@@ -77,9 +77,9 @@ has no equilibrium at all, and no MoI). ``centering_N``, ``centering_fraction``:
 centering force and its fraction of the stage's weight (:func:`stage_centering`; 0 for a
 stage that stands). ``adhesion_kPa``: the least adhesion of the stage's model (docs/model.md
 6.12, :func:`stage_adhesion`; 0 for a stage that stands dry, empty where it has none).
-``load_factor``: the collapse load factor of the
-stage under the lateral load of ``params.lateral`` (:func:`stage_load_factor`); empty
-without one, or where the stage does not stand under its own weight. ``time_h``: with a mortar that ages
+``load_factor``: the collapse load factor of the stage under the lateral load of
+``params.lateral`` (:func:`stage_load_factor`); empty without one, or where the stage does
+not stand under its own weight. ``time_h``: with a mortar that ages
 (:func:`joint_strength`), the hours from the start of the first stage to the end of this
 one, which set its joints' ages; empty without a laying rate."""
 
@@ -170,23 +170,25 @@ def joint_strength(model: Model, params, plan: StagePlan, stage: int,
     A joint is made at the stage that lays the later of its two blocks (a support, and
     a block present from the start, at stage 0); at the end of stage ``k`` its age is
     the time the stages after it took (:meth:`Laying.stage_hours`, the bricks of the
-    scene each stage lays), and its strength the mortar's at that age.
+    scene each stage lays), and its strength the mortar's at that age, times its joint
+    kind's factor (:meth:`~masonry.rbe.settings.Analysis.joint_factor`).
 
     Returns
     -------
     tuple
         ``({'cohesion': c, 'tensile': t_c}, time_h)``: pascals, floats where every joint
-        has the same strength (``params``' contact law without ``laying``), else (IV,)
+        has the same strength, else (IV,)
         arrays over ``model``'s interface vertices (a joint not yet made takes the
         strength at age 0); ``time_h`` the hours to the end of ``stage``, None without
         a laying rate.
     """
+    factor = params.analysis.joint_factor(model.interfaces)
     if laying is None:
-        law = params.analysis.law
-        return {"cohesion": law.cohesion_Pa, "tensile": law.tensile_Pa}, None
+        return _law_mortar(params, model), None
     if laying.rate_per_hour is None:
         cohesion, tensile = laying.mortar.strength_kPa(0.0)
-        return {"cohesion": 1e3 * float(cohesion), "tensile": 1e3 * float(tensile)}, None
+        return {"cohesion": 1e3 * float(cohesion) * factor,
+                "tensile": 1e3 * float(tensile) * factor}, None
     laid = plan.block_stage[plan.block_stage >= 1]
     hours = laying.stage_hours(np.bincount(laid, minlength=plan.n_stages + 1)[1:])
     source = (np.arange(model.blocks.n_blocks) if model.block_source is None
@@ -196,7 +198,8 @@ def joint_strength(model: Model, params, plan: StagePlan, stage: int,
     age = np.maximum(hours[stage] - hours[np.minimum(made, stage)], 0.0)
     cohesion, tensile = laying.mortar.strength_kPa(
         np.repeat(age, model.interfaces.vertex_count))
-    return {"cohesion": 1e3 * cohesion, "tensile": 1e3 * tensile}, float(hours[stage])
+    return ({"cohesion": 1e3 * cohesion * factor, "tensile": 1e3 * tensile * factor},
+            float(hours[stage]))
 
 
 def stage_adhesion(part: Model, params, plan: StagePlan, stage: int, row,
@@ -239,7 +242,9 @@ def stage_adhesion(part: Model, params, plan: StagePlan, stage: int, row,
                                    "no adhesion holds it"}
     analysis = params.analysis
     options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone,
-                   ratio=analysis.adhesion_tension_ratio)
+                   ratio=analysis.adhesion_tension_ratio,
+                   head_ratio=analysis.head_joint_ratio,
+                   support_ratio=analysis.support_joint_ratio)
     if sequence is None:
         result, source = least_adhesion(part, **options), part.block_source
     else:
@@ -290,7 +295,7 @@ def stage_centering(part: Model, params, stands: bool, result=None, mortar=None)
     if result is None:
         analysis = params.analysis
         result = centering_force(part, mu=analysis.mu, density=analysis.density,
-                                 cone=analysis.cone, **(mortar or _law_mortar(params)))
+                                 cone=analysis.cone, **(mortar or _law_mortar(params, part)))
         source = part.block_source
     return {"centering_N": result.total_N, "centering_fraction": result.fraction,
             "held": result.held_forces(source)}
@@ -314,8 +319,10 @@ def loose_blocks(part: Model) -> np.ndarray:
     return np.unique(source[loose])
 
 
-def _law_mortar(params) -> dict:
-    law = params.analysis.law
+def _law_mortar(params, model: Model) -> dict:
+    """``params``' contact law at ``model``'s joints as the solvers' keyword arguments
+    (:meth:`~masonry.rbe.settings.Analysis.law_on`)."""
+    law = params.analysis.law_on(model.interfaces)
     return {"cohesion": law.cohesion_Pa, "tensile": law.tensile_Pa}
 
 
@@ -340,7 +347,7 @@ def stage_load_factor(part: Model, params, mortar=None) -> float | None:
     live = params.load.on(part, analysis.density)
     result = collapse_load(part, live, mu=analysis.mu, density=analysis.density,
                            cone=analysis.cone, friction=analysis.friction_law,
-                           dead_load_feasible=True, **(mortar or _law_mortar(params)))
+                           dead_load_feasible=True, **(mortar or _law_mortar(params, part)))
     return result.load_factor
 
 
