@@ -32,7 +32,6 @@ import numpy as np
 
 from masonry.errors import MasonryError
 from masonry.friction import FrictionCone
-from masonry.interfaces import INTERFACE_KINDS
 
 TENSION_RATIO = 0.5
 """The default ratio ``t_c / c`` of the least adhesion's tensile strength to its cohesion
@@ -135,7 +134,8 @@ class ContactLaw:
 
     def scaled(self, factor) -> "ContactLaw":
         """This law with both strengths times ``factor`` (a float, or (IV,) per vertex:
-        :func:`joint_factor`); itself where the factor is 1 everywhere or it is dry."""
+        :func:`masonry.interfaces.joint_factor`); itself where the factor is 1 everywhere
+        or it is dry."""
         if self.is_dry or (np.ndim(factor) == 0 and factor == 1.0):
             return self
         return ContactLaw(self.cone, self.mu, as_strength(factor * np.asarray(self.cohesion_Pa)),
@@ -172,39 +172,6 @@ class ContactLaw:
         return {"friction_model": self.cone.name, "mu": self.mu,
                 "cohesion_Pa": self.cohesion_Pa, "tensile_Pa": self.tensile_Pa,
                 "tension_cutoff_Pa": self.cutoff_Pa, "text": self.describe()}
-
-
-JOINT_KINDS = {"bed": ("horizontal",), "head": ("vertical", "boundary"),
-               "support": ("support",)}
-"""The joint kinds whose strengths differ (:func:`joint_factor`) by the interface kinds
-(:data:`masonry.interfaces.INTERFACE_KINDS`) they take: a joint between two webs
-(``boundary``, at a polygonal dome's corner or a sector's edge) joins bricks of one course
-side by side, a head joint."""
-
-
-def joint_factor(interfaces, head=1.0, support=1.0) -> float | np.ndarray:
-    """Every interface vertex's strength over the bed joints' (:data:`JOINT_KINDS`):
-    1 at bed joints, ``head`` at head joints, ``support`` at joints with a support;
-    ``1.0`` (a float) where both ratios are 1.
-
-    Parameters
-    ----------
-    interfaces : masonry.interfaces.Interfaces
-    head, support : float
-        >= 0.
-
-    Returns
-    -------
-    float or (IV,) float
-    """
-    if head == 1.0 and support == 1.0:
-        return 1.0
-    kind = np.asarray(interfaces.kind)
-    per = np.ones(len(kind))
-    for name, ratio in (("head", head), ("support", support)):
-        codes = [INTERFACE_KINDS.index(k) for k in JOINT_KINDS[name]]
-        per[np.isin(kind, codes)] = ratio
-    return np.repeat(per, np.diff(np.asarray(interfaces.offsets)))
 
 
 def as_strength(value) -> float | np.ndarray:

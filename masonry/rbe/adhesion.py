@@ -38,9 +38,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from masonry.contact import TENSION_RATIO, ContactLaw, joint_factor
+from masonry.contact import TENSION_RATIO, ContactLaw
 from masonry.errors import MasonryError
-from masonry.interfaces import INTERFACE_KINDS
+from masonry.interfaces import INTERFACE_KINDS, joint_factor
 from masonry.rbe.collapse import friction_columns
 from masonry.rbe.equilibrium import EquilibriumSystem, assemble
 from masonry.rbe.solvers.direct_clarabel import solve_cone_program
@@ -173,7 +173,7 @@ def least_adhesion(model, *, mu=0.7, density=2000.0, cone="circle", ratio=TENSIO
         ``t_c / c``, >= 0 (:data:`TENSION_RATIO`).
     head_ratio, support_ratio : float
         Head joints and joints with a support hold these fractions of ``a``
-        (:func:`masonry.contact.joint_factor`); ``a*`` is the bed joints'.
+        (:func:`masonry.interfaces.joint_factor`); ``a*`` is the bed joints'.
     time_limit : float, s
 
     Returns
@@ -204,40 +204,61 @@ def solve_adhesion(system: EquilibriumSystem, interfaces, *, ratio=TENSION_RATIO
     ratio = check_ratio(ratio)
     system = system.with_material(cohesion=0.0, tensile=0.0)
     columns = friction_columns(system)
-    area_ref = float(np.mean(system.vertex_area))
-    area = system.vertex_area / area_ref
-    held = area * joint_factor(interfaces, head_ratio, support_ratio)  # c_i A_i / a
+    area_ref, held = _held(system, interfaces, head_ratio, support_ratio)
     A, b, rows, h, cones = _program(system, columns, held, ratio)
     q = np.zeros(A.shape[1])
     q[-1] = 1.0
     status, z, iterations = solve_cone_program(q, A, b, rows, h, cones, time_limit)
-    law = system.law
     if z is None:
         log.warning("least adhesion: Clarabel ended %s", status)
         reason = (f"infeasible: no adhesion balances it with tension ratio {ratio:g}"
                   if status == "PrimalInfeasible" else f"Clarabel ended {status}")
-        return _unsolved(interfaces, law, ratio, reason, status,
+        return _unsolved(interfaces, system.law, ratio, reason, status,
                          iterations, time.perf_counter() - start)
     # within the acceptance tolerance of standing dry is standing dry (checked at 0)
     a = float(z[-1]) if z[-1] > ACCEPT_RESIDUAL else 0.0
     x = columns.edges @ z[:-1]
     x[system.layout.columns("c")] -= a * held / system.mu       # the physical n
-    residual, violation = _residuals(system, x, a * held, ratio)
+    return adhesion_at(system, interfaces, x, a * system.weight_ref / area_ref / 1e3,
+                       ratio=ratio, head_ratio=head_ratio, support_ratio=support_ratio,
+                       status=status, iterations=iterations, start=start)
+
+
+def adhesion_at(system: EquilibriumSystem, interfaces, x, a_kPa, *, ratio=TENSION_RATIO,
+                head_ratio=1.0, support_ratio=1.0, status="optimal", iterations=0,
+                start=None) -> AdhesionResult:
+    """The least adhesion ``a_kPa`` with the point that shows it: the physical vertex
+    forces ``x`` (solver units of ``system``, dry) balance the blocks within the law at
+    cohesion ``a`` (per joint kind) and tension ``r a``, recomputed; a point beyond
+    :data:`~masonry.tolerances.ACCEPT_RESIDUAL` gives no value. ``start``: the
+    :func:`time.perf_counter` its search began at (``time_s``)."""
+    start = time.perf_counter() if start is None else start
+    system = system.with_material(cohesion=0.0, tensile=0.0)
+    area_ref, held = _held(system, interfaces, head_ratio, support_ratio)
     unit_kPa = system.weight_ref / area_ref / 1e3
-    used = _interface_use(system, x, area, ratio) * unit_kPa
+    residual, violation = _residuals(system, x, a_kPa / unit_kPa * held, ratio)
     common = dict(ratio=ratio, interface_pair=np.asarray(interfaces.pair),
-                  interface_kind=np.asarray(interfaces.kind), law=law, iterations=iterations,
-                  time_s=time.perf_counter() - start, residual_eq=residual,
-                  law_violation=violation)
+                  interface_kind=np.asarray(interfaces.kind), law=system.law,
+                  iterations=iterations, time_s=time.perf_counter() - start,
+                  residual_eq=residual, law_violation=violation)
     if max(residual, violation) > ACCEPT_RESIDUAL:
-        log.warning("least adhesion: Clarabel's point (%s) rejected: residual %.1e, law "
+        log.warning("least adhesion: the point (%s) rejected: residual %.1e, law "
                     "violation %.1e", status, residual, violation)
         return AdhesionResult(None, interface_kPa=np.zeros(len(interfaces)), status=status,
                               reason=f"the optimum failed its check (residual "
                                      f"{residual:.1e}, law violation {violation:.1e})",
                               **common)
-    log.info("least adhesion: %.6g kPa, %d iterations", a * unit_kPa, iterations)
-    return AdhesionResult(a * unit_kPa, interface_kPa=used, status="optimal", **common)
+    log.info("least adhesion: %.6g kPa, %d iterations", a_kPa, iterations)
+    used = _interface_use(system, x, system.vertex_area / area_ref, ratio) * unit_kPa
+    return AdhesionResult(a_kPa, interface_kPa=used, status="optimal", **common)
+
+
+def _held(system, interfaces, head_ratio, support_ratio) -> tuple:
+    """``(A_ref, held)``: the mean tributary area (m^2) and every vertex's strength per
+    unit ``a`` in units of it, its tributary area times its joint's factor."""
+    area_ref = float(np.mean(system.vertex_area))
+    factor = joint_factor(interfaces, head_ratio, support_ratio)
+    return area_ref, system.vertex_area / area_ref * factor
 
 
 def stands_dry(interfaces, law, ratio) -> AdhesionResult:
