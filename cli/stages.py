@@ -4,8 +4,8 @@ from masonry.errors import ParameterError
 from masonry.params import Params, validate
 
 from .options import (add_analysis_options, add_figure_options, add_model_options,
-                      add_overlap_option, add_verbosity, centering_line, given_inputs, params_from_args,
-                      pattern_note)
+                      add_overlap_option, add_verbosity, centering_line, given_inputs,
+                      params_from_args, pattern_note)
 
 
 NAME = "stages"
