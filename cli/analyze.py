@@ -3,6 +3,7 @@
 from masonry.params import Params, validate
 
 from .options import (add_analysis_options, add_live_load_options, add_output_options,
+                      add_overlap_option,
                       check_print_size, collapse_summary, given_inputs, rbe_summary, summary)
 
 
@@ -27,6 +28,7 @@ def register(subparsers):
                    help="every block reaching down to z <= Z (metres) is a support")
     g.add_argument("--ground", action="store_true",
                    help="add a ground slab (a support) under the lowest blocks")
+    add_overlap_option(g)
     add_analysis_options(parser, boundary=False)
     add_live_load_options(parser)
     parser.add_argument("--fast", action="store_true", default=None,
@@ -44,7 +46,8 @@ def handle(args, report):
     from masonry.scenes.imported import load_assembly
 
     scene, source = load_assembly(args.files, supports=args.support,
-                                  support_below=args.support_below, ground=args.ground)
+                                  support_below=args.support_below, ground=args.ground,
+                                  overlap_tolerance=args.overlap_tolerance)
     inputs = assembly_inputs(scene.blocks, source, given)  # the options win over a Problem's
     params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **inputs))
     record = run(params, args.out, analyse=True, force=args.force, scene=scene,

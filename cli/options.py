@@ -14,7 +14,8 @@ from masonry.rbe.settings import BOUNDARIES, FRICTION_LAWS, FRICTIONS, Analysis
 from masonry.rbe.accuracy import ACCURACY
 from masonry.rbe.solvers import RBE, names as solver_names
 from masonry.scenes import KINDS, kind_of
-from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS
+from masonry.tolerances import (BYTES_PER_BRICK, INTERPENETRATION_REL, MAX_BRICKS,
+                                OVERLAP_TOLERANCE_RANGE)
 
 ACCURACIES, SOLVERS = tuple(ACCURACY), solver_names(RBE)
 PARTS = (Analysis, Outputs, *(kind.geometry for kind in KINDS.values()))
@@ -193,6 +194,14 @@ def _scene_help(name, declaration, geometry, groups) -> str:
 
 def _text(value) -> str:
     return "none" if value is None else f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def add_overlap_option(group):
+    low, high = OVERLAP_TOLERANCE_RANGE
+    group.add_argument("--overlap-tolerance", dest="overlap_tolerance", type=float,
+                       metavar="REL", help="accept blocks that interpenetrate by up to this "
+                       f"fraction of the smaller one's size ({low:g} to {high:g}; default "
+                       f"{INTERPENETRATION_REL:g}): for models that overlap by design")
 
 
 def add_analysis_options(parser, boundary=True):

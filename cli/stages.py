@@ -4,8 +4,8 @@ from masonry.errors import ParameterError
 from masonry.params import Params, validate
 
 from .options import (add_analysis_options, add_figure_options, add_model_options,
-                      add_verbosity, centering_line, given_inputs, params_from_args,
-                      pattern_note)
+                      add_overlap_option, add_verbosity, centering_line, given_inputs,
+                      params_from_args, pattern_note)
 
 
 NAME = "stages"
@@ -42,6 +42,7 @@ def register(subparsers):
                    help="every block reaching down to z <= Z (metres) is a support")
     g.add_argument("--ground", action="store_true",
                    help="add a ground slab (a support) under the lowest blocks")
+    add_overlap_option(g)
     add_model_options(parser)
     add_analysis_options(parser)
     g = parser.add_argument_group("mortar by age (docs/model.md 6.13)")
@@ -99,12 +100,12 @@ def _refuse_inapplicable(args):
                                      "not built")
         return
     given = {"support": bool(args.support), "support_below": args.support_below is not None,
-             "ground": args.ground}  # a height of 0 is given too
+             "ground": args.ground, "overlap_tolerance": args.overlap_tolerance is not None}
     name = next((name for name, is_given in given.items() if is_given), None)
     if name is not None:
         raise ParameterError(name, getattr(args, name),
-                             "FILE... beside it: it chooses the supports of blocks read "
-                             "from files; a dome or wall stands on its ground slab")
+                             "FILE... beside it: it applies to blocks read from files; a "
+                             "dome or wall stands on its ground slab")
 
 
 def handle(args, report):
@@ -116,7 +117,8 @@ def handle(args, report):
         given = given_inputs(args)
         validate(Params.of(scene="assembly", assembly="-", **given))  # before any reading
         scene, source = load_assembly(args.files, supports=args.support,
-                                      support_below=args.support_below, ground=args.ground)
+                                      support_below=args.support_below, ground=args.ground,
+                                      overlap_tolerance=args.overlap_tolerance)
         params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly,
                                     **given))
         by = args.by or "block"

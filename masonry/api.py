@@ -265,7 +265,8 @@ def build(preset=None, **inputs) -> Structure:
     return Structure(params, scene, model)
 
 
-def read(*paths, support=(), support_below=None, ground=False, **inputs) -> Structure:
+def read(*paths, support=(), support_below=None, ground=False, overlap_tolerance=None,
+         **inputs) -> Structure:
     """A structure of blocks read from mesh files (OBJ, STL, PLY, COMPAS JSON;
     docs/assemblies.md).
 
@@ -280,6 +281,9 @@ def read(*paths, support=(), support_below=None, ground=False, **inputs) -> Stru
         Every block reaching below this height (metres) is fixed.
     ground : bool
         Add a ground slab (a support) under the lowest blocks.
+    overlap_tolerance : float, optional
+        Accept blocks that interpenetrate by up to this fraction of the smaller one's
+        size (default :data:`masonry.tolerances.INTERPENETRATION_REL`; docs/assemblies.md).
     **inputs
         Analysis, live-load and output inputs (``mu``, ``density``, ``lateral`` ...);
         they win over a compas_dem Problem's (:func:`assembly_inputs`).
@@ -289,13 +293,14 @@ def read(*paths, support=(), support_below=None, ground=False, **inputs) -> Stru
     masonry.scenes.imported.AssemblyError
         A file or block that cannot be read, no support, overlapping blocks.
     masonry.errors.ParameterError
-        An input out of its range or of the wrong type, or a ``scene`` (the blocks are
-        the scene).
+        An input out of its range or of the wrong type (``overlap_tolerance`` too), or a
+        ``scene`` (the blocks are the scene).
     """
     supports = _checked_supports(paths, support, support_below, ground, inputs)
     validate(Params.of(scene="assembly", assembly="-", **inputs))  # before any file is read
     scene, source = load_assembly(paths, supports=supports,
-                                  support_below=plain(support_below), ground=ground)
+                                  support_below=plain(support_below), ground=ground,
+                                  overlap_tolerance=overlap_tolerance)
     inputs = assembly_inputs(scene.blocks, source, inputs)
     params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **inputs))
     return Structure(params, scene, analysis_model(scene, params.analysis.boundary), source)

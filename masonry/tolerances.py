@@ -200,13 +200,20 @@ back) lies inside an edge or inside the face and is dropped
 INTERPENETRATION_REL = 1e-3
 """Two blocks of an imported assembly overlap when they interpenetrate by more than this
 fraction of the smaller one's size (its bounding box diagonal): overlapping solids are
-not a structure (:func:`masonry.scenes.imported.overlapping_pairs`). Less is taken for
-the imprecision of a drawing (the interface detector closes such gaps)."""
+not a structure (:func:`masonry.scenes.overlaps.overlapping_pairs`). Less is taken for
+the imprecision of a drawing (the interface detector closes such gaps). The default of
+``--overlap-tolerance``, which accepts models that overlap by design (docs/assemblies.md)."""
+
+OVERLAP_TOLERANCE_RANGE = (1e-6, 0.1)
+"""The overlaps ``--overlap-tolerance`` may accept, as fractions of the smaller block's
+size: from the contact tolerance's order (blocks that merely touch are never taken for
+overlapping) to a tenth of a block, beyond which the blocks are not the model's but
+something else (compas_cra's Armadillo's convex hulls overlap by up to 4%)."""
 
 PARALLEL_SIN = 1e-9
 """Two unit edge directions whose cross product is shorter than this (the sine of their
 angle) are parallel: their cross product is no separating axis, and the blocks' face
-normals already test that direction (:func:`masonry.scenes.imported.overlapping_pairs`)."""
+normals already test that direction (:func:`masonry.scenes.overlaps.overlapping_pairs`)."""
 
 GROUND_MARGIN_REL = 0.05
 """The ground slab that ``masonry analyze --ground`` adds reaches past the footprint of

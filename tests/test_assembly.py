@@ -264,7 +264,7 @@ def test_overlapping_pairs_agree_with_the_intersection_volume():
     import manifold3d
 
     from masonry.blocks import Blocks
-    from masonry.scenes.imported import overlapping_pairs
+    from masonry.scenes.overlaps import overlapping_pairs
     from masonry.tolerances import INTERPENETRATION_REL
     from scipy.spatial.transform import Rotation
 
@@ -279,7 +279,7 @@ def test_overlapping_pairs_agree_with_the_intersection_volume():
         blocks = Blocks.from_hexahedra(corners, block_class=[0, 0])
         solids = [manifold3d.Manifold.hull_points(c) for c in corners]
         volume = (solids[0] ^ solids[1]).volume()
-        found = len(overlapping_pairs(blocks)) == 1
+        found = len(overlapping_pairs(blocks)[0]) == 1
         smaller = min(np.linalg.norm(s) for s in sizes)
         # the intersection lies in a slab as wide as the overlap along any axis, and its
         # sections are no larger than smaller^2 (smaller: the smaller box's diagonal), so

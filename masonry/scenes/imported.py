@@ -31,6 +31,7 @@ face on either side), instead of joining everything that shares an edge.
 import dataclasses
 import hashlib
 import logging
+import numbers
 import re
 import time
 from dataclasses import dataclass
@@ -45,9 +46,10 @@ from masonry.meshing import merge_vertices
 from masonry.parameters import declare
 from masonry.scenes.base import Scene, SceneKind
 from masonry.scenes.mesh_files import AssemblyError, TriangleSoup, read_mesh
-from masonry.tolerances import (COINCIDENT_ANGLE, CONVEXITY_REL,
-                                GROUND_MARGIN_REL, INTERPENETRATION_REL, PARALLEL_SIN,
-                                Tolerances)
+from masonry.scenes.overlaps import overlapping_pairs
+from masonry.errors import ParameterError
+from masonry.tolerances import (COINCIDENT_ANGLE, CONVEXITY_REL, GROUND_MARGIN_REL,
+                                INTERPENETRATION_REL, OVERLAP_TOLERANCE_RANGE, Tolerances)
 
 log = logging.getLogger(__name__)
 
@@ -223,7 +225,8 @@ class Assembly(SceneKind):
         return f"assembly_{geometry.assembly}"
 
 
-def load_assembly(paths, *, supports=(), support_below=None, ground=False):
+def load_assembly(paths, *, supports=(), support_below=None, ground=False,
+                  overlap_tolerance=None):
     """The ``assembly`` scene of mesh files: blocks, supports, optional ground slab.
 
     Parameters
@@ -234,6 +237,10 @@ def load_assembly(paths, *, supports=(), support_below=None, ground=False):
         Either replaces the supports a COMPAS file flags; without them, those are kept.
     ground : bool
         Add a ground slab under the lowest blocks (:func:`with_ground`).
+    overlap_tolerance : float, optional
+        Blocks may interpenetrate by up to this fraction of the smaller one's size
+        (:func:`~masonry.scenes.overlaps.overlapping_pairs`); default
+        :data:`~masonry.tolerances.INTERPENETRATION_REL`.
 
     Returns
     -------
@@ -242,16 +249,19 @@ def load_assembly(paths, *, supports=(), support_below=None, ground=False):
         directions (bed and head joints are named with respect to z) and no CAD offset.
     source : dict
         Provenance for run.json: ``files``, ``support``, ``support_below``, ``ground``,
-        the number of ``supports`` and the reading time ``read_s`` (seconds).
+        the number of ``supports``, the ``overlap_tolerance`` and the overlaps it
+        accepted (``overlaps``: count and deepest, in metres and as a fraction of the
+        smaller block's size) and the reading time ``read_s`` (seconds).
 
     Raises
     ------
     AssemblyError
         A file or a block is bad (:func:`read_blocks`), a support pattern matches
-        nothing, no block (or every block) is a support, or two blocks overlap
-        (:func:`overlapping_pairs`).
+        nothing, no block (or every block) is a support, or two blocks overlap by more
+        than ``overlap_tolerance``.
     """
     start = time.perf_counter()
+    overlap_tolerance = checked_overlap_tolerance(overlap_tolerance)
     if not paths:
         raise AssemblyError("no mesh file given")
     soups = [read_mesh(p) for p in paths]
@@ -269,13 +279,13 @@ def load_assembly(paths, *, supports=(), support_below=None, ground=False):
     if is_support.all():
         raise AssemblyError(f"every one of the {len(is_support)} blocks is a support: "
                             "nothing is left to analyse")
-    _refuse_overlaps(blocks, paths)
+    overlaps = _checked_overlaps(blocks, paths, overlap_tolerance)
     blocks = dataclasses.replace(blocks, block_is_support=is_support)
     geometry = AssemblyGeometry(assembly_name(paths, blocks))
     source = {"files": [str(p) for p in paths], "support": list(supports),
               "support_below": support_below, "ground": bool(ground),
-              "supports": int(is_support.sum()),
-              "read_s": round(time.perf_counter() - start, 4)}
+              "supports": int(is_support.sum()), "overlap_tolerance": overlap_tolerance,
+              "overlaps": overlaps, "read_s": round(time.perf_counter() - start, 4)}
     if problem is not None:
         source["problem"] = problem
     log.info("read %d blocks (%d supports) in %.3g s", blocks.n_blocks, source["supports"],
@@ -302,16 +312,64 @@ def _problem_record(paths, soups, first) -> dict | None:
     return {"file": str(path), **record}
 
 
-def _refuse_overlaps(blocks: Blocks, paths):
-    """Raise :class:`AssemblyError` naming the first pair of :func:`overlapping_pairs`."""
-    overlaps = overlapping_pairs(blocks)
-    if len(overlaps):
-        a, b = blocks.block_name[overlaps[0, 0]], blocks.block_name[overlaps[0, 1]]
-        more = f" ({len(overlaps) - 1} more pairs)" if len(overlaps) > 1 else ""
+def checked_overlap_tolerance(rel) -> float:
+    """``rel`` (None: :data:`~masonry.tolerances.INTERPENETRATION_REL`) as a float.
+
+    Raises
+    ------
+    masonry.errors.ParameterError
+        ``rel`` is not a number within :data:`~masonry.tolerances.OVERLAP_TOLERANCE_RANGE`.
+    """
+    if rel is None:
+        return INTERPENETRATION_REL
+    low, high = OVERLAP_TOLERANCE_RANGE
+    if isinstance(rel, bool) or not isinstance(rel, numbers.Real) or not low <= rel <= high:
+        raise ParameterError("overlap_tolerance", rel, f"a fraction of the smaller block's "
+                             f"size from {low:g} to {high:g} (default {INTERPENETRATION_REL:g})")
+    return float(rel)
+
+
+def _checked_overlaps(blocks: Blocks, paths, rel) -> dict:
+    """The overlaps that ``rel`` accepts, for run.json: the number of ``pairs`` deeper
+    than :data:`~masonry.tolerances.INTERPENETRATION_REL` (or ``rel`` if less), the
+    deepest ``depth_m`` and the largest ``fraction`` of the smaller block's size.
+
+    Raises
+    ------
+    AssemblyError
+        Blocks overlap by more than ``rel``: naming the deepest pair, how many pairs, and
+        the ``--overlap-tolerance`` that would accept them all.
+    """
+    pairs, depth = overlapping_pairs(blocks, min(rel, INTERPENETRATION_REL))
+    if len(pairs) == 0:
+        return {"pairs": 0, "depth_m": 0.0, "fraction": 0.0}
+    fraction = depth / _smaller_size(blocks, pairs)
+    k = int(np.argmax(fraction))
+    if fraction[k] > rel:
+        a, b = blocks.block_name[pairs[k, 0]], blocks.block_name[pairs[k, 1]]
         files = ", ".join(str(p) for p in paths)
-        raise AssemblyError(f"{files}: blocks {a!r} and {b!r} overlap{more}: interpenetrating "
-                            "solids are not a structure (a block given twice, or the same "
-                            "file twice?)")
+        enough = _round_up(fraction[k])
+        way_out = (f"if the model overlaps by design, accept it with --overlap-tolerance "
+                   f"{enough:g}" if enough <= OVERLAP_TOLERANCE_RANGE[1] else
+                   f"deeper than --overlap-tolerance accepts ({OVERLAP_TOLERANCE_RANGE[1]:g})")
+        raise AssemblyError(
+            f"{files}: blocks {a!r} and {b!r} overlap by {1000 * depth[k]:.3g} mm, "
+            f"{fraction[k]:.3g} of the smaller one's size ({int((fraction > rel).sum())} "
+            f"pairs overlap by more than --overlap-tolerance {rel:g}): interpenetrating "
+            f"solids are not a structure (a block or file given twice?); {way_out}")
+    return {"pairs": len(pairs), "depth_m": float(depth[k]), "fraction": float(fraction[k])}
+
+
+def _smaller_size(blocks: Blocks, pairs) -> np.ndarray:
+    """(P,) float, metres: the smaller bounding box diagonal of each pair's blocks."""
+    size = np.linalg.norm(blocks.block_bounds[:, 1] - blocks.block_bounds[:, 0], axis=1)
+    return np.minimum(size[pairs[:, 0]], size[pairs[:, 1]])
+
+
+def _round_up(fraction: float) -> float:
+    """``fraction`` rounded up to one significant digit (0.0137 -> 0.02)."""
+    step = 10.0 ** np.floor(np.log10(fraction))
+    return float(np.ceil(fraction / step) * step)
 
 
 # ---------------------------------------------------------------------- triangle soups
@@ -576,98 +634,3 @@ def _classes_from_names(names):
             block_class[i] = BLOCK_CLASSES.index(match.group(1))
             block_course[i] = int(match.group(2))
     return block_class, block_course
-
-
-# ---------------------------------------------------------------------- overlaps
-def overlapping_pairs(blocks: Blocks) -> np.ndarray:
-    """Pairs of convex blocks that interpenetrate by more than
-    :data:`~masonry.tolerances.INTERPENETRATION_REL` of the smaller one's size (its
-    bounding box diagonal).
-
-    Decided by the separating axis theorem: pairs whose bounding boxes overlap are
-    projected on the face normals of both blocks, all at once (blocks in contact are
-    separated by their common face's normal); the few left are projected on the cross
-    products of their edges too, which makes the test exact.
-
-    Parameters
-    ----------
-    blocks : Blocks
-        Convex blocks (metres).
-
-    Returns
-    -------
-    (P, 2) int
-        Block index pairs, lower index first, sorted.
-    """
-    lo, hi = blocks.block_bounds[:, 0], blocks.block_bounds[:, 1]
-    size = np.linalg.norm(hi - lo, axis=1)
-    a, b = _box_pairs(lo, hi)
-    depth = INTERPENETRATION_REL * np.minimum(size[a], size[b])
-    boxes = (np.minimum(hi[a], hi[b]) - np.maximum(lo[a], lo[b])).min(axis=1) > depth
-    a, b, depth = a[boxes], b[boxes], depth[boxes]
-    points, normals = _padded(blocks)
-    deep = np.zeros(len(a), bool)
-    chunk = 4096  # pairs at a time: bounded memory
-    for start in range(0, len(a), chunk):
-        i, j = a[start:start + chunk], b[start:start + chunk]
-        axes = np.concatenate([normals[i], normals[j]], axis=1)
-        pa = np.einsum("pvk,pfk->pvf", points[i], axes)
-        pb = np.einsum("pvk,pfk->pvf", points[j], axes)
-        overlap = np.minimum(pa.max(axis=1) - pb.min(axis=1), pb.max(axis=1) - pa.min(axis=1))
-        deep[start:start + chunk] = overlap.min(axis=1) > depth[start:start + chunk]
-    found = [(min(i, j), max(i, j)) for i, j, d in zip(a[deep], b[deep], depth[deep])
-             if _overlap_on_edge_axes(blocks, i, j) > d]
-    return np.array(sorted(found), int).reshape(-1, 2)
-
-
-def _box_pairs(lo, hi):
-    """Index pairs ``(a, b)`` of boxes whose x ranges overlap (a sweep along x)."""
-    n = len(lo)
-    order = np.argsort(lo[:, 0], kind="stable")
-    start = lo[order, 0]
-    end = np.searchsorted(start, hi[order, 0], side="left")
-    counts = np.maximum(end - np.arange(n) - 1, 0)
-    first = np.repeat(np.arange(n), counts)
-    offset = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-    return order[first], order[first + 1 + offset]
-
-
-def _padded(blocks: Blocks):
-    """``(B, V, 3)`` vertices and ``(B, F, 3)`` face normals per block, each padded with
-    its block's first one (which changes no projection's range)."""
-    vertex_counts = np.diff(blocks.vertex_offsets)
-    rank = np.arange(len(blocks.vertices)) - np.repeat(blocks.vertex_offsets[:-1],
-                                                       vertex_counts)
-    points = np.repeat(blocks.vertices[blocks.vertex_offsets[:-1], None, :],
-                       vertex_counts.max(), axis=1)
-    points[np.repeat(np.arange(blocks.n_blocks), vertex_counts), rank] = blocks.vertices
-    face_counts = np.bincount(blocks.face_block, minlength=blocks.n_blocks)
-    first_face = np.concatenate([[0], np.cumsum(face_counts)[:-1]])
-    rank = np.arange(blocks.n_faces) - first_face[blocks.face_block]
-    normals = np.repeat(blocks.face_normal[first_face, None, :], face_counts.max(), axis=1)
-    normals[blocks.face_block, rank] = blocks.face_normal
-    return points, normals
-
-
-def _overlap_on_edge_axes(blocks: Blocks, a: int, b: int) -> float:
-    """Smallest overlap of two blocks along the cross products of their edges."""
-    edges_a, edges_b = _block_edges(blocks, a), _block_edges(blocks, b)
-    cross = np.cross(edges_a[:, None, :], edges_b[None, :, :]).reshape(-1, 3)
-    length = np.linalg.norm(cross, axis=1)
-    axes = cross[length > PARALLEL_SIN] / length[length > PARALLEL_SIN, None]
-    if len(axes) == 0:
-        return np.inf
-    pa, pb = blocks.block_vertices(a) @ axes.T, blocks.block_vertices(b) @ axes.T
-    return float(np.minimum(pa.max(axis=0) - pb.min(axis=0),
-                            pb.max(axis=0) - pa.min(axis=0)).min())
-
-
-def _block_edges(blocks: Blocks, block: int) -> np.ndarray:
-    """(E, 3) unit edge directions of one block (each edge once per face using it)."""
-    edges = []
-    for face in blocks.block_faces(block):
-        polygon = blocks.face_polygon(face)
-        edges.append(np.roll(polygon, -1, axis=0) - polygon)
-    edges = np.vstack(edges)
-    length = np.linalg.norm(edges, axis=1)
-    return edges[length > 0] / length[length > 0, None]
