@@ -189,7 +189,7 @@ def _whole_dome_pngs(blocks, interfaces, forces, fast, title, n, noise, render) 
 
 
 def adhesion_pngs(blocks, interfaces, used_kPa, a_kPa, fast=False, title="",
-                  render=PNG) -> dict:
+                  render=PNG, drawn=None) -> dict:
     """The interfaces coloured by the adhesion each uses at the least adhesion's optimum
     (docs/model.md 6.12), kPa, on the magnitude map from 0 to the largest (the joint
     that uses most in the map's top colour; no percentile: the largest is the point);
@@ -204,6 +204,8 @@ def adhesion_pngs(blocks, interfaces, used_kPa, a_kPa, fast=False, title="",
         :attr:`~masonry.rbe.adhesion.AdhesionResult.interface_kPa`.
     a_kPa : float
         ``a*`` > 0.
+    drawn : (B,) bool, optional
+        The blocks outlined (default all; a construction stage's laid ones), faintly.
     """
     used = np.asarray(used_kPa, dtype=float)
     needs = used > ADHESION_REPORTED_REL * a_kPa
@@ -218,14 +220,16 @@ def adhesion_pngs(blocks, interfaces, used_kPa, a_kPa, fast=False, title="",
     for view in views_of(blocks.bounds, fast):
         fig, ax = view_axes(blocks.bounds, view)
         # the blocks' outlines, faint: where the joints are in the structure
-        faces = visible_faces(blocks, np.ones(blocks.n_blocks, bool), view)
+        faces = visible_faces(blocks, np.ones(blocks.n_blocks, bool) if drawn is None
+                              else drawn, view)
         add_polygons(ax, view, face_array(blocks, faces), NO_FILL, edgecolors="0.7",
                      linewidths=0.2)
         add_polygons(ax, view, polygons, colours,
                      linewidths=_interface_linewidth(len(polygons)))
         colour_bar(fig, ax, scale, "adhesion the joint uses")
-        legend_below(fig, ax, [Patch(facecolor=NO_ADHESION, label="no adhesion: dry "
-                                     "friction holds the joint")])
+        if not needs.all():
+            legend_below(fig, ax, [Patch(facecolor=NO_ADHESION, label="no adhesion: dry "
+                                         "friction holds the joint")])
         ax.set_title(f"joints coloured by the adhesion they use: a* = {a_kPa:.4g} kPa, "
                      f"{int(needs.sum())} of {len(used)} joints use it\n{title}",
                      fontsize=9)
