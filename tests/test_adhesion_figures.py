@@ -50,7 +50,8 @@ def thin_arch():
 @pytest.fixture
 def drawn(monkeypatch):
     """Per figure saved: the colour bar's range and, in the order given, the colours of
-    the joints (the collection of an elevation with filled faces)."""
+    the joints of each filled collection of an elevation (those dry friction holds,
+    then those that use adhesion)."""
     kept = []
 
     def keep(fig, dpi, render=None, close=True):
@@ -58,10 +59,7 @@ def drawn(monkeypatch):
         ax, bar = fig.axes[0], fig.axes[1]
         joints = [c for c in ax.collections if isinstance(c, Projected)
                   and (c.get_facecolor()[:, 3] > 0).all()]
-        colours = None
-        if joints:
-            (collection,) = joints
-            colours = collection.get_facecolor()[np.argsort(collection.order)]
+        colours = [c.get_facecolor()[np.argsort(c.order)] for c in joints]
         kept.append((bar.get_ylim(), colours))
         plt.close(fig)
         return {"png": b"\x89PNG kept"}
@@ -84,13 +82,13 @@ def test_the_bar_spans_zero_to_the_largest_use_and_the_top_joint_has_the_top_col
     assert sorted(files) == [f"{view}.png" for view in VIEWS]
     (low, high), _ = drawn[0]
     assert (low, high) == (0.0, pytest.approx(top, rel=1e-9))
-    _, colours = drawn[1]  # the arch's face
+    _, (held, using) = drawn[1]  # the arch's face
     viridis = matplotlib.colormaps["viridis"]
-    assert colours[np.argmax(used)] == pytest.approx(np.array(viridis(1.0)), abs=1e-12)
     uses = used > 1e-3 * result.a_kPa
     assert 0 < uses.sum() < len(used)
-    assert colours[uses] == pytest.approx(viridis(used[uses] / top), abs=1e-12)
-    assert colours[~uses] == pytest.approx(np.tile(to_rgba(NO_ADHESION), ((~uses).sum(), 1)))
+    assert using[np.argmax(used[uses])] == pytest.approx(np.array(viridis(1.0)), abs=1e-12)
+    assert using == pytest.approx(viridis(used[uses] / top), abs=1e-12)
+    assert held == pytest.approx(np.tile(to_rgba(NO_ADHESION), ((~uses).sum(), 1)))
 
 
 def test_the_stage_where_the_adhesion_peaks_is_drawn_from_its_own_program(drawn):
@@ -109,7 +107,7 @@ def test_the_stage_where_the_adhesion_peaks_is_drawn_from_its_own_program(drawn)
     (low, high), _ = drawn[0]
     assert low == 0.0 and high == pytest.approx(alone.interface_kPa.max(), rel=1e-4)
     _, colours = drawn[1]
-    assert len(colours) == len(part.interfaces)
+    assert sum(len(c) for c in colours) == len(part.interfaces)
 
 
 def _traces(path) -> list:
@@ -129,8 +127,8 @@ def _array(value) -> np.ndarray:
 def test_a_run_that_needs_adhesion_writes_its_joints_figure_and_page_layer(tmp_path):
     """``masonry run`` of the thin arch at --dpi 60 in PNG and SVG: the figure of every
     view, listed in run.json, the PNG as many pixels as the SVG's size in points at 60
-    per 72 (within 2 %: text is measured at each resolution, and the crop follows it); dome.html's ``joints`` trace holds the
-    joints RBE/adhesion.csv says use adhesion (more than 1e-3 of a*), each with its
+    per 72 (within 2 %: text is measured at each resolution, and the crop follows it);
+    dome.html's ``joints`` trace holds the joints RBE/adhesion.csv says use adhesion (more than 1e-3 of a*), each with its
     kPa to 1e-9 (the CSV's digits) and named by its blocks, on a bar from 0 to the
     largest; the page offers the colouring that shows it."""
     assert main(["run", "--scene", "arch", "--thickness", "0.4", "--dpi", "60",

@@ -9,15 +9,17 @@ instead."""
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.colors import Normalize, to_rgba
+from matplotlib.colors import Normalize
+from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from masonry.blocks import concatenate, rotated_web, rotation_z
-from masonry.plots.colours import (NO_ADHESION, SEQUENTIAL, colour_bar, colour_scale,
-                                   one_value)
-from masonry.plots.common import (HORIZONTAL_KINDS, NO_FILL, PNG, add_polygons, as_files,
-                                  axes_3d, figure_files, legend_below, recolour, view_axes,
-                                  views_of, visible_faces)
+from masonry.plots.colours import (EMPHASIS, NO_ADHESION, SEQUENTIAL, colour_bar,
+                                   colour_scale, one_value)
+from masonry.plots.common import (ELEVATIONS, HORIZONTAL_KINDS, NO_FILL, PNG, add_points,
+                                  add_polygons, as_files, axes_3d, figure_files,
+                                  legend_below, recolour, view_axes, views_of,
+                                  visible_faces)
 from masonry.plots.faces import face_array, interface_array
 from masonry.tolerances import ADHESION_REPORTED_REL
 
@@ -188,13 +190,20 @@ def _whole_dome_pngs(blocks, interfaces, forces, fast, title, n, noise, render) 
     return out
 
 
+RINGED_JOINTS = (30, 0.05)
+"""When at most this many joints use adhesion, and at most this fraction of them,
+:func:`adhesion_pngs` rings each (:data:`~masonry.plots.colours.EMPHASIS`): a few joints
+among thousands show at any scale (where many use it, they show themselves)."""
+
+
 def adhesion_pngs(blocks, interfaces, used_kPa, a_kPa, fast=False, title="",
                   render=PNG, drawn=None) -> dict:
     """The interfaces coloured by the adhesion each uses at the least adhesion's optimum
     (docs/model.md 6.12), kPa, on the magnitude map from 0 to the largest (the joint
     that uses most in the map's top colour; no percentile: the largest is the point);
     those that use at most :data:`~masonry.tolerances.ADHESION_REPORTED_REL` of ``a_kPa``
-    (the joints dry friction holds) light grey (:data:`~masonry.plots.colours.NO_ADHESION`).
+    (the joints dry friction holds) light grey (:data:`~masonry.plots.colours.NO_ADHESION`),
+    under the others; a few joints that use it ringed too (:data:`RINGED_JOINTS`).
     ``<view>.png`` per view of the model's extent, in the formats of ``render``.
 
     Parameters
@@ -213,23 +222,33 @@ def adhesion_pngs(blocks, interfaces, used_kPa, a_kPa, fast=False, title="",
     scale = {"factor": 1.0, "unit": "kPa", "norm": Normalize(0.0, top),
              "cmap": matplotlib.colormaps[SEQUENTIAL], "extend": "neither", "above": 0,
              "below": 0, "largest": top}
-    colours = np.where(needs[:, None], scale["cmap"](scale["norm"](used)),
-                       to_rgba(NO_ADHESION))
     polygons = interface_array(interfaces, np.arange(len(interfaces)))
+    width = _interface_linewidth(len(polygons))
     out = {}
     for view in views_of(blocks.bounds, fast):
         fig, ax = view_axes(blocks.bounds, view)
+        if view not in ELEVATIONS:
+            ax.computed_zorder = False  # in the order below: the joints that use it on top
         # the blocks' outlines, faint: where the joints are in the structure
         faces = visible_faces(blocks, np.ones(blocks.n_blocks, bool) if drawn is None
                               else drawn, view)
         add_polygons(ax, view, face_array(blocks, faces), NO_FILL, edgecolors="0.7",
                      linewidths=0.2)
-        add_polygons(ax, view, polygons, colours,
-                     linewidths=_interface_linewidth(len(polygons)))
-        colour_bar(fig, ax, scale, "adhesion the joint uses")
+        handles = []
         if not needs.all():
-            legend_below(fig, ax, [Patch(facecolor=NO_ADHESION, label="no adhesion: dry "
-                                         "friction holds the joint")])
+            add_polygons(ax, view, polygons[~needs], NO_ADHESION, linewidths=width)
+            handles.append(Patch(facecolor=NO_ADHESION, label="no adhesion: dry friction "
+                                                              "holds the joint"))
+        add_polygons(ax, view, polygons[needs], scale["cmap"](scale["norm"](used[needs])),
+                     linewidths=width)
+        if needs.sum() <= min(RINGED_JOINTS[0], RINGED_JOINTS[1] * len(used)):
+            add_points(ax, view, interfaces.centre[needs], s=160, facecolors="none",
+                       edgecolors=EMPHASIS, linewidths=1.2)
+            handles.append(Line2D([], [], color=EMPHASIS, marker="o", markersize=9,
+                                  fillstyle="none", linestyle="none",
+                                  label="uses adhesion (ringed)"))
+        colour_bar(fig, ax, scale, "adhesion the joint uses")
+        legend_below(fig, ax, handles)
         ax.set_title(f"joints coloured by the adhesion they use: a* = {a_kPa:.4g} kPa, "
                      f"{int(needs.sum())} of {len(used)} joints use it\n{title}",
                      fontsize=9)
