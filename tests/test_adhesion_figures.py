@@ -128,9 +128,10 @@ def test_a_run_that_needs_adhesion_writes_its_joints_figure_and_page_layer(tmp_p
     """``masonry run`` of the thin arch at --dpi 60 in PNG and SVG: the figure of every
     view, listed in run.json, the PNG as many pixels as the SVG's size in points at 60
     per 72 (within 2 %: text is measured at each resolution, and the crop follows it);
-    dome.html's ``joints`` trace holds the joints RBE/adhesion.csv says use adhesion (more than 1e-3 of a*), each with its
-    kPa to 1e-9 (the CSV's digits) and named by its blocks, on a bar from 0 to the
-    largest; the page offers the colouring that shows it."""
+    dome.html's ``joints`` trace holds the joints RBE/adhesion.csv says use adhesion
+    (more than 1e-3 of a*), each with its kPa to 1e-9 (the CSV's digits) and named by
+    its blocks, on a bar from 0 to the largest; the page offers the colouring that
+    shows it."""
     assert main(["run", "--scene", "arch", "--thickness", "0.4", "--dpi", "60",
                  "--figure-format", "png,svg", "--no-printable", "--out", str(tmp_path),
                  "-q"]) == 0
