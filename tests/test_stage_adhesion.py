@@ -102,7 +102,8 @@ def test_a_stage_with_a_loose_block_has_no_adhesion_and_says_why():
 def test_the_run_folder_reports_every_stage_s_adhesion(tmp_path, capsys, arch_stages):
     """``masonry stages --scene arch``: stages.csv's column (read back typed) is the
     stages' values, run.json gives the peak and where, the summary says it, and
-    adhesion.png is written."""
+    adhesion.png and the peak stage's joints (adhesion_peak/, in the arch's views) are
+    written and listed."""
     _, _, _, rows = arch_stages
     assert main(["stages", "--scene", "arch", "--out", str(tmp_path)]) == 0
     (folder,) = tmp_path.glob("*_stages_*")
@@ -117,6 +118,10 @@ def test_the_run_folder_reports_every_stage_s_adhesion(tmp_path, capsys, arch_st
     assert stages["adhesion_max_course"] is None and stages["adhesion_unsolved"] is None
     assert stages["adhesion_tension_ratio"] == ARCH.analysis.adhesion_tension_ratio
     assert (folder / "adhesion.png").stat().st_size > 10_000
+    listed = json.loads((folder / "run.json").read_text())["figures"]["files"]
+    for view in ("01_angle", "04_side"):
+        assert f"adhesion_peak/{view}.png" in listed
+        assert (folder / "adhesion_peak" / f"{view}.png").stat().st_size > 10_000
     out = capsys.readouterr().out
     assert f"least adhesion: {top['adhesion_kPa']:.4g} kPa at most (stage 7, brick " in out
 

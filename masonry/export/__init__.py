@@ -12,6 +12,7 @@ import logging
 from functools import cache
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import PurePosixPath
 
 import numpy as np
 
@@ -403,6 +404,24 @@ def _force_plot_files(made: RunOutputs) -> Export:
     return _figures(files)
 
 
+def _adhesion_plot_files(made: RunOutputs) -> Export:
+    """The joints coloured by the adhesion they use (``RBE/<view>/adhesion.png``, as the
+    force figures)."""
+    from masonry import plots
+
+    adhesion, model = made.adhesion, made.model
+    drawn = plots.adhesion_pngs(model.blocks, model.interfaces, adhesion.interface_kPa,
+                                adhesion.a_kPa, made.outputs.quick, made.figure_title,
+                                plots.Render.of(made.outputs))
+    return _figures({f"RBE/{PurePosixPath(name).stem}/adhesion{PurePosixPath(name).suffix}":
+                     data for name, data in drawn.items()})
+
+
+def _needs_adhesion(made: RunOutputs) -> bool:
+    """Whether the run's structure needs adhesion to stand (``a* > 0``)."""
+    return made.adhesion is not None and bool(made.adhesion.a_kPa)
+
+
 EXPORTERS = (
     # the forces first, under a stage of their own: parameters to forces is the time a
     # user waits for results (the model's files do not need them)
@@ -411,6 +430,9 @@ EXPORTERS = (
     # (masonry.pipeline.write_exports), and finish about together
     Exporter("force_plots", "plots", _force_plot_files,
              wanted=lambda made: made.outputs.plots and made.forces is not None,
+             record_key="figures", imports=("masonry.plots",)),
+    Exporter("adhesion_plots", "plots", _adhesion_plot_files,
+             wanted=lambda made: made.outputs.plots and _needs_adhesion(made),
              record_key="figures", imports=("masonry.plots",)),
     Exporter("printable", "printable", _printable_files,
              wanted=lambda made: made.outputs.printable, imports=("manifold3d", "trimesh")),

@@ -15,7 +15,7 @@ import numpy as np
 
 from masonry.blocks import BLOCK_CLASSES, CLASS_COLOURS
 from masonry.rbe.collapse_result import vertex_displacements
-from masonry.tolerances import FACE_COVERED, TENSION_REPORTED_REL
+from masonry.tolerances import ADHESION_REPORTED_REL, FACE_COVERED, TENSION_REPORTED_REL
 
 FORCE_PERCENTILE = 99.0
 """A force colouring's scale ends at this percentile of the free bricks' values (the
@@ -33,6 +33,14 @@ of the plot's height and of :data:`FIT_ASPECT` times it across."""
 FIT_ASPECT = 1.2
 """The width over the height of the plot (the window less the bar and the colour bar)
 the first view is fitted to: a landscape window's, or less."""
+
+SEEN_THROUGH = "#d0d0d0"
+"""The bricks' colour when the page shows the joints that use adhesion
+(:func:`adhesion_trace`), drawn at :data:`JOINTS_SEEN_THROUGH` opacity so the joints
+inside show through them."""
+
+JOINTS_SEEN_THROUGH = 0.15
+"""The bricks' opacity when the page shows the joints that use adhesion."""
 
 FOVY = np.pi / 4
 """Radians: plotly's 3D perspective camera's vertical field of view."""
@@ -68,11 +76,14 @@ page.colourings.forEach((c, i) => {
   option.disabled = !!c.empty;
   select.add(option);
 });
+const joints = gd.data.findIndex(t => t.name === 'joints');
 select.onchange = () => {
   const c = page.colourings[select.value];
   const s = c.style;
   Plotly.restyle(gd, {intensity: [Float32Array.from(owner, b => c.values[b])],
-    colorscale: [s.colorscale], cmin: s.cmin, cmax: s.cmax, colorbar: [s.colorbar]}, [0]);
+    colorscale: [s.colorscale], cmin: s.cmin, cmax: s.cmax, colorbar: [s.colorbar],
+    showscale: !c.joints, opacity: c.opacity === undefined ? 1 : c.opacity}, [0]);
+  if (joints >= 0) Plotly.restyle(gd, {visible: !!c.joints}, [joints]);
 };
 function pick(brick) {
   const rows = [page.name[brick],
@@ -215,9 +226,46 @@ def colourings(made) -> list:
             "collapse displacement", shown(largest), free, "", "Viridis",
             relative=f"collapse displacement (largest = 1) at lambda = "
                 f"{collapse.load_factor:.4g}"))
+    if made.adhesion is not None and made.adhesion.a_kPa:
+        largest = shown(model.block_largest(made.adhesion.interface_kPa)[:n])
+        out.append({"label": "adhesion its joints use", "unit": "kPa", "joints": True,
+                    "opacity": JOINTS_SEEN_THROUGH, "values": _rounded(largest),
+                    "style": {"colorscale": [[0.0, SEEN_THROUGH], [1.0, SEEN_THROUGH]],
+                              "cmin": 0.0, "cmax": 1.0, "colorbar": {}}})
     if not made.is_solved.all():
         out.append(_solved_colouring(made.is_solved))
     return out
+
+
+def adhesion_trace(model, adhesion):
+    """The joints that use adhesion at the least adhesion's optimum (more than
+    :data:`~masonry.tolerances.ADHESION_REPORTED_REL` of ``a*``), as one plotly
+    ``Mesh3d`` named ``joints`` (hidden until the page's colouring ``adhesion its joints
+    use`` shows it): each joint's polygon a fan of triangles of its own vertices, coloured
+    by the kPa it uses (float64, the values of ``RBE/adhesion.csv``) on the figures'
+    magnitude map from 0 to the largest, its hover text naming its two blocks and the
+    kPa. Of a cyclic section, the solved section's joints only (the page stays small)."""
+    import plotly.graph_objects as go
+
+    interfaces, used = model.interfaces, np.asarray(adhesion.interface_kPa, dtype=float)
+    chosen = np.flatnonzero(used > ADHESION_REPORTED_REL * adhesion.a_kPa)
+    start, count = interfaces.offsets[chosen], np.diff(interfaces.offsets)[chosen]
+    first = np.concatenate([[0], np.cumsum(count)])
+    owner = np.repeat(np.arange(len(chosen)), count)
+    vertices = interfaces.vertices[start[owner] + np.arange(first[-1]) - first[owner]]
+    fan = np.repeat(np.arange(len(chosen)), count - 2)  # polygon k: count - 2 triangles
+    step = np.arange(len(fan)) - (first[fan] - 2 * fan)
+    triangles = np.column_stack([first[fan], first[fan] + step + 1, first[fan] + step + 2])
+    names = model.blocks.block_name[interfaces.pair[chosen]]
+    text = [f"{a} | {b}: {value:.4g} kPa" for (a, b), value in zip(names, used[chosen])]
+    return go.Mesh3d(x=vertices[:, 0], y=vertices[:, 1], z=vertices[:, 2],
+                     i=triangles[:, 0], j=triangles[:, 1], k=triangles[:, 2],
+                     intensity=used[chosen][owner], intensitymode="vertex",
+                     colorscale="Viridis", cmin=0.0, cmax=float(used.max()),
+                     colorbar={"title": {"text": "adhesion the joint uses (kPa)",
+                                         "side": "right"}, "len": 0.8},
+                     hovertext=[text[k] for k in owner], hoverinfo="text",
+                     flatshading=True, name="joints", visible=False)
 
 
 def _arrow_traces(live, model, bounds) -> list:
@@ -297,7 +345,9 @@ def dome_html(made) -> str:
     arrows = [] if live is None else _arrow_traces(live, made.model, blocks.bounds)
     drawn = np.concatenate([vertices, *(np.column_stack([a.x, a.y, a.z]) for a in arrows)])
     hidden = dict(visible=False)
-    fig = go.Figure([mesh, *arrows])
+    joints = ([adhesion_trace(made.model, made.adhesion)]
+              if made.adhesion is not None and made.adhesion.a_kPa else [])
+    fig = go.Figure([mesh, *arrows, *joints])
     fig.update_layout(template="none", margin=dict(l=0, r=0, t=0, b=0),
                       scene=dict(aspectmode="data", xaxis=hidden, yaxis=hidden,
                                  zaxis=hidden, camera=camera(drawn)))

@@ -1,7 +1,7 @@
 """Plots as PNG bytes (matplotlib, Agg), one module per figure family: the flattened
 pattern (:mod:`.pattern`), the structure views (:mod:`.structure`), the interfaces
-coloured by their area and forces (:mod:`.forces`), the thrust line (:mod:`.thrust`),
-where the structure fails (:mod:`.failure`), the collapse mechanism
+coloured by their area, forces and the adhesion they use (:mod:`.forces`), the thrust
+line (:mod:`.thrust`), where the structure fails (:mod:`.failure`), the collapse mechanism
 (:mod:`.mechanism`) and its load factor by azimuth (:mod:`.azimuths`), and the
 construction stages (:mod:`.stages`), and an optimisation's convergence
 (:mod:`.convergence`). They share the views, the drawing helpers
@@ -38,7 +38,7 @@ from masonry.plots.common import (  # noqa: E402
 from masonry.plots.convergence import convergence_png  # noqa: E402
 from masonry.plots.failure import RANKED, failure_png  # noqa: E402
 from masonry.plots.forces import (  # noqa: E402
-    FORCE_LABELS, FORCE_PLOTS, force_pngs, interface_pngs)
+    FORCE_LABELS, FORCE_PLOTS, adhesion_pngs, force_pngs, interface_pngs)
 from masonry.plots.mechanism import MECHANISM_SCALE, mechanism_pngs  # noqa: E402
 from masonry.plots.pattern import pattern_png  # noqa: E402
 from masonry.plots.stages import (  # noqa: E402
@@ -51,7 +51,7 @@ __all__ = [
     "ANGLE", "BAR_3D", "CLASS_COLOURS", "COLOUR_PERCENTILE", "DIVERGING", "ELEVATIONS",
     "FORCE_LABELS", "FORCE_PLOTS", "FRESH_MORTAR_KPA", "HINGE_ECCENTRICITY",
     "HORIZONTAL_KINDS", "MARK_DECADES", "MECHANISM_SCALE", "NO_FILL", "ONE_SIDED",
-    "OUTLINE_COLOUR", "PNG", "RANKED", "Render", "SEQUENTIAL", "VIEWS", "as_files",
+    "OUTLINE_COLOUR", "PNG", "RANKED", "Render", "SEQUENTIAL", "VIEWS", "adhesion_pngs", "as_files",
     "azimuths_png", "figure_files", "colour_scale", "convergence_png", "failure_png", "force_pngs",
     "force_unit", "interface_pngs", "marked_structure_pngs", "mechanism_pngs", "pattern_png",
     "stage_adhesion_png", "stage_chart_png", "structure_pngs", "thrust_line_png",

@@ -29,6 +29,9 @@ WEB_OUTLINE = "#000000"
 """A web's boundary (its level table's half widths), dashed."""
 THRUST = "#000000"
 """The thrust line."""
+NO_ADHESION = "#d9d9d9"
+"""A joint that uses no adhesion at the least adhesion's optimum, among joints coloured
+by the adhesion they use (the magnitude map): light grey."""
 EMPHASIS = "#000000"
 """A value the figure points at (the least load factor of the azimuths, the load factor
 of the stages)."""

@@ -1,18 +1,27 @@
 """Interfaces drawn as polygons coloured by one value each: their area (thesis figures
-3.12-3.13) and the forces they carry (figures 4.1-4.8), in the views of the model's
+3.12-3.13), the forces they carry (figures 4.1-4.8) and the adhesion they use
+(docs/model.md 6.12), in the views of the model's
 extent; for a cyclic section also the whole dome, the section's forces rotated into
 every web. A force no interface carries beyond the solver's noise, or a value the same
 on every interface (one colour), has no figure: the returned dict maps it to the reason
 instead."""
 
+import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.colors import Normalize
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
 from masonry.blocks import concatenate, rotated_web, rotation_z
-from masonry.plots.colours import colour_bar, colour_scale, one_value
-from masonry.plots.common import (HORIZONTAL_KINDS, PNG, add_polygons, as_files, axes_3d,
-                                  figure_files, recolour, view_axes, views_of)
-from masonry.plots.faces import interface_array
+from masonry.plots.colours import (EMPHASIS, NO_ADHESION, SEQUENTIAL, colour_bar,
+                                   colour_scale, one_value)
+from masonry.plots.common import (ELEVATIONS, HORIZONTAL_KINDS, NO_FILL, PNG, add_points,
+                                  add_polygons, as_files, axes_3d, figure_files,
+                                  legend_below, recolour, view_axes, views_of,
+                                  visible_faces)
+from masonry.plots.faces import face_array, interface_array
+from masonry.tolerances import ADHESION_REPORTED_REL
 
 
 def _interface_linewidth(count: int) -> float:
@@ -178,4 +187,70 @@ def _whole_dome_pngs(blocks, interfaces, forces, fast, title, n, noise, render) 
                      f"{title}", fontsize=9)
         out.update(as_files(f"05_dome/{name}.png", figure_files(fig, 70 if fast else 130,
                                                                 render)))
+    return out
+
+
+RINGED_JOINTS = (30, 0.05)
+"""When at most this many joints use adhesion, and at most this fraction of them,
+:func:`adhesion_pngs` rings each (:data:`~masonry.plots.colours.EMPHASIS`): a few joints
+among thousands show at any scale (where many use it, they show themselves)."""
+
+
+def adhesion_pngs(blocks, interfaces, used_kPa, a_kPa, fast=False, title="",
+                  render=PNG, drawn=None) -> dict:
+    """The interfaces coloured by the adhesion each uses at the least adhesion's optimum
+    (docs/model.md 6.12), kPa, on the magnitude map from 0 to the largest (the joint
+    that uses most in the map's top colour; no percentile: the largest is the point);
+    those that use at most :data:`~masonry.tolerances.ADHESION_REPORTED_REL` of ``a_kPa``
+    (the joints dry friction holds) light grey (:data:`~masonry.plots.colours.NO_ADHESION`),
+    under the others; a few joints that use it ringed too (:data:`RINGED_JOINTS`).
+    ``<view>.png`` per view of the model's extent, in the formats of ``render``.
+
+    Parameters
+    ----------
+    blocks, interfaces : the analysed model's
+    used_kPa : (K,) float
+        :attr:`~masonry.rbe.adhesion.AdhesionResult.interface_kPa`.
+    a_kPa : float
+        ``a*`` > 0.
+    drawn : (B,) bool, optional
+        The blocks outlined (default all; a construction stage's laid ones), faintly.
+    """
+    used = np.asarray(used_kPa, dtype=float)
+    needs = used > ADHESION_REPORTED_REL * a_kPa
+    top = float(used.max())
+    scale = {"factor": 1.0, "unit": "kPa", "norm": Normalize(0.0, top),
+             "cmap": matplotlib.colormaps[SEQUENTIAL], "extend": "neither", "above": 0,
+             "below": 0, "largest": top}
+    polygons = interface_array(interfaces, np.arange(len(interfaces)))
+    width = _interface_linewidth(len(polygons))
+    out = {}
+    for view in views_of(blocks.bounds, fast):
+        fig, ax = view_axes(blocks.bounds, view)
+        if view not in ELEVATIONS:
+            ax.computed_zorder = False  # in the order below: the joints that use it on top
+        # the blocks' outlines, faint: where the joints are in the structure
+        faces = visible_faces(blocks, np.ones(blocks.n_blocks, bool) if drawn is None
+                              else drawn, view)
+        add_polygons(ax, view, face_array(blocks, faces), NO_FILL, edgecolors="0.7",
+                     linewidths=0.2)
+        handles = []
+        if not needs.all():
+            add_polygons(ax, view, polygons[~needs], NO_ADHESION, linewidths=width)
+            handles.append(Patch(facecolor=NO_ADHESION, label="no adhesion: dry friction "
+                                                              "holds the joint"))
+        add_polygons(ax, view, polygons[needs], scale["cmap"](scale["norm"](used[needs])),
+                     linewidths=width)
+        if needs.sum() <= min(RINGED_JOINTS[0], RINGED_JOINTS[1] * len(used)):
+            add_points(ax, view, interfaces.centre[needs], s=160, facecolors="none",
+                       edgecolors=EMPHASIS, linewidths=1.2)
+            handles.append(Line2D([], [], color=EMPHASIS, marker="o", markersize=9,
+                                  fillstyle="none", linestyle="none",
+                                  label="uses adhesion (ringed)"))
+        colour_bar(fig, ax, scale, "adhesion the joint uses")
+        legend_below(fig, ax, handles)
+        ax.set_title(f"joints coloured by the adhesion they use: a* = {a_kPa:.4g} kPa, "
+                     f"{int(needs.sum())} of {len(used)} joints use it\n{title}",
+                     fontsize=9)
+        out.update(as_files(f"{view}.png", figure_files(fig, 60 if fast else 110, render)))
     return out

@@ -62,7 +62,7 @@ from masonry.rbe.solve import RBEProblem
 from masonry.runfolder import Publication, check_output_root
 from masonry.scenes import check_size
 from masonry.studies.plans import StagePlan, make_plan
-from masonry.studies.stage_records import first_unsupported, stage_record
+from masonry.studies.stage_records import adhesion_peak, first_unsupported, stage_record
 from masonry.tolerances import MAX_BRICKS
 
 log = logging.getLogger(__name__)
@@ -113,7 +113,8 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
         stage's wall time: model, assembly and solves; ``load_factor`` None: no lateral
         load, or the stage does not stand), ``loose_blocks`` and ``held``: the scene
         blocks a support must hold, largest first (see :func:`stage_centering`);
-        ``adhesion_reason`` and ``adhesion_joint`` (:func:`stage_adhesion`).
+        ``adhesion_reason``, ``adhesion_joint`` and ``adhesion_used`` (:func:`stage_adhesion`;
+        the joints into ``model``'s interfaces).
     """
     start = time.perf_counter()
     part = restrict(model, plan.is_present(stage))
@@ -158,6 +159,9 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
     row.update(stage_centering(part, params, row["feasible"], centering, own))
     dry = not any(np.any(value) for value in mortar.values())
     row.update(stage_adhesion(part, params, plan, stage, row, sequence, dry))
+    if row["adhesion_used"] is not None:  # into the model's interfaces, as the figure's
+        joints, used = row["adhesion_used"]
+        row["adhesion_used"] = (np.flatnonzero(chosen)[joints], used)
     row["solve_s"] = round(time.perf_counter() - start, 4)
     return row
 
@@ -232,12 +236,15 @@ def stage_adhesion(part: Model, params, plan: StagePlan, stage: int, row,
         stage has a block that no joint joins to a support or the program gives no
         checked value; ``adhesion_reason`` why not ('' with a value);
         ``adhesion_joint``: the two scene blocks of the joint that needs most, the later
-        laid first (None without a positive value).
+        laid first (None without a positive value); ``adhesion_used``: the joints that
+        need adhesion (:attr:`~masonry.rbe.adhesion.AdhesionResult.needing`, into the
+        part's interfaces) and the kPa each uses, or None.
     """
     if row["feasible"] and dry:
-        return {"adhesion_kPa": 0.0, "adhesion_reason": "", "adhesion_joint": None}
+        return {"adhesion_kPa": 0.0, "adhesion_reason": "", "adhesion_joint": None,
+                "adhesion_used": None}
     if row["loose"] or len(part.interfaces) == 0:
-        return {"adhesion_kPa": None, "adhesion_joint": None,
+        return {"adhesion_kPa": None, "adhesion_joint": None, "adhesion_used": None,
                 "adhesion_reason": "a block touches nothing that joins it to a support: "
                                    "no adhesion holds it"}
     analysis = params.analysis
@@ -257,8 +264,10 @@ def stage_adhesion(part: Model, params, plan: StagePlan, stage: int, row,
         pair = result.interface_pair[result.needing[0]]
         pair = pair if source is None else source[pair]
         joint = [int(b) for b in pair[np.argsort(-plan.block_stage[pair], kind="stable")]]
+    used = None if not result.a_kPa else (result.needing,
+                                          result.interface_kPa[result.needing])
     return {"adhesion_kPa": result.a_kPa, "adhesion_reason": result.reason,
-            "adhesion_joint": joint}
+            "adhesion_joint": joint, "adhesion_used": used}
 
 
 def stage_centering(part: Model, params, stands: bool, result=None, mortar=None) -> dict:
@@ -570,8 +579,8 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
         rows = analyse_stages(model, params, plan, laying=laying)
     record = stage_record(params, scene, model, plan, rows, cached, source, laying)
     record["stages"]["wall_s"] = timer.seconds["stages"]
-    folder = job.publish(lambda folder: _write(folder, params, scene, plan, rows, record,
-                                               timer))
+    folder = job.publish(lambda folder: _write(folder, params, scene, model, plan, rows,
+                                               record, timer))
     if cached == "computed":  # only a model whose study completed is cached
         write_cache(params, out_root, scene, model)
     return {**record, "path": str(folder.target), "rows": rows}
@@ -591,7 +600,7 @@ def _identify(record) -> dict:
             {k: v for k, v in mortar.items() if k != "law"}}
 
 
-def _write(folder, params, scene, plan, rows, record, timer):
+def _write(folder, params, scene, model, plan, rows, record, timer):
     """Every file of a stage study and, last, its ``run.json``."""
     folder.write("00_parameters.txt", parameters_text(params, structure_id(params)))
     folder.write("stages.csv", stages_csv(rows))
@@ -600,7 +609,7 @@ def _write(folder, params, scene, plan, rows, record, timer):
         folder.write("first_unsupported/held.csv", held_csv(scene.blocks, first["held"]))
     if params.outputs.plots:
         with timer.stage("plots"):
-            figures = stage_pngs(params, scene, plan, rows)
+            figures = stage_pngs(params, scene, model, plan, rows)
             for name, data in figures.items():
                 folder.write(name, data)
             record["figures"] = {"files": sorted(figures)}
@@ -610,11 +619,12 @@ def _write(folder, params, scene, plan, rows, record, timer):
     folder.write_json("run.json", record)
 
 
-def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
+def stage_pngs(params, scene, model: Model, plan: StagePlan, rows) -> dict:
     """``stages.png`` (the centering force of every stage as a fraction of its weight,
     which stages stand), ``adhesion.png`` (the least adhesion of every stage, kPa) and,
     when a stage needs support, ``first_unsupported/<view>.png``:
-    that stage, its bricks coloured by the support force they need; each figure in the
+    that stage, its bricks coloured by the support force they need, and
+    ``adhesion_peak/<view>.png`` (:func:`peak_adhesion_pngs`); each figure in the
     formats the outputs ask (``.png``, ``.svg``, ``.pdf``): path -> bytes."""
     from masonry import plots  # matplotlib, imported only by the runs that draw
 
@@ -639,6 +649,7 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
         ratio=params.analysis.adhesion_tension_ratio, render=render)}
     out = {path: data for name, figure in out.items()
            for path, data in plots.as_files(name, figure).items()}
+    out.update(peak_adhesion_pngs(params, model, plan, rows))
     first = first_unsupported(rows)
     if first is None:
         return out
@@ -661,3 +672,26 @@ def stage_pngs(params, scene, plan: StagePlan, rows) -> dict:
         render=render)
     out.update({f"first_unsupported/{name}": png for name, png in views.items()})
     return out
+
+
+def peak_adhesion_pngs(params, model: Model, plan: StagePlan, rows) -> dict:
+    """``adhesion_peak/<view>.png``: the stage whose least adhesion peaks
+    (:func:`~masonry.studies.stage_records.adhesion_peak`), its joints coloured by the
+    adhesion they use there (the values its program gave, ``adhesion_used``: no other
+    solve), its blocks outlined in the whole structure's frame; none when no stage needs
+    adhesion or a stage has none."""
+    from masonry import plots
+
+    peak = adhesion_peak(rows)
+    if peak is None or peak["adhesion_used"] is None:
+        return {}
+    stage, (joints, kPa) = peak["stage"], peak["adhesion_used"]
+    present = kept_blocks(model, plan.is_present(stage))
+    chosen = present[model.interfaces.pair].all(axis=1)
+    used = np.zeros(len(model.interfaces))
+    used[joints] = kPa
+    views = plots.adhesion_pngs(
+        model.blocks, model.interfaces.subset(chosen), used[chosen], peak["adhesion_kPa"],
+        params.outputs.quick, f"stage {stage} of {plan.n_stages}, where the least adhesion "
+        f"peaks | {structure_id(params)}", plots.Render.of(params.outputs), drawn=present)
+    return {f"adhesion_peak/{name}": data for name, data in views.items()}
