@@ -21,7 +21,7 @@ from masonry.rbe.boundary import Model
 from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
                                   collapse_load, fixed_capacity_factor)
 from masonry.rbe.lateral_search import lateral_azimuths, symmetric_key, worst_lateral
-from masonry.rbe.loads import crown_load, lateral, point_loads
+from masonry.rbe.loads import PointLoads, crown_load, lateral, point_loads
 from masonry.rbe.solvers.interior_lp import LoadFactorOptions
 from masonry.scenes.arch import arch_profile
 from masonry.studies.structures import lateral_record
@@ -168,6 +168,18 @@ def test_a_point_load_on_no_block_is_refused_naming_the_option(tmp_path, capsys)
     assert code == 2 and len(error) == 1 and not any(tmp_path.iterdir())
     assert error[0].startswith("masonry: error: --point-load zzz:0,0,-1: expected a name")
 
+
+
+def test_point_loads_name_their_folder_as_written_where_they_are_short_and_plain():
+    """Names and numbers alone, up to 40 characters: the specs in the id, ``:`` as ``@``,
+    joined by ``+``; a pattern, an exponent's ``+`` or a long list: a digest. Two lists
+    never share a name (the tag's ``@`` and ``+`` are not in a plain spec)."""
+    tag = lambda *specs: PointLoads.parse(list(specs)).tag
+    assert tag("w0_b0123:0,0,-1000") == "_pl_w0_b0123@0,0,-1000"
+    assert tag("a:1,2,3", "b:4,5,6") == "_pl_a@1,2,3+b@4,5,6"
+    for digest in (tag("w*:0,0,-1"), tag("b0:1e+3,0,0"), tag(*[f"b{i}:0,0,-1" for i in range(9)])):
+        assert len(digest) == 11 and digest.startswith("_pl") and "@" not in digest
+    assert tag("a:1,2,3", "b:4,5,6") != tag("b:4,5,6", "a:1,2,3")
 
 def test_free_wall_overturns_out_of_plane_at_t_over_h():
     params = from_preset("wall")

@@ -94,6 +94,9 @@ def test_two_objectives_give_the_pareto_front_of_the_trials(tmp_path):
     trials = _read(tmp_path / "optimize_thick" / "trials.csv")
     assert len(trials) == 8
     assert all(0.5 <= float(r["arch_thickness"]) <= 1.0 for r in trials)
+    # on the range's grid (steps of 0.0001 for a width of 0.5), as a person writes them
+    assert all(abs(1e4 * float(r["arch_thickness"]) - round(1e4 * float(r["arch_thickness"])))
+               < 1e-6 for r in trials)
     points = {r["trial"]: np.array([float(r["load_factor"]), -float(r["weight_N"])])
               for r in trials if r["load_factor"]}
     front = [t for t, p in points.items()

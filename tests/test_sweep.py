@@ -7,6 +7,7 @@ import pytest
 
 from masonry import forking
 from masonry.studies import workers
+from masonry.studies.sweep import on_grid, sample_step
 from masonry_cli.main import main
 
 STUDY = """
@@ -120,10 +121,23 @@ def test_samples_are_seeded_and_bad_names_refused(tmp_path, capsys):
     first, again = load_study(path).variants(), load_study(path).variants()
     assert first == again and len(first) == 8
     assert all(1000 <= v["density"] <= 3000 for v in first)
+    # steps of 1 for a range 2000 wide: three digits finer than its width
+    assert all(v["density"] == round(v["density"]) for v in first)
+    assert len({v["density"] for v in first}) == 2
     path.write_text(STUDY + "\nfrobnicate = [1, 2]\n")
     assert main(["sweep", str(path), "--out", str(tmp_path / "x")]) == 2
     assert "grid.frobnicate" in capsys.readouterr().err
     assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize("low, high, value, step, on", [
+    (0.4, 1.0, 0.73419062, 1e-4, 0.7342), (0.1, 0.7, 0.30000004, 1e-4, 0.3),
+    (1000.0, 3000.0, 1234.5678, 1.0, 1235.0), (0.0, 0.05, 0.05, 1e-5, 0.05),
+    (2.0, 2.0, 2.0, 0.0, 2.0)])
+def test_a_sampled_float_lies_on_its_ranges_grid(low, high, value, step, on):
+    """Three digits finer than the range's width, within the range, to 12 digits."""
+    assert sample_step(low, high) == pytest.approx(step, rel=1e-12)
+    assert on_grid(value, low, high) == on
 
 
 # ---------------------------------------------------------------------- stages

@@ -19,6 +19,7 @@ one); the case builds its :class:`LiveLoad` on a model.
 import fnmatch
 import hashlib
 import math
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -285,6 +286,16 @@ class Lateral:
         return lateral(model, self.azimuth_deg, density)
 
 
+READABLE_TAG = re.compile(r"[A-Za-z0-9_.,:-]+")
+"""A point load named as written in a structure id (:attr:`PointLoads.tag`): characters
+every file system takes, without the tag's own ``@`` and ``+`` (so two lists of loads
+never share a name); a pattern's ``*`` or ``?``, or ``1e+3``, goes by a digest."""
+
+READABLE_TAG_CHARS = 40
+"""The longest point loads named as written in a structure id; longer ones go by a
+digest."""
+
+
 @dataclass(frozen=True)
 class PointLoads:
     """Forces at the top faces of named blocks: ``specs`` as the user wrote them
@@ -304,7 +315,12 @@ class PointLoads:
 
     @property
     def tag(self) -> str:
-        """``_pl`` and a digest of the specs (they can be long)."""
+        """``_pl`` and the specs as written, ``:`` as ``@`` and joined by ``+``
+        (``_pl_w0_b0123@0,0,-1000``), where they are short and of characters every file
+        system takes (:data:`READABLE_TAG`); else ``_pl`` and a digest of them."""
+        text = "+".join(self.specs)
+        if len(text) <= READABLE_TAG_CHARS and all(map(READABLE_TAG.fullmatch, self.specs)):
+            return f"_pl_{text.replace(':', '@')}"
         return f"_pl{hashlib.sha1(chr(10).join(self.specs).encode()).hexdigest()[:8]}"
 
     def options(self) -> dict:

@@ -2,7 +2,8 @@
 
 The search space is the study's (:class:`masonry.studies.sweep.Study`): every ``grid``
 list is a choice (categorical), every ``sample`` range ``(low, high)`` an integer range
-where both ends are integers, else a float range. Each trial is one sweep variant, run
+where both ends are integers, else a float range on the sweep's grid
+(:func:`~masonry.studies.sweep.sample_step`). Each trial is one sweep variant, run
 by the sweep's :class:`~masonry.studies.sweep.Runner` (serially, on a local Dask cluster
 or on a scheduler) into its own run folder, so a variant run before, by a sweep or an
 earlier trial, is reused. Its objective values are summary columns of its row
@@ -172,6 +173,8 @@ class Search:
         from optuna.distributions import (CategoricalDistribution, FloatDistribution,
                                           IntDistribution)
 
+        from masonry.studies.sweep import on_grid, sample_step
+
         out = {name: CategoricalDistribution(values)
                for name, values in self.study.grid.items()}
         for name, (low, high) in self.study.sample.items():
@@ -179,8 +182,9 @@ class Search:
                 continue
             if isinstance(low, int) and isinstance(high, int):
                 out[name] = IntDistribution(low, high)
-            else:
-                out[name] = FloatDistribution(float(low), float(high))
+            else:  # on the sweep's grid (names as a person writes them)
+                out[name] = FloatDistribution(float(low), on_grid(high, low, high),
+                                              step=sample_step(low, high))
         return out
 
 

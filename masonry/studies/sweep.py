@@ -87,6 +87,30 @@ def column_key(name: str) -> str:
     return {column: key for key, column in HEADERS.items()}.get(name, name)
 
 
+
+SAMPLE_DIGITS = 3
+"""A float drawn from a ``[sample]`` range (a sweep's draw, an optimisation's trial) lies
+on a grid of ``10^(floor(log10(high - low)) - SAMPLE_DIGITS)``: three digits finer than
+the range's width (``[0.4, 1.0]``: steps of 0.0001), so run folders and tables name it
+as a person would write it (``_mu0.7342``, not ``_mu0.7341906253``)."""
+
+
+def sample_step(low: float, high: float) -> float:
+    """The grid step of a float range (:data:`SAMPLE_DIGITS`); 0 for an empty range."""
+    width = float(high) - float(low)
+    return 10.0 ** (math.floor(math.log10(width)) - SAMPLE_DIGITS) if width > 0 else 0.0
+
+
+def on_grid(value: float, low: float, high: float) -> float:
+    """``value`` at the nearest point of its range's grid within ``[low, high]``, to 12
+    significant digits (the sum's rounding dropped)."""
+    step = sample_step(low, high)
+    if step == 0:
+        return float(low)
+    count = math.floor((float(high) - float(low)) / step + 1e-9)
+    k = min(max(round((value - low) / step), 0), count)
+    return float(f"{low + k * step:.12g}")
+
 @dataclass(frozen=True)
 class Study:
     """A parameter study over a run's inputs (:func:`masonry.params.names`).
@@ -193,8 +217,8 @@ class Study:
                     low, high = bounds
                     if isinstance(low, int) and isinstance(high, int):
                         draw[name] = int(rng.integers(low, high + 1))
-                    else:  # ten digits: its run folder's name and summary.csv's
-                        draw[name] = float(f"{rng.uniform(low, high):.10g}")
+                    else:
+                        draw[name] = on_grid(rng.uniform(low, high), low, high)
                 draws.append(draw)
         return [{**self.base, **point, **draw} for point in points for draw in draws]
 
