@@ -68,6 +68,12 @@ def register(subparsers):
                              "(masonry stages --dome --by brick), both laying orders, "
                              "solved in sequence and each alone, against one masonry run "
                              "of the dome; writes DIR/bench_stages/stages.md")
+    parser.add_argument("--adhesion-course", dest="adhesion_course", type=int,
+                        metavar="K",
+                        help="instead: course K of each preset's cyclic section laid "
+                             "brick by brick (masonry stages --dome --by brick --course "
+                             "K): each stage's least adhesion against its RBE solve, both "
+                             "in one sequence; writes DIR/bench_adhesion/adhesion.md")
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root: writes DIR/bench/bench.csv, bench.md and "
                              "frontier.png (default exports)")
@@ -85,19 +91,15 @@ def handle(args, report):
         raise ParameterError("repeats", args.repeats, "an integer >= 1")
     if args.p is not None and args.p < MIN_PATTERN_P:  # the presets lay the pattern
         raise ParameterError("p", args.p, f"an integer >= {MIN_PATTERN_P}")
-    if args.collapse and args.friction_models is not None:
-        raise ParameterError("friction_models", args.friction_models,
-                             "one bench at a time: not with --collapse")
-    if args.readers and (args.collapse or args.friction_models is not None):
-        raise ParameterError("readers", args.readers, "one bench at a time: not with "
-                             "--collapse or --friction-models")
-    if args.outputs and (args.collapse or args.friction_models is not None or args.readers):
-        raise ParameterError("outputs", True, "one bench at a time: not with --collapse, "
-                             "--friction-models or --readers")
-    if args.stages and (args.collapse or args.friction_models is not None or args.readers
-                        or args.outputs):
-        raise ParameterError("stages", True, "one bench at a time: not with --collapse, "
-                             "--friction-models, --readers or --outputs")
+    chosen = [option for option, on in (
+        ("collapse", args.collapse), ("friction_models", args.friction_models is not None),
+        ("readers", bool(args.readers)), ("outputs", args.outputs), ("stages", args.stages),
+        ("adhesion_course", args.adhesion_course is not None)) if on]
+    if len(chosen) > 1:
+        raise ParameterError(chosen[1], getattr(args, chosen[1]), f"one bench at a time: "
+                             f"not with --{chosen[0].replace('_', '-')}")
+    if args.adhesion_course is not None and args.adhesion_course < 1:
+        raise ParameterError("adhesion_course", args.adhesion_course, "a course, >= 1")
     check_output_root(args.out)
     if args.outputs:
         return _outputs(args, report)
@@ -109,6 +111,8 @@ def handle(args, report):
         return _readers(args, report)
     if args.stages:
         return _stages(args, report)
+    if args.adhesion_course is not None:
+        return _adhesion(args, report)
     from masonry.studies.bench import (bench, frontier_png, ratios_markdown, table_csv,
                                        table_markdown)
 
@@ -188,6 +192,22 @@ def _stages(args, report):
     markdown = stages_markdown(rows)
     with RunFolder(args.out, "bench_stages") as folder:
         folder.write("stages.md", markdown)
+    report(markdown)
+    report(f"written: {folder.target}")
+    return 0
+
+
+def _adhesion(args, report):
+    from masonry.studies.stages_bench import adhesion_bench, adhesion_markdown
+
+    overrides = {} if args.p is None else {"p": args.p}
+    sections = {f"preset {k} cyclic section": from_preset(k, boundary="cyclic", **overrides)
+                for k in args.presets}
+    rows = adhesion_bench(sections, args.adhesion_course,
+                          progress=None if args.quiet else _progress)
+    markdown = adhesion_markdown(rows)
+    with RunFolder(args.out, "bench_adhesion") as folder:
+        folder.write("adhesion.md", markdown)
     report(markdown)
     report(f"written: {folder.target}")
     return 0

@@ -555,6 +555,27 @@ def test_stages_solved_in_sequence_equal_stages_solved_alone(mu, order):
     assert max(r["adhesion_kPa"] for r in cold) > 0
 
 
+
+def test_adhesion_bench_times_the_stages_masonry_stages_solves(tmp_path, capsys):
+    """Course 8 of the small dome at mu 0.4, laid along: the bench's stages that need
+    adhesion are those `analyse_stages` finds standing on no dry joints, and its largest
+    least adhesion is theirs (rel 1e-5); a course below 1 is refused by name."""
+    from masonry.studies.stages_bench import adhesion_bench, adhesion_markdown
+
+    params = validate(from_preset("1", **SMALL_DOME, boundary="cyclic", mu=0.4))
+    (row,) = adhesion_bench({"small dome": params}, 8, orders=("along",))
+    scene = build(params)
+    rows = analyse_stages(analysis_model(scene, "cyclic"), params,
+                          make_plan(scene, "brick", "along", 8))
+    assert row["stages"] == len(rows) and row["needing"] == sum(not r["feasible"] for r in rows)
+    assert row["needing"] >= 1 and row["rbe_s"] > 0 and row["ratio_median"] > 0
+    assert row["adhesion_max_kPa"] == pytest.approx(max(r["adhesion_kPa"] for r in rows),
+                                                    rel=1e-5)
+    assert "| small dome | 8 | along |" in adhesion_markdown([row])
+    assert main(["bench", "--adhesion-course", "0", "--out", str(tmp_path / "x")]) == 2
+    assert "--adhesion-course 0" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+
 def test_stages_bench_rows_and_its_refusal(tmp_path, capsys):
     from masonry.studies.stages_bench import stages_bench, stages_markdown
 

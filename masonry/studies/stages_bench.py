@@ -2,7 +2,8 @@
 dome's cyclic section, in both laying orders, solved in sequence
 (:class:`masonry.rbe.sequence.StageSequence`: the work of one stage reused for the next)
 and each stage alone, against one run of the dome (docs/bench.md, "Construction stages
-brick by brick").
+brick by brick"); and (``masonry bench --adhesion-course K``) each brick stage's least
+adhesion against its RBE solve.
 """
 
 import statistics
@@ -13,6 +14,7 @@ from masonry.params import validate
 from masonry.pipeline import build_model, run
 from masonry.studies.orders import BRICK_ORDERS
 from masonry.studies.plans import make_plan
+from masonry.rbe.sequence import StageSequence
 from masonry.studies.stages import analyse_stages
 
 STAGES_COLUMNS = ("structure", "order", "stages", "standing", "same_verdicts",
@@ -108,3 +110,76 @@ def stages_markdown(rows) -> str:
             "" if row.get(c) is None else formats.get(c, "{}").format(row[c])
             for c in STAGES_COLUMNS) + " |")
     return "\n".join(lines) + "\n\n" + STAGES_NOTE + "\n"
+
+
+ADHESION_COLUMNS = ("structure", "course", "order", "stages", "needing", "rbe_s",
+                    "adhesion_s", "ratio_median", "ratio_max", "adhesion_max_kPa")
+"""Columns of an adhesion bench row (:data:`ADHESION_NOTE`)."""
+
+ADHESION_NOTE = """One row per structure and laying order (`masonry bench --adhesion-course
+K`): course K of the cyclic section laid brick by brick on the courses under it, every
+stage solved in one sequence (`StageSequence`) as `masonry stages` solves it: the RBE
+(its friction flow, `auto`: friction-net, then friction+ where it cannot stand) and,
+where a stage cannot stand dry, its least adhesion (one Clarabel program on the stage's
+rows and columns of the whole model's matrices). `needing`: the stages that need
+adhesion; `rbe_s`, `adhesion_s`: their seconds, summed over those stages; `ratio_median`,
+`ratio_max`: a stage's least adhesion over its RBE solve, the median and the largest over
+those stages; `adhesion_max_kPa`: the largest least adhesion."""
+
+
+def adhesion_bench(structures, course, orders=tuple(BRICK_ORDERS), progress=None) -> list:
+    """Time each brick stage of ``course`` of each structure: its RBE solve and, where it
+    cannot stand dry, its least adhesion, in one :class:`StageSequence` (one pass).
+
+    Parameters
+    ----------
+    structures : dict str -> Params
+        Named cyclic sections (their ``analysis`` is the stages').
+    course : int
+    orders : sequence of str
+    """
+    rows = []
+    for name, params in structures.items():
+        scene, model = build_model(params)
+        a = params.analysis
+        options = dict(mu=a.mu, density=a.density, cone=a.cone)
+        for order in orders:
+            plan = make_plan(scene, "brick", order, course)
+            sequence, rbe, held, ratios, largest = StageSequence(model), 0.0, 0.0, [], 0.0
+            for stage in range(1, plan.n_stages + 1):
+                start = time.perf_counter()
+                result = sequence.solve(plan.is_present(stage), plan.local(stage),
+                                        plan.is_present(plan.course_end(stage)),
+                                        friction=a.friction, accuracy=a.accuracy, **options)
+                middle = time.perf_counter()
+                if result.feasible:
+                    continue
+                found = sequence.adhesion(plan.is_present(stage),
+                                          ratio=a.adhesion_tension_ratio, **options)
+                end = time.perf_counter()
+                rbe, held = rbe + middle - start, held + end - middle
+                ratios.append((end - middle) / (middle - start))
+                largest = max(largest, found.a_kPa or 0.0)
+            rows.append(dict(structure=name, course=course, order=order,
+                             stages=plan.n_stages, needing=len(ratios), rbe_s=rbe,
+                             adhesion_s=held, adhesion_max_kPa=largest,
+                             ratio_median=statistics.median(ratios) if ratios else None,
+                             ratio_max=max(ratios, default=None)))
+            if progress:
+                progress(f"{name}, course {course}, {order}: {len(ratios)} of "
+                         f"{plan.n_stages} stages need adhesion, {held:.3g} s against "
+                         f"their RBE's {rbe:.3g} s")
+    return rows
+
+
+def adhesion_markdown(rows) -> str:
+    """The rows as a markdown table, then :data:`ADHESION_NOTE`."""
+    formats = {"rbe_s": "{:.2f}", "adhesion_s": "{:.2f}", "ratio_median": "{:.2f}",
+               "ratio_max": "{:.2f}", "adhesion_max_kPa": "{:.4g}"}
+    lines = ["| " + " | ".join(ADHESION_COLUMNS) + " |",
+             "|" + "---|" * len(ADHESION_COLUMNS)]
+    for row in rows:
+        lines.append("| " + " | ".join(
+            "" if row.get(c) is None else formats.get(c, "{}").format(row[c])
+            for c in ADHESION_COLUMNS) + " |")
+    return "\n".join(lines) + "\n\n" + ADHESION_NOTE + "\n"
