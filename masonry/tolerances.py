@@ -305,6 +305,12 @@ THRUST_ACTIVE_REL = 1e-7
 passes within this fraction of (total weight x R) of it
 (:func:`masonry.studies.thrust_line.thrust_line_margin`)."""
 
+THRUST_PLANE_REL = 1e-6
+"""A bed joint reaches the thrust line's plane when its polygon comes within this
+fraction of the model's size of it: a joint that only touches the plane along its edge
+(the plane on a head joint, two bricks meeting there) counts
+(:func:`masonry.plots.thrust.plane_joints`)."""
+
 MOTION_TOL = 1e-3
 """Relative motion at a vertex, per largest block displacement (1 after normalising),
 above which an interface counts as opening or sliding in a collapse mechanism
