@@ -19,10 +19,14 @@ from masonry.plots import (azimuths, common, forces as force_figures, mechanism,
 from masonry.plots.common import views_of
 from masonry.plots.faces import hidden_faces
 from masonry.plots.forces import force_pngs, interface_pngs
-from masonry.plots.thrust import chains
+from masonry.plots import thrust
+from masonry.plots.thrust import chains, joint_levels
 from masonry.rbe.collapse import collapse_load
 from masonry.rbe.loads import lateral
+from masonry.rbe.resultants import interface_resultants
+from masonry.scenes.base import ThrustSection
 from test_collapse import DENSITY, column
+from test_rbe import make_interfaces
 
 
 @pytest.fixture
@@ -247,6 +251,78 @@ def test_thrust_line_chains_follow_one_column_of_blocks():
     assert [run.tolist() for run in chains(pairs)] == [[0, 1, 2], [3], [4, 5]]
     assert chains(np.zeros((0, 2), int)) == []
     assert [run.tolist() for run in chains([(4, 5)])] == [[0]]
+
+
+def test_joints_of_one_level_share_a_block_that_faces_both_the_same_way():
+    up = (0.0, 0.0, 1.0)
+    # bricks 1 and 2 meet at the plane on the ground 0 and carry brick 3, which carries 4
+    pairs = [(0, 1), (0, 2), (1, 3), (2, 3), (3, 4)]
+    label = joint_levels(pairs, [up] * 5)
+    assert label[0] == label[1] and label[2] == label[3]
+    assert len({label[0], label[2], label[4]}) == 3
+    # an arch's crown: voussoirs 8 and 9 lean on each other, 7 under 8 and 10 under 9
+    left, crown, right = (0.6, 0.0, 0.8), (1.0, 0.0, 0.0), (-0.6, 0.0, 0.8)
+    assert len(set(joint_levels([(7, 8), (8, 9), (10, 9)], [left, crown, right]))) == 3
+
+
+def _bed_joint(x0, y0, y1, z):
+    """A bed joint 0.2 m wide in x from ``x0``, ``y0`` to ``y1``, at height ``z``."""
+    return [(x0, y0, z), (x0 + 0.2, y0, z), (x0 + 0.2, y1, z), (x0, y1, z)]
+
+
+def test_thrust_line_joins_levels_and_names_its_breaks(monkeypatch):
+    """A column whose lowest bricks meet at the plane y = 0 (their joints only touch
+    it), a joint beside the column and a joint with no normal force: one line through
+    the column's three levels, the level of two joints at its joints' normal forces'
+    weighted point, and each break drawn and named."""
+    pairs = [(0, 1), (0, 2), (1, 3), (2, 3), (3, 4), (7, 8), (8, 9)]
+    polygons = [_bed_joint(0, -0.2, 0, 0), _bed_joint(0, 0, 0.2, 0), _bed_joint(0, -0.1, 0, 0.1),
+                _bed_joint(0, 0, 0.1, 0.1), _bed_joint(0, -0.1, 0.1, 0.2),
+                _bed_joint(0, -0.1, 0.1, 0.3), _bed_joint(0, -0.1, 0.1, 0.4)]
+    kind = [2, 2, 0, 0, 0, 0, 0]
+    joints = make_interfaces(pairs, polygons, [(0, 0, 1)] * 7, kind)
+    x = [0.05, 0.15, 0.1, 0.1, 0.25, 0.1, np.nan]
+    point = np.column_stack([x, [-0.1, 0.1, -0.05, 0.05, 0, 0, np.nan], joints.centre[:, 2]])
+    resultants = {"sigma": np.array([1.0, 3.0, 2.0, 2.0, 4.0, 1.0, 0.0]), "point": point}
+    kept = []
+    monkeypatch.setattr(thrust, "figure_files", lambda fig, dpi, render: kept.append(fig))
+    section = ThrustSection(0.0, 2, (-1.0, 0.0), False, "y = 0 m")
+    thrust.thrust_line_png(joints, resultants, section)
+    ax = kept[0].axes[0]
+    line = [ln for ln in ax.lines if ln.get_linestyle() == "-" and ln.get_marker() == "o"]
+    assert len(line) == 1
+    # the ground level's point: (0.05 * 1 + 0.15 * 3) / 4
+    np.testing.assert_allclose(line[0].get_xydata(), [[0.125, 0], [0.1, 0.1], [0.25, 0.2]],
+                               atol=1e-12)
+    marks = {ln.get_label(): ln.get_xydata() for ln in ax.lines}
+    alone = next(v for k, v in marks.items() if "no block joins it" in k)
+    empty = next(v for k, v in marks.items() if "no normal force" in k)
+    outside = next(v for k, v in marks.items() if "leaves the section" in k)
+    np.testing.assert_allclose(alone, [[0.1, 0.3]], atol=1e-12)
+    np.testing.assert_allclose(empty, [[0.1, 0.4]], atol=1e-12)  # the joint's middle
+    np.testing.assert_allclose(outside, [[0.25, 0.2]], atol=1e-12)  # 0.05 m beyond its end
+    legend = [t.get_text() for t in kept[0].legends[0].get_texts()]
+    assert sum("no block joins it" in t or "no normal force" in t for t in legend) == 2
+    title = ax.get_title()
+    assert "5 levels" in title and "7 joints" in title and "1 joint off the column" in title
+    assert "1 joint without force" in title and "1 outside" in title
+    plt.close("all")
+
+
+def test_thrust_line_of_an_arch_runs_through_every_joint(monkeypatch):
+    params = validate(Params.of(scene="arch"))
+    scene, model = build_model(params)
+    result = solve(model, params, Timer())
+    resultants = interface_resultants(model.interfaces, result.layout, result.x)
+    kept = []
+    monkeypatch.setattr(thrust, "figure_files", lambda fig, dpi, render: kept.append(fig))
+    thrust.thrust_line_png(model.interfaces, resultants, scene.kind.thrust_section(scene))
+    ax = kept[0].axes[0]
+    line = [ln for ln in ax.lines if ln.get_linestyle() == "-" and ln.get_marker() == "o"]
+    # one line, springing to springing: N voussoirs have N + 1 joints, left to right
+    assert len(line) == 1 and len(line[0].get_xdata()) == params.geometry.arch_blocks + 1
+    assert np.all(np.diff(line[0].get_xdata()) > 0)
+    plt.close("all")
 
 
 def test_the_azimuths_radius_starts_near_the_smallest_factor(figures):

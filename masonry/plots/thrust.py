@@ -1,17 +1,16 @@
 """The thrust line: where the resultant of the bed joints at the structure's mid-plane
 acts, drawn in that plane over the joints, hinges and points outside their joint marked.
 
-The joints the plane reaches are grouped by level: the joints that share their lower or
-their upper block bear between the same bricks (a brick on two that meet at the plane,
-whose joints only touch it along their edge, or two on one), and act as one joint whose
-resultant is their sum. A line joins the levels' points along a chain (each level shares
+The joints the plane reaches are grouped by level: joints that share a block facing
+both the same way bear between the same bricks (a brick on two that meet at the plane,
+whose joints only touch it along their edge, or two under one), and act as one joint
+whose resultant is their sum. A line joins the levels' points along a chain (each level shares
 a block with the next: one column of blocks); it breaks where a level shares no block
 with the next (the plane leaves the column: the load passes beside it) and where a
 level carries no normal force (its resultant has no point)."""
 
 import matplotlib.pyplot as plt
 import numpy as np
-from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
 from masonry.plots.colours import HINGE, TENSION, THRUST
@@ -64,15 +63,16 @@ def _plane_joints(section, interfaces, tolerance):
     return np.flatnonzero(bed)
 
 
-def joint_levels(pairs) -> np.ndarray:
-    """The level of each bed joint: joints that share their lower block, or their upper
-    one, bear between the same bricks.
+def joint_levels(pairs, normals) -> np.ndarray:
+    """The level of each bed joint: joints that share a block which faces both the same
+    way (a brick on two, or two bricks under one) bear between the same bricks.
 
     Parameters
     ----------
     pairs : (n, 2) int
-        The blocks of each joint, lower first (an interface's main block is the lower
-        one of a bed joint).
+        The blocks of each joint.
+    normals : (n, 3) float
+        Each joint's unit normal, from its first block into its second.
 
     Returns
     -------
@@ -80,17 +80,18 @@ def joint_levels(pairs) -> np.ndarray:
         A label per joint, equal for the joints of one level.
     """
     pairs = np.asarray(pairs).reshape(-1, 2)
-    count = len(pairs)
-    if count == 0:
+    normals = np.asarray(normals, dtype=float).reshape(-1, 3)
+    if len(pairs) == 0:
         return np.zeros(0, int)
-    # a graph of joints and block sides (a block below, a block above): each joint
-    # links its two sides
-    _, side = np.unique(np.stack([2 * pairs[:, 0], 2 * pairs[:, 1] + 1], axis=1),
-                        return_inverse=True)
-    nodes = count + int(side.max()) + 1
-    graph = coo_matrix((np.ones(2 * count), (np.repeat(np.arange(count), 2),
-                                             count + side.ravel())), shape=(nodes, nodes))
-    return connected_components(graph, directed=False)[1][:count]
+    # a block faces a joint along its normal from the first block, against it from the
+    # second; the crown of an arch, where both neighbours lean on one voussoir from
+    # either side, faces them opposite ways
+    facing = normals @ normals.T
+    linked = np.zeros(facing.shape, bool)
+    for s, t in ((0, 0), (0, 1), (1, 0), (1, 1)):
+        sign = 1 if s == t else -1
+        linked |= (pairs[:, s][:, None] == pairs[:, t][None, :]) & (sign * facing > 0)
+    return connected_components(linked, directed=False)[1]
 
 
 def chains(blocks, has_point=None) -> list:
@@ -140,7 +141,7 @@ def _levels(section, interfaces, resultants):
     index = _plane_joints(section, interfaces, tolerance)
     if len(index) == 0:
         return None
-    label = joint_levels(interfaces.pair[index])
+    label = joint_levels(interfaces.pair[index], interfaces.normal[index])
     members = [index[label == k] for k in range(label.max() + 1)]
     along = [interfaces.centre[joints, section.axis].mean() for joints in members]
     members = [members[k] for k in np.argsort(along, kind="stable")]
@@ -188,8 +189,8 @@ def _draw_points(ax, levels) -> dict:
     if len(alone):
         ax.plot(point[alone, 0], point[alone, 1], "D", markerfacecolor="none",
                 markeredgecolor=THRUST, markersize=4, linestyle="none",
-                label="a joint's point, the line broken: the plane leaves the column "
-                      "of blocks (the load passes beside it)")
+                label="a joint's point, the line broken: no block joins it to the next "
+                      "joint at the plane (the load passes beside the plane)")
     empty = ~has_point
     if empty.any():
         middle = levels["segment"][empty].mean(axis=1)
