@@ -332,3 +332,71 @@ def test_the_azimuths_radius_starts_near_the_smallest_factor(figures):
     azimuths.azimuths_png(collapse)
     low, high = figures[0].ylim
     assert 0.7 < low < 0.79 and 0.82 < high < 0.85
+
+
+def _sweep_figures(monkeypatch, swept, rows):
+    """The summary figures of ``rows``, kept as drawn: ``{file name: figure}``."""
+    from masonry.plots import sweep as sweep_figures
+
+    kept, names = [], []
+
+    def keep(fig, dpi, render):
+        kept.append(fig)
+        return {}
+
+    monkeypatch.setattr(sweep_figures, "figure_files", keep)
+    monkeypatch.setattr(sweep_figures, "as_files", lambda path, files: names.append(path) or {})
+    sweep_figures.summary_figures(swept, rows, "study")
+    return dict(zip(names, kept))
+
+
+def _row(variant, status="computed", error="", **inputs):
+    return {**inputs, "variant": variant, "status": status, "error": error,
+            "feasible": None if status == "failed" else True,
+            "moi_factor": None if status == "failed" else 0.0, "load_factor": None}
+
+
+def test_sweep_plots_tell_every_swept_input_apart_and_name_why_a_variant_failed(
+        monkeypatch):
+    """A 2 x 2 x 2 study whose variants all have the same result, one failed: the
+    legend lists every value of the other inputs, the series differ in colour and
+    marker, and the failed variant is a cross at its value with its reason."""
+    reason = "ParameterError: invalid parameter point_loads='x': expected a free block"
+    rows = [_row(k, mu=mu, stretch=stretch, pattern=pattern)
+            for k, (mu, stretch, pattern) in enumerate(
+                (m, s, p) for m in (0.5, 0.7) for s in (0.8, 1.2)
+                for p in ("herringbone", "none"))]
+    rows[5] = _row(5, "failed", reason + "\nTraceback ...", **{
+        k: rows[5][k] for k in ("mu", "stretch", "pattern")})
+    figures = _sweep_figures(monkeypatch, ["mu", "stretch", "pattern"], rows)
+    assert set(figures) == {"moi_factor_mu.png", "moi_factor_stretch.png",
+                            "moi_factor_pattern.png"}
+    fig = figures["moi_factor_mu.png"]
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert {"stretch = 0.8", "stretch = 1.2", 'pattern = herringbone',
+            "pattern = none"} <= set(legend)
+    assert "failed (1): " + reason in [t.replace("\n", " ") for t in legend]
+    top = fig.axes[0]
+    series = [ln for ln in top.lines if ln.get_marker() != "X"]
+    # four series (stretch x pattern), each told apart by colour and marker
+    assert len({(tuple(ln.get_color()), ln.get_marker()) for ln in series}) == 4
+    # where their points coincide, each ring is another size
+    assert len({ln.get_markersize() for ln in series}) == 4
+    crosses = [ln for ln in top.lines if ln.get_marker() == "X"]
+    assert len(crosses) == 1 and crosses[0].get_xdata().tolist() == [0.7]
+    assert any(t.get_text() == "1" for t in top.texts)
+    strip = fig.axes[1]
+    assert [t.get_text() for t in strip.get_yticklabels()] == ["failed", "infeasible",
+                                                              "feasible"]
+    plt.close("all")
+
+
+def test_a_sampled_input_is_a_colour_scale_with_its_bar(monkeypatch):
+    density = [1500.0 + 100 * k for k in range(10)]
+    rows = [_row(k, mu=mu, density=d) for k, (mu, d) in enumerate(
+        (m, d) for m in (0.5, 0.7) for d in density)]
+    fig = _sweep_figures(monkeypatch, ["mu", "density"], rows)["moi_factor_mu.png"]
+    bars = [ax for ax in fig.axes if ax.get_ylabel() == "density"]
+    assert len(bars) == 1 and bars[0].get_ylim() == (1500.0, 2400.0)
+    assert "not told apart" not in fig.axes[0].get_title()
+    plt.close("all")

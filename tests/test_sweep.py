@@ -77,6 +77,9 @@ def test_a_failing_variant_is_recorded_the_rest_complete_and_the_exit_says_so(
     failed = [r for r in rows if r["status"] == "failed"]
     assert len(failed) == 2 and all("no memory" in r["error"] for r in failed)
     assert sum(r["status"] == "computed" for r in rows) == 2
+    # the summary's figures still drawn, one per swept input
+    assert {"moi_factor_mu.png", "moi_factor_friction.png"} <= {
+        p.name for p in (tmp_path / "sweep_study").iterdir()}
 
 
 @pytest.mark.parametrize("values, shown", [("[0.7, -1.0]", "grid.mu = -1.0"),

@@ -32,6 +32,9 @@ THRUST = "#000000"
 NO_ADHESION = "#d9d9d9"
 """A joint that uses no adhesion at the least adhesion's optimum, among joints coloured
 by the adhesion they use (the magnitude map): light grey."""
+FAILED = "#000000"
+"""A variant of a study that failed (no result): a numbered cross at the axis, its
+number that of its reason in the legend."""
 EMPHASIS = "#000000"
 """A value the figure points at (the least load factor of the azimuths, the load factor
 of the stages)."""

@@ -571,92 +571,27 @@ def summary_parquet(study: Study, rows):
     return buf.getvalue()
 
 
+def summary_figures(study: Study, rows, label="") -> dict:
+    """The study's summary plots (:func:`masonry.plots.sweep.summary_figures`, in the
+    study's figure formats and resolution), titled with ``label`` (the study's name),
+    its variants and its fixed inputs: ``{file name: bytes}``."""
+    # matplotlib, imported only by the runs that draw
+    from masonry.plots.common import Render
+    from masonry.plots.sweep import summary_figures as figures
+
+    failed = sum(r["status"] == "failed" for r in rows)
+    fixed = _fixed_inputs(study)
+    title = (f"{label + ': ' if label else ''}{len(rows) - failed} variants ({failed} "
+             f"failed)" + (f"\nfixed: {fixed}" if fixed else ""))
+    return figures(study.swept, rows, title, Render(tuple(study.figure_format), study.dpi))
+
+
 def _fixed_inputs(study: Study) -> str:
     """The study's fixed inputs away from their defaults, for figure titles."""
     default = Params.of().inputs()
     text = ", ".join(f"{key} {value}" for key, value in study.base.items()
                      if key not in study.swept and default.get(key) != value)
     return text if len(text) <= 80 else text[:77] + "..."
-
-
-PLOTTED_LIMIT = 1e15
-"""Swept values at least this large are drawn one tick per value, not on a numeric axis
-(an axis spanning +-1e308 overflows matplotlib's limits)."""
-
-
-def _label(value) -> str:
-    """A swept value as an axis tick or legend entry (any value a study file holds)."""
-    return value if isinstance(value, str) else json.dumps(value)
-
-
-def summary_pngs(study: Study, rows, label="") -> dict:
-    """MoI factor and feasibility against each swept input (one figure per input); with
-    a second swept input, one colour per value of it (the first other swept input).
-    Titled with ``label`` (the study's name), its variants and its fixed inputs.
-
-    Returns
-    -------
-    dict str -> bytes
-        ``moi_factor_<input>.png`` -> PNG bytes, one per name of ``study.swept``; failed
-        variants are left out of the points and counted in the title.
-    """
-    # matplotlib, imported only by the runs that draw
-    from masonry.plots.common import plt, png_bytes
-
-    out = {}
-    done = [r for r in rows if r["status"] != "failed"]
-    fixed = _fixed_inputs(study)
-    title = (f"{label + ': ' if label else ''}{len(done)} variants ({len(rows) - len(done)} "
-             f"failed)" + (f"\nfixed: {fixed}" if fixed else ""))
-    for name in study.swept:
-        others = [other for other in study.swept if other != name]
-        group = others[0] if others else None
-        fig, (top, bottom) = plt.subplots(2, 1, figsize=(6, 6), sharex=True,
-                                          gridspec_kw={"height_ratios": [3, 1]})
-        x = [r[name] for r in done]
-        # numbers on a numeric axis; anything else (names, lists of point loads, numbers
-        # too large to place) one tick per value
-        numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool)
-                      and abs(v) < PLOTTED_LIMIT for v in x)
-        labels = sorted({_label(v) for v in x}) if not numeric else None
-        xs = np.array(x if numeric else [labels.index(_label(v)) for v in x], dtype=float)
-        keys = [None] if group is None else sorted({_label(r[group]) for r in done})
-        if len(keys) > 8:  # e.g. a sampled input: too many values to tell apart
-            group, keys = None, [None]
-        # feasibility points of the groups side by side, not on top of each other
-        offsets = 0.06 * (np.arange(len(keys)) - (len(keys) - 1) / 2)
-        for colour, key, offset in zip(plt.cm.viridis(np.linspace(0, 0.9, len(keys))), keys,
-                                       offsets):
-            mine = [i for i, r in enumerate(done) if group is None or _label(r[group]) == key]
-            mine.sort(key=lambda i: xs[i])
-            label = None if group is None else f"{group} = {key}"
-            top.plot(xs[mine], [done[i]["moi_factor"] for i in mine], "-o", color=colour,
-                     markersize=4, linewidth=1, label=label)
-            bottom.plot(xs[mine], [(1 if done[i]["feasible"] else 0) + offset for i in mine],
-                        "o", color=colour, markersize=4)
-        if group is not None:
-            top.legend(fontsize=7, frameon=False)
-        top.set_ylabel("MoI factor")
-        bottom.set_yticks([0, 1], ["infeasible", "feasible"])
-        bottom.set_ylim(-0.5, 1.5)  # the markers inside the strip, not cut at its edges
-        bottom.set_xlabel(name)
-        if labels is not None:
-            bottom.set_xticks(range(len(labels)), labels)
-        top.set_title(title, fontsize=9)
-        out[f"moi_factor_{name}.png"] = png_bytes(fig, 100)
-        factors = [(v, r["load_factor"]) for v, r in zip(xs, done)
-                   if r.get("load_factor") is not None]
-        if factors:
-            fig, ax = plt.subplots(figsize=(6, 3.5))
-            ax.scatter(*zip(*factors), c="C2", s=18)
-            ax.set_ylabel("collapse load factor lambda")
-            ax.set_xlabel(name)
-            if labels is not None:
-                ax.set_xticks(range(len(labels)), labels)
-            ax.set_ylim(bottom=0)
-            ax.set_title(title, fontsize=9)
-            out[f"load_factor_{name}.png"] = png_bytes(fig, 100)
-    return out
 
 
 def publish_summary(study: Study, rows, out_root, name: str, label="",
@@ -684,8 +619,8 @@ def publish_summary(study: Study, rows, out_root, name: str, label="",
         parquet = summary_parquet(study, rows)
         if parquet is not None:
             folder.write("summary.parquet", parquet)
-        for png_name, png in summary_pngs(study, rows, label).items():
-            folder.write(png_name, png)
+        for figure_name, data in summary_figures(study, rows, label).items():
+            folder.write(figure_name, data)
         folder.write_json("run.json", record)
 
     job = Publication(out_root, name, identity, record["outputs"], force=True)
