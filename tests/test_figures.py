@@ -353,7 +353,8 @@ def _sweep_figures(monkeypatch, swept, rows):
 def _row(variant, status="computed", error="", **inputs):
     return {**inputs, "variant": variant, "status": status, "error": error,
             "feasible": None if status == "failed" else True,
-            "moi_factor": None if status == "failed" else 0.0, "load_factor": None}
+            "moi_factor": None if status == "failed" else 0.0,
+            "load_factor": None if status == "failed" else 0.5}
 
 
 def test_sweep_plots_tell_every_swept_input_apart_and_name_why_a_variant_failed(
@@ -369,13 +370,14 @@ def test_sweep_plots_tell_every_swept_input_apart_and_name_why_a_variant_failed(
     rows[5] = _row(5, "failed", reason + "\nTraceback ...", **{
         k: rows[5][k] for k in ("mu", "stretch", "pattern")})
     figures = _sweep_figures(monkeypatch, ["mu", "stretch", "pattern"], rows)
-    assert set(figures) == {"moi_factor_mu.png", "moi_factor_stretch.png",
-                            "moi_factor_pattern.png"}
+    assert set(figures) == {f"{y}_{x}.png" for y in ("moi_factor", "load_factor")
+                            for x in ("mu", "stretch", "pattern")}
+    for fig in figures["moi_factor_mu.png"], figures["load_factor_mu.png"]:
+        legend = [t.get_text() for t in fig.legends[0].get_texts()]
+        assert {"stretch = 0.8", "stretch = 1.2", 'pattern = herringbone',
+                "pattern = none"} <= set(legend)
+        assert "failed (1): " + reason in [t.replace("\n", " ") for t in legend]
     fig = figures["moi_factor_mu.png"]
-    legend = [t.get_text() for t in fig.legends[0].get_texts()]
-    assert {"stretch = 0.8", "stretch = 1.2", 'pattern = herringbone',
-            "pattern = none"} <= set(legend)
-    assert "failed (1): " + reason in [t.replace("\n", " ") for t in legend]
     top = fig.axes[0]
     series = [ln for ln in top.lines if ln.get_marker() != "X"]
     # four series (stretch x pattern), each told apart by colour and marker

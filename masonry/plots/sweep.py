@@ -13,6 +13,7 @@ characters).
 
 import json
 import textwrap
+from collections import Counter
 
 import matplotlib
 import matplotlib.pyplot as plt
@@ -150,14 +151,18 @@ def _draw_series(ax, x, y, rows, channels, joined):
 
 def _draw_failed(ax, x, numbers, y=None):
     """Numbered crosses of the failed variants at ``x``: at ``y``, or at the bottom of
-    ``ax``."""
+    ``ax``; variants that failed at one place for one reason share a number, which says
+    how many they are."""
     transform = ax.transData if y is not None else blended_transform_factory(
         ax.transData, ax.transAxes)
     y = np.zeros(len(x)) if y is None else np.full(len(x), float(y))
     ax.plot(x, y, "X", color=FAILED, markersize=7, linestyle="none", transform=transform,
             clip_on=False)
-    for xi, yi, number in zip(x, y, numbers):
-        ax.annotate(str(number), (xi, yi), xycoords=transform, xytext=(5, 4),
+    # one number per place and reason, with how many variants failed there
+    places = [(float(xi), number) for xi, number in zip(x, numbers)]
+    for (xi, number), count in Counter(places).items():
+        ax.annotate(f"{number}" + (f" ({count} variants)" if count > 1 else ""),
+                    (xi, y[0] if len(y) else 0.0), xycoords=transform, xytext=(5, 4),
                     textcoords="offset points", fontsize=7, color=FAILED)
 
 
