@@ -29,6 +29,8 @@ WEB_OUTLINE = "#000000"
 """A web's boundary (its level table's half widths), dashed."""
 THRUST = "#000000"
 """The thrust line."""
+NO_FORCE = "#737373"
+"""A joint of the thrust line that carries no normal force (no point): a grey cross."""
 NO_ADHESION = "#d9d9d9"
 """A joint that uses no adhesion at the least adhesion's optimum, among joints coloured
 by the adhesion they use (the magnitude map): light grey."""

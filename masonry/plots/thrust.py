@@ -13,7 +13,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from scipy.sparse.csgraph import connected_components
 
-from masonry.plots.colours import HINGE, TENSION, THRUST
+from masonry.plots.colours import HINGE, NO_FORCE, TENSION, THRUST
 from masonry.plots.common import HORIZONTAL_KINDS, PNG, figure_files
 from masonry.rbe.resultants import NO_NORMAL_FORCE_REL
 from masonry.tolerances import THRUST_PLANE_REL
@@ -194,7 +194,7 @@ def _draw_points(ax, levels) -> dict:
     empty = ~has_point
     if empty.any():
         middle = levels["segment"][empty].mean(axis=1)
-        ax.plot(middle[:, 0], middle[:, 1], "x", color="0.45", markersize=6,
+        ax.plot(middle[:, 0], middle[:, 1], "x", color=NO_FORCE, markersize=6,
                 label="a joint with no normal force (no point: the line broken)")
     return {"alone": len(alone), "empty": int(empty.sum())}
 
