@@ -128,6 +128,20 @@ def names(kind=None) -> dict:
             **dict.fromkeys(declarations(Outputs), "outputs")}
 
 
+
+def input_dtypes() -> dict:
+    """pandas dtypes of the inputs as tables write them (a sweep's ``summary.csv``, an
+    optimisation's trials): every declared input by its kind (integers, booleans and
+    floats; text for names, friction models and figure formats), the scene and the
+    preset as text, ``lateral`` as text (an azimuth or ``all``), point loads as text."""
+    dtypes = {"int": "Int64", "bool": "boolean", "float": "float64"}
+    out = {"scene": "str", "preset": "str", "fast": "boolean", "lateral": "str",
+           "point_loads": "str", "crown_load": "float64"}
+    for part in (*(k.geometry for k in KINDS.values()), Analysis, Outputs):
+        out.update({name: dtypes.get(d.kind, "str")
+                    for name, d in declarations(part).items()})
+    return out
+
 def applies(name: str, kind) -> bool:
     """Whether the input ``name`` applies to scenes of ``kind`` (a boundary only to the
     kinds that take one)."""

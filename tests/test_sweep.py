@@ -5,6 +5,8 @@ import json
 
 import pytest
 
+import masonry
+
 from masonry import forking
 from masonry.studies import workers
 from masonry.studies.sweep import on_grid, sample_step
@@ -80,6 +82,22 @@ def test_a_failing_variant_is_recorded_the_rest_complete_and_the_exit_says_so(
     # the summary's figures still drawn, one per swept input
     assert {"moi_factor_mu.png", "moi_factor_friction.png"} <= {
         p.name for p in (tmp_path / "sweep_study").iterdir()}
+
+
+def test_a_summary_of_swept_text_inputs_reads_back_typed(tmp_path):
+    """Point loads, a lateral azimuth or ``all``, a friction model and a pattern swept:
+    summary.csv reads back with each input in its declared type (text, integers,
+    floats), as every file the project writes."""
+    path = tmp_path / "texts.toml"
+    path.write_text('[base]\nscene = "arch"\nblocks = 6\n[grid]\n'
+                    'point-load = ["v003:0,0,-100", "v00*:0,0,-10"]\n'
+                    'friction-cone = ["circle", "polygon:16"]\n')
+    assert main(["sweep", str(path), "--workers", "1", "--out", str(tmp_path), "-q"]) == 0
+    table = masonry.read_table(tmp_path / "sweep_texts" / "summary.csv")
+    assert set(table["point_loads"]) == {"v003:0,0,-100", "v00*:0,0,-10"}
+    assert set(table["friction_cone"]) == {"circle", "polygon:16"}
+    assert str(table["bricks"].dtype) == "Int64" and table["feasible"].dtype == "boolean"
+    assert table["weight_N"].dtype == "float64"
 
 
 @pytest.mark.parametrize("values, shown", [("[0.7, -1.0]", "grid.mu = -1.0"),

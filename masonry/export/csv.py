@@ -6,6 +6,7 @@ import numpy as np
 from masonry.blocks import BLOCK_CLASSES, Blocks
 from masonry.export._text import format_floats
 from masonry.interfaces import INTERFACE_KINDS
+from masonry.params import input_dtypes
 from masonry.tolerances import TENSION_REPORTED_REL
 
 TENSION_TOP_COUNT = 20
@@ -33,11 +34,15 @@ def header(columns) -> list:
 
 def column_types(names) -> dict:
     """pandas dtypes of masonry's CSV columns ``names``: integers, text and booleans as
-    declared, every other column a float (its name says its unit). ``pd.read_csv(path,
+    declared, the inputs of a sweep's rows by their declarations
+    (:func:`masonry.params.input_dtypes`), every other column a float (its name says its
+    unit). ``pd.read_csv(path,
     dtype=column_types(header))`` types a file with only its header as one with rows;
     :func:`masonry.read_table` does it."""
+    inputs = input_dtypes()
     return {name: "Int64" if name in INTEGER_COLUMNS else "str" if name in TEXT_COLUMNS
-            else "boolean" if name in BOOLEAN_COLUMNS else "float64" for name in names}
+            else "boolean" if name in BOOLEAN_COLUMNS else inputs.get(name, "float64")
+            for name in names}
 
 
 def missing_values(names) -> dict:
