@@ -128,6 +128,11 @@ measurements; ``constant`` is :meth:`Mortar.constant` of the run's strengths."""
 
 MORTAR_NAMES = ("constant", *MORTARS)
 
+LAYING_INPUTS = ("mortar", "laying_rate", "masons")
+"""A stage study's mortar by age (``masonry stages --mortar --laying-rate --masons``):
+inputs of the construction, not of a run's analysis, which a parameter file's
+``[mortar]`` table and a study file take beside the analysis's mortar inputs."""
+
 
 @dataclass(frozen=True)
 class Laying:
