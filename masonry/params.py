@@ -129,6 +129,15 @@ def names(kind=None) -> dict:
             **dict.fromkeys(declarations(Outputs), "outputs")}
 
 
+def text_inputs() -> tuple:
+    """The inputs whose values are names (``scene``, ``pattern``, ``friction_cone``,
+    ...): a study's columns of them are text."""
+    parts = [kind.geometry for kind in KINDS.values()] + [Analysis, Outputs]
+    return ("scene", *sorted({name for part in parts
+                              for name, declaration in declarations(part).items()
+                              if declaration.kind in ("str", "any")}))
+
+
 def applies(name: str, kind) -> bool:
     """Whether the input ``name`` applies to scenes of ``kind`` (a boundary only to the
     kinds that take one)."""

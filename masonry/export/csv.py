@@ -19,9 +19,10 @@ INTEGER_COLUMNS = ("id", "rank", "brick", "block", "block_a", "block_b", "course
                    "course_a", "course_b", "vertex", "vertices", "stage", "bricks", "step",
                    "variant", "interfaces", "stages", "stages_standing", "interface",
                    "first_unsupported_stage", "first_unsupported_course",
-                   "first_unsupported_brick", "adhesion_max_course", "trial", "loose")
+                   "first_unsupported_brick", "adhesion_max_course", "trial", "loose",
+                   "masons")
 TEXT_COLUMNS = ("name", "name_a", "name_b", "class", "kind", "laid", "status", "error",
-                "friction_used", "friction_model", "structure_id")
+                "friction_used", "friction_model", "structure_id", "mortar")
 BOOLEAN_COLUMNS = ("feasible", "stands", "constraints_met", "best")
 """The columns of masonry's CSV files that are not floats, by type: :func:`column_types`."""
 
@@ -31,22 +32,24 @@ def header(columns) -> list:
     return [HEADERS.get(c, c) for c in columns]
 
 
-def column_types(names) -> dict:
+def column_types(names, text=()) -> dict:
     """pandas dtypes of masonry's CSV columns ``names``: integers, text and booleans as
-    declared, every other column a float (its name says its unit). ``pd.read_csv(path,
+    declared, and ``text`` (a study's inputs whose values are names) as text, every other
+    column a float (its name says its unit). ``pd.read_csv(path,
     dtype=column_types(header))`` types a file with only its header as one with rows;
     :func:`masonry.read_table` does it."""
-    return {name: "Int64" if name in INTEGER_COLUMNS else "str" if name in TEXT_COLUMNS
-            else "boolean" if name in BOOLEAN_COLUMNS else "float64" for name in names}
+    return {name: "Int64" if name in INTEGER_COLUMNS else
+            "str" if name in TEXT_COLUMNS or name in text else
+            "boolean" if name in BOOLEAN_COLUMNS else "float64" for name in names}
 
 
-def missing_values(names) -> dict:
+def missing_values(names, text=()) -> dict:
     """The cells of masonry's CSV columns ``names`` that read as missing (pandas
     ``na_values``): an empty cell in every column, and ``nan`` in a float column (what
     :func:`~masonry.export._text.format_floats` prints for NaN: a point of application
     that does not exist). A name's ``nan`` stays text."""
     return {name: ["", "nan"] if dtype == "float64" else [""]
-            for name, dtype in column_types(names).items()}
+            for name, dtype in column_types(names, text).items()}
 
 
 def _table(columns) -> bytes:
