@@ -85,9 +85,12 @@ def test_a_study_sweeps_the_laying_rate_of_a_mortar_that_ages(tmp_path):
 
 
 def test_a_study_sweeps_the_mortar_and_the_masons_and_reads_back_typed(tmp_path):
+    """The per joint kind strengths of [mortar] reach every variant's stage study (its
+    folder and its record)."""
     study = tmp_path / "crews.toml"
     study.write_text('[base]\nscene = "arch"\nlaying_rate = 600\n[grid]\n'
                      'mortar = ["lime", "gypsum"]\nmasons = [1, 2]\n'
+                     '[mortar]\nsupport_joint_ratio = 0.5\nhead_joint_ratio = 0.25\n'
                      '[outputs]\nstages = "block"\n')
     out = tmp_path / "out"
     assert _sweep(study, out) == 0
@@ -96,7 +99,11 @@ def test_a_study_sweeps_the_mortar_and_the_masons_and_reads_back_typed(tmp_path)
     assert str(table["masons"].dtype) == "Int64" and list(table["masons"]) == [1, 2, 1, 2]
     assert (table["status"] == "computed").all()
     # two masons lay the same stage in half the time
-    stages = masonry.read_table(_stage_folder(out, "_lime600x2") / "stages.csv")
+    folder = _stage_folder(out, "_lime600x2")
+    assert "_hj0.25_sj0.5_" in folder.name
+    params = json.loads((folder / "run.json").read_text())["params"]
+    assert (params["head_joint_ratio"], params["support_joint_ratio"]) == (0.25, 0.5)
+    stages = masonry.read_table(folder / "stages.csv")
     assert np.allclose(stages["time_h"], np.arange(1, 9) * ARCH_STAGE / 1200, rtol=1e-9)
 
 
@@ -115,6 +122,7 @@ STAGES = '[outputs]\nstages = "block"\n'
     ('[grid]\nlaying_rate = [60]\n', "grid.laying_rate = [60]: expected [outputs] stages"),
     ('[grid]\nmu = [0.7]\n[mortar]\ncohesion_kpa = -1\n', "mortar.cohesion_kpa = -1"),
     ('[grid]\nmu = [0.7]\n[mortar]\nage = 3\n', "mortar.age = 3"),
+    ('[grid]\nmu = [0.7]\n[mortar]\nhead_joint_ratio = 2\n', "mortar.head_joint_ratio = 2"),
     ('[grid]\nmu = [0.7]\n[mortar]\ncohesion_kpa = [1, 2]\n', "mortar.cohesion_kpa"),
     ('[base]\ncohesion_kpa = 1\n[grid]\nmu = [0.7]\n[mortar]\ncohesion_kpa = 2\n',
      "in [mortar] or in [base]"),
@@ -265,7 +273,7 @@ def test_a_block_on_a_bed_with_cohesion_slides_at_mu_plus_c_a_over_w(tmp_path, l
     lambda = mu + c A / W, here 0.7 + 0.5 = 1.2 with c = p / 2 (p = W / A = 1962 Pa);
     tipping needs b / h = 4. The bed is a square on Coulomb's circle: every azimuth
     gives the same, and so does the search over them."""
-    weight = 2000.0 * 9.81 * np.prod(BLOCK)
+    weight = 2000.0 * 9.81 * float(np.prod(BLOCK))
     area = BLOCK[0] * BLOCK[1]
     cohesion_kpa = 0.5 * weight / area / 1e3
     out = tmp_path / "out"
