@@ -379,11 +379,12 @@ def given_inputs(args) -> dict:
     return given
 
 
-def params_from_args(args) -> Params:
+def params_from_args(args, laying=False) -> Params:
     """Preset or file first, then every option the user gave; validated. Options that do
     not apply to the resulting scene are refused (:func:`masonry.params.applies`). A
     section whose boundary neither an option nor the file gives is cyclic: it stands for
-    the whole dome, the question a run answers first."""
+    the whole dome, the question a run answers first. ``laying``: a stage study's, whose
+    file's ``[mortar]`` may give the mortar by age (:func:`masonry.params.load`)."""
     given = given_inputs(args)
     scene = given.get("scene")
     if args.params is None and args.preset:
@@ -401,7 +402,7 @@ def params_from_args(args) -> Params:
         raise ParameterError("dome", True, f"an option of a section, not of this "
                                            f"{scene} scene")
     if args.params is not None:
-        params = load(args.params, **given)
+        params = load(args.params, laying=laying, **given)
         _refuse_inapplicable(given, params.kind)
     elif args.preset:
         params = from_preset(args.preset, **given)

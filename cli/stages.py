@@ -124,14 +124,13 @@ def handle(args, report):
         by = args.by or "block"
     else:
         scene = source = None
-        params, by = params_from_args(args), args.by or "course"
+        params, by = params_from_args(args, laying=True), args.by or "course"
         if not params.kind.has_courses and args.by is None:
             by = "block"
         params = stage_params(params, args.boundary is not None or args.dome)
     record = run_stages(params, args.out, by=by, order=args.order, course=args.course,
                         force=args.force, scene=scene, source=source,
-                        max_bricks=args.max_bricks, mortar=args.mortar,
-                        laying_rate=args.laying_rate, masons=args.masons)
+                        max_bricks=args.max_bricks, **_laying(args, params))
     stages = record["stages"]
     state = "up to date, reused" if record.get("reused") else "written"
     report(f"{record['structure_id']}: {record['plan']['described']}")
@@ -168,6 +167,29 @@ def handle(args, report):
                f"{', ...' if len(loose) > 10 else ''} (stages.csv, column loose)")
     report(f"{state}: {record['path']}")
     return 0
+
+
+def _laying(args, params) -> dict:
+    """The mortar by age (:data:`~masonry.mortars.LAYING_INPUTS`): the options given,
+    else the ``--params`` file's ``[mortar]``; checked here, so that a file's value is
+    refused naming the file and key."""
+    from masonry.mortars import LAYING_INPUTS
+    from masonry.params import laying_inputs
+    from masonry.studies.stages import stage_laying
+
+    given = {name: getattr(args, name) for name in LAYING_INPUTS}
+    from_file = {} if getattr(args, "params", None) is None else {
+        name: value for name, value in laying_inputs(args.params).items()
+        if given[name] is None}
+    inputs = {**given, **from_file}
+    try:
+        stage_laying(params, **inputs)
+    except ParameterError as error:
+        if error.name not in from_file:
+            raise
+        raise ParameterError(error.name, error.value, error.expected,
+                             where=args.params) from None
+    return inputs
 
 
 def _with_mortar(record) -> str:

@@ -8,10 +8,11 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from masonry.errors import ParameterError
+from masonry.mortars import LAYING_INPUTS, split_laying
 from masonry.optional import optional_import
 from masonry.outputs import Outputs, figure_formats
 from masonry.parameters import declarations, read_toml
-from masonry.params import PRESETS, Params, names, validate
+from masonry.params import MORTAR_KEYS, PRESETS, Params, names, validate
 from masonry.runfolder import check_output_root, check_study_folder
 
 from . import run as run_command
@@ -124,7 +125,7 @@ NOT_AN_INPUT = {
 """Why a study table refuses a run option that is not an input, by its destination."""
 
 
-TABLES = ("base", "grid", "sample", "outputs", "constraints")
+TABLES = ("base", "grid", "sample", "mortar", "outputs", "constraints")
 MAX_VARIANTS = 100_000
 """Largest study (grid points times samples): a study file asking for more is refused."""
 
@@ -167,6 +168,7 @@ def load_study(path, draws=True):
         if not ok:
             refuse(key, value, expected)
     stages = _stage_outputs(outputs, refuse)
+    mortar = _mortar_table(data.get("mortar", {}), base, refuse)
     for key, values in grid.items():
         if not isinstance(values, list) or not values:
             refuse(f"grid.{key}", values, "a non-empty list of values")
@@ -180,20 +182,60 @@ def load_study(path, draws=True):
     size = math.prod(len(v) for v in grid.values()) * max(count, 1)
     if size > MAX_VARIANTS and draws:
         refuse("grid", f"{size} variants", f"at most {MAX_VARIANTS} variants")
-    names = run_option_names()
+    names = {**run_option_names(), **{spelling: (name, True) for name in LAYING_INPUTS
+                                      for spelling in (name, name.replace("_", "-"))}}
     from masonry.studies.sweep import Study  # the pipeline: once the file is read
 
+    tables = {"base": _fields(base, "base", names, where),
+              "grid": _fields(grid, "grid", names, where, lists=True),
+              "sample": _fields(sample, "sample", names, where), "mortar": mortar}
+    _check_laying(tables, stages, where)
     study = Study(
-        base={**(PRESETS[str(preset)] if preset is not None else {}),
-              **_fields(base, "base", names, where)},
-        grid=_fields(grid, "grid", names, where, lists=True),
-        sample=_fields(sample, "sample", names, where), count=count, seed=seed,
+        base={**(PRESETS[str(preset)] if preset is not None else {}), **tables["base"],
+              **mortar},
+        grid=tables["grid"], sample=tables["sample"], count=count, seed=seed,
         plots=outputs.get("plots", False), printable=outputs.get("printable", False),
         html=outputs.get("html", False), constraints=constraints, **stages,
         **_figure_outputs(outputs, refuse))
     study = _checked_constraints(study, where)
-    _check_variants(study, where, None if draws else _search_probes(study))
+    _check_variants(study, where, None if draws else _search_probes(study), mortar)
     return study
+
+
+MORTAR_TABLE = (*MORTAR_KEYS, *LAYING_INPUTS)
+"""The keys of a study's ``[mortar]`` table: the analysis's mortar inputs and, for a
+study of stages, their mortar by age."""
+
+
+def _mortar_table(table, base, refuse) -> dict:
+    """``[mortar]``: fixed inputs of every variant (:data:`MORTAR_TABLE`, as a parameter
+    file's ``[mortar]``), refused by key when it is another key, not one value, or
+    ``[base]`` gives it too."""
+    out = {}
+    for key, value in table.items():
+        name = key.replace("-", "_")
+        if name not in MORTAR_TABLE:
+            refuse(f"mortar.{key}", value, f"one of {', '.join(MORTAR_TABLE)}")
+        if isinstance(value, (list, dict)):
+            refuse(f"mortar.{key}", value, "one value, the same in every variant (a list "
+                                           "to sweep goes in [grid])")
+        if name in base or key in base:
+            refuse(f"mortar.{key}", value, "in [mortar] or in [base], not in both")
+        out[name] = value
+    return out
+
+
+def _check_laying(tables, stages, where):
+    """Refuse a mortar by age (:data:`~masonry.mortars.LAYING_INPUTS`) in a study
+    without stage studies: it ages the joints of the stages, not of a run."""
+    if stages:
+        return
+    for table, inputs in tables.items():
+        for name in LAYING_INPUTS:
+            if name in inputs:
+                raise ParameterError(f"{table}.{name}", inputs[name], "[outputs] stages "
+                                     "beside it: the mortar by age of every variant's "
+                                     "stage study (masonry stages --mortar)", where=where)
 
 
 def _constraints(table, where) -> dict:
@@ -303,26 +345,29 @@ def _stage_outputs(outputs, refuse) -> dict:
     return {"stages": by, "stages_course": course, "stages_order": order}
 
 
-def _check_variants(study, where, variants=None):
+def _check_variants(study, where, variants=None, mortar=()):
     """Every variant's inputs (or ``variants``) checked as ``masonry run`` (and for a
-    study of stages ``masonry stages``) checks them, before any runs: a value out of
-    range names the table and key it came from (the input refused, else the first other
-    input the check involves that the study gives; one the study leaves at its default
-    says so); a plan by course or brick of a scene not laid in courses names
-    ``outputs.stages``."""
+    study of stages ``masonry stages``, its mortar by age too) checks them, before any
+    runs: a value out of range names the table and key it came from (the input refused,
+    else the first other input the check involves that the study gives; one the study
+    leaves at its default says so; ``mortar`` the keys of the ``[mortar]`` table); a
+    plan by course or brick of a scene not laid in courses names ``outputs.stages``."""
     for inputs in variants if variants is not None else study.variants():
         try:
-            params = validate(Params.of(**inputs))
+            run_inputs, laying = split_laying(inputs)
+            params = validate(Params.of(**run_inputs))
             if study.stages:  # what 'masonry stages' would refuse of the variant
-                from masonry.studies.stages import check_live_load, stage_params
+                from masonry.studies.stages import check_live_load, stage_laying, stage_params
 
                 check_live_load(params)
-                stage_params(params, "boundary" in inputs)
+                stage_laying(stage_params(params, "boundary" in inputs), **laying)
         except ParameterError as error:
             names = (error.name, *error.related)
-            table, name = next(((t, n) for n in names for t in ("grid", "sample", "base")
-                                if n in getattr(study, t)), (None, error.name))
-            key = _option_of(name)
+            tables = {"grid": study.grid, "sample": study.sample, "mortar": mortar,
+                      "base": study.base}
+            table, name = next(((t, n) for n in names for t in tables if n in tables[t]),
+                               (None, error.name))
+            key = name if table == "mortar" else _option_of(name)
             raise ParameterError(f"{table}.{key}" if table else f"{key} (the default)",
                                  inputs.get(name, error.value), error.expected,
                                  where=where) from None

@@ -35,7 +35,8 @@ from masonry.rbe.resultants import interface_resultants
 from masonry.scenes import check_size
 from masonry.scenes.imported import AssemblyError, load_assembly
 from masonry.studies.plans import make_plan
-from masonry.studies.stages import STAGE_COLUMNS, analyse_stages, check_live_load
+from masonry.studies.stages import (STAGE_COLUMNS, analyse_stages, check_live_load,
+                                    stage_laying)
 from masonry.tolerances import Tolerances
 
 
@@ -180,9 +181,11 @@ class Structure:
         # a solved equilibrium stands for the dead load; else the program decides it
         return collapse_of(self.model, params, self.__dict__.get("_equilibrium"))
 
-    def stages(self, by="course", order=None, course=None):
+    def stages(self, by="course", order=None, course=None, mortar=None, laying_rate=None,
+               masons=None):
         """Whether it stands at every stage of its construction without centering
-        (docs/model.md 4.7): one row per stage.
+        (docs/model.md 4.7): one row per stage, as ``masonry stages`` writes
+        ``stages.csv``.
 
         Parameters
         ----------
@@ -193,6 +196,15 @@ class Structure:
             The laying order of bricks or blocks (``masonry stages --help``).
         course : int, optional
             The course laid brick by brick.
+        mortar : {'constant', 'lime', 'gypsum'}, optional
+            Every joint has the strength of its age (docs/model.md 6.13): a named
+            mortar's table, or ``constant`` (the analysis's ``cohesion_kpa`` and
+            ``tensile_kpa`` at every age). None: the analysis's contact law at every
+            joint.
+        laying_rate : float, optional
+            Bricks per hour per mason (> 0; needed by ``lime`` and ``gypsum``).
+        masons : int, optional
+            Masons laying side by side (>= 1, default 1).
 
         Returns
         -------
@@ -200,13 +212,22 @@ class Structure:
             The columns of ``stages.csv``, one row per stage (docs/stages.md): blocks
             laid, verdict, MoI factor, centering force, least adhesion
             (``adhesion_kPa``, docs/model.md 6.12), the load factor of the live load if
-            the structure has one.
+            the structure has one, the hours from the start to the stage's end
+            (``time_h``, with a laying rate).
+
+        Raises
+        ------
+        masonry.errors.ParameterError
+            A mortar, rate or number of masons refused (named as the argument), a
+            mortar that ages beside the analysis's strengths, or a plan the structure
+            does not take.
         """
         import pandas
 
         check_live_load(self.params)
+        laying = stage_laying(self.params, mortar, laying_rate, masons)
         plan = make_plan(self.scene, by, order, course)
-        rows = analyse_stages(self.model, self.params, plan)
+        rows = analyse_stages(self.model, self.params, plan, laying=laying)
         frame = pandas.DataFrame(rows, columns=STAGE_COLUMNS)
         return frame.rename(columns=HEADERS).set_index("stage")
 
@@ -367,8 +388,9 @@ def read_table(path):
     """One of the CSV files masonry writes (``RBE/forces.csv``, ``tension_top.csv``,
     ``stages.csv``, a sweep's ``summary.csv``, ...) as a pandas DataFrame with every
     column's type, also when the file holds only its header (nothing in tension): integer
-    ids and counts, text names, booleans ``True``/``False``, floats for the rest (their
-    names carry the unit; an empty cell or ``nan`` is NaN).
+    ids and counts, text names (also a study's inputs whose values are names, such as
+    ``pattern``), booleans ``True``/``False``, floats for the rest (their names carry the
+    unit; an empty cell or ``nan`` is NaN).
 
     Parameters
     ----------

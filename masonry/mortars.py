@@ -128,6 +128,18 @@ measurements; ``constant`` is :meth:`Mortar.constant` of the run's strengths."""
 
 MORTAR_NAMES = ("constant", *MORTARS)
 
+LAYING_INPUTS = ("mortar", "laying_rate", "masons")
+"""A stage study's mortar by age (``masonry stages --mortar --laying-rate --masons``):
+inputs of the construction, not of a run's analysis, which a parameter file's
+``[mortar]`` table and a study file take beside the analysis's mortar inputs."""
+
+
+def split_laying(inputs: dict) -> tuple:
+    """A study variant's inputs (flat names) as ``(run inputs, mortar by age)``: the
+    second its :data:`LAYING_INPUTS` (of its stage study), the first every other."""
+    return ({k: v for k, v in inputs.items() if k not in LAYING_INPUTS},
+            {k: v for k, v in inputs.items() if k in LAYING_INPUTS})
+
 
 @dataclass(frozen=True)
 class Laying:

@@ -16,6 +16,7 @@ import json
 from dataclasses import dataclass
 
 from masonry.errors import ParameterError
+from masonry.mortars import LAYING_INPUTS
 from masonry.outputs import Outputs
 from masonry.parameters import (check_fields, declarations, defaults, plain, read_toml, text_of,
                                 values)
@@ -128,7 +129,6 @@ def names(kind=None) -> dict:
             **dict.fromkeys(declarations(Outputs), "outputs")}
 
 
-
 def input_dtypes() -> dict:
     """pandas dtypes of the inputs as tables write them (a sweep's ``summary.csv``, an
     optimisation's trials): every declared input by its kind (integers, booleans and
@@ -141,6 +141,7 @@ def input_dtypes() -> dict:
         out.update({name: dtypes.get(d.kind, "str")
                     for name, d in declarations(part).items()})
     return out
+
 
 def applies(name: str, kind) -> bool:
     """Whether the input ``name`` applies to scenes of ``kind`` (a boundary only to the
@@ -212,10 +213,12 @@ def from_preset(name, **overrides) -> Params:
     return validate(Params.of(**{**PRESETS[key], **overrides}))
 
 
-def load(path, **overrides) -> Params:
+def load(path, *, laying=False, **overrides) -> Params:
     """The inputs of a TOML file of flat names (e.g. ``fixtures/presets/*.toml``), at the
     top level or in a ``[params]`` table, and the mortar's in a ``[mortar]`` table
-    (:data:`MORTAR_KEYS`); ``overrides`` win over the file.
+    (:data:`MORTAR_KEYS`); ``overrides`` win over the file. ``laying``: the file is a
+    stage study's, whose ``[mortar]`` may also give :data:`LAYING_INPUTS`
+    (:func:`laying_inputs` reads them); else they are refused.
 
     Raises
     ------
@@ -223,13 +226,14 @@ def load(path, **overrides) -> Params:
         Named ``params`` when the file cannot be read or is not TOML; named after the key
         (with ``where`` the file) when a key is unknown or its value invalid.
     """
-    raw = read_toml(path, "params")
-    data = raw.get("params", raw)
-    if not isinstance(data, dict):
-        raise ParameterError("params", str(path), "a file whose [params] is a table")
-    mortar = raw.get("mortar", data.get("mortar", {}))
-    data = {key: value for key, value in data.items() if key != "mortar"}
-    data.update(_mortar_table(mortar, path))
+    data, mortar = _file_tables(path)
+    if not laying:
+        for key in LAYING_INPUTS:
+            if key in mortar:
+                raise ParameterError(key, mortar[key], "none for masonry run: the mortar "
+                                     "by age of a construction's stages (masonry stages)",
+                                     where=str(path))
+    data.update({key: value for key, value in mortar.items() if key not in LAYING_INPUTS})
     known = ["scene", "fast", *names()]
     for key, value in data.items():
         if key not in known:
@@ -251,20 +255,36 @@ def load(path, **overrides) -> Params:
 
 MORTAR_KEYS = ("cohesion_kpa", "tensile_kpa", "head_joint_ratio", "support_joint_ratio",
                "adhesion_tension_ratio")
-"""The keys of a parameter file's ``[mortar]`` table (the analysis's mortar inputs)."""
+"""The analysis's keys of a parameter file's ``[mortar]`` table (its mortar inputs); a
+stage study's file may also give :data:`~masonry.mortars.LAYING_INPUTS`."""
 
 
-def _mortar_table(table, path) -> dict:
-    """The inputs of a parameter file's ``[mortar]`` table (:data:`MORTAR_KEYS`), refused
-    by key when it is not a table or names another key."""
+def laying_inputs(path) -> dict:
+    """The :data:`~masonry.mortars.LAYING_INPUTS` a parameter file's ``[mortar]`` table
+    gives (``mortar``, ``laying_rate``, ``masons``), unchecked: a stage study checks them
+    (:func:`masonry.studies.stages.stage_laying`)."""
+    _, mortar = _file_tables(path)
+    return {key: value for key, value in mortar.items() if key in LAYING_INPUTS}
+
+
+def _file_tables(path) -> tuple:
+    """A parameter file's flat inputs (dict) and its ``[mortar]`` table (dict), refused
+    when either is not a table or ``[mortar]`` names a key of neither :data:`MORTAR_KEYS`
+    nor :data:`~masonry.mortars.LAYING_INPUTS`."""
+    raw = read_toml(path, "params")
+    data = raw.get("params", raw)
+    if not isinstance(data, dict):
+        raise ParameterError("params", str(path), "a file whose [params] is a table")
+    table = raw.get("mortar", data.get("mortar", {}))
+    keys = (*MORTAR_KEYS, *LAYING_INPUTS)
     if not isinstance(table, dict):
-        raise ParameterError("mortar", table, f"a table of {' and '.join(MORTAR_KEYS)}",
+        raise ParameterError("mortar", table, f"a table of {', '.join(keys)}",
                              where=str(path))
     for key, value in table.items():
-        if key not in MORTAR_KEYS:
-            raise ParameterError(key, value, f"{' or '.join(MORTAR_KEYS)} in [mortar]",
+        if key not in keys:
+            raise ParameterError(key, value, f"{', '.join(keys)} in [mortar]",
                                  where=str(path))
-    return dict(table)
+    return {key: value for key, value in data.items() if key != "mortar"}, dict(table)
 
 
 def structure_id(params: Params) -> str:

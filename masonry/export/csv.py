@@ -20,9 +20,10 @@ INTEGER_COLUMNS = ("id", "rank", "brick", "block", "block_a", "block_b", "course
                    "course_a", "course_b", "vertex", "vertices", "stage", "bricks", "step",
                    "variant", "interfaces", "stages", "stages_standing", "interface",
                    "first_unsupported_stage", "first_unsupported_course",
-                   "first_unsupported_brick", "adhesion_max_course", "trial", "loose")
+                   "first_unsupported_brick", "adhesion_max_course", "trial", "loose",
+                   "masons")
 TEXT_COLUMNS = ("name", "name_a", "name_b", "class", "kind", "laid", "status", "error",
-                "friction_used", "friction_model", "structure_id")
+                "friction_used", "friction_model", "structure_id", "mortar")
 BOOLEAN_COLUMNS = ("feasible", "stands", "constraints_met", "best")
 """The columns of masonry's CSV files that are not floats, by type: :func:`column_types`."""
 

@@ -29,6 +29,7 @@ import numpy as np
 from masonry.export._text import format_floats
 from masonry.export.csv import HEADERS, TEXT_COLUMNS, header
 from masonry.errors import ParameterError
+from masonry.mortars import LAYING_INPUTS, split_laying
 from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run, versions
 from masonry.studies.stage_records import (STAGE_SUMMARY_COLUMNS, STANDS_THROUGHOUT,
@@ -131,7 +132,9 @@ class Study:
     stages : str or None
         Also a stage study of every variant (:func:`masonry.studies.stages.run_stages`),
         laid by ``course``, ``brick`` or ``block``; its results add
-        :data:`STAGE_SUMMARY_COLUMNS` to the summary.
+        :data:`STAGE_SUMMARY_COLUMNS` to the summary. Its mortar by age
+        (:data:`~masonry.mortars.LAYING_INPUTS`) is among the inputs of ``base``,
+        ``grid`` and ``sample``.
     stages_course : int or None
         The course a brick plan lays brick by brick; None: every course (the whole
         construction).
@@ -196,7 +199,7 @@ class Study:
             For names that are no run's inputs, a grid entry that is not a
             non-empty list, or samples with ``count < 1``.
         """
-        fields = {"scene", "fast", *names()}
+        fields = {"scene", "fast", *names(), *(LAYING_INPUTS if self.stages else ())}
         unknown = (set(self.base) | set(self.grid) | set(self.sample)) - fields
         if unknown:
             raise ParameterError("study", sorted(unknown), "inputs named as run options")
@@ -247,7 +250,8 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     Parameters
     ----------
     inputs : dict
-        The variant's inputs (flat names).
+        The variant's inputs (flat names), and with ``stages`` its stage study's mortar
+        by age (:func:`~masonry.mortars.split_laying`).
     out_root : str or Path
         The study's output root; the variant's run folder is named by its structure id.
     analyse, plots, printable, html : bool
@@ -273,13 +277,14 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     use_one_blas_thread()  # in a Dask worker process too
     start = time.perf_counter()
     row = {"status": "failed", "error": ""}
+    inputs, laying = split_laying(inputs)
     try:
         params = validate(Params.of(**{"plots": plots, "printable": printable,
                                        "html": html, "figure_format": figure_format,
                                        "dpi": dpi, **inputs}))
         record = run(params, out_root, analyse=analyse)
         staged = None if stages is None else run_stages(
-            stage_params(params, "boundary" in inputs), out_root, **stages)
+            stage_params(params, "boundary" in inputs), out_root, **stages, **laying)
     except Exception as error:  # a variant's failure is data, not the study's end
         raise_interrupt(error)  # an interrupt an extension's loader made an ImportError
         row["error"] = f"{type(error).__name__}: {error}"
@@ -339,7 +344,7 @@ def geometry_group(inputs: dict) -> str:
         (such a variant is a group of its own and fails on its own).
     """
     try:
-        return geometry_key(Params.of(**inputs))
+        return geometry_key(Params.of(**split_laying(inputs)[0]))
     except (TypeError, ValueError):  # an invalid variant: alone, to fail on its own
         return json.dumps(inputs, sort_keys=True, default=str)
 

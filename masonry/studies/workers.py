@@ -12,6 +12,7 @@ import logging
 from contextlib import contextmanager
 
 from masonry import forking
+from masonry.mortars import split_laying
 from masonry.params import Params, validate
 
 DASK_MIN_BRICKS = 5_000
@@ -27,7 +28,7 @@ when it has a core of its own."""
 def estimated_bricks(inputs: dict) -> float:
     """The blocks a variant's model would have (its scene's estimate), from its
     inputs."""
-    params = validate(Params.of(**inputs))
+    params = validate(Params.of(**split_laying(inputs)[0]))
     return params.kind.estimate_blocks(params.geometry)
 
 
