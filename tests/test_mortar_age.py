@@ -216,3 +216,16 @@ def test_the_cli_names_the_mortar_and_the_rate(tmp_path, capsys):
     assert record["mortar"]["law"].startswith("Coulomb circle, mu 0.7, per joint by its age")
     table = read_table(folder / "stages.csv")
     assert np.allclose(table["time_h"], np.arange(1, 9) * 2 / 600, rtol=1e-9)
+
+
+def test_the_law_line_of_a_mortar_by_age_names_the_joint_kinds():
+    """With --head-joint-ratio 0.5 the one-line law of a stage study with lime says so,
+    as the uniform law's does; without ratios it ends with the mortar."""
+    from masonry.studies.stage_records import law_line
+
+    laying = Laying.of(MORTARS["lime"], 60.0)
+    halved = dataclasses.replace(ARCH, analysis=dataclasses.replace(
+        ARCH.analysis, head_joint_ratio=0.5))
+    assert law_line(halved, laying).endswith(
+        "at bed joints; head joints x0.5, joints with a support x1")
+    assert law_line(ARCH, laying).endswith(MORTARS["lime"].describe())

@@ -119,10 +119,15 @@ class Analysis:
         """The contact law in one line, with the joint kinds' ratios where they are not
         1 and the joints have a mortar."""
         text = self.law.describe()
-        if self.law.is_dry or (self.head_joint_ratio, self.support_joint_ratio) == (1, 1):
-            return text
-        return (f"{text} at bed joints; head joints x{self.head_joint_ratio:g}, joints "
-                f"with a support x{self.support_joint_ratio:g}")
+        return text if self.law.is_dry else text + self.kinds_text()
+
+    def kinds_text(self) -> str:
+        """The joint kinds' ratios as the end of a law's line (``' at bed joints; head
+        joints x0.5, joints with a support x1'``), '' where both are 1."""
+        if (self.head_joint_ratio, self.support_joint_ratio) == (1, 1):
+            return ""
+        return (f" at bed joints; head joints x{self.head_joint_ratio:g}, joints with a "
+                f"support x{self.support_joint_ratio:g}")
 
     @property
     def cone(self) -> FrictionCone:

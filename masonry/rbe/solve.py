@@ -414,7 +414,8 @@ def _candidates(method, solver, preset) -> list:
 def _stated(system, method, candidates, attempts) -> list:
     """``candidates`` without the solvers that cannot state ``system``'s constraints (a
     tension cut-off some do not take, :meth:`~masonry.rbe.solvers.base.Backend.refusal`),
-    each refusal warned and kept in ``attempts``; the load-path LP goes with Newton,
+    each refusal logged (information: the flow is designed to pass it on) and kept in
+    ``attempts``; the load-path LP goes with Newton,
     whose stalled point it needs."""
     kept = []
     for name in candidates:
@@ -423,7 +424,7 @@ def _stated(system, method, candidates, attempts) -> list:
         if refusal is None:
             kept.append(name)
         elif name != LOAD_PATH:
-            log.warning("%s; the next solver takes friction-%s", refusal, method)
+            log.info("%s; the next solver takes friction-%s", refusal, method)
             attempts.append({"friction": method, "solver": real, "status": "refused",
                              "iterations": -1, "setup_s": 0.0, "solve_s": 0.0,
                              "reason": refusal})

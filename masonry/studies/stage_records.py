@@ -132,10 +132,11 @@ def law_line(params, laying) -> str:
     if laying is None:
         return params.analysis.law_text()
     head = f"Coulomb {law.cone.name}, mu {law.mu:g}"
+    kinds = params.analysis.kinds_text()
     if laying.rate_per_hour is None:
-        return f"{head}, {laying.describe()}"
+        return f"{head}, {laying.describe()}{kinds}"
     return (f"{head}, per joint by its age: {laying.describe()}; "
-            f"{laying.mortar.describe()}")
+            f"{laying.mortar.describe()}{kinds}")
 
 
 def _adhesion_record(scene, rows, ratio) -> dict:
