@@ -5,7 +5,7 @@ import math
 import shlex
 
 from masonry.errors import ParameterError
-from masonry.outputs import DPI_RANGE, FIGURE_FORMATS, Outputs
+from masonry.outputs import DPI_RANGE, FIGURE_FORMATS, PLOTLY_SOURCES, Outputs
 from masonry.parameters import declarations, defaults, read_toml
 from masonry.params import (PRESETS, Params, applies, from_preset, load, names,
                             section_default, validate)
@@ -333,8 +333,15 @@ def add_output_options(parser):
                    help="skip all plots")
     g.add_argument("--no-printable", dest="printable", action="store_false", default=None,
                    help="skip the printable body (dome.stl, dome.obj)")
+    g.add_argument("--html", dest="html", action="store_true", default=None,
+                   help="write dome.html (the bricks in 3D, for a browser) also with "
+                        "--no-plots (default: with the figures)")
     g.add_argument("--no-html", dest="html", action="store_false", default=None,
-                   help="skip dome.html (the bricks in 3D, for a browser)")
+                   help="skip dome.html (default: with the figures)")
+    g.add_argument("--html-plotly", dest="html_plotly", choices=PLOTLY_SOURCES,
+                   help="where dome.html finds plotly.js: shared, one file beside the run "
+                        "folders, written once per --out (the default); inline, inside "
+                        "the page (4.8 MB more), which then opens wherever it is copied")
     add_figure_options(g)
     g.add_argument("--print-size", dest="print_size", type=float, metavar="MM",
                    help=f"also write dome.3mf for a slicer, in millimetres, its largest "

@@ -114,6 +114,8 @@ NOT_AN_INPUT = {
                  "table (printable = false)",
     "html": "an input of each variant: dome.html is chosen in the [outputs] table "
             "(html = false)",
+    "html_plotly": "an input of each variant: where dome.html finds plotly.js is chosen "
+                   "in the [outputs] table (html_plotly = \"inline\")",
     "figure_format": "an input of each variant: the figures' formats are chosen in the "
                      "[outputs] table (figure_format = [\"png\", \"pdf\"])",
     "dpi": "an input of each variant: the figures' resolution is chosen in the [outputs] "
@@ -195,7 +197,7 @@ def load_study(path, draws=True):
               **mortar},
         grid=tables["grid"], sample=tables["sample"], count=count, seed=seed,
         plots=outputs.get("plots", False), printable=outputs.get("printable", False),
-        html=outputs.get("html", False), constraints=constraints, **stages,
+        html=outputs.get("html"), constraints=constraints, **stages,
         **_figure_outputs(outputs, refuse))
     study = _checked_constraints(study, where)
     _check_variants(study, where, None if draws else _search_probes(study), mortar)
@@ -289,8 +291,8 @@ def _stage_plans() -> dict:
     return {"course": (), "brick": BRICK_ORDERS, "block": BLOCK_ORDERS}
 
 
-FIGURE_OUTPUTS = ("figure_format", "dpi")
-"""The ``[outputs]`` keys of the figures' files, checked by their declarations
+FIGURE_OUTPUTS = ("figure_format", "dpi", "html_plotly")
+"""The ``[outputs]`` keys of the figures' and the page's files, checked by their declarations
 (:class:`masonry.outputs.Outputs`)."""
 
 
@@ -319,7 +321,8 @@ def _stage_outputs(outputs, refuse) -> dict:
                 refuse(f"outputs.{key}", value, "true or false")
         elif key not in ("stages", "stages_course", "stages_order", *FIGURE_OUTPUTS):
             refuse(f"outputs.{key}", value, "plots, printable, html, figure_format, dpi, "
-                                            "stages, stages_course or stages_order")
+                                            "html_plotly, stages, stages_course or "
+                                            "stages_order")
     by, course = outputs.get("stages"), outputs.get("stages_course")
     order = outputs.get("stages_order")
     if by is None:

@@ -9,6 +9,11 @@ FIGURE_FORMATS = ("png", "svg", "pdf")
 """The files a figure can be written as: a raster PNG, or vector SVG and PDF (matplotlib's
 own backends) for a paper."""
 
+PLOTLY_SOURCES = ("shared", "inline")
+"""Where ``dome.html`` finds plotly.js: ``shared``, one file beside the run folders in their
+output root (:data:`masonry.export.html.PLOTLY_FILE`), written once for all of them;
+``inline``, inside the page (4.8 MB), which then opens wherever it is copied."""
+
 DPI_RANGE = (50, 600)
 """Resolutions a raster figure may ask for: below 50 dpi a figure's labels do not read,
 600 dpi is what a printer prints (a 7 inch figure 4,200 pixels wide)."""
@@ -40,7 +45,9 @@ class Outputs:
     writes it as ``dome.3mf`` of that size in millimetres; ``figure_format`` the files each figure is
     written as (:data:`FIGURE_FORMATS`); ``dpi`` a raster figure's resolution (None: each
     figure's own, 110 dots per inch for most); ``html`` the page
-    ``dome.html`` (the bricks in 3D in a browser); ``cad_offset`` moves every brick of the
+    ``dome.html`` (the bricks in 3D in a browser; None: with the figures,
+    :attr:`writes_html`); ``html_plotly`` where the page finds plotly.js
+    (:data:`PLOTLY_SOURCES`); ``cad_offset`` moves every brick of the
     CAD files inward by that many units (thesis 3.4.1).
     """
 
@@ -58,13 +65,24 @@ class Outputs:
         None, "dots per inch of a PNG figure (None: each figure's own)", kind="int",
         low=DPI_RANGE[0], high=DPI_RANGE[1], optional=True,
         expected=f"an integer {DPI_RANGE[0]} to {DPI_RANGE[1]} (dots per inch)")
-    html: bool = declare(True, "write dome.html, the bricks in 3D in a browser", kind="bool")
+    html: bool | None = declare(
+        None, "write dome.html, the bricks in 3D in a browser (None: with the figures)",
+        kind="bool", optional=True)
+    html_plotly: str = declare(
+        "shared", "where dome.html finds plotly.js: one file beside the run folders, or "
+                  "inside the page", kind="str", choices=PLOTLY_SOURCES)
     cad_offset: float = declare(1.0, "units the CAD files move each brick inward", low=0.0,
                                 high=4.0, expected="0 to 4 (units)", tag="cad")
 
     def __post_init__(self):
         # "png,pdf" (a command line, the API) or ["png", "pdf"] (TOML) alike
         object.__setattr__(self, "figure_format", figure_formats(self.figure_format))
+
+    @property
+    def writes_html(self) -> bool:
+        """Whether the run writes ``dome.html``: as ``html`` says, else with the
+        figures."""
+        return self.plots if self.html is None else self.html
 
     def checked(self) -> "Outputs":
         """These outputs validated; raises :class:`~masonry.errors.ParameterError`."""

@@ -33,7 +33,8 @@ PRESETS = {
     "wall": dict(scene="wall", wall_length=32.0, wall_courses=10),
 }
 
-RECORDED_OUTPUTS = ("quick", "print_size", "figure_format", "dpi", "cad_offset")
+RECORDED_OUTPUTS = ("quick", "print_size", "figure_format", "dpi", "html_plotly",
+                    "cad_offset")
 """The outputs' inputs a run records among its parameters (those of
 :data:`WRITTEN_OUTPUTS` are recorded as what the run wrote)."""
 
@@ -41,7 +42,8 @@ WRITTEN_OUTPUTS = ("plots", "printable", "html")
 """The outputs a run writes or not, recorded in ``run.json``'s ``outputs`` (what the run
 wrote), not among its parameters."""
 
-FILE_OUTPUTS = (*WRITTEN_OUTPUTS, "quick", "print_size", "figure_format", "dpi")
+FILE_OUTPUTS = (*WRITTEN_OUTPUTS, "quick", "print_size", "figure_format", "dpi",
+                "html_plotly")
 """Inputs that choose files, not results: a folder whose run differs only in them holds
 the same input (not in the structure id)."""
 

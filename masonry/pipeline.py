@@ -22,7 +22,7 @@ from pathlib import Path
 import masonry
 from masonry import __version__, forking
 from masonry.blocks import BLOCK_CLASSES
-from masonry.export import EXPORTERS, RunOutputs, rhino
+from masonry.export import EXPORTERS, RunOutputs, html, rhino
 from masonry.params import (FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, geometry_key, structure_id,
                             validate)
 from masonry.rbe.adhesion import AdhesionResult, least_adhesion, stands_dry
@@ -366,13 +366,15 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     # date once it is
     wanted = {"analyse": analyse, "centering": analyse, "adhesion": analyse,
               "3dm": rhino.available(),
-              **{name: getattr(out, name) for name in FILE_OUTPUTS}}
+              **{name: getattr(out, name) for name in FILE_OUTPUTS}, "html": out.writes_html}
     job = Publication(out_root, structure_id(params), {"params": identity(params)}, wanted,
                       force=force, identify=_identify)
     reused = job.reusable()
     if reused is not None:
+        share_plotly(out_root, reused["outputs"])
         return reused
     outputs = job.outputs()
+    share_plotly(out_root, outputs)  # before the page that reads it is published
     params = with_outputs(params, outputs)
     timer = Timer()
     scene, model, cached = run_model(params, out_root, timer, scene)
@@ -397,6 +399,26 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     if cached == "computed":  # only a model whose run completed is cached
         write_cache(params, out_root, scene, model)
     return {**record, "path": str(folder.target)}
+
+
+def share_plotly(out_root, outputs: dict):
+    """The plotly.js file the pages of ``out_root``'s run folders read
+    (:func:`masonry.export.html.plotly_file`), when ``outputs`` (a run's, as ``run.json``
+    records them) has a page that reads it: written once per output root, and read back.
+
+    Raises
+    ------
+    OSError
+        When the file cannot be written or reads back other than it was written.
+    """
+    if outputs.get("html") is not True or outputs.get("html_plotly") != "shared":
+        return
+    path, data = Path(out_root) / html.plotly_file(), html.plotly_js()
+    if path.is_file() and path.read_bytes() == data:
+        return
+    write_file_atomically(path, data)
+    if path.read_bytes() != data:
+        raise OSError(f"{path} reads back other than was written")
 
 
 def results_record(result: RBEResult | None, collapse: CollapseResult | None,
@@ -466,7 +488,8 @@ def run_record(params: Params, scene: Scene, model: Model, outputs: dict, cached
         "params": params.record(),
         "outputs": {name: outputs[name] for name in ("analyse", "centering", "adhesion",
                                                      *WRITTEN_OUTPUTS, "quick",
-                                                     "figure_format", "dpi")},
+                                                     "figure_format", "dpi",
+                                                     "html_plotly")},
         **model_record(scene, params.analysis.density),
         "coordinates": coordinates_record(scene, params.outputs.cad_offset),
         "cache": {"geometry": cached},

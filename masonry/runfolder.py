@@ -398,7 +398,9 @@ class Publication:
         not stand for the full ones), ``print_size`` (mm of ``dome.3mf`` or None: a
         3MF of another size is not the one asked for), ``figure_format`` (the figures'
         formats: a folder without one of them does not hold what is asked) and ``dpi``
-        (figures at another resolution are not the ones asked for).
+        (figures at another resolution are not the ones asked for), ``html_plotly``
+        (where ``dome.html`` finds plotly.js: a page that reads a shared file is not the
+        one asked for with plotly.js inside).
     force : bool
         Recompute even when the folder holds what is asked for (it still only grows).
     identify : callable, optional
@@ -482,6 +484,10 @@ def covers(record: dict, wanted: dict) -> bool:
                 return False
         elif name == "dpi":  # figures at another resolution are not the ones asked
             if wanted.get("plots") and had.get("plots") is True and had.get("dpi") != value:
+                return False
+        elif name == "html_plotly":  # a page with plotly.js inside opens anywhere
+            if (value == "inline" and wanted.get("html") and had.get("html") is True
+                    and had.get("html_plotly", "inline") != "inline"):
                 return False
         elif name == "print_size":
             if value is not None and wanted.get("printable") and printed_size(record) != value:

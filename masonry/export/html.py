@@ -5,7 +5,9 @@ One plotly ``Mesh3d`` holds the bricks' outer faces (a face wholly in contact wi
 another brick of the scene is inside the structure and never seen): vertices as float32,
 triangles as int32, which plotly writes as base64 typed arrays. A colouring is one value
 per brick, expanded to the brick's vertices by the page's script when the user chooses
-it. plotly.js is written into the page (``include_plotlyjs=True``): no network needed.
+it. plotly.js is read from one file beside the run folders, shared by the pages of an
+output root (:func:`plotly_file`; ``html_plotly = "shared"``, a page that does not find it
+says where it looked), or written into the page (``inline``); no network needed.
 """
 
 import html
@@ -102,6 +104,31 @@ gd.on('plotly_click', e => {
   if (p.curveNumber === 0) pick(owner[p.pointNumber]);
 });
 """
+
+
+_SHARED_PLOTLY = ("<script charset=\"utf-8\" src=\"{src}\" onerror=\"document."
+                  "getElementById('pick').textContent = 'plotly.js did not load: this page "
+                  "reads it from {src}, beside its run folder (in the output root). Copy "
+                  "that file there, or write the page with plotly.js inside it (masonry "
+                  "run --html-plotly inline).'\"></script>\n")
+"""The page's script tag of the shared plotly.js (``{src}``, relative to the page); a
+page copied without it says where it looked and what to do."""
+
+
+def plotly_file() -> str:
+    """The name of the shared plotly.js file, beside the run folders of an output root:
+    ``plotly-<version>.min.js``, so that pages written by another plotly read the version
+    they were written for."""
+    from plotly.offline import get_plotlyjs_version
+
+    return f"plotly-{get_plotlyjs_version()}.min.js"
+
+
+def plotly_js() -> bytes:
+    """The content of :func:`plotly_file`: plotly.js, minified, as plotly ships it."""
+    from plotly.offline import get_plotlyjs
+
+    return get_plotlyjs().encode("utf-8")
 
 
 def outer_faces(blocks, interfaces) -> np.ndarray:
@@ -324,7 +351,9 @@ def camera(points) -> dict:
 def dome_html(made) -> str:
     """The page of a run (:class:`~masonry.export.RunOutputs`): its scene's bricks
     (:func:`outer_faces` only), coloured by each of :func:`colourings` in turn, the live
-    load's direction as an arrow, and a picked brick's name, course, web and values."""
+    load's direction as an arrow, and a picked brick's name, course, web and values;
+    plotly.js inside it, or read from :func:`plotly_file` in the output root, as the
+    run's ``outputs.html_plotly`` says."""
     import plotly.graph_objects as go
 
     blocks = made.shown
@@ -351,9 +380,12 @@ def dome_html(made) -> str:
     fig.update_layout(template="none", margin=dict(l=0, r=0, t=0, b=0),
                       scene=dict(aspectmode="data", xaxis=hidden, yaxis=hidden,
                                  zaxis=hidden, camera=camera(drawn)))
-    plot = fig.to_html(full_html=False, include_plotlyjs=True, default_width="100%",
+    shared = made.outputs.html_plotly == "shared"
+    plot = fig.to_html(full_html=False, include_plotlyjs=not shared, default_width="100%",
                        default_height="100%", config={"displaylogo": False},
                        post_script=_SCRIPT)
+    if shared:  # the run folder is one level below the output root
+        plot = _SHARED_PLOTLY.format(src=html.escape(f"../{plotly_file()}")) + plot
     bricks = {"first": first.tolist(), "name": blocks.block_name.tolist(),
               "course": blocks.block_course.tolist(), "web": blocks.block_web.tolist(),
               "solved": made.is_solved.tolist(), "colourings": shown}

@@ -132,7 +132,8 @@ class Search:
         """What makes the trials: the study's inputs and constraints, the objectives,
         seed, batch and sampler (not the number of trials: asking for more continues)."""
         study = {k: v for k, v in asdict(self.study).items()
-                 if k not in ("count", "plots", "printable", "html", "figure_format", "dpi")}
+                 if k not in ("count", "plots", "printable", "html", "figure_format", "dpi",
+                              "html_plotly")}
         return {"study": study, "objectives": [list(o) for o in self.objectives],
                 "seed": self.seed, "batch": self.batch, "sampler": self.sampler}
 

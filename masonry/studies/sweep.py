@@ -127,8 +127,11 @@ class Study:
         integers), seeded by ``seed``; combined with every grid point.
     count, seed : int
     analyse, plots, printable, html : bool
-        What each run does and writes (defaults: solve, no plots, no printable body, no
-        ``dome.html``).
+        What each run does and writes (defaults: solve, no plots, no printable body,
+        ``dome.html`` with the plots; ``html`` None: with the plots).
+    figure_format, dpi, html_plotly :
+        The figures' files and where ``dome.html`` finds plotly.js
+        (:class:`masonry.outputs.Outputs`).
     stages : str or None
         Also a stage study of every variant (:func:`masonry.studies.stages.run_stages`),
         laid by ``course``, ``brick`` or ``block``; its results add
@@ -154,9 +157,10 @@ class Study:
     analyse: bool = True
     plots: bool = False
     printable: bool = False
-    html: bool = False
+    html: bool | None = None
     figure_format: tuple = ("png",)
     dpi: int | None = None
+    html_plotly: str = "shared"
     stages: str | None = None
     stages_course: int | None = None
     stages_order: str | None = None
@@ -182,7 +186,7 @@ class Study:
             "by": self.stages, "course": self.stages_course, "order": self.stages_order}
         return dict(analyse=self.analyse, plots=self.plots, printable=self.printable,
                     html=self.html, figure_format=self.figure_format, dpi=self.dpi,
-                    stages=stages)
+                    html_plotly=self.html_plotly, stages=stages)
 
     def variants(self) -> list:
         """One dict of inputs per variant (base, then grid point, then sample).
@@ -243,7 +247,8 @@ class Study:
 
 
 def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=False,
-                html=False, stages=None, figure_format=("png",), dpi=None) -> dict:
+                html=None, stages=None, figure_format=("png",), dpi=None,
+                html_plotly="shared") -> dict:
     """Run one variant (and its stage study); never raises: a failure becomes a row with
     its error.
 
@@ -257,8 +262,9 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     analyse, plots, printable, html : bool
         What the run does and writes (:func:`masonry.pipeline.run`; ``plots``,
         ``printable`` and ``html`` unless the variant's inputs say otherwise).
-    figure_format, dpi :
-        The figures' formats and resolution (:class:`masonry.outputs.Outputs`).
+    figure_format, dpi, html_plotly :
+        The figures' formats and resolution, and where ``dome.html`` finds plotly.js
+        (:class:`masonry.outputs.Outputs`).
     stages : dict or None
         ``by``, ``course`` and ``order`` of a stage study of the variant
         (:func:`masonry.studies.stages.run_stages`, in its own run folder; a section
@@ -281,7 +287,7 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     try:
         params = validate(Params.of(**{"plots": plots, "printable": printable,
                                        "html": html, "figure_format": figure_format,
-                                       "dpi": dpi, **inputs}))
+                                       "dpi": dpi, "html_plotly": html_plotly, **inputs}))
         record = run(params, out_root, analyse=analyse)
         staged = None if stages is None else run_stages(
             stage_params(params, "boundary" in inputs), out_root, **stages, **laying)
