@@ -20,14 +20,14 @@ from masonry import __version__
 from masonry.errors import MasonryError
 from masonry.forking import use_one_blas_thread
 
-from . import (analyze, arch_thickness, bench, build, optimize, run, stages, structures,
-               sweep)
+from . import (analyze, arch_thickness, bench, build, clean, optimize, run, stages,
+               structures, sweep)
 from .interrupts import interrupt_behind, interrupted
 from .options import Parser, describe_error, option_names, typed_values
 from .streams import silence_stdout
 
 SUBCOMMANDS = (build, run, structures, analyze, arch_thickness, sweep, optimize, bench,
-               stages)
+               stages, clean)
 
 
 def make_parser(argv=None):
