@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from masonry.blocks import Blocks, whole_of_web
-from masonry.export.html import brick_mesh, outer_faces
+from masonry.export.html import brick_mesh, outer_faces, plotly_file
 from masonry.interfaces import detect
 from masonry.params import Params, validate
 from masonry.pipeline import run
@@ -80,14 +80,14 @@ def test_faces_wholly_in_contact_are_not_drawn():
 
 @pytest.mark.parametrize("scene", sorted(SMALL))
 def test_every_scene_writes_the_page(tmp_path, scene):
-    """One page per run, standing alone (plotly.js inline, no address to fetch), that
-    names every brick of the scene and colours it by class and, after the solve, by its
-    largest compression and tension; after a collapse with a mechanism by its
-    displacement, with the live load's arrow."""
+    """One page per run, reading plotly.js from the one file beside the run folders (no
+    other address to fetch), that names every brick of the scene and colours it by class
+    and, after the solve, by its largest compression and tension; after a collapse with a
+    mechanism by its displacement, with the live load's arrow."""
     record = quick_run(tmp_path, **SMALL[scene])
     path = tmp_path / record["structure_id"] / "dome.html"
     text = path.read_text()
-    assert not re.search(r"<script[^>]+src=", text)
+    assert re.findall(r"<script[^>]+src=\"([^\"]+)\"", text) == [f"../{plotly_file()}"]
     assert "Plotly.newPlot" in text
     data = page_data(path)
     built = build(validate(Params.of(**SMALL[scene])))
@@ -124,7 +124,7 @@ def test_an_assembly_and_a_build_write_the_page(tmp_path, fixtures_dir):
                        assembly=scene.geometry.assembly)
     names = page_data(tmp_path / record["structure_id"] / "dome.html")["name"]
     assert sorted(names) == sorted(str(n) for n in scene.blocks.block_name)
-    params = validate(Params.of(**SMALL["wall"], plots=False, printable=False))
+    params = validate(Params.of(**SMALL["wall"], plots=False, printable=False, html=True))
     record = run(params, tmp_path / "build", analyse=False)
     data = page_data(tmp_path / "build" / record["structure_id"] / "dome.html")
     assert [c["label"] for c in data["colourings"]] == ["class"]
@@ -141,6 +141,43 @@ def test_a_folder_without_the_page_is_not_up_to_date(tmp_path):
     assert not second.get("reused") and (folder / "dome.html").is_file()
     assert quick_run(tmp_path, **SMALL["wall"]).get("reused")
     assert quick_run(tmp_path, html=False, **SMALL["wall"]).get("reused")
+
+
+def test_the_page_follows_the_figures_unless_asked(tmp_path):
+    """Without ``html`` the page is written with the figures; ``html`` says otherwise
+    either way."""
+    wall = dict(SMALL["wall"], printable=False)
+    for plots, html, written in ((False, None, False), (True, None, True),
+                                 (False, True, True), (True, False, False)):
+        record = run(validate(Params.of(**wall, plots=plots, html=html)), tmp_path / "out",
+                     analyse=False, force=True)
+        assert record["outputs"]["html"] is written, (plots, html)
+        path = tmp_path / "out" / record["structure_id"] / "dome.html"
+        assert path.is_file() is written, (plots, html)
+        shutil.rmtree(tmp_path / "out")
+
+
+def test_the_pages_of_an_output_root_share_one_plotly(tmp_path):
+    """Two runs into one root: one plotly.js file beside them, as plotly ships it (read
+    back), each page small (plotly.js is 4.8 MB) and reading it; asked ``inline``, the
+    page holds plotly.js itself, and a shared page is not the one asked for (written
+    again), while an inline page stands for a shared one (reused)."""
+    from plotly.offline import get_plotlyjs
+
+    for p in (3, 4):
+        quick_run(tmp_path, **SMALL["free section"] | {"p": p})
+    assert [f.name for f in tmp_path.glob("plotly*")] == [plotly_file()]
+    assert (tmp_path / plotly_file()).read_text() == get_plotlyjs()
+    pages = sorted(tmp_path.glob("*/dome.html"))
+    assert len(pages) == 2 and all(page.stat().st_size < 0.5e6 for page in pages)
+    params = validate(Params.of(**SMALL["wall"], plots=False, printable=False, html=True))
+    first = run(params, tmp_path)
+    page = tmp_path / first["structure_id"] / "dome.html"
+    inline = run(params.replace(html_plotly="inline"), tmp_path)
+    assert not inline.get("reused") and inline["outputs"]["html_plotly"] == "inline"
+    text = page.read_text()
+    assert not re.search(r"<script[^>]+src=", text) and get_plotlyjs() in text
+    assert run(params, tmp_path).get("reused")
 
 
 # --------------------------------------------------------------------------- browser
@@ -259,3 +296,22 @@ def test_the_mechanism_and_the_load_show_in_a_browser(browser, tmp_path):
     assert drawn_fraction(page.screenshot()) > 0.01
     assert errors == []
     page.close()
+
+
+def test_a_page_copied_without_plotly_says_where_it_looked(browser, tmp_path):
+    """A run folder copied alone: its page draws nothing and says which file it reads
+    plotly.js from; the same page with plotly.js inside draws anywhere."""
+    for source in ("shared", "inline"):
+        params = validate(Params.of(**SMALL["wall"], plots=False, printable=False,
+                                    html=True, html_plotly=source))
+        record = run(params, tmp_path / source)
+        copy = tmp_path / "copies" / source
+        shutil.copytree(tmp_path / source / record["structure_id"], copy)
+        page = browser.new_page()
+        page.goto((copy / "dome.html").as_uri())
+        page.wait_for_load_state("load")
+        drawn_plot = page.evaluate("document.querySelector('.js-plotly-plot') !== null")
+        assert drawn_plot is (source == "inline")
+        if source == "shared":
+            assert f"../{plotly_file()}" in page.inner_text("#pick")
+        page.close()
