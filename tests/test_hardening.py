@@ -60,7 +60,7 @@ def test_run_after_build_adds_the_forces_and_keeps_the_plots(tmp_path):
     assert record["outputs"] == {"analyse": True, "centering": True, "adhesion": True,
                                  "plots": True, "printable": False, "html": True,
                                  "quick": True, "figure_format": ["png"], "dpi": None,
-                                 "3dm": True}
+                                 "html_plotly": "shared", "3dm": True}
     assert (tmp_path / WALL_ID / "RBE" / "forces.csv").is_file()
     assert (tmp_path / WALL_ID / "00_pattern.png").is_file()
 

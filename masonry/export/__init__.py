@@ -443,7 +443,7 @@ EXPORTERS = (
              wanted=lambda made: made.outputs.plots, record_key="figures",
              imports=("masonry.plots",)),
     Exporter("rhino", "exports", _rhino_files, wanted=_rhino_wanted),
-    Exporter("html", "html", _html_files, wanted=lambda made: made.outputs.html),
+    Exporter("html", "html", _html_files, wanted=lambda made: made.outputs.writes_html),
     Exporter("collapse", "exports", _collapse_files,
              wanted=lambda made: made.collapse is not None),
     Exporter("compas", "exports", _compas_files, wanted=_is_whole),
