@@ -194,3 +194,17 @@ def test_a_domes_own_bricks_analysed_back_without_the_printable_body(tmp_path, c
     assert record["outputs"]["printable"] is False and "skipped" in record["printable"]
     folder = next(tmp_path.glob("analyze/*"))
     assert (folder / "RBE" / "forces.csv").is_file() and not (folder / "dome.stl").exists()
+
+
+@pytest.mark.parametrize("value", ['"cdn"', "true"])
+def test_a_study_asks_where_the_page_finds_plotly_by_name(tmp_path, capsys, value):
+    """``[outputs] html_plotly`` is ``shared`` or ``inline``: anything else is refused in
+    one line naming the file's key, before anything is written."""
+    study = tmp_path / "study.toml"
+    study.write_text(f'[base]\nscene = "wall"\n[grid]\nmu = [0.7]\n'
+                     f'[outputs]\nhtml_plotly = {value}\n')
+    out = tmp_path / "out"
+    assert main(["sweep", str(study), "--out", str(out), "-q"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "outputs.html_plotly" in err[0] and "shared, inline" in err[0]
+    assert not out.exists()
