@@ -243,7 +243,9 @@ class Structure:
         **outputs
             What to write (docs/model.md 7): ``plots``, ``quick``, ``printable``,
             ``print_size``, ``figure_format`` (``"png,pdf"`` or ``["png", "svg"]``),
-            ``dpi``, ``html``, ``cad_offset``.
+            ``dpi``, ``html`` (None: with the plots), ``html_plotly`` (``"shared"``:
+            plotly.js in one file of ``out`` for every page, ``"inline"``: in the page),
+            ``cad_offset``.
 
         Returns
         -------
