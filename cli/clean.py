@@ -34,8 +34,10 @@ def handle(args, report):
             report(f"{size:>12,d}  {path.relative_to(cleaning.root)}")
     else:
         clean(cleaning)
-    report(f"{verb} {len(cleaning.files)} files, {megabytes(cleaning.bytes)}, from "
-           f"{args.out} ({len(cleaning.records)} run folders' run.json updated)")
+    files, folders = len(cleaning.files), len(cleaning.records)
+    report(f"{verb} {files} file{'s' * (files != 1)}, {megabytes(cleaning.bytes)}, from "
+           f"{args.out} (run.json of {folders} run folder{'s' * (folders != 1)} "
+           f"{'would be ' if args.dry_run else ''}updated)")
     return 0
 
 

@@ -15,7 +15,7 @@ ROOT = Path(masonry.__file__).parent
 STAGES = (
     ("masonry.errors", "masonry.parameters", "masonry.tolerances", "masonry.optional",
      "masonry.friction", "masonry.contact", "masonry.mortars", "masonry.outputs",
-     "masonry.runfolder", "masonry.forking"),
+     "masonry.runfolder", "masonry.forking", "masonry.cleaning"),
     ("masonry.blocks", "masonry.meshing"),
     ("masonry.dome",),
     ("masonry.scenes",),
