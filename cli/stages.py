@@ -161,6 +161,8 @@ def handle(args, report):
     line = _adhesion_line(stages, record["plan"]["by"])
     if line:
         report(line)
+    if record.get("mortar") and "hold_max_h" in record["mortar"]:
+        report(_hold_line(record["mortar"], stages))
     loose = [str(r["stage"]) for r in record.get("rows", ()) if r.get("loose")]
     if loose:
         report(f"stages with blocks joined to no support, so no MoI: {', '.join(loose[:10])}"
@@ -173,9 +175,8 @@ def _laying(args, params) -> dict:
     """The mortar by age (:data:`~masonry.mortars.LAYING_INPUTS`): the options given,
     else the ``--params`` file's ``[mortar]``; checked here, so that a file's value is
     refused naming the file and key."""
-    from masonry.mortars import LAYING_INPUTS
+    from masonry.mortars import LAYING_INPUTS, stage_laying
     from masonry.params import laying_inputs
-    from masonry.studies.stages import stage_laying
 
     given = {name: getattr(args, name) for name in LAYING_INPUTS}
     from_file = {} if getattr(args, "params", None) is None else {
@@ -211,6 +212,21 @@ def _loose(first) -> str:
     if not first.get("loose"):
         return ""
     return f": {', '.join(first['loose'][:3])} touch nothing that joins them to a support"
+
+
+def _hold_line(mortar, stages) -> str:
+    """How long the brick just laid must be held until the mortar holds its stage."""
+    name = mortar["mortar"]["name"]
+    if mortar["hold_never_stage"] is not None:
+        return (f"{name} mortar never holds the least adhesion of stage "
+                f"{mortar['hold_never_stage']} (stages.csv, column hold_h)")
+    if not mortar["hold_max_h"]:
+        return f"{name} mortar holds every stage when laid: no brick needs holding"
+    hours = mortar["hold_max_h"]
+    held = f"{hours:.3g} h" if hours >= 1 else f"{60 * hours:.3g} min"
+    return (f"{name} mortar: a brick just laid is held at most {held} (stage "
+            f"{mortar['hold_max_stage']}) until its mortar holds the stage's least adhesion "
+            f"(stages.csv, column hold_h)")
 
 
 def _adhesion_line(stages, by) -> str:

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.errors import MasonryError
+from masonry.errors import MasonryError, ParameterError
 
 
 class MortarError(MasonryError, ValueError):
@@ -90,6 +90,18 @@ class Mortar:
         return (np.interp(age, self.hours, self.cohesion_kPa),
                 np.interp(age, self.hours, self.tensile_kPa))
 
+    def hours_to_hold(self, adhesion_kPa, ratio) -> float | None:
+        """The age (hours) from which this mortar holds an adhesion ``a``: cohesion at
+        least ``a`` and tensile strength at least ``ratio a`` (the least adhesion's law,
+        docs/model.md 6.12); 0 where it holds when laid, None where it never does
+        (beyond its last row) or ``adhesion_kPa`` is None. The table interpolated
+        linearly, as :meth:`strength_kPa`."""
+        if adhesion_kPa is None:
+            return None
+        return max((_first_age(self.hours, strength, need) for strength, need in (
+            (self.cohesion_kPa, adhesion_kPa), (self.tensile_kPa, ratio * adhesion_kPa))),
+            key=lambda age: math.inf if age is None else age)
+
     def describe(self) -> str:
         """One line: the name and the strengths at the table's ends."""
         if len(self.hours) == 1:
@@ -102,6 +114,17 @@ class Mortar:
     def record(self) -> dict:
         return {"name": self.name, "table": [list(row) for row in zip(
             self.hours, self.cohesion_kPa, self.tensile_kPa)], "source": self.source}
+
+
+def _first_age(hours, strength, need) -> float | None:
+    """The first age at which the piecewise linear ``strength`` reaches ``need``; None
+    where it never does."""
+    if need <= strength[0]:
+        return 0.0
+    for (h0, s0), (h1, s1) in zip(zip(hours, strength), zip(hours[1:], strength[1:])):
+        if s1 >= need:
+            return h0 + (h1 - h0) * (need - s0) / (s1 - s0)
+    return None
 
 
 def _age(hours: float) -> str:
@@ -191,3 +214,41 @@ class Laying:
     def record(self) -> dict:
         return {"mortar": self.mortar.record(), "rate_bricks_per_hour": self.rate_per_hour,
                 "masons": self.masons, "text": self.describe()}
+
+
+def stage_laying(params, mortar=None, laying_rate=None, masons=None) -> Laying | None:
+    """The :class:`Laying` of a stage study's options, checked
+    (:class:`ParameterError` naming the option): ``mortar`` a name of
+    :data:`MORTAR_NAMES` (``constant``: ``params``' cohesion and tensile
+    strength at every age), ``laying_rate`` bricks per hour per mason (needed by a mortar
+    that ages), ``masons`` >= 1 (default 1). None without ``mortar``: ``params``'
+    contact law at every joint."""
+    if mortar is None:
+        for name, value in (("laying_rate", laying_rate), ("masons", masons)):
+            if value is not None:
+                raise ParameterError(name, value, "--mortar NAME beside it (the rate ages "
+                                     "a mortar's joints)")
+        return None
+    if mortar not in MORTAR_NAMES:
+        raise ParameterError("mortar", mortar, f"one of {', '.join(MORTAR_NAMES)}")
+    analysis = params.analysis
+    if mortar != "constant":
+        for name in ("cohesion_kpa", "tensile_kpa"):
+            if getattr(analysis, name) != 0:
+                raise ParameterError(name, getattr(analysis, name), f"0 with --mortar "
+                                     f"{mortar}: its table gives the strengths (or "
+                                     f"--mortar constant)", related=("mortar",))
+    table = (MORTARS[mortar] if mortar != "constant" else
+             Mortar.constant(analysis.cohesion_kpa, analysis.tensile_kpa))
+    if laying_rate is None and mortar != "constant":
+        raise ParameterError("laying_rate", None, f"bricks per hour per mason with "
+                             f"--mortar {mortar} (its joints' age)", related=("mortar",))
+    if laying_rate is not None and not (isinstance(laying_rate, (int, float))
+                                        and np.isfinite(laying_rate) and laying_rate > 0):
+        raise ParameterError("laying_rate", laying_rate, "bricks per hour per mason, a "
+                             "finite number > 0 (a mason lays 30 to 100 an hour)")
+    if masons is not None and (isinstance(masons, bool) or not isinstance(masons, int)
+                               or masons < 1):
+        raise ParameterError("masons", masons, "an integer >= 1 (masons laying side by "
+                             "side)")
+    return Laying.of(table, laying_rate, 1 if masons is None else masons)

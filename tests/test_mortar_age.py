@@ -14,6 +14,7 @@ import dataclasses
 import json
 
 import numpy as np
+import pandas as pd
 import pytest
 from test_rbe import SUPPORT, box, make_interfaces, rot_y
 from test_stage_adhesion import ARCH
@@ -79,6 +80,9 @@ def test_the_slope_joint_holds_once_it_is_old_enough(rate, stands):
         assert rows[0]["feasible"] is False
         assert rows[1]["feasible"] is stands, (rate, sequence)
         assert rows[1]["time_h"] == pytest.approx(2.0 / rate, rel=1e-12)
+        # the slope needs 0.15 kPa and half of it in tension: the ramp reaches both at
+        # 0.5 h, the longest its block must be held whatever the rate
+        assert rows[0]["hold_h"] == pytest.approx(0.5, rel=1e-5)  # a*'s precision
         # the least adhesion is the stage's own, whatever the mortar
         assert rows[0]["adhesion_kPa"] == pytest.approx(NEEDED_KPA, rel=1e-5)
         # the least force at the centroid that puts the weight W = p A back on the
@@ -216,6 +220,17 @@ def test_the_cli_names_the_mortar_and_the_rate(tmp_path, capsys):
     assert record["mortar"]["law"].startswith("Coulomb circle, mu 0.7, per joint by its age")
     table = read_table(folder / "stages.csv")
     assert np.allclose(table["time_h"], np.arange(1, 9) * 2 / 600, rtol=1e-9)
+    # the hold: gypsum's table inverted at each stage's least adhesion (or never, past
+    # its last row's 300 kPa), independently of the code's own inversion
+    for a, hold in zip(table["adhesion_kPa"], table["hold_h"]):
+        if a > 300:
+            assert pd.isna(hold)
+        else:
+            expected = np.interp(a, MORTARS["gypsum"].cohesion_kPa, MORTARS["gypsum"].hours)
+            assert hold == pytest.approx(expected if a > 0.1 else 0.0, rel=1e-9, abs=1e-12)
+    never = int(table["stage"][table["adhesion_kPa"] > 300].min())
+    assert record["mortar"]["hold_never_stage"] == never
+    assert f"gypsum mortar never holds the least adhesion of stage {never}" in out
 
 
 def test_the_law_line_of_a_mortar_by_age_names_the_joint_kinds():
@@ -229,3 +244,15 @@ def test_the_law_line_of_a_mortar_by_age_names_the_joint_kinds():
     assert law_line(halved, laying).endswith(
         "at bed joints; head joints x0.5, joints with a support x1")
     assert law_line(ARCH, laying).endswith(MORTARS["lime"].describe())
+
+
+
+@pytest.mark.parametrize("adhesion, ratio, hours", [
+    (0.15, 0.5, 0.5), (0.05, 0.5, 0.0), (200.0, 0.5, None), (0.3, 2.0, 4 + 20 * 0.35 / 0.75),
+    (None, 0.5, None)])
+def test_the_age_a_mortar_holds_an_adhesion_from(adhesion, ratio, hours):
+    """Lime's table by hand: 0.15 kPa and 0.075 in tension at 0.5 h (both halfway from
+    0.1/0.05 to 0.2/0.1); 0.05 kPa when laid; 200 kPa never (100 at 28 days); at ratio 2
+    the tension decides: 0.6 kPa between 0.25 at 4 h and 1 at 24 h."""
+    held = MORTARS["lime"].hours_to_hold(adhesion, ratio)
+    assert held == (None if hours is None else pytest.approx(hours, rel=1e-12, abs=1e-15))

@@ -99,7 +99,7 @@ def stage_record(params, scene, model, plan: StagePlan, rows, cached, source,
         "cache": {"geometry": cached},
         "friction_model": params.analysis.cone.record(),
         "mortar": None if laying is None else {**laying.record(), "law": law_line(
-            params, laying)},
+            params, laying), **hold_record(rows)},
         "stages": {
             "count": plan.n_stages,
             "standing": int(sum(bool(row["feasible"]) for row in rows)),
@@ -123,6 +123,21 @@ def stage_record(params, scene, model, plan: StagePlan, rows, cached, source,
     if source is not None:
         record["source"] = source
     return record
+
+
+def hold_record(rows) -> dict:
+    """With a mortar: ``hold_max_h``, the longest a brick just laid must be held until
+    the mortar holds its stage's least adhesion (stages.csv's ``hold_h``; 0 where fresh
+    mortar holds every stage; None where no stage has a value), its stage
+    ``hold_max_stage`` (None where it is 0), and ``hold_never_stage``, the first stage
+    whose least adhesion the mortar never reaches (None where it reaches every one)."""
+    never = [row["stage"] for row in rows
+             if row["adhesion_kPa"] is not None and row["hold_h"] is None]
+    top = max((row for row in rows if row["hold_h"] is not None),
+              key=lambda row: row["hold_h"], default=None)
+    return {"hold_max_h": None if top is None else top["hold_h"],
+            "hold_max_stage": top["stage"] if top is not None and top["hold_h"] > 0 else None,
+            "hold_never_stage": never[0] if never else None}
 
 
 def law_line(params, laying) -> str:

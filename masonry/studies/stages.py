@@ -49,7 +49,7 @@ from masonry.errors import ParameterError
 from masonry.export._text import format_float
 from masonry.export.csv import header, held_csv
 from masonry.export.summaries import parameters_text
-from masonry.mortars import MORTAR_NAMES, MORTARS, Laying, Mortar
+from masonry.mortars import Laying, stage_laying
 from masonry.params import FILE_OUTPUTS, structure_id, validate
 from masonry.pipeline import Timer, identity, run_model, versions, write_cache
 from masonry.rbe.adhesion import least_adhesion
@@ -69,7 +69,7 @@ log = logging.getLogger(__name__)
 
 STAGE_COLUMNS = ("stage", "course", "laid", "bricks", "feasible", "loose", "moi",
                  "moi_factor", "centering_N", "centering_fraction", "adhesion_kPa",
-                 "load_factor", "time_h", "solve_s")
+                 "load_factor", "time_h", "hold_h", "solve_s")
 """Columns of ``stages.csv``, one row per stage. ``laid``: the names of the blocks the
 stage lays, in a brick or block plan (a course plan's stage is its course). ``loose``: the
 laid blocks that touch nothing joining them to a support (:func:`loose_blocks`: the stage
@@ -81,7 +81,10 @@ stage that stands). ``adhesion_kPa``: the least adhesion of the stage's model (d
 ``params.lateral`` (:func:`stage_load_factor`); empty without one, or where the stage does
 not stand under its own weight. ``time_h``: with a mortar that ages
 (:func:`joint_strength`), the hours from the start of the first stage to the end of this
-one, which set its joints' ages; empty without a laying rate."""
+one, which set its joints' ages; empty without a laying rate. ``hold_h``: with a mortar
+(``--mortar``), the age from which it holds the stage's least adhesion
+(:meth:`~masonry.mortars.Mortar.hours_to_hold`): how long the brick just laid must be
+held at most; 0 where fresh mortar holds it, empty where the mortar never does."""
 
 # ---------------------------------------------------------------------- one stage
 def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
@@ -159,6 +162,8 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
     row.update(stage_centering(part, params, row["feasible"], centering, own))
     dry = not any(np.any(value) for value in mortar.values())
     row.update(stage_adhesion(part, params, plan, stage, row, sequence, dry))
+    row["hold_h"] = None if laying is None else laying.mortar.hours_to_hold(
+        row["adhesion_kPa"], params.analysis.adhesion_tension_ratio)
     if row["adhesion_used"] is not None:  # into the model's interfaces, as the figure's
         joints, used = row["adhesion_used"]
         row["adhesion_used"] = (np.flatnonzero(chosen)[joints], used)
@@ -469,44 +474,6 @@ def check_live_load(params) -> None:
                                                "not offered: run one azimuth per study)")
 
 
-def stage_laying(params, mortar=None, laying_rate=None, masons=None) -> Laying | None:
-    """The :class:`~masonry.mortars.Laying` of a stage study's options, checked
-    (:class:`ParameterError` naming the option): ``mortar`` a name of
-    :data:`~masonry.mortars.MORTAR_NAMES` (``constant``: ``params``' cohesion and tensile
-    strength at every age), ``laying_rate`` bricks per hour per mason (needed by a mortar
-    that ages), ``masons`` >= 1 (default 1). None without ``mortar``: ``params``'
-    contact law at every joint."""
-    if mortar is None:
-        for name, value in (("laying_rate", laying_rate), ("masons", masons)):
-            if value is not None:
-                raise ParameterError(name, value, "--mortar NAME beside it (the rate ages "
-                                     "a mortar's joints)")
-        return None
-    if mortar not in MORTAR_NAMES:
-        raise ParameterError("mortar", mortar, f"one of {', '.join(MORTAR_NAMES)}")
-    analysis = params.analysis
-    if mortar != "constant":
-        for name in ("cohesion_kpa", "tensile_kpa"):
-            if getattr(analysis, name) != 0:
-                raise ParameterError(name, getattr(analysis, name), f"0 with --mortar "
-                                     f"{mortar}: its table gives the strengths (or "
-                                     f"--mortar constant)", related=("mortar",))
-    table = (MORTARS[mortar] if mortar != "constant" else
-             Mortar.constant(analysis.cohesion_kpa, analysis.tensile_kpa))
-    if laying_rate is None and mortar != "constant":
-        raise ParameterError("laying_rate", None, f"bricks per hour per mason with "
-                             f"--mortar {mortar} (its joints' age)", related=("mortar",))
-    if laying_rate is not None and not (isinstance(laying_rate, (int, float))
-                                        and np.isfinite(laying_rate) and laying_rate > 0):
-        raise ParameterError("laying_rate", laying_rate, "bricks per hour per mason, a "
-                             "finite number > 0 (a mason lays 30 to 100 an hour)")
-    if masons is not None and (isinstance(masons, bool) or not isinstance(masons, int)
-                               or masons < 1):
-        raise ParameterError("masons", masons, "an integer >= 1 (masons laying side by "
-                             "side)")
-    return Laying.of(table, laying_rate, 1 if masons is None else masons)
-
-
 def run_stages(params, out_root="exports", *, by="course", order=None, course=None,
                force=False, scene=None, source=None, max_bricks=MAX_BRICKS, mortar=None,
                laying_rate=None, masons=None) -> dict:
@@ -537,8 +504,8 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
         A model estimated larger (:func:`masonry.scenes.check_size`) is refused before
         anything is built.
     mortar, laying_rate, masons
-        The joints' strength by age (:func:`stage_laying`, docs/model.md 6.13); default
-        ``params``' contact law at every joint.
+        The joints' strength by age (:func:`~masonry.mortars.stage_laying`, docs/model.md
+        6.13); default ``params``' contact law at every joint.
 
     Returns
     -------
