@@ -149,11 +149,7 @@ def _collapse(args, report):
     rows = collapse_bench(domes, repeats=args.repeats, progress=progress)
     rows += collapse_bench(small, repeats=args.repeats, search=True, progress=progress)
     markdown = collapse_markdown(rows)
-    with RunFolder(args.out, "bench_collapse") as folder:
-        folder.write("collapse.md", markdown)
-    report(markdown)
-    report(f"written: {folder.target}")
-    return 0
+    return _published(args, report, "collapse", markdown)
 
 
 def _friction(args, report):
@@ -172,45 +168,42 @@ def _friction(args, report):
     rows = friction_bench(domes, models, repeats=args.repeats,
                           progress=None if args.quiet else _progress)
     markdown = friction_markdown(rows)
-    with RunFolder(args.out, "bench_friction") as folder:
-        folder.write("friction.md", markdown)
+    return _published(args, report, "friction", markdown)
+
+
+def _published(args, report, name, markdown) -> int:
+    """``markdown`` written to ``DIR/bench_<name>/<name>.md`` and reported; exit 0."""
+    with RunFolder(args.out, f"bench_{name}") as folder:
+        folder.write(f"{name}.md", markdown)
     report(markdown)
     report(f"written: {folder.target}")
     return 0
+
+
+def _sections(args) -> dict:
+    """Each of ``--presets``' cyclic section (``--p`` overriding), named."""
+    overrides = {} if args.p is None else {"p": args.p}
+    named = "" if args.p is None else f" (p {args.p})"
+    return {f"preset {k} cyclic section{named}": from_preset(k, boundary="cyclic", **overrides)
+            for k in args.presets}
 
 
 def _stages(args, report):
     from masonry.studies.stages_bench import stages_bench, stages_markdown
 
-    overrides = {} if args.p is None else {"p": args.p}
-    named = "" if args.p is None else f" (p {args.p})"
-    sections = {f"preset {k} cyclic section{named}": from_preset(k, boundary="cyclic",
-                                                                 **overrides)
-                for k in args.presets}
-    rows = stages_bench(sections, repeats=args.repeats,
+    rows = stages_bench(_sections(args), repeats=args.repeats,
                         progress=None if args.quiet else _progress)
     markdown = stages_markdown(rows)
-    with RunFolder(args.out, "bench_stages") as folder:
-        folder.write("stages.md", markdown)
-    report(markdown)
-    report(f"written: {folder.target}")
-    return 0
+    return _published(args, report, "stages", markdown)
 
 
 def _adhesion(args, report):
     from masonry.studies.stages_bench import adhesion_bench, adhesion_markdown
 
-    overrides = {} if args.p is None else {"p": args.p}
-    sections = {f"preset {k} cyclic section": from_preset(k, boundary="cyclic", **overrides)
-                for k in args.presets}
-    rows = adhesion_bench(sections, args.adhesion_course,
+    rows = adhesion_bench(_sections(args), args.adhesion_course,
                           progress=None if args.quiet else _progress)
     markdown = adhesion_markdown(rows)
-    with RunFolder(args.out, "bench_adhesion") as folder:
-        folder.write("adhesion.md", markdown)
-    report(markdown)
-    report(f"written: {folder.target}")
-    return 0
+    return _published(args, report, "adhesion", markdown)
 
 
 def _readers(args, report):
@@ -219,11 +212,7 @@ def _readers(args, report):
     rows = reader_bench(args.readers, repeats=args.repeats,
                         progress=None if args.quiet else _progress)
     markdown = readers_markdown(rows)
-    with RunFolder(args.out, "bench_readers") as folder:
-        folder.write("readers.md", markdown)
-    report(markdown)
-    report(f"written: {folder.target}")
-    return 0
+    return _published(args, report, "readers", markdown)
 
 
 def _outputs(args, report):
@@ -238,11 +227,7 @@ def _outputs(args, report):
     rows = output_bench(structures, repeats=args.repeats,
                         progress=None if args.quiet else _progress)
     markdown = outputs_markdown(rows)
-    with RunFolder(args.out, "bench_outputs") as folder:
-        folder.write("outputs.md", markdown)
-    report(markdown)
-    report(f"written: {folder.target}")
-    return 0
+    return _published(args, report, "outputs", markdown)
 
 
 def _progress(message):

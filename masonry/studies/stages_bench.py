@@ -100,16 +100,21 @@ def _agreement(ours, theirs) -> dict:
 
 def stages_markdown(rows) -> str:
     """The rows as a markdown table, then :data:`STAGES_NOTE`."""
-    formats = {"moi_factor_diff": "{:.1e}", "sequence_s": "{:.1f}", "alone_s": "{:.1f}",
-               "speedup": "{:.2f}", "run_s": "{:.2f}", "sequence_runs": "{:.1f}",
-               "alone_runs": "{:.1f}"}
-    lines = ["| " + " | ".join(STAGES_COLUMNS) + " |",
-             "|" + "---|" * len(STAGES_COLUMNS)]
+    return _markdown(rows, STAGES_COLUMNS, {
+        "moi_factor_diff": "{:.1e}", "sequence_s": "{:.1f}", "alone_s": "{:.1f}",
+        "speedup": "{:.2f}", "run_s": "{:.2f}", "sequence_runs": "{:.1f}",
+        "alone_runs": "{:.1f}"}, STAGES_NOTE)
+
+
+def _markdown(rows, columns, formats, note) -> str:
+    """``rows`` as a markdown table of ``columns`` (each cell by its format in
+    ``formats``, else as it is; empty for None), then ``note``."""
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
     for row in rows:
         lines.append("| " + " | ".join(
             "" if row.get(c) is None else formats.get(c, "{}").format(row[c])
-            for c in STAGES_COLUMNS) + " |")
-    return "\n".join(lines) + "\n\n" + STAGES_NOTE + "\n"
+            for c in columns) + " |")
+    return "\n".join(lines) + "\n\n" + note + "\n"
 
 
 ADHESION_COLUMNS = ("structure", "course", "order", "stages", "needing", "rbe_s",
@@ -174,12 +179,6 @@ def adhesion_bench(structures, course, orders=tuple(BRICK_ORDERS), progress=None
 
 def adhesion_markdown(rows) -> str:
     """The rows as a markdown table, then :data:`ADHESION_NOTE`."""
-    formats = {"rbe_s": "{:.2f}", "adhesion_s": "{:.2f}", "ratio_median": "{:.2f}",
-               "ratio_max": "{:.2f}", "adhesion_max_kPa": "{:.4g}"}
-    lines = ["| " + " | ".join(ADHESION_COLUMNS) + " |",
-             "|" + "---|" * len(ADHESION_COLUMNS)]
-    for row in rows:
-        lines.append("| " + " | ".join(
-            "" if row.get(c) is None else formats.get(c, "{}").format(row[c])
-            for c in ADHESION_COLUMNS) + " |")
-    return "\n".join(lines) + "\n\n" + ADHESION_NOTE + "\n"
+    return _markdown(rows, ADHESION_COLUMNS, {
+        "rbe_s": "{:.2f}", "adhesion_s": "{:.2f}", "ratio_median": "{:.2f}",
+        "ratio_max": "{:.2f}", "adhesion_max_kPa": "{:.4g}"}, ADHESION_NOTE)
