@@ -183,3 +183,16 @@ def test_the_figure_shows_the_curve_the_references_and_a_legend_below(drawn, top
     assert any("no value" in label for label in labels)
     (label,) = ax.texts
     assert label.xy[0] == 3 and label.get_text() == f"{top:.4g} kPa"
+
+
+def test_a_stage_standing_on_its_mortar_is_a_ring_not_dry(drawn):
+    """With a mortar a stage can stand with a* above 0: drawn as a green ring and
+    counted apart from the stages that stand dry (a* = 0) and those it does not hold."""
+    stage_figures.stage_adhesion_png(range(1, 5), [0.474, 0.474, 0.474, 0.0],
+                                     [False, True, True, True], ratio=0.5)
+    (fig,) = drawn
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels[:3] == ["stands dry (1)", "stands on its mortar (2)", "needs adhesion (1)"]
+    ring = next(c for c in ax.collections if c.get_label() == "stands on its mortar (2)")
+    assert len(ring.get_offsets()) == 2 and ring.get_facecolors().size == 0

@@ -164,8 +164,9 @@ reference lines and a large ``a*`` show on one axis."""
 def stage_adhesion_png(stage, adhesion_kPa, feasible, title="", xlabel="stage",
                        ratio=None, render=PNG) -> dict:
     """The least adhesion of every stage (docs/model.md 6.12) against the stage, kPa:
-    stages that stand dry in green (at 0), those that need adhesion in vermillion (the
-    largest labelled), stages without a value as black crosses at 0, and dotted lines at
+    stages that stand dry in green (at 0), stages that stand on the study's mortar (a*
+    above 0) as green rings, those that need adhesion in vermillion (the largest
+    labelled), stages without a value as black crosses at 0, and dotted lines at
     :data:`FRESH_MORTAR_KPA`; a logarithmic axis beyond :data:`LINEAR_DECADES`.
 
     Parameters
@@ -174,7 +175,7 @@ def stage_adhesion_png(stage, adhesion_kPa, feasible, title="", xlabel="stage",
     adhesion_kPa : (N,) float
         ``a*`` per stage, kPa (NaN: no value).
     feasible : (N,) bool
-        The stage stands with dry joints.
+        The stage stands (with dry joints, or with the study's mortar).
     ratio : float, optional
         The tension ratio ``t_c / c``, named in the axis label.
     render : masonry.plots.common.Render
@@ -185,8 +186,14 @@ def stage_adhesion_png(stage, adhesion_kPa, feasible, title="", xlabel="stage",
     feasible = np.asarray(feasible, dtype=bool)
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(stage, value, color="0.6", linewidth=0.8, zorder=1)
-    ax.scatter(stage[feasible], value[feasible], s=14, color=STANDS,
-               label=f"stands dry ({int(feasible.sum())})", zorder=2)
+    dry = feasible & ~(value > 0)
+    ax.scatter(stage[dry], value[dry], s=14, color=STANDS,
+               label=f"stands dry ({int(dry.sum())})", zorder=2)
+    mortar = feasible & (value > 0)
+    if mortar.any():
+        ax.scatter(stage[mortar], value[mortar], s=22, facecolors="none",
+                   edgecolors=STANDS, linewidths=1.2, zorder=2,
+                   label=f"stands on its mortar ({int(mortar.sum())})")
     held = ~feasible & np.isfinite(value)
     ax.scatter(stage[held], value[held], s=14, color=NEEDS_SUPPORT,
                label=f"needs adhesion ({int(held.sum())})", zorder=2)
