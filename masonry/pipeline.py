@@ -374,7 +374,6 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
         share_plotly(out_root, reused["outputs"])
         return reused
     outputs = job.outputs()
-    share_plotly(out_root, outputs)  # before the page that reads it is published
     params = with_outputs(params, outputs)
     timer = Timer()
     scene, model, cached = run_model(params, out_root, timer, scene)
@@ -395,6 +394,7 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
                                  adhesion))
     made = RunOutputs(params, scene, model, result, collapse=collapse, centering=centering,
                       adhesion=adhesion, title=structure_id(params))
+    share_plotly(out_root, outputs)  # once the run has a page, before it is published
     folder = job.publish(lambda folder: write_run(folder, made, record, timer))
     if cached == "computed":  # only a model whose run completed is cached
         write_cache(params, out_root, scene, model)

@@ -362,6 +362,7 @@ PLAUSIBLE = {
     "--adhesion-tension-ratio": ["0", "0.5", "1"],
     "--head-joint-ratio": ["0", "0.5", "1"], "--support-joint-ratio": ["0", "1", "2"],
     "--figure-format": ["png", "svg", "pdf", "png,pdf", "tiff"], "--dpi": ["50", "110", "300"],
+    "--html-plotly": ["shared", "inline", "cdn"],
     "--span": ["1", "5", "10", "0.5"], "--thickness": ["0.05", "0.3", "0.6", "2"],
     "--rise": ["1", "2.5", "5", "8"], "--depth": ["0.2", "1", "3"],
     "--blocks": ["2", "3", "8", "16", "40"],
@@ -411,7 +412,7 @@ def value_of(option):
     plausible = st.sampled_from(PLAUSIBLE[option])
     if option in ("--shape", "--boundary", "--friction", "--accuracy", "--point-load",
                   "--friction-law", "--friction-cone", "--helix", "--pattern",
-                  "--figure-format"):
+                  "--figure-format", "--html-plotly"):
         return plausible
     wild = WILD_INTEGERS if option in INTEGER_OPTIONS else WILD_FLOATS
     return st.one_of(plausible, plausible, plausible, wild)
