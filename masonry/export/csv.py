@@ -6,6 +6,7 @@ import numpy as np
 from masonry.blocks import BLOCK_CLASSES, Blocks
 from masonry.export._text import format_floats
 from masonry.interfaces import INTERFACE_KINDS
+from masonry.export.columns import COLUMNS, DTYPES
 from masonry.params import input_dtypes
 from masonry.tolerances import TENSION_REPORTED_REL
 
@@ -13,19 +14,9 @@ TENSION_TOP_COUNT = 20
 """Rows of ``RBE/tension_top.csv``: the interfaces with the largest tension."""
 
 
-HEADERS = {"moi": "moi_N", "objective": "objective_N2"}
-"""Record keys whose CSV columns name their unit (``run.json`` keeps the keys)."""
-
-INTEGER_COLUMNS = ("id", "rank", "brick", "block", "block_a", "block_b", "course",
-                   "course_a", "course_b", "vertex", "vertices", "stage", "bricks", "step",
-                   "variant", "interfaces", "stages", "stages_standing", "interface",
-                   "first_unsupported_stage", "first_unsupported_course",
-                   "first_unsupported_brick", "adhesion_max_course", "trial", "loose",
-                   "masons")
-TEXT_COLUMNS = ("name", "name_a", "name_b", "class", "kind", "laid", "status", "error",
-                "friction_used", "friction_model", "structure_id", "mortar")
-BOOLEAN_COLUMNS = ("feasible", "stands", "constraints_met", "best")
-"""The columns of masonry's CSV files that are not floats, by type: :func:`column_types`."""
+HEADERS = {c.name: c.header for c in COLUMNS.values() if c.header is not None}
+"""Record keys whose CSV columns name their unit (``run.json`` keeps the keys):
+:attr:`masonry.export.columns.Column.header`."""
 
 
 def header(columns) -> list:
@@ -34,16 +25,14 @@ def header(columns) -> list:
 
 
 def column_types(names) -> dict:
-    """pandas dtypes of masonry's CSV columns ``names``: integers, text and booleans as
-    declared, the inputs of a sweep's rows by their declarations
-    (:func:`masonry.params.input_dtypes`), every other column a float (its name says its
-    unit). ``pd.read_csv(path,
-    dtype=column_types(header))`` types a file with only its header as one with rows;
-    :func:`masonry.read_table` does it."""
+    """pandas dtypes of masonry's CSV columns ``names``: the declared columns by their
+    kind (:data:`masonry.export.columns.COLUMNS`), the inputs of a sweep's rows by their
+    declarations (:func:`masonry.params.input_dtypes`), every other column a float (its
+    name says its unit). ``pd.read_csv(path, dtype=column_types(header))`` types a file
+    with only its header as one with rows; :func:`masonry.read_table` does it."""
     inputs = input_dtypes()
-    return {name: "Int64" if name in INTEGER_COLUMNS else "str" if name in TEXT_COLUMNS
-            else "boolean" if name in BOOLEAN_COLUMNS else inputs.get(name, "float64")
-            for name in names}
+    return {name: DTYPES[COLUMNS[name].kind] if name in COLUMNS
+            else inputs.get(name, "float64") for name in names}
 
 
 def missing_values(names) -> dict:

@@ -2,17 +2,16 @@
 stages, its ``run.json`` record, and the columns a parameter study's summary takes from
 that record (docs/stages.md)."""
 
+from masonry.export.columns import STAGE_COLUMNS, column_names, summary_row
 from masonry.params import structure_id
 from masonry.pipeline import model_record
 from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
 from masonry.studies.plans import StagePlan
 from masonry.tolerances import ADHESION_TIE_REL
 
-STAGE_SUMMARY_COLUMNS = ("stages", "stages_standing", "first_unsupported_stage",
-                         "first_unsupported_course", "first_unsupported_brick",
-                         "centering_max_N", "centering_max_fraction",
-                         "stages_load_factor_min", "adhesion_max_kPa", "adhesion_max_course")
-"""A stage study's columns in a sweep's summary (:func:`stage_summary`), after
+STAGE_SUMMARY_COLUMNS = column_names(STAGE_COLUMNS)
+"""A stage study's columns in a sweep's summary (:func:`stage_summary`;
+:data:`masonry.export.columns.STAGE_COLUMNS`), after
 :data:`masonry.studies.sweep.SUMMARY_COLUMNS` when the study asks for stages
 (``Study.stages``)."""
 
@@ -190,14 +189,4 @@ def stage_summary(record) -> dict:
     that stage's weight), the smallest lateral load factor and the largest least
     adhesion (kPa, and the course where it peaks) over the stages
     (:func:`stage_extremes`)."""
-    stages = record["stages"]
-    first = stages["first_unsupported"] or {}
-    return {"stages": stages["count"], "stages_standing": stages["standing"],
-            "first_unsupported_stage": first.get("stage"),
-            "first_unsupported_course": first.get("course"),
-            "first_unsupported_brick": first.get("brick"),
-            "centering_max_N": stages["centering_max_N"],
-            "centering_max_fraction": stages["centering_max_fraction"],
-            "stages_load_factor_min": stages["load_factor_min"],
-            "adhesion_max_kPa": stages["adhesion_max_kPa"],
-            "adhesion_max_course": stages["adhesion_max_course"]}
+    return summary_row(STAGE_COLUMNS, record)

@@ -27,7 +27,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from masonry.export._text import format_floats
-from masonry.export.csv import HEADERS, TEXT_COLUMNS, header
+from masonry.export.columns import COLUMNS, RUN_COLUMNS, column_names, summary_row
+from masonry.export.csv import HEADERS, header
 from masonry.errors import ParameterError
 from masonry.mortars import LAYING_INPUTS, split_laying
 from masonry.params import Params, geometry_key, names, validate
@@ -42,19 +43,10 @@ from masonry.studies.workers import WORKER_LOG_LEVEL, quiet_shutdown
 
 log = logging.getLogger(__name__)
 
-SUMMARY_COLUMNS = ("variant", "status", "error", "feasible", "friction_used",
-                   "friction_model", "moi", "moi_factor", "centering_N",
-                   "centering_fraction", "adhesion_kPa", "objective", "weight_N", "bricks",
-                   "interfaces",
-                   "residual_eq", "load_factor", "load_azimuth_deg", "time_s",
-                   "structure_id")
-"""Result columns of the summary; the swept inputs come first. ``centering_N``,
-``centering_fraction``: the run's centering force (docs/model.md 6.10), 0 where the
-structure stands; ``adhesion_kPa``: its least adhesion (docs/model.md 6.12), empty where
-none was found. ``load_factor`` (and the lateral load's azimuth, the worst one for
-``lateral = "all"``) when the study gives a live load (``lateral``, ``point-load`` or
-``crown-load``, docs/model.md 6.8). A study of stages adds
-:data:`~masonry.studies.stage_records.STAGE_SUMMARY_COLUMNS`."""
+SUMMARY_COLUMNS = column_names(RUN_COLUMNS)
+"""Result columns of the summary (:data:`masonry.export.columns.RUN_COLUMNS`: their
+sources in ``run.json``, types, units and meanings); the swept inputs come first. A study
+of stages adds :data:`~masonry.studies.stage_records.STAGE_SUMMARY_COLUMNS`."""
 
 def measure(row: dict, column: str):
     """A result column of a variant's row as a number, for an optimisation: a boolean as
@@ -79,7 +71,8 @@ def measure_columns(study) -> list:
     """The result columns an optimisation may maximise, minimise or bound, as
     ``summary.csv`` names them (:func:`~masonry.export.csv.header`): every result column
     but the labels (the variant, its status and error, names) and ``constraints_met``."""
-    labels = {"variant", "constraints_met", *TEXT_COLUMNS}
+    labels = {"variant", "constraints_met",
+              *(name for name, c in COLUMNS.items() if c.kind == "str")}
     return header([c for c in result_columns(study) if c not in labels])
 
 
@@ -306,23 +299,9 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
 
 def run_summary(record) -> dict:
     """The result columns of :data:`SUMMARY_COLUMNS` from a run's ``run.json`` record
-    (see :func:`run_variant`)."""
-    rbe = record.get("rbe", {})
-    centering = record.get("centering") or {}
-    stands = rbe.get("feasible") is True
-    collapse = record.get("collapse", {})
-    return dict(
-        feasible=rbe.get("feasible"), friction_used=rbe.get("friction"),
-        friction_model=rbe.get("friction_model"),
-        moi=rbe.get("moi"), moi_factor=rbe.get("moi_factor"),
-        centering_N=0.0 if stands else centering.get("total_N"),
-        centering_fraction=0.0 if stands else centering.get("fraction"),
-        adhesion_kPa=(record.get("adhesion") or {}).get("a_kPa"),
-        objective=rbe.get("objective"), weight_N=record.get("weight_N"),
-        bricks=record["counts"]["bricks"],
-        interfaces=sum(record["counts"].get("interfaces", {}).values()),
-        residual_eq=rbe.get("residual_eq"), structure_id=record["structure_id"],
-        load_factor=collapse.get("load_factor"), load_azimuth_deg=collapse.get("azimuth_deg"))
+    (see :func:`run_variant`), each where its row of
+    :data:`masonry.export.columns.RUN_COLUMNS` says."""
+    return summary_row(RUN_COLUMNS, record)
 
 
 def run_after(previous, inputs: dict, out_root, **options) -> dict:
@@ -573,9 +552,9 @@ def summary_parquet(study: Study, rows):
     if pa is None or pq is None:
         return None
     columns = study.columns
+    text_columns = [c.name for c in RUN_COLUMNS if c.kind == "str"]
     table = pa.table({HEADERS.get(c, c): [None if r.get(c) is None else str(r.get(c))
-                          if c in ("error", "status", "friction_used", "friction_model",
-                                   "structure_id")
+                          if c in text_columns
                           else r.get(c) for r in rows] for c in columns})
     buf = io.BytesIO()
     pq.write_table(table, buf)
