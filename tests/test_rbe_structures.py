@@ -91,9 +91,9 @@ def test_golden_interface_counts_and_moi_factor(preset):
 
 @pytest.mark.slow
 def test_infeasible_structure_is_reported_infeasible_by_net():
-    """friction-net alone on structure 1.1 gives no solution and no fake optimum; the LP
-    check agrees."""
-    result = solved("1", friction="net", lp_check=True)
+    """friction-net alone on structure 3.1 (the free section, 567 blocks) gives no
+    solution and no fake optimum; the LP check agrees."""
+    result = solved("3", friction="net", lp_check=True)
     assert not result.feasible
     assert result.lp_feasible is False
     assert result.x is None and np.isnan(result.moi)

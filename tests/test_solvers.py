@@ -889,7 +889,7 @@ def test_a_solve_given_one_core_solves_friction_plus_here(monkeypatch):
 
 
 # ---------------------------------------------------------------------- reuse
-@pytest.mark.parametrize("solver, cone", [("newton", None), ("osqp", "polygon:16"),
+@pytest.mark.parametrize("solver, cone", [("newton", None), ("osqp", "square"),
                                           ("clarabel", None), ("clarabel", "square")])
 @pytest.mark.slow
 def test_reuse_between_friction_coefficients_changes_nothing(solver, cone):
