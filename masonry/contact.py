@@ -134,7 +134,7 @@ class ContactLaw:
 
     def scaled(self, factor) -> "ContactLaw":
         """This law with both strengths times ``factor`` (a float, or (IV,) per vertex:
-        :func:`masonry.interfaces.joint_factor`); itself where the factor is 1 everywhere
+        :func:`joint_factor`); itself where the factor is 1 everywhere
         or it is dry."""
         if self.is_dry or (np.ndim(factor) == 0 and factor == 1.0):
             return self
@@ -172,6 +172,37 @@ class ContactLaw:
         return {"friction_model": self.cone.name, "mu": self.mu,
                 "cohesion_Pa": self.cohesion_Pa, "tensile_Pa": self.tensile_Pa,
                 "tension_cutoff_Pa": self.cutoff_Pa, "text": self.describe()}
+
+
+JOINT_KINDS = {"bed": ("horizontal",), "head": ("vertical", "boundary"),
+               "support": ("support",)}
+"""The joint kinds whose strengths differ (:func:`joint_factor`) by the interface kinds
+(:data:`masonry.interfaces.INTERFACE_KINDS`) they take: a joint between two webs
+(``boundary``, at a polygonal dome's corner or a sector's edge) joins bricks of one course
+side by side, a head joint."""
+
+
+def joint_factor(interfaces, head=1.0, support=1.0) -> float | np.ndarray:
+    """Every interface vertex's strength over the bed joints' (:data:`JOINT_KINDS`):
+    1 at bed joints, ``head`` at head joints, ``support`` at joints with a support;
+    ``1.0`` (a float) where both ratios are 1.
+
+    Parameters
+    ----------
+    interfaces : masonry.interfaces.Interfaces
+    head, support : float
+        >= 0.
+
+    Returns
+    -------
+    float or (IV,) float
+    """
+    if head == 1.0 and support == 1.0:
+        return 1.0
+    per = np.ones(len(interfaces))
+    for name, ratio in (("head", head), ("support", support)):
+        per[interfaces.is_kind(*JOINT_KINDS[name])] = ratio
+    return np.repeat(per, np.diff(np.asarray(interfaces.offsets)))
 
 
 def as_strength(value) -> float | np.ndarray:

@@ -32,39 +32,6 @@ INTERFACE_KINDS = ("horizontal", "vertical", "support", "boundary")
 ``boundary``: contact with a neighbouring web (dome boundary modes)."""
 
 
-JOINT_KINDS = {"bed": ("horizontal",), "head": ("vertical", "boundary"),
-               "support": ("support",)}
-"""The joint kinds whose strengths differ (:func:`joint_factor`) by the interface kinds
-(:data:`masonry.interfaces.INTERFACE_KINDS`) they take: a joint between two webs
-(``boundary``, at a polygonal dome's corner or a sector's edge) joins bricks of one course
-side by side, a head joint."""
-
-
-def joint_factor(interfaces, head=1.0, support=1.0) -> float | np.ndarray:
-    """Every interface vertex's strength over the bed joints' (:data:`JOINT_KINDS`):
-    1 at bed joints, ``head`` at head joints, ``support`` at joints with a support;
-    ``1.0`` (a float) where both ratios are 1.
-
-    Parameters
-    ----------
-    interfaces : masonry.interfaces.Interfaces
-    head, support : float
-        >= 0.
-
-    Returns
-    -------
-    float or (IV,) float
-    """
-    if head == 1.0 and support == 1.0:
-        return 1.0
-    kind = np.asarray(interfaces.kind)
-    per = np.ones(len(kind))
-    for name, ratio in (("head", head), ("support", support)):
-        codes = [INTERFACE_KINDS.index(k) for k in JOINT_KINDS[name]]
-        per[np.isin(kind, codes)] = ratio
-    return np.repeat(per, np.diff(np.asarray(interfaces.offsets)))
-
-
 @dataclass(frozen=True, eq=False)
 class Interfaces:
     """Interfaces as a struct of arrays.
@@ -114,6 +81,10 @@ class Interfaces:
     def counts(self) -> dict:
         """Number of interfaces per kind name."""
         return {name: int((self.kind == i).sum()) for i, name in enumerate(INTERFACE_KINDS)}
+
+    def is_kind(self, *names) -> np.ndarray:
+        """(K,) bool: the interfaces of the kinds ``names`` (:data:`INTERFACE_KINDS`)."""
+        return np.isin(self.kind, [INTERFACE_KINDS.index(name) for name in names])
 
     def subset(self, mask, block_remap=None) -> "Interfaces":
         """The interfaces selected by a boolean mask or index array, in their order.

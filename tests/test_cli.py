@@ -10,8 +10,9 @@ from masonry_cli.main import main
 
 
 def run_folders(root):
-    """The run folders under an output root (not the hidden geometry cache)."""
-    return [p for p in root.iterdir() if not p.name.startswith(".")]
+    """The run folders under an output root (not the hidden geometry cache, nor the
+    pages' shared plotly.js)."""
+    return [p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".")]
 
 
 @pytest.mark.slow

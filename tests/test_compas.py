@@ -147,7 +147,7 @@ def dome_run(tmp_path_factory):
     code = main(["run", "--scene", "dome", "--n", "6", "--r", "0", "--p", "3", "--cut", "0.5",
                  "--no-plots", "--no-printable", "--no-html", "--out", str(out)])
     assert code == 0
-    folder = next(p for p in out.iterdir() if not p.name.startswith("."))
+    folder = next(p for p in out.iterdir() if p.is_dir() and not p.name.startswith("."))
     return folder, json.loads((folder / "run.json").read_text())
 
 

@@ -49,7 +49,7 @@ def test_the_default_run_is_the_cyclic_section_and_says_what_its_verdict_means(
         tmp_path, capsys):
     assert main(["run", *SMALL, "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    (folder,) = [p for p in tmp_path.iterdir() if not p.name.startswith(".")]
+    (folder,) = [p for p in tmp_path.iterdir() if p.is_dir() and not p.name.startswith(".")]
     assert folder.name.startswith("dome1_")  # the section with cyclic neighbours
     assert json.loads((folder / "run.json").read_text())["params"]["boundary"] == "cyclic"
     assert "RBE: feasible" in out
@@ -192,7 +192,7 @@ def test_mesh_coordinates_beyond_any_map_are_refused_naming_the_file(tmp_path, c
             assert line.startswith(f"masonry: error: {path}: ") and "farther than 1e+08 m" in line
         else:  # map coordinates (UTM northings reach 1e7 m) are read
             assert code == 0
-    (folder,) = [p for p in (tmp_path / "o").iterdir() if not p.name.startswith(".")]
+    (folder,) = [p for p in (tmp_path / "o").iterdir() if p.is_dir() and not p.name.startswith(".")]
     assert folder.name.startswith("assembly_far1e")
 
 

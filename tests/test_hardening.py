@@ -128,7 +128,7 @@ def test_leftovers_of_dead_runs_are_removed_and_live_ones_kept(tmp_path):
 def test_sigterm_during_the_exports_leaves_the_previous_run(tmp_path):
     args = ["--preset", "1", "--fast", "--no-printable", "--out", str(tmp_path), "-q"]
     assert main(["build", *args]) == 0
-    (folder,) = [p for p in tmp_path.iterdir() if not p.name.startswith(".")]
+    (folder,) = [p for p in tmp_path.iterdir() if p.is_dir() and not p.name.startswith(".")]
     before = snapshot(folder)
     process = subprocess.Popen([sys.executable, "-m", "masonry_cli.main", "build",
                                 "--force", *args], stderr=subprocess.PIPE, text=True)
@@ -273,7 +273,7 @@ def test_a_long_stage_says_it_is_still_running(monkeypatch, caplog):
 def test_a_stage_study_without_plots_keeps_the_plots_of_one_with(tmp_path, capsys):
     args = ["stages", "--scene", "arch", "--blocks", "6", "--out", str(tmp_path), "-q"]
     assert main(args) == 0
-    (folder,) = [p for p in tmp_path.iterdir() if not p.name.startswith(".")]
+    (folder,) = [p for p in tmp_path.iterdir() if p.is_dir() and not p.name.startswith(".")]
     before = snapshot(folder)
     assert any(p.suffix == ".png" for p in before)
     assert main([*args, "--no-plots"]) == 0

@@ -221,7 +221,7 @@ def test_lines_that_end_far_below_the_top_are_reported(tmp_path, capsys):
     out = capsys.readouterr().out
     assert ("note: 2 of 4 pattern lines end far below the top course 17, on course 8: "
             in out)
-    (folder,) = [p for p in tmp_path.iterdir() if not p.name.startswith(".")]
+    (folder,) = [p for p in tmp_path.iterdir() if p.is_dir() and not p.name.startswith(".")]
     saved = json.loads((folder / "run.json").read_text())["pattern"]
     assert saved["ended_far_below_top"] == record["pattern"]["ended_far_below_top"]
     # lines that end near the top, where the web has narrowed, are not reported
@@ -239,7 +239,7 @@ def test_lines_that_end_far_below_the_top_are_reported(tmp_path, capsys):
 def test_build_writes_a_plain_dome(tmp_path, capsys):
     assert main(["build", "--preset", "1", "--pattern", "none", "--fast", "--no-printable",
                  "--out", str(tmp_path), "-q"]) == 0
-    (folder,) = [p for p in tmp_path.iterdir() if not p.name.startswith(".")]
+    (folder,) = [p for p in tmp_path.iterdir() if p.is_dir() and not p.name.startswith(".")]
     assert folder.name == "dome1_fast1_fricauto_s1_n8_r1_p10_c0.1_u0.1_patnone"
     assert (folder / "00_pattern.png").stat().st_size > 10_000
     text = (folder / "00_parameters.txt").read_text()

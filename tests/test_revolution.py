@@ -262,7 +262,7 @@ def test_run_writes_the_dome_of_revolution(tmp_path):
     args = ["run", "--scene", "sector", "--boundary", "cyclic", "--radius", "20", "--p", "3",
             "--cut", "0.3", "--fast", "--no-printable", "--out", str(tmp_path), "-q"]
     assert main(args) == 0
-    (folder,) = [p for p in tmp_path.iterdir() if not p.name.startswith(".")]
+    (folder,) = [p for p in tmp_path.iterdir() if p.is_dir() and not p.name.startswith(".")]
     assert folder.name.startswith("sector1_fast1_fricauto_R20_")
     assert (folder / "00_pattern.png").is_file() and (folder / "RBE" / "forces.csv").is_file()
     assert (folder / "05_dome" / "3_structure.png").is_file()

@@ -321,7 +321,8 @@ def test_stages_command_writes_its_own_folder_reproducibly(tmp_path, capsys):
             "--fast", "--no-plots", "--out", str(tmp_path), "-q"]
     assert main(["run", *args[1:]]) == 0  # a run of the same dome, beside the stages
     assert main(args) == 0
-    folders = sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("."))
+    folders = sorted(p.name for p in tmp_path.iterdir()
+                     if p.is_dir() and not p.name.startswith("."))
     # run and stages both model the section as cyclic unless told otherwise
     assert len(folders) == 2 and folders[1] == folders[0] + "_stages_course"
     folder = tmp_path / folders[1]

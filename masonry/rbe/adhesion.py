@@ -38,9 +38,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from masonry.contact import TENSION_RATIO, ContactLaw
+from masonry.contact import TENSION_RATIO, ContactLaw, joint_factor
 from masonry.errors import MasonryError
-from masonry.interfaces import INTERFACE_KINDS, joint_factor
+from masonry.interfaces import INTERFACE_KINDS
 from masonry.rbe.collapse import friction_columns
 from masonry.rbe.equilibrium import EquilibriumSystem, assemble
 from masonry.rbe.solvers.direct_clarabel import solve_cone_program
@@ -173,7 +173,7 @@ def least_adhesion(model, *, mu=0.7, density=2000.0, cone="circle", ratio=TENSIO
         ``t_c / c``, >= 0 (:data:`TENSION_RATIO`).
     head_ratio, support_ratio : float
         Head joints and joints with a support hold these fractions of ``a``
-        (:func:`masonry.interfaces.joint_factor`); ``a*`` is the bed joints'.
+        (:func:`masonry.contact.joint_factor`); ``a*`` is the bed joints'.
     time_limit : float, s
 
     Returns

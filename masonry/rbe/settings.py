@@ -5,10 +5,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.contact import TENSION_RATIO, ContactLaw
+from masonry.contact import TENSION_RATIO, ContactLaw, joint_factor
 from masonry.errors import ParameterError
 from masonry.friction import FrictionCone, FrictionModelError
-from masonry.interfaces import joint_factor
 from masonry.parameters import check_fields, declare
 from masonry.rbe.accuracy import ACCURACY
 from masonry.rbe.solvers import BACKENDS, RBE, names
@@ -34,7 +33,7 @@ class Analysis:
     ``head_joint_ratio`` and ``support_joint_ratio`` the strength of head joints and of
     joints with a support as a fraction of the bed joints' (cohesion and tension alike,
     also of a mortar by age and of the least adhesion;
-    :func:`masonry.interfaces.joint_factor`),
+    :func:`masonry.contact.joint_factor`),
     ``adhesion_tension_ratio`` the ratio ``t_c / c`` of the least adhesion
     (:mod:`masonry.rbe.adhesion`).
     """
@@ -107,7 +106,7 @@ class Analysis:
 
     def joint_factor(self, interfaces) -> float | np.ndarray:
         """Every vertex's strength over the bed joints' (1.0, a float, where every joint
-        has the bed joints'; :func:`masonry.interfaces.joint_factor`)."""
+        has the bed joints'; :func:`masonry.contact.joint_factor`)."""
         return joint_factor(interfaces, self.head_joint_ratio, self.support_joint_ratio)
 
     def law_on(self, interfaces) -> ContactLaw:
