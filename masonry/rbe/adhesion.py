@@ -219,38 +219,32 @@ def solve_adhesion(system: EquilibriumSystem, interfaces, *, ratio=TENSION_RATIO
     a = float(z[-1]) if z[-1] > ACCEPT_RESIDUAL else 0.0
     x = columns.edges @ z[:-1]
     x[system.layout.columns("c")] -= a * held / system.mu       # the physical n
-    return adhesion_at(system, interfaces, x, a * system.weight_ref / area_ref / 1e3,
-                       ratio=ratio, head_ratio=head_ratio, support_ratio=support_ratio,
-                       status=status, iterations=iterations, start=start)
+    return _checked(system, interfaces, x, a, area_ref, held, ratio, status, iterations,
+                    start)
 
 
-def adhesion_at(system: EquilibriumSystem, interfaces, x, a_kPa, *, ratio=TENSION_RATIO,
-                head_ratio=1.0, support_ratio=1.0, status="optimal", iterations=0,
-                start=None) -> AdhesionResult:
-    """The least adhesion ``a_kPa`` with the point that shows it: the physical vertex
-    forces ``x`` (solver units of ``system``, dry) balance the blocks within the law at
-    cohesion ``a`` (per joint kind) and tension ``r a``, recomputed; a point beyond
-    :data:`~masonry.tolerances.ACCEPT_RESIDUAL` gives no value. ``start``: the
-    :func:`time.perf_counter` its search began at (``time_s``)."""
-    start = time.perf_counter() if start is None else start
-    system = system.with_material(cohesion=0.0, tensile=0.0)
-    area_ref, held = _held(system, interfaces, head_ratio, support_ratio)
+def _checked(system, interfaces, x, a, area_ref, held, ratio, status, iterations,
+             start) -> AdhesionResult:
+    """The result of the program's optimum ``a`` (units of ``W_ref / A_ref``) and its
+    physical vertex forces ``x``: the equilibrium residual and the law's violation at
+    ``a`` recomputed; a point beyond :data:`~masonry.tolerances.ACCEPT_RESIDUAL` gives
+    no value."""
     unit_kPa = system.weight_ref / area_ref / 1e3
-    residual, violation = _residuals(system, x, a_kPa / unit_kPa * held, ratio)
+    residual, violation = _residuals(system, x, a * held, ratio)
     common = dict(ratio=ratio, interface_pair=np.asarray(interfaces.pair),
                   interface_kind=np.asarray(interfaces.kind), law=system.law,
                   iterations=iterations, time_s=time.perf_counter() - start,
                   residual_eq=residual, law_violation=violation)
     if max(residual, violation) > ACCEPT_RESIDUAL:
-        log.warning("least adhesion: the point (%s) rejected: residual %.1e, law "
+        log.warning("least adhesion: Clarabel's point (%s) rejected: residual %.1e, law "
                     "violation %.1e", status, residual, violation)
         return AdhesionResult(None, interface_kPa=np.zeros(len(interfaces)), status=status,
                               reason=f"the optimum failed its check (residual "
                                      f"{residual:.1e}, law violation {violation:.1e})",
                               **common)
-    log.info("least adhesion: %.6g kPa, %d iterations", a_kPa, iterations)
+    log.info("least adhesion: %.6g kPa, %d iterations", a * unit_kPa, iterations)
     used = _interface_use(system, x, system.vertex_area / area_ref, ratio) * unit_kPa
-    return AdhesionResult(a_kPa, interface_kPa=used, status="optimal", **common)
+    return AdhesionResult(a * unit_kPa, interface_kPa=used, status="optimal", **common)
 
 
 def _held(system, interfaces, head_ratio, support_ratio) -> tuple:
