@@ -34,7 +34,7 @@ from masonry.rbe.solvers import cholesky, ordering
 from masonry.rbe.solvers.cholesky import BlockCholesky
 from masonry.rbe.solvers.embedded import Embedded
 from masonry.rbe.solvers.highs import highs_lp
-from masonry.rbe.solvers.interior import _scaling, vertex_cones, vertex_inverse
+from masonry.rbe.solvers.interior import scaling_of, vertex_cones, vertex_inverse
 from masonry.rbe.solvers.net_feasibility import decide
 from masonry.rbe.solvers.newton import COMPONENTS, NewtonOptions, NewtonSystem
 from masonry.rbe.solvers.standard_form import standard_form
@@ -420,7 +420,7 @@ def test_interior_point_vertex_blocks_are_the_inverse(method, name):
         s, z = (vc.cone.identity(200) * 2.0 + rng.uniform(-0.5, 0.5, (200, vc.cone.m))
                 for _ in range(2))
         s, z = s * np.exp(rng.uniform(-3, 3, (200, 1))), z * np.exp(rng.uniform(-3, 3, (200, 1)))
-        _, w = _scaling(vc.cone, s, z)
+        _, w = scaling_of(vc.cone, s, z)
         w_inverse.append(w)
         w2 = np.einsum("vk,vk->vk", w, w) if w.ndim == 2 else w @ w
         stiffness = stiffness + (np.einsum("ki,vk,kj->vij", vc.G, w2, vc.G) if w.ndim == 2

@@ -17,12 +17,16 @@ the cone's shift (:mod:`masonry.contact`): with the shifted compression ``c~_i =
 A_i / mu`` the friction model is the dry one in ``(c~, f)``, and ``a`` enters linearly,
 as one column of the equilibrium rows (``-a A_eq[:, c] A / mu``) and of the cut-off rows
 ``c~_i >= a A_i (1 / mu - r)`` (where ``r < 1 / mu``; beyond, the cone's apex is the
-cut-off). So ``a`` is one more variable of a conic program of the collapse program's
-columns (:func:`masonry.rbe.collapse.friction_columns`), solved once by Clarabel
-(:func:`masonry.rbe.solvers.direct_clarabel.solve_cone_program`), not a bisection. The
-program is always feasible for a large enough ``a`` where every block touches a joint,
-and bounded below by 0: it has an optimum, which is 0 exactly when the structure stands
-dry.
+cut-off). So ``a`` is one more variable of a conic program, solved once, not a
+bisection: by the own interior point method on the Newton method's matrix
+(:mod:`masonry.rbe.solvers.interior_adhesion`, which a stage sequence runs on the
+symbolic factorization its RBE solve made), and where that ends without a checked
+optimum by Clarabel on the collapse program's columns
+(:func:`masonry.rbe.collapse.friction_columns`,
+:func:`masonry.rbe.solvers.direct_clarabel.solve_cone_program`), which also tells an
+infeasible program. The program is always feasible for a large enough ``a`` where every
+block touches a joint and tension holds (``r > 0``), and bounded below by 0: it has an
+optimum, which is 0 exactly when the structure stands dry.
 
 Scaling: forces in units of the reference weight ``W_ref``, moment rows divided by
 ``L_ref`` (the RBE's); ``a`` in units of ``W_ref / A_ref``, ``A_ref`` the mean tributary
@@ -43,14 +47,20 @@ from masonry.errors import MasonryError
 from masonry.interfaces import INTERFACE_KINDS
 from masonry.rbe.collapse import friction_columns
 from masonry.rbe.equilibrium import EquilibriumSystem, assemble
+from masonry.rbe.solvers import interior_adhesion
+from masonry.rbe.solvers.base import OPTIMAL, OPTIMAL_INACCURATE
 from masonry.rbe.solvers.direct_clarabel import solve_cone_program
+from masonry.rbe.solvers.newton import NewtonSystem
 from masonry.rbe.solvers.program import NONNEGATIVE
 from masonry.tolerances import ACCEPT_RESIDUAL, ADHESION_REPORTED_REL
 
 log = logging.getLogger(__name__)
 
 SOLVER = "clarabel"
-"""The solver of the program (module docstring)."""
+INTERIOR = "interior"
+SOLVERS = (INTERIOR, SOLVER)
+"""The solvers of the program: the own interior point method (default; Clarabel where it
+ends without a checked optimum), or Clarabel alone (module docstring)."""
 
 RESULT_KEYS = ("a_kPa", "ratio", "friction_model", "mu", "status", "solver",
                "iterations", "time_s", "residual_eq", "law_violation", "reason")
@@ -158,7 +168,8 @@ class AdhesionResult:
 
 
 def least_adhesion(model, *, mu=0.7, density=2000.0, cone="circle", ratio=TENSION_RATIO,
-                   head_ratio=1.0, support_ratio=1.0, time_limit=600.0) -> AdhesionResult:
+                   head_ratio=1.0, support_ratio=1.0, time_limit=600.0,
+                   solver=INTERIOR) -> AdhesionResult:
     """The least uniform adhesion with which ``model`` stands (module docstring).
 
     Parameters
@@ -175,6 +186,9 @@ def least_adhesion(model, *, mu=0.7, density=2000.0, cone="circle", ratio=TENSIO
         Head joints and joints with a support hold these fractions of ``a``
         (:func:`masonry.contact.joint_factor`); ``a*`` is the bed joints'.
     time_limit : float, s
+        Clarabel's.
+    solver : str
+        One of :data:`SOLVERS`.
 
     Returns
     -------
@@ -193,18 +207,48 @@ def least_adhesion(model, *, mu=0.7, density=2000.0, cone="circle", ratio=TENSIO
                       side_block=model.side_block, side_rotation=model.side_rotation,
                       cone=cone)
     return solve_adhesion(system, model.interfaces, ratio=ratio, head_ratio=head_ratio,
-                          support_ratio=support_ratio, time_limit=time_limit)
+                          support_ratio=support_ratio, time_limit=time_limit, solver=solver)
 
 
 def solve_adhesion(system: EquilibriumSystem, interfaces, *, ratio=TENSION_RATIO,
-                   head_ratio=1.0, support_ratio=1.0, time_limit=600.0) -> AdhesionResult:
+                   head_ratio=1.0, support_ratio=1.0, time_limit=600.0, solver=INTERIOR,
+                   symbolic=None) -> AdhesionResult:
     """:func:`least_adhesion` on assembled matrices (their friction model and ``mu``;
-    a mortar they carry is dropped: ``a`` is the program's)."""
+    a mortar they carry is dropped: ``a`` is the program's): by the own interior point
+    method (:mod:`masonry.rbe.solvers.interior_adhesion`, on ``symbolic``, the
+    :class:`~masonry.rbe.solvers.cholesky.BlockCholesky` analysis of the system's
+    blocks, made here when None), and by Clarabel where that ends without a checked
+    optimum; by Clarabel alone with ``solver`` ``clarabel``."""
     start = time.perf_counter()
     ratio = check_ratio(ratio)
+    if solver not in SOLVERS:
+        raise ValueError(f"solver {solver!r}: expected one of {', '.join(SOLVERS)}")
     system = system.with_material(cohesion=0.0, tensile=0.0)
-    columns = friction_columns(system)
     area_ref, held = _held(system, interfaces, head_ratio, support_ratio)
+    if solver == SOLVER:
+        return _by_clarabel(system, interfaces, area_ref, held, ratio, time_limit, start)
+    ns = NewtonSystem(system, "net", symbolic=symbolic)
+    found = interior_adhesion.solve(ns, held, ratio)
+    if found.status in (OPTIMAL, OPTIMAL_INACCURATE):
+        x = ns.full_vector(found.x, system.layout)
+        result = _checked(system, interfaces, x, _clamped(found.point.a), area_ref, held,
+                          ratio, found.status, found.iterations, start, INTERIOR)
+        if result.a_kPa is not None:
+            return result
+    log.info("least adhesion: the interior point method ended %s; Clarabel", found.status)
+    return _by_clarabel(system, interfaces, area_ref, held, ratio, time_limit, start)
+
+
+def _clamped(a) -> float:
+    """``a`` at least 0: within the acceptance tolerance of standing dry is standing dry
+    (the point is checked at 0)."""
+    return float(a) if a > ACCEPT_RESIDUAL else 0.0
+
+
+def _by_clarabel(system, interfaces, area_ref, held, ratio, time_limit,
+                 start) -> AdhesionResult:
+    """The program solved by Clarabel (module docstring)."""
+    columns = friction_columns(system)
     A, b, rows, h, cones = _program(system, columns, held, ratio)
     q = np.zeros(A.shape[1])
     q[-1] = 1.0
@@ -215,16 +259,15 @@ def solve_adhesion(system: EquilibriumSystem, interfaces, *, ratio=TENSION_RATIO
                   if status == "PrimalInfeasible" else f"Clarabel ended {status}")
         return _unsolved(interfaces, system.law, ratio, reason, status,
                          iterations, time.perf_counter() - start)
-    # within the acceptance tolerance of standing dry is standing dry (checked at 0)
-    a = float(z[-1]) if z[-1] > ACCEPT_RESIDUAL else 0.0
+    a = _clamped(z[-1])
     x = columns.edges @ z[:-1]
     x[system.layout.columns("c")] -= a * held / system.mu       # the physical n
     return _checked(system, interfaces, x, a, area_ref, held, ratio, status, iterations,
-                    start)
+                    start, SOLVER)
 
 
 def _checked(system, interfaces, x, a, area_ref, held, ratio, status, iterations,
-             start) -> AdhesionResult:
+             start, solver) -> AdhesionResult:
     """The result of the program's optimum ``a`` (units of ``W_ref / A_ref``) and its
     physical vertex forces ``x``: the equilibrium residual and the law's violation at
     ``a`` recomputed; a point beyond :data:`~masonry.tolerances.ACCEPT_RESIDUAL` gives
@@ -234,10 +277,12 @@ def _checked(system, interfaces, x, a, area_ref, held, ratio, status, iterations
     common = dict(ratio=ratio, interface_pair=np.asarray(interfaces.pair),
                   interface_kind=np.asarray(interfaces.kind), law=system.law,
                   iterations=iterations, time_s=time.perf_counter() - start,
-                  residual_eq=residual, law_violation=violation)
+                  residual_eq=residual, law_violation=violation, solver=solver)
     if max(residual, violation) > ACCEPT_RESIDUAL:
-        log.warning("least adhesion: Clarabel's point (%s) rejected: residual %.1e, law "
-                    "violation %.1e", status, residual, violation)
+        # the interior point method's is not the last word: Clarabel follows
+        log.log(logging.INFO if solver == INTERIOR else logging.WARNING,
+                "least adhesion: the point of %s (%s) rejected: residual %.1e, law "
+                "violation %.1e", solver, status, residual, violation)
         return AdhesionResult(None, interface_kPa=np.zeros(len(interfaces)), status=status,
                               reason=f"the optimum failed its check (residual "
                                      f"{residual:.1e}, law violation {violation:.1e})",

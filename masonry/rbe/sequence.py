@@ -38,8 +38,9 @@ within the solver's accuracy (tests/test_stages.py). What :class:`StageSequence`
   local blocks alone is one of the part's program with the same total: the least, so
   the part's centering force. Otherwise the whole part's program is solved.
 - **The least adhesion** (docs/model.md 6.12) of a part: its program on the part's rows
-  and columns of the whole model's matrices (:meth:`StageSequence.adhesion`), one
-  Clarabel program per part; nothing carries over from the last part yet.
+  and columns of the whole model's matrices (:meth:`StageSequence.adhesion`), by the
+  own interior point method on the part's symbolic factorization (the one its RBE solve
+  used).
 - **Mortar.** A part's strengths (``cohesion``, ``tensile``: one number, or an array
   over the whole model's interface vertices, the joints' ages differing) are sliced
   with its columns and shift its own ``f_ext`` (:meth:`EquilibriumSystem.with_material`);
@@ -54,7 +55,7 @@ import time
 
 import numpy as np
 
-from masonry.rbe.adhesion import TENSION_RATIO, AdhesionResult, solve_adhesion
+from masonry.rbe.adhesion import INTERIOR, TENSION_RATIO, AdhesionResult, solve_adhesion
 from masonry.rbe.boundary import Model, kept_blocks
 from masonry.rbe.centering import CenteringResult, solve_centering
 from masonry.rbe.equilibrium import FRICTION_METHODS, EquilibriumSystem, VariableLayout, assemble
@@ -241,6 +242,13 @@ class StageSequence:
         y[~known] = 0.0
         return y[rows].ravel()
 
+    def _within_of(self, rows) -> np.ndarray:
+        """The free blocks of the last symbolic factorization when they hold ``rows`` (the
+        part's own solve made it), else ``rows``."""
+        if self._within is not None and not (rows & ~self._within[0]).any():
+            return self._within[0]
+        return rows
+
     def _symbolic(self, rows, within) -> Embedded:
         """The part's symbolic factorization: that of the free blocks ``within`` ((F,)
         bool, a superset of ``rows``), made in the whole model's order when they are not
@@ -284,10 +292,7 @@ class StageSequence:
         # the loads are at the limit of what the part carries (the least support), where
         # Newton creeps: a point within the acceptance tolerance is all the check needs
         preset = ACCURACY[accuracy]
-        within = rows
-        if self._within is not None and not (rows & ~self._within[0]).any():
-            within = self._within[0]  # the part's own solve's
-        workspace = {"symbolic": self._symbolic(rows, within)}
+        workspace = {"symbolic": self._symbolic(rows, self._within_of(rows))}
         if self._known["net"][rows].any():
             workspace["warm"] = {"net": self._start("net", rows)}
         outcome = BACKENDS["newton"].solve_rbe(loaded, "net", {
@@ -309,7 +314,8 @@ class StageSequence:
                                    block=source[reduced.block])
 
     def adhesion(self, is_present, *, mu=0.7, density=2000.0, cone="circle",
-                 ratio=TENSION_RATIO, head_ratio=1.0, support_ratio=1.0) -> AdhesionResult:
+                 ratio=TENSION_RATIO, head_ratio=1.0, support_ratio=1.0,
+                 solver=INTERIOR) -> AdhesionResult:
         """The least adhesion (docs/model.md 6.12) of the part whose scene blocks
         ``is_present``: :func:`masonry.rbe.adhesion.solve_adhesion` on the part's rows and
         columns of the whole model's matrices, one conic program per part (the part's
@@ -317,10 +323,13 @@ class StageSequence:
         ``interface_pair`` indexes the whole model's blocks."""
         keep = kept_blocks(self.model, is_present)
         interfaces = keep[self.model.interfaces.pair].all(axis=1)
-        system = part_system(self.whole, keep[self.whole.free_block],
-                             interfaces).with_material(mu=mu, density=density, cone=cone)
+        rows = keep[self.whole.free_block]
+        system = part_system(self.whole, rows, interfaces).with_material(
+            mu=mu, density=density, cone=cone)
         return solve_adhesion(system, self.model.interfaces.subset(interfaces), ratio=ratio,
-                              head_ratio=head_ratio, support_ratio=support_ratio)
+                              head_ratio=head_ratio, support_ratio=support_ratio,
+                              solver=solver,
+                              symbolic=self._symbolic(rows, self._within_of(rows)))
 
     def _touching(self, rows) -> np.ndarray:
         """(K,) bool: the interfaces with a side on the free blocks ``rows``."""

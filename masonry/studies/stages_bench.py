@@ -11,6 +11,7 @@ import tempfile
 import time
 
 from masonry.params import validate
+from masonry.rbe.adhesion import INTERIOR, SOLVER
 from masonry.pipeline import build_model, run
 from masonry.studies.orders import BRICK_ORDERS
 from masonry.studies.plans import make_plan
@@ -118,23 +119,29 @@ def _markdown(rows, columns, formats, note) -> str:
 
 
 ADHESION_COLUMNS = ("structure", "course", "order", "stages", "needing", "rbe_s",
-                    "adhesion_s", "ratio_median", "ratio_max", "adhesion_max_kPa")
+                    "adhesion_s", "ratio_median", "ratio_max", "by_interior", "clarabel_s",
+                    "clarabel_ratio_median", "diff_max", "adhesion_max_kPa")
 """Columns of an adhesion bench row (:data:`ADHESION_NOTE`)."""
 
 ADHESION_NOTE = """One row per structure and laying order (`masonry bench --adhesion-course
 K`): course K of the cyclic section laid brick by brick on the courses under it, every
 stage solved in one sequence (`StageSequence`) as `masonry stages` solves it: the RBE
 (its friction flow, `auto`: friction-net, then friction+ where it cannot stand) and,
-where a stage cannot stand dry, its least adhesion (one Clarabel program on the stage's
-rows and columns of the whole model's matrices). `needing`: the stages that need
-adhesion; `rbe_s`, `adhesion_s`: their seconds, summed over those stages; `ratio_median`,
-`ratio_max`: a stage's least adhesion over its RBE solve, the median and the largest over
-those stages; `adhesion_max_kPa`: the largest least adhesion."""
+where a stage cannot stand dry, its least adhesion (the interior point method on the
+stage's rows and columns of the whole model's matrices, Clarabel where it ends without a
+checked optimum). `needing`: the stages that need adhesion; `rbe_s`, `adhesion_s`: their
+seconds, summed over those stages; `ratio_median`, `ratio_max`: a stage's least adhesion
+over its RBE solve, the median and the largest over those stages; `by_interior`: the
+stages whose value the interior point method gave; `clarabel_s`,
+`clarabel_ratio_median`: the same stages' program by Clarabel alone (the reference);
+`diff_max`: the largest relative difference of the two values; `adhesion_max_kPa`: the
+largest least adhesion."""
 
 
 def adhesion_bench(structures, course, orders=tuple(BRICK_ORDERS), progress=None) -> list:
     """Time each brick stage of ``course`` of each structure: its RBE solve and, where it
-    cannot stand dry, its least adhesion, in one :class:`StageSequence` (one pass).
+    cannot stand dry, its least adhesion by the interior point method and by Clarabel, in
+    one :class:`StageSequence` (one pass).
 
     Parameters
     ----------
@@ -146,39 +153,58 @@ def adhesion_bench(structures, course, orders=tuple(BRICK_ORDERS), progress=None
     rows = []
     for name, params in structures.items():
         scene, model = build_model(params)
-        a = params.analysis
-        options = dict(mu=a.mu, density=a.density, cone=a.cone)
         for order in orders:
             plan = make_plan(scene, "brick", order, course)
-            sequence, rbe, held, ratios, largest = StageSequence(model), 0.0, 0.0, [], 0.0
-            for stage in range(1, plan.n_stages + 1):
-                start = time.perf_counter()
-                result = sequence.solve(plan.is_present(stage), plan.local(stage),
-                                        plan.is_present(plan.course_end(stage)),
-                                        friction=a.friction, accuracy=a.accuracy, **options)
-                middle = time.perf_counter()
-                if result.feasible:
-                    continue
-                found = sequence.adhesion(plan.is_present(stage),
-                                          ratio=a.adhesion_tension_ratio, **options)
-                end = time.perf_counter()
-                rbe, held = rbe + middle - start, held + end - middle
-                ratios.append((end - middle) / (middle - start))
-                largest = max(largest, found.a_kPa or 0.0)
-            rows.append(dict(structure=name, course=course, order=order,
-                             stages=plan.n_stages, needing=len(ratios), rbe_s=rbe,
-                             adhesion_s=held, adhesion_max_kPa=largest,
-                             ratio_median=statistics.median(ratios) if ratios else None,
-                             ratio_max=max(ratios, default=None)))
+            stages = _adhesion_stages(StageSequence(model), plan, params.analysis)
+            ratios = [ours / rbe for rbe, ours, *_ in stages]
+            rows.append(dict(
+                structure=name, course=course, order=order, stages=plan.n_stages,
+                needing=len(stages), rbe_s=sum(t[0] for t in stages),
+                adhesion_s=sum(t[1] for t in stages),
+                ratio_median=statistics.median(ratios) if ratios else None,
+                ratio_max=max(ratios, default=None),
+                by_interior=sum(t[5] == "interior" for t in stages),
+                clarabel_s=sum(t[2] for t in stages),
+                clarabel_ratio_median=statistics.median(t[2] / t[0] for t in stages)
+                if stages else None,
+                diff_max=max((abs(t[3] / t[4] - 1) for t in stages if t[3] and t[4]),
+                             default=None),
+                adhesion_max_kPa=max((t[3] or 0.0 for t in stages), default=0.0)))
             if progress:
-                progress(f"{name}, course {course}, {order}: {len(ratios)} of "
-                         f"{plan.n_stages} stages need adhesion, {held:.3g} s against "
-                         f"their RBE's {rbe:.3g} s")
+                row = rows[-1]
+                progress(f"{name}, course {course}, {order}: {row['needing']} of "
+                         f"{plan.n_stages} stages need adhesion, {row['adhesion_s']:.3g} s "
+                         f"against their RBE's {row['rbe_s']:.3g} s")
     return rows
+
+
+def _adhesion_stages(sequence, plan, analysis) -> list:
+    """Per stage that cannot stand dry, in order: ``(RBE s, least adhesion s, Clarabel s,
+    a* kPa, Clarabel's a* kPa, solver)``."""
+    options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone)
+    out = []
+    for stage in range(1, plan.n_stages + 1):
+        start = time.perf_counter()
+        result = sequence.solve(plan.is_present(stage), plan.local(stage),
+                                plan.is_present(plan.course_end(stage)),
+                                friction=analysis.friction, accuracy=analysis.accuracy,
+                                **options)
+        solved = time.perf_counter()
+        if result.feasible:
+            continue
+        found, ends = [], []
+        for solver in (INTERIOR, SOLVER):
+            found.append(sequence.adhesion(plan.is_present(stage), solver=solver,
+                                           ratio=analysis.adhesion_tension_ratio, **options))
+            ends.append(time.perf_counter())
+        out.append((solved - start, ends[0] - solved, ends[1] - ends[0], found[0].a_kPa,
+                    found[1].a_kPa, found[0].solver))
+    return out
 
 
 def adhesion_markdown(rows) -> str:
     """The rows as a markdown table, then :data:`ADHESION_NOTE`."""
     return _markdown(rows, ADHESION_COLUMNS, {
         "rbe_s": "{:.2f}", "adhesion_s": "{:.2f}", "ratio_median": "{:.2f}",
-        "ratio_max": "{:.2f}", "adhesion_max_kPa": "{:.4g}"}, ADHESION_NOTE)
+        "ratio_max": "{:.2f}", "clarabel_s": "{:.2f}", "clarabel_ratio_median": "{:.2f}",
+        "diff_max": "{:.1e}", "adhesion_max_kPa": "{:.4g}"}, ADHESION_NOTE)

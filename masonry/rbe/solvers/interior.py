@@ -113,7 +113,7 @@ def vertex_cones(components, friction_cone, mu) -> list:
     return out
 
 
-def _scaling(cone, s, z):
+def scaling_of(cone, s, z):
     """The cone's scaling of ``(s, z)`` and its ``W^-1`` per vertex ((V, m) for the
     orthant's diagonal, (V, m, m) for the second-order cone), the orthant's weights
     ``z / s`` bounded by :data:`WEIGHT_BOUNDS` (at the end, a pair 1e30 apart makes the
@@ -160,7 +160,7 @@ class _Iterate:
 
     def __init__(self, ns: NewtonSystem, cones, s, z, shift):
         self.ns, self.cones = ns, cones
-        self.scalings, w_inverse = zip(*(_scaling(vc.cone, sb, zb)
+        self.scalings, w_inverse = zip(*(scaling_of(vc.cone, sb, zb)
                                          for vc, sb, zb in zip(cones, s, z)))
         self.weights = [w * w if w.ndim == 2 else w @ w for w in w_inverse]
         self.D = vertex_inverse(ns.h, cones, w_inverse)
@@ -213,10 +213,11 @@ def start_scale(mu) -> float:
     return float(np.clip((START_MU / mu) ** 2, *START_SCALE))
 
 
-def _step(cones, s, z, ds, dz) -> float:
-    """The largest step ``<= 1`` that keeps every slack and multiplier in its cone."""
-    return min(min(vc.cone.max_step(sb, dsb), vc.cone.max_step(zb, dzb))
-               for vc, sb, zb, dsb, dzb in zip(cones, s, z, ds, dz))
+def largest_step(cones, s, z, ds, dz) -> float:
+    """The largest step ``<= 1`` that keeps every slack and multiplier in its cone (one
+    of ``cones`` each)."""
+    return min(min(cone.max_step(sb, dsb), cone.max_step(zb, dzb))
+               for cone, sb, zb, dsb, dzb in zip(cones, s, z, ds, dz))
 
 
 def _dot(a, b) -> float:
@@ -280,7 +281,7 @@ def solve(ns: NewtonSystem, options: InteriorOptions) -> Outcome:
         lam_square = [vc.cone.product(sc.lam, sc.lam)
                       for vc, sc in zip(cones, point.scalings)]
         dx, dy, ds, dz = point.direction(r_dual, r_primal, r_cone, lam_square)
-        step = _step(cones, s, z, ds, dz)
+        step = largest_step([vc.cone for vc in cones], s, z, ds, dz)
         predicted = _dot([sb + step * d for sb, d in zip(s, ds)],
                          [zb + step * d for zb, d in zip(z, dz)]) / degree
         sigma = (predicted / gap) ** 3
@@ -289,7 +290,7 @@ def solve(ns: NewtonSystem, options: InteriorOptions) -> Outcome:
                   for vc, sc, square, dsb, dzb in zip(cones, point.scalings, lam_square,
                                                       ds, dz)]
         dx, dy, ds, dz = point.direction(r_dual, r_primal, r_cone, r_comp)
-        step = options.step_fraction * _step(cones, s, z, ds, dz)
+        step = options.step_fraction * largest_step([vc.cone for vc in cones], s, z, ds, dz)
         if step < options.min_step:
             log.info("interior point stalled at iteration %d (step %.1e)", iterations, step)
             break

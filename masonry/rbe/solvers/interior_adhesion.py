@@ -1,0 +1,479 @@
+"""Primal-dual interior point method for the least adhesion, on the Newton method's matrix.
+
+The program of :mod:`masonry.rbe.adhesion` in the shifted vertex forces ``x~_v = (n~,
+f1, f2)``, ``n~ = n + a A_v / mu`` (scaled rows and columns of
+:mod:`masonry.rbe.equilibrium`; ``A_v`` the vertex's strength per unit ``a``), so that the
+cohesion moves the cone's apex and the friction model is the dry one::
+
+    minimize a   subject to   A x~ + a l = b              6 rows per free block
+                              G_1 x~_v + s_1v = 0          s_1v in the friction model
+                              G_2 x~_v + q_v a + s_2v = 0  s_2v >= 0 (the cut-off)
+
+``l = -A c`` the equilibrium rows' share of the shift (``c_v = (A_v / mu, 0, 0)``); the
+friction model's rows ``G_1`` (:func:`~.interior.vertex_cones`: a pyramid's faces, or
+Coulomb's cone on ``(mu n~, f1, f2)``); where the tension cut-off lies inside the cone
+(``r < 1 / mu``) its row ``n~ - a A_v (1 / mu - r) >= 0``. Every vertex's unknowns meet
+only their own cones and the equilibrium rows; ``a`` meets the equilibrium rows and the
+cut-off rows.
+
+Eliminating the slacks, their multipliers and ``x~`` from the Newton system of the
+perturbed optimality conditions (Nesterov-Todd scalings ``W_b``, :mod:`.cones`) leaves ::
+
+    A D A^T dy - w da = r_y,   w^T dy + sigma da = r_a,
+    D_v = (sum_b G_b^T W_bv^-2 G_b)^-1,   w = A D v - l
+
+``A D A^T`` is the Newton method's matrix (one 3 x 3 block ``D_v`` per vertex, six rows
+per free block, the same :class:`~.cholesky.BlockCholesky` symbolic analysis, which a
+stage sequence already holds); ``a``'s row borders it (a second solve with ``w`` on the
+same factor), ``v_v = G_2^T W_2v^-2 q_v`` and ``sigma`` its Schur complement, both in
+closed form (:func:`_reduced`). Mehrotra's predictor-corrector, as :mod:`.interior` (the
+form of CVXOPT's ``coneqp``), with iterative refinement of the directions near the
+optimum (:data:`REFINEMENTS`), from a start that meets the equilibrium and cone rows
+(:func:`_cold`).
+
+Why it exists: Clarabel factors the whole KKT system (a row per vertex force and cone
+row) at every one of its iterations; this factors the six rows per free block that the
+stage's RBE solve factored (docs/bench.md, "The least adhesion of every brick stage").
+
+It assumes a bounded optimum (a structure whose blocks all touch a joint has one,
+:mod:`masonry.rbe.adhesion`) and has no infeasibility detection: a program it does not
+solve (an infeasible one: no adhesion holds a block that needs tension with ``r = 0``)
+ends with status ``user_limit`` and the caller asks Clarabel. Near the optimum the
+scalings span 20 decades and the reduced matrix loses its small directions: the last
+point within :attr:`AdhesionOptions.reduced` is then the answer (``optimal_inaccurate``,
+checked as every other by the caller).
+"""
+
+import logging
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from masonry.rbe.solvers.base import OPTIMAL, OPTIMAL_INACCURATE, SOLVER_ERROR, USER_LIMIT
+from masonry.rbe.solvers.cones import Orthant
+from masonry.rbe.solvers.interior import (
+    VertexCone,
+    largest_step,
+    scaling_of,
+    vertex_cones,
+    vertex_inverse,
+)
+from masonry.rbe.solvers.newton import NewtonSystem
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class AdhesionOptions:
+    """Settings of :func:`solve`.
+
+    Parameters
+    ----------
+    tol, dual_tol, gap_tol : float
+        Stop (status ``optimal``) when the equilibrium and cone rows' residuals relative
+        to the largest load are at most ``tol``, the dual rows' at most ``dual_tol``
+        (``x~``'s relative to the largest multiplier, ``a``'s to its objective
+        coefficient 1) and the gap ``s^T z`` (an upper bound of ``a - a*`` while the
+        dual rows hold) at most ``gap_tol`` times ``a`` (``gap_floor`` at least).
+    reduced : tuple of float
+        ``(tol, dual_tol, gap_tol)`` of a point accepted as ``optimal_inaccurate`` where
+        the method cannot go on (a stalled step, a reduced matrix that factors only with
+        a raised shift): near the optimum the scalings span 20 decades and the reduced
+        matrix loses its small directions (the point is then checked as every other).
+    gap_floor : float
+        The least ``a`` the gap is relative to (units of ``W_ref / A_ref``).
+    max_iter : int
+    step_fraction : float
+        Fraction of the largest step to the boundary of the cones that is taken.
+    regularization : float
+        Shift of the reduced matrix relative to its mean diagonal.
+    min_step : float
+        Stop when a step falls below this.
+    """
+
+    tol: float = 1e-8
+    dual_tol: float = 1e-6
+    gap_tol: float = 1e-7
+    reduced: tuple = (1e-7, 1e-4, 1e-2)
+    gap_floor: float = 1e-6
+    max_iter: int = 60
+    step_fraction: float = 0.99
+    regularization: float = 1e-12
+    min_step: float = 1e-6
+
+
+@dataclass
+class Point:
+    """An iterate: ``x`` (V, 3), ``a``, ``y`` (6 F,), per cone ``s`` and ``z`` (lists of
+    (V, m) arrays: the vertex cones', then ``a >= 0``'s as (1, 1))."""
+
+    x: np.ndarray
+    a: float
+    y: np.ndarray
+    s: list
+    z: list
+
+
+@dataclass(frozen=True)
+class Solution:
+    """The end of :func:`solve`: ``status`` (``optimal``, ``user_limit``,
+    ``solver_error``), the last :class:`Point` (None without one), its physical vertex
+    forces ``x`` ((V, 3) ``(n, f1, f2)``) and the iterations."""
+
+    status: str
+    point: Point | None
+    x: np.ndarray | None
+    iterations: int
+    time_s: float
+
+
+CUTOFF = VertexCone(Orthant(1), np.array([[-1.0, 0.0, 0.0]]))
+"""The tension cut-off's row: ``-n~ + a A_v (1 / mu - r) + s = 0``, ``s >= 0``."""
+
+
+class _Program:
+    """The program (module docstring) on ``ns``: ``held`` ((V,) float) the strength of
+    every vertex per unit ``a``, ``ratio`` the tension cut-off's ``r``."""
+
+    def __init__(self, ns: NewtonSystem, held, ratio):
+        self.ns = ns
+        self.friction = vertex_cones(ns.components, ns.cone, ns.mu)[0]
+        self.shift = held / ns.mu                      # n = n~ - a A_v / mu
+        shift = np.zeros((len(held), 3))
+        shift[:, 0] = self.shift
+        self.load = -(ns.A @ shift.ravel())           # A x = A x~ + a load
+        apex = 1.0 / ns.mu - ratio
+        self.cutoff = apex * held if apex > 0 else None   # n~ >= a A_v (1 / mu - r)
+        self.n = len(held)
+        self.cones = [self.friction.cone] + ([CUTOFF.cone] if apex > 0 else [])
+        self.degree = self.n * sum(cone.degree for cone in self.cones)
+
+    def residuals(self, p: Point):
+        """``(r_x, r_a, r_primal, r_cones)``: the dual rows of ``x~`` and ``a``, the
+        equilibrium rows and the cone rows (friction, cut-off, ``a >= 0``)."""
+        ns = self.ns
+        r_x = -(ns.AT @ p.y).reshape(p.x.shape) + p.z[0] @ self.friction.G
+        r_a = 1.0 - float(self.load @ p.y)
+        r_cones = [sb - exact for sb, exact in zip(p.s, self.slacks(p.x, p.a))]
+        if self.cutoff is not None:
+            r_x = r_x + p.z[1] @ CUTOFF.G
+            r_a += float(self.cutoff @ p.z[1][:, 0])
+        r_primal = ns.A @ p.x.ravel() + self.load * p.a - ns.b
+        return r_x, r_a, r_primal, r_cones
+
+    def slacks(self, x, a) -> list:
+        """The cone rows' slacks of ``(x~, a)``: ``-(G_b x~ + q_b a)``."""
+        out = [-(x @ self.friction.G.T)]
+        if self.cutoff is not None:
+            out.append(-(x @ CUTOFF.G.T) - self.cutoff[:, None] * a)
+        return out
+
+    def physical(self, p: Point) -> np.ndarray:
+        """(V, 3) the vertex forces ``(n, f1, f2)`` of ``p``'s ``x~``."""
+        x = p.x.copy()
+        x[:, 0] -= p.a * self.shift
+        return x
+
+
+class _Iterate:
+    """The reduced system at one point (module docstring): factored once, solved for the
+    predictor and the corrector."""
+
+    def __init__(self, program: _Program, s, z, shift):
+        self.program = program
+        ns = program.ns
+        self.scalings, w_inverse = zip(*(scaling_of(cone, sb, zb) for cone, sb, zb in
+                                         zip(program.cones, s, z)))
+        self.w2_inverse = [w * w if w.ndim == 2 else w @ w for w in w_inverse]
+        self.D, self.Dv, self.sigma = _reduced(program, self.scalings, w_inverse,
+                                               self.w2_inverse)
+        self.factor = _factor(ns, self.D, shift)
+        self.w = ns.A @ self.Dv.ravel() - program.load
+        self.t = None
+
+    def _bordered(self, rhs_y, rhs_a):
+        """``(dy, da)`` with ``N dy - w da = rhs_y`` and ``w^T dy + sigma da = rhs_a``
+        (``N`` the factored ``A D A^T``): ``dy = N^-1 rhs_y + da N^-1 w``."""
+        if self.t is None:  # w's solve once per factor, with the first right-hand side
+            both = self.factor.solve(np.column_stack([rhs_y, self.w]))
+            u, self.t = both[:, 0], both[:, 1]
+        else:
+            u = self.factor.solve(rhs_y)
+        da = (rhs_a - float(self.w @ u)) / (self.sigma + float(self.w @ self.t))
+        return u + da * self.t, da
+
+    def _w2i(self, b, v):
+        """``W_b^-2 v`` per vertex."""
+        w = self.w2_inverse[b]
+        return w * v if w.ndim == 2 else np.einsum("vij,vj->vi", w, v)
+
+    def direction(self, r_x, r_a, r_primal, r_cones, r_comp, refinements=0):
+        """``(dx, da, dy, ds, dz)`` for the residuals of :meth:`_Program.residuals` and
+        the scaled complementarity ``lam o (W^-1 ds + W dz) = -r_comp`` (per cone), with
+        ``refinements`` passes of iterative refinement on the unreduced rows."""
+        cones = self.program.cones
+        q_c = [-cone.divide(sc.lam, rc) for cone, sc, rc in zip(cones, self.scalings, r_comp)]
+        target = (r_x, r_a, r_primal, r_cones, q_c)
+        d = self._solve(*target)
+        for _ in range(refinements):
+            left = self._left(d, target)
+            d = tuple(_add(u, v) for u, v in zip(d, self._solve(*left)))
+        return d
+
+    def _left(self, d, target) -> tuple:
+        """What ``d`` leaves of the rows it solves: the right-hand side of its
+        correction."""
+        program, ns = self.program, self.program.ns
+        dx, da, dy, ds, dz = d
+        r_x, r_a, r_primal, r_cones, q_c = target
+        G = [program.friction.G] + ([CUTOFF.G] if program.cutoff is not None else [])
+        e_x = -(ns.AT @ dy).reshape(dx.shape) + sum(zb @ g for zb, g in zip(dz, G)) + r_x
+        e_a = -float(program.load @ dy) + r_a
+        if program.cutoff is not None:
+            e_a += float(program.cutoff @ dz[1][:, 0])
+        e_primal = ns.A @ dx.ravel() + program.load * da + r_primal
+        shifts = [0.0] + ([program.cutoff[:, None]] if program.cutoff is not None else [])
+        e_cones = [dx @ g.T + qb * da + dsb + rc
+                   for g, qb, dsb, rc in zip(G, shifts, ds, r_cones)]
+        e_comp = [sc.times_w_inverse(dsb) + sc.times_w(dzb) - q
+                  for sc, dsb, dzb, q in zip(self.scalings, ds, dz, q_c)]
+        return e_x, e_a, e_primal, e_cones, [-e for e in e_comp]
+
+    def _solve(self, r_x, r_a, r_primal, r_cones, q_c):
+        """The direction for the rows' residuals and ``W^-1 ds + W dz = q_c``."""
+        program, ns = self.program, self.program.ns
+        cones, cut = program.cones, program.cutoff
+        wq = [sc.times_w_inverse(q) for sc, q in zip(self.scalings, q_c)]
+        pulled = [wq[b] + self._w2i(b, r_cones[b]) for b in range(len(cones))]
+        qx = -r_x - pulled[0] @ program.friction.G
+        qa = -r_a
+        if cut is not None:
+            qx = qx - pulled[1] @ CUTOFF.G
+            qa -= float(cut @ pulled[1][:, 0])
+        rhs_y = -r_primal - ns.A @ np.einsum("vij,vj->vi", self.D, qx).ravel()
+        rhs_a = qa - float(np.sum(self.Dv * qx))
+        dy, da = self._bordered(rhs_y, rhs_a)
+        dx = np.einsum("vij,vj->vi", self.D,
+                       qx - da * self._v() + (ns.AT @ dy).reshape(qx.shape))
+        dz = [wq[0] + self._w2i(0, r_cones[0] + dx @ program.friction.G.T)]
+        if cut is not None:
+            dz.append(wq[1] + self._w2i(1, r_cones[1] + dx @ CUTOFF.G.T
+                                        + cut[:, None] * da))
+        # ds from the cone rows, which keeps them exact (W^2 dz loses their digits)
+        ds = [-r_cones[0] - dx @ program.friction.G.T]
+        if cut is not None:
+            ds.append(-r_cones[1] - dx @ CUTOFF.G.T - cut[:, None] * da)
+        return dx, da, dy, ds, dz
+
+    def _v(self):
+        """``v`` (V, 3): the cut-off's ``G^T W^-2 q`` (zero without one)."""
+        if self.program.cutoff is None:
+            return np.zeros((self.program.n, 3))
+        return (self.w2_inverse[1] * self.program.cutoff[:, None]) @ CUTOFF.G
+
+
+REFINEMENTS = 2
+REFINE_GAP = 1.0
+"""Passes of iterative refinement of a direction (CVXOPT's) once the gap is below this
+times ``a``: near the optimum ``W^-2`` amplifies the rounding of ``dx`` in ``dz`` by up to
+1e20, and the dual rows are lost without them (before, a direction's error is corrected
+by the next one)."""
+
+
+def _add(u, v):
+    if isinstance(u, list):
+        return [a + b for a, b in zip(u, v)]
+    return u + v
+
+
+REGULARIZATION_RAISE = 1e3
+REGULARIZATION_RAISES = 2
+"""A reduced matrix that does not factor is shifted up to this many times more, by this
+factor each time (the refinement's products are the unshifted matrix's)."""
+
+
+def _factor(ns, D, shift):
+    """The factor of ``A D A^T + shift I``, the shift raised while it fails
+    (``LinAlgError`` when it still does)."""
+    blocks = ns.newton_blocks(D, 0.0, incremental=False)
+    diagonal = blocks[ns.diagonal_blocks].copy()
+    for attempt in range(REGULARIZATION_RAISES + 1):
+        blocks[ns.diagonal_blocks] = diagonal + shift * REGULARIZATION_RAISE**attempt \
+            * np.eye(6)
+        try:
+            return ns.symbolic.factor(blocks)
+        except np.linalg.LinAlgError:
+            if attempt == REGULARIZATION_RAISES:
+                raise
+            log.debug("least adhesion: reduced matrix shifted by %.1e",
+                      shift * REGULARIZATION_RAISE**(attempt + 1))
+
+
+def _reduced(program, scalings, w_inverse, w2_inverse) -> tuple:
+    """``(D, D v, sigma)``: per vertex ``D = (G_1^T W_1^-2 G_1 + d g g^T)^-1`` (the
+    friction rows and the cut-off's ``g`` of weight ``d``), ``D v`` and ``a``'s Schur
+    complement ``sigma = v^T ... = alpha - v^T D v``, from ``D_1`` (the friction rows'
+    alone) and ``gamma = g^T D_1 g``: ``D = D_1 - d D_1 g g^T D_1 / (1 + d gamma)``,
+    ``D g = D_1 g / (1 + d gamma)``, ``sigma = sum_v q_v^2 d / (1 + d gamma)`` (the
+    difference of two large sums would cancel). Coulomb's cone has ``D_1 = G_1^-1 W_1^2
+    G_1^-T`` (``G_1 = diag(-mu, -1, -1)``); where ``d gamma`` exceeds :data:`STIFF` (an
+    active cut-off: the update would cancel) and for a pyramid's faces, ``D`` and ``D_1``
+    by QR (:func:`~.interior.vertex_inverse`)."""
+    friction = program.friction
+    cut = program.cutoff is not None
+    if friction.G.shape[0] == 3:       # Coulomb's cone: G_1 invertible
+        g_inverse = np.linalg.inv(friction.G)
+        D1 = g_inverse @ scalings[0].D @ g_inverse.T
+    else:
+        D1 = vertex_inverse(np.zeros((program.n, 3)), [friction], w_inverse[:1])
+    if not cut:
+        return D1, np.zeros((program.n, 3)), 0.0
+    d, q = w2_inverse[1][:, 0], program.cutoff
+    gamma = D1[:, 0, 0]                                   # g = (-1, 0, 0)
+    share = d / (1.0 + d * gamma)
+    column = D1[:, :, 0]                                  # -D_1 g
+    D = D1 - share[:, None, None] * column[:, :, None] * column[:, None, :]
+    stiff = np.flatnonzero((d * gamma > STIFF) | (friction.G.shape[0] != 3))
+    if len(stiff):
+        D[stiff] = vertex_inverse(np.zeros((len(stiff), 3)), [friction, CUTOFF],
+                                  [w[stiff] for w in w_inverse[:2]])
+    return D, -(q * share)[:, None] * column, float(np.sum(q * q * share))
+
+
+STIFF = 1e4
+"""``d gamma`` above which a vertex's ``D`` is found by QR rather than the rank-one
+update (which loses about ``log10(d gamma)`` of its digits along the cut-off's row)."""
+
+
+def _cold(program: _Program, shift) -> Point:
+    """A start that meets the equilibrium and cone rows: the least-squares vertex forces
+    of the unit scaling (``A x = b``), with the least ``a`` that puts every vertex's
+    slacks :data:`START_MARGIN` inside its cones (a vertex no ``a`` helps is shifted
+    inside); the least-squares multipliers of ``a``'s objective, scaled to the slacks,
+    shifted inside and balanced with them (:func:`centred_start`'s rule)."""
+    cones = program.cones
+    units = [cone.identity(program.n) for cone in cones]
+    first = _Iterate(program, units, units, shift)
+    zero = [np.zeros_like(u) for u in units]
+    x, a, _, _, _ = first.direction(np.zeros((program.n, 3)), 0.0, -program.ns.b, zero, zero)
+    _, _, y, _, z = first.direction(np.zeros((program.n, 3)), 1.0,
+                                    np.zeros_like(program.ns.b), zero, zero)
+    force = program.physical(Point(x, a, y, [], []))
+    margin = START_MARGIN * float(np.sqrt(np.mean(np.sum(force * force, axis=1))))
+    a = _least_inside(program, force, margin)
+    p = Point(force, a, y, [], [])
+    p.x[:, 0] += a * program.shift                      # x~ of the physical forces
+    s = program.slacks(p.x, a)
+    s = [sb + np.maximum(0.0, margin - cone.min_eigenvalue(sb))[:, None]
+         * cone.identity(len(sb)) for cone, sb in zip(cones, s)]
+    least = min(float(cone.min_eigenvalue(zb).min()) for cone, zb in zip(cones, z))
+    z = [zb + max(0.0, -1.5 * least) * cone.identity(len(zb)) for cone, zb in zip(cones, z)]
+    product = sum(float(np.sum(sb * zb)) for sb, zb in zip(s, z))
+    trace = sum(cone.trace(sb) for cone, sb in zip(cones, s))
+    z = [zb + (0.5 * product / trace) * cone.identity(len(zb)) for cone, zb in zip(cones, z)]
+    return Point(p.x, a, y, s, z)
+
+
+START_MARGIN = 0.1
+"""The starting slacks' least eigenvalue, relative to the root mean square vertex
+force."""
+
+
+def _least_inside(program, force, margin) -> float:
+    """The least ``a >= 0`` with which every vertex's slacks of ``force`` lie ``margin``
+    inside its cones, over the vertices some ``a`` helps."""
+    friction = program.friction
+    held = program.shift * program.ns.mu
+    slack = -(force @ friction.G.T)                      # at a = 0
+    rate = -friction.G[:, 0][None, :] * program.shift[:, None]   # d slack / d a
+    helped = held > 0
+    if isinstance(friction.cone, Orthant):
+        need = np.max((margin - slack) / np.where(rate > 0, rate, np.inf), axis=1)
+    else:  # the second-order cone's least eigenvalue grows by rate[:, 0]
+        need = (margin - friction.cone.min_eigenvalue(slack)) / np.where(helped, held, np.inf)
+    if program.cutoff is not None:
+        ratio = 1.0 / program.ns.mu - program.cutoff / np.where(helped, held, np.inf)
+        tension = (margin - force[:, 0]) / np.where(helped & (ratio > 0), ratio * held, np.inf)
+        need = np.maximum(need, tension)
+    need = need[np.isfinite(need)]
+    return max(0.0, float(need.max(initial=0.0)))
+
+
+def solve(ns: NewtonSystem, held, ratio,
+          options: AdhesionOptions = AdhesionOptions()) -> Solution:
+    """The least adhesion's program (module docstring) on the friction-net system ``ns``
+    (its friction model, ``mu`` and ``b``): ``held`` ((V,) float) every vertex's strength
+    per unit ``a``, ``ratio`` ``t_c / c``."""
+    begin = time.perf_counter()
+    program = _Program(ns, np.asarray(held, dtype=float), ratio)
+    shift = options.regularization * ns.diagonal_scale
+    try:
+        p = _cold(program, shift)
+    except np.linalg.LinAlgError as error:
+        log.warning("least adhesion: reduced matrix not positive definite: %s", error)
+        return Solution(SOLVER_ERROR, None, None, 0, time.perf_counter() - begin)
+    status, iterations, best = USER_LIMIT, 0, None
+    for iterations in range(options.max_iter + 1):
+        residuals = program.residuals(p)
+        measures = _measures(program, p, residuals)
+        if _within(measures, (options.tol, options.dual_tol, options.gap_tol), p.a, options):
+            status = OPTIMAL
+            break
+        if _within(measures, options.reduced, p.a, options):
+            best = p
+        if iterations == options.max_iter:
+            break
+        try:
+            step, direction = _step(program, p, residuals, measures[2], shift, options)
+        except np.linalg.LinAlgError as error:
+            log.debug("least adhesion: reduced matrix not positive definite: %s", error)
+            step = 0.0
+        if step < options.min_step:
+            log.debug("least adhesion: stopped at iteration %d (step %.1e; primal %.1e, "
+                      "dual %.1e, gap %.1e)", iterations, step, *measures)
+            if best is not None:  # the last point within the reduced tolerances
+                status, p = OPTIMAL_INACCURATE, best
+            break
+        p = Point(*(old + step * d for old, d in zip((p.x, p.a, p.y), direction[:3])),
+                  [sb + step * d for sb, d in zip(p.s, direction[3])],
+                  [zb + step * d for zb, d in zip(p.z, direction[4])])
+        log.debug("least adhesion %d: a %.6e, primal %.1e, dual %.1e, gap %.1e, step %.3f",
+                  iterations, p.a, *measures, step)
+    return Solution(status, p, program.physical(p), iterations, time.perf_counter() - begin)
+
+
+def _measures(program, p: Point, residuals) -> tuple:
+    """``(primal, dual, gap)`` of ``p`` (:class:`AdhesionOptions`)."""
+    r_x, r_a, r_primal, r_cones = residuals
+    b_inf = float(np.abs(program.ns.b).max())
+    primal = max(float(np.abs(r_primal).max()),
+                 max(float(np.abs(rc).max()) for rc in r_cones)) / b_inf
+    dual = max(float(np.abs(r_x).max()) / max(1.0, float(np.abs(p.y).max())), abs(r_a))
+    return primal, dual, float(sum(np.sum(sb * zb) for sb, zb in zip(p.s, p.z)))
+
+
+def _within(measures, tolerances, a, options) -> bool:
+    primal, dual, gap = measures
+    tol, dual_tol, gap_tol = tolerances
+    return primal <= tol and dual <= dual_tol \
+        and gap <= gap_tol * max(abs(a), options.gap_floor)
+
+
+def _step(program, p: Point, residuals, gap, shift, options) -> tuple:
+    """``(step, direction)``: Mehrotra's predictor, then the corrector on the same
+    factor (``LinAlgError`` where the reduced matrix does not factor)."""
+    cones = program.cones
+    point = _Iterate(program, p.s, p.z, shift)
+    squares = [cone.product(sc.lam, sc.lam) for cone, sc in zip(cones, point.scalings)]
+    refinements = REFINEMENTS if gap <= REFINE_GAP * max(abs(p.a), options.gap_floor) else 0
+    _, _, _, ds, dz = point.direction(*residuals, squares, refinements)
+    step = largest_step(cones, p.s, p.z, ds, dz)
+    predicted = float(sum(np.sum((sb + step * dsb) * (zb + step * dzb))
+                          for sb, zb, dsb, dzb in zip(p.s, p.z, ds, dz)))
+    target = (predicted / gap) ** 3 * gap / program.degree
+    r_comp = [square + cone.product(sc.times_w_inverse(dsb), sc.times_w(dzb))
+              - target * cone.identity(len(square))
+              for cone, sc, square, dsb, dzb in zip(cones, point.scalings, squares, ds, dz)]
+    direction = point.direction(*residuals, r_comp, refinements)
+    return options.step_fraction * largest_step(cones, p.s, p.z, *direction[3:]), direction
