@@ -24,14 +24,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+SECTOR = "--scene sector --boundary cyclic --radius 53.1127 --p 10 --cut 0.1"
 PROFILES = {
     "preset1": ("--preset 1", (36, 62)),
     "hemisphere": ("--scene section --n 8 --r 1 --p 10 --cut 0.1 --stretch 0.92388",
                    (33, 57)),
-    "preset1-revolution": ("--scene sector --boundary cyclic --radius 53.1127 "
-                           "--stretch 1.082392 --p 10 --cut 0.1", (36, 62)),
-    "hemisphere-revolution": ("--scene sector --boundary cyclic --radius 53.1127 "
-                              "--stretch 1 --p 10 --cut 0.1", (33, 57)),
+    "preset1-revolution": (f"{SECTOR} --stretch 1.082392", (36, 62)),
+    "hemisphere-revolution": (f"{SECTOR} --stretch 1", (33, 57)),
 }
 """The four profiles of docs/revolution.md (their ``masonry stages`` arguments) and the
 courses whose beds are steeper than about 35 degrees (atan 0.7), where a brick alone
