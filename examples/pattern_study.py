@@ -117,7 +117,7 @@ def run(args) -> int:
             continue
         # masonry's own interpreter runs it, as the command line would
         done = subprocess.run([sys.executable, "-m", "masonry_cli.main", *argv[1:]],
-                              capture_output=True, text=True)
+                              capture_output=True, text=True, check=False)
         written = [line.split("written: ", 1)[1] for line in done.stdout.splitlines()
                    if line.startswith("written: ")]
         if done.returncode != 0 or not written:
