@@ -159,22 +159,22 @@ def write(rows, out: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    profiles = sorted({r["profile"] for r in rows})
+    named = {r["profile"] for r in rows}
+    profiles = [name for name in PROFILES if name in named] + sorted(named - set(PROFILES))
     figure, axes = plt.subplots(1, len(profiles), figsize=(4.2 * len(profiles), 3.6),
                                 sharey=True, squeeze=False)
-    styles = {("herringbone", "pattern-first"): ("tab:red", "-", "herringbone, pattern-first"),
-              ("herringbone", "along"): ("tab:red", ":", "herringbone, along the course"),
-              ("none", "pattern-first"): ("0.35", "-", "plain (running bond)"),
-              ("none", "along"): ("0.35", "-", "plain (running bond)")}
+    styles = {("herringbone", "pattern-first"): ("tab:red", "-o", "herringbone, pattern-first"),
+              ("herringbone", "along"): ("tab:red", ":x", "herringbone, along the course"),
+              ("none", "pattern-first"): ("0.35", "-s", "plain (running bond)"),
+              ("none", "along"): ("0.35", "-s", "plain (running bond)")}
     for axis, profile in zip(axes[0], profiles):
         for mu in sorted({r["mu"] for r in rows if r["profile"] == profile}):
             for (pattern, order), (colour, line, label) in styles.items():
                 picked = [r for r in rows if (r["profile"], r["mu"], r["pattern"],
                                               r["order"]) == (profile, mu, pattern, order)]
                 if picked:
-                    axis.plot([r["course"] for r in picked],
-                              [r["adhesion_max_kPa"] for r in picked], line, color=colour,
-                              marker=".", label=f"{label}, mu {mu:g}")
+                    axis.plot(*_gapped(picked), line, color=colour, markersize=3,
+                              label=f"{label}, mu {mu:g}")
         axis.set_title(profile)
         axis.set_xlabel("course laid brick by brick")
         axis.grid(alpha=0.3)
@@ -183,6 +183,20 @@ def write(rows, out: Path) -> None:
     figure.tight_layout()
     figure.savefig(out / "pattern_study.png", dpi=150)
     plt.close(figure)
+
+
+def _gapped(rows) -> tuple:
+    """Courses and values, with a break (NaN) where courses were skipped: a line joins
+    consecutive courses only."""
+    courses, values = [], []
+    for row in rows:
+        if courses and row["course"] > courses[-1] + 1:
+            courses.append(courses[-1] + 0.5)
+            values.append(float("nan"))
+        courses.append(row["course"])
+        values.append(float("nan") if row["adhesion_max_kPa"] is None
+                      else row["adhesion_max_kPa"])
+    return courses, values
 
 
 def main(argv=None) -> int:
