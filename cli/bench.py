@@ -21,7 +21,7 @@ HELP = ("measure time, iterations and accuracy of every solver preset on the the
 
 def register(subparsers):
     # the studies load the whole pipeline: imported when this command runs (masonry_cli.app)
-    from masonry.studies.bench import FRICTION_MODELS, SCENES
+    from masonry_benchmarks.bench import FRICTION_MODELS, SCENES
 
     parser = subparsers.add_parser(NAME, help=HELP)
     parser.add_argument("--presets", nargs="+", default=["1", "2", "3"],
@@ -113,7 +113,7 @@ def handle(args, report):
         return _stages(args, report)
     if args.adhesion_course is not None:
         return _adhesion(args, report)
-    from masonry.studies.bench import (bench, frontier_png, ratios_markdown, table_csv,
+    from masonry_benchmarks.bench import (bench, frontier_png, ratios_markdown, table_csv,
                                        table_markdown)
 
     rows = bench(presets=args.presets, scenes=args.scenes, accuracies=args.accuracy,
@@ -138,7 +138,7 @@ def handle(args, report):
 
 
 def _collapse(args, report):
-    from masonry.studies.bench import collapse_bench, collapse_markdown
+    from masonry_benchmarks.bench import collapse_bench, collapse_markdown
 
     overrides = {} if args.p is None else {"p": args.p}
     named = "" if args.p is None else f" (p {args.p})"
@@ -153,7 +153,7 @@ def _collapse(args, report):
 
 
 def _friction(args, report):
-    from masonry.studies.bench import FRICTION_MODELS, friction_bench, friction_markdown
+    from masonry_benchmarks.bench import FRICTION_MODELS, friction_bench, friction_markdown
 
     models = args.friction_models or list(FRICTION_MODELS)
     for name in models:
@@ -189,7 +189,7 @@ def _sections(args) -> dict:
 
 
 def _stages(args, report):
-    from masonry.studies.stages_bench import stages_bench, stages_markdown
+    from masonry_benchmarks.stages_bench import stages_bench, stages_markdown
 
     rows = stages_bench(_sections(args), repeats=args.repeats,
                         progress=None if args.quiet else _progress)
@@ -198,7 +198,7 @@ def _stages(args, report):
 
 
 def _adhesion(args, report):
-    from masonry.studies.stages_bench import adhesion_bench, adhesion_markdown
+    from masonry_benchmarks.stages_bench import adhesion_bench, adhesion_markdown
 
     rows = adhesion_bench(_sections(args), args.adhesion_course,
                           progress=None if args.quiet else _progress)
@@ -207,7 +207,7 @@ def _adhesion(args, report):
 
 
 def _readers(args, report):
-    from masonry.studies.reader_bench import reader_bench, readers_markdown
+    from masonry_benchmarks.reader_bench import reader_bench, readers_markdown
 
     rows = reader_bench(args.readers, repeats=args.repeats,
                         progress=None if args.quiet else _progress)
@@ -216,7 +216,7 @@ def _readers(args, report):
 
 
 def _outputs(args, report):
-    from masonry.studies.output_bench import output_bench, outputs_markdown
+    from masonry_benchmarks.output_bench import output_bench, outputs_markdown
 
     overrides = {} if args.p is None else {"p": args.p}
     named = "" if args.p is None else f" (p {args.p})"
@@ -233,4 +233,4 @@ def _outputs(args, report):
 def _progress(message):
     import logging
 
-    logging.getLogger("masonry.studies.bench").info(message)
+    logging.getLogger("masonry_benchmarks.bench").info(message)

@@ -315,7 +315,7 @@ def test_mesh_files_give_the_blocks_triangles_as_written(fixtures_dir, tmp_path)
 
 
 def test_reader_bench_rows_and_command(wall, tmp_path, capsys):
-    from masonry.studies.reader_bench import READER_COLUMNS, reader_bench
+    from masonry_benchmarks.reader_bench import READER_COLUMNS, reader_bench
 
     obj, stl = tmp_path / "wall.obj", tmp_path / "wall.stl"
     obj.write_bytes(blocks_obj(wall))

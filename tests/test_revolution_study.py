@@ -1,5 +1,5 @@
 """The herringbone against the plain dome (docs/revolution.md,
-masonry/studies/revolution_study.py), on tiny domes."""
+benchmarks/revolution_study.py), on tiny domes."""
 
 import numpy as np
 import pytest
@@ -10,7 +10,7 @@ from masonry.blocks import Blocks
 from masonry.interfaces import detect
 from masonry.rbe.solve import RBEProblem
 from masonry.scenes.revolution import profile_of
-from masonry.studies import revolution_study as rs
+from masonry_benchmarks import revolution_study as rs
 
 TINY = dict(n=6, r=0, p=5, cut=0.3, profiles={"hemisphere": 1.0})
 """Four domes of 8 courses, 120 to 210 bricks; the chords of courses 7 and 8 lean 35.85

@@ -257,7 +257,7 @@ def test_run_json_names_only_the_files_the_folder_holds(tmp_path):
 
 
 def test_the_output_bench_times_every_exporter_a_run_writes(tmp_path, capsys):
-    from masonry.studies.output_bench import output_bench, outputs_markdown
+    from masonry_benchmarks.output_bench import output_bench, outputs_markdown
 
     params = validate(Params.of(scene="arch", fast=True))
     rows = output_bench({"arch": params})

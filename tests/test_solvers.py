@@ -17,7 +17,7 @@ import scipy.sparse as sp
 
 from masonry import forking
 from masonry.export.csv import header
-from masonry.studies.bench import (COLUMNS, bench, frontier_png, ratios, ratios_markdown,
+from masonry_benchmarks.bench import (COLUMNS, bench, frontier_png, ratios, ratios_markdown,
                                    table_csv, table_markdown)
 from masonry.friction import FrictionCone
 from masonry.rbe.equilibrium import assemble

@@ -561,7 +561,7 @@ def test_adhesion_bench_times_the_stages_masonry_stages_solves(tmp_path, capsys)
     """Course 8 of the small dome at mu 0.4, laid along: the bench's stages that need
     adhesion are those `analyse_stages` finds standing on no dry joints, and its largest
     least adhesion is theirs (rel 1e-5); a course below 1 is refused by name."""
-    from masonry.studies.stages_bench import adhesion_bench, adhesion_markdown
+    from masonry_benchmarks.stages_bench import adhesion_bench, adhesion_markdown
 
     params = validate(from_preset("1", **SMALL_DOME, boundary="cyclic", mu=0.4))
     (row,) = adhesion_bench({"small dome": params}, 8, orders=("along",))
@@ -578,7 +578,7 @@ def test_adhesion_bench_times_the_stages_masonry_stages_solves(tmp_path, capsys)
     assert not (tmp_path / "x").exists()
 
 def test_stages_bench_rows_and_its_refusal(tmp_path, capsys):
-    from masonry.studies.stages_bench import stages_bench, stages_markdown
+    from masonry_benchmarks.stages_bench import stages_bench, stages_markdown
 
     params = validate(from_preset("1", **SMALL_DOME, boundary="cyclic"))
     rows = stages_bench({"small dome": params}, orders=("along",), repeats=1)

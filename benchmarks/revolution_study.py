@@ -25,7 +25,7 @@ circumradius).
 Every measurement is kept as JSON in ``OUT/cases/`` under a key of its inputs, so a
 stopped study goes on where it stopped::
 
-    python -m masonry.studies.revolution_study --out exports/revolution_study
+    python -m masonry_benchmarks.revolution_study --out exports/revolution_study
 
 writes ``revolution.csv`` (one row per dome), ``revolution_bricks.csv`` (one row per
 dome, order and course scanned), ``revolution_azimuths.csv``, the two tables in
