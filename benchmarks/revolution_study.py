@@ -56,9 +56,9 @@ from masonry.errors import ParameterError
 from masonry.params import Params, validate
 from masonry.pipeline import build_model, collapse_of, geometry_code_digest
 from masonry.rbe.solve import ACCURACY, RBEProblem
-from masonry.studies.orders import BRICK_ORDERS
-from masonry.studies.plans import make_plan
-from masonry.studies.stages import analyse_stages
+from masonry.stages.analysis import analyse_stages
+from masonry.stages.orders import BRICK_ORDERS
+from masonry.stages.plans import make_plan
 from masonry.tolerances import G
 
 log = logging.getLogger(__name__)
@@ -630,7 +630,7 @@ def main(argv=None) -> None:
         figures(args.out, note=args.figures)
         return
     logging.basicConfig(level=logging.INFO, format="%(asctime)s %(message)s")
-    for name in ("masonry.rbe", "masonry.studies.stages", "masonry.pipeline"):
+    for name in ("masonry.rbe", "masonry.stages", "masonry.pipeline"):
         logging.getLogger(name).setLevel(logging.WARNING)
     study(args.out, settings=Settings(args.mu, args.accuracy,
                                       None if args.confirm == "none" else args.confirm))

@@ -11,12 +11,12 @@ import tempfile
 import time
 
 from masonry.params import validate
-from masonry.rbe.adhesion import INTERIOR, SOLVER
 from masonry.pipeline import build_model, run
-from masonry.studies.orders import BRICK_ORDERS
-from masonry.studies.plans import make_plan
+from masonry.rbe.adhesion import INTERIOR, SOLVER
 from masonry.rbe.sequence import StageSequence
-from masonry.studies.stages import analyse_stages
+from masonry.stages.analysis import analyse_stages
+from masonry.stages.orders import BRICK_ORDERS
+from masonry.stages.plans import make_plan
 
 STAGES_COLUMNS = ("structure", "order", "stages", "standing", "same_verdicts",
                   "moi_factor_diff", "sequence_s", "alone_s", "speedup", "run_s",
@@ -46,7 +46,7 @@ def stages_bench(structures, orders=tuple(BRICK_ORDERS), repeats=3, alone=True,
     structures : dict str -> Params
         Named cyclic sections (their ``analysis`` is the stages' and the run's).
     orders : sequence of str
-        :data:`~masonry.studies.stages.BRICK_ORDERS` names.
+        :data:`~masonry.stages.orders.BRICK_ORDERS` names.
     repeats : int
         Runs of the dome timed (the stages are timed once).
     alone : bool

@@ -16,7 +16,7 @@ HELP = ("construction stages without centering: the rigid block equilibrium of e
 
 def register(subparsers):
     from masonry.mortars import MORTAR_NAMES
-    from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
+    from masonry.stages.orders import BLOCK_ORDERS, BRICK_ORDERS
 
     parser = subparsers.add_parser(NAME, help=HELP)
     parser.add_argument("files", nargs="*", metavar="FILE",
@@ -111,7 +111,7 @@ def _refuse_inapplicable(args):
 def handle(args, report):
     _refuse_inapplicable(args)
     from masonry.scenes.imported import load_assembly
-    from masonry.studies.stages import run_stages, stage_params
+    from masonry.stages.run import run_stages, stage_params
 
     if args.files:
         given = given_inputs(args)
@@ -175,7 +175,8 @@ def _laying(args, params) -> dict:
     """The mortar by age (:data:`~masonry.mortars.LAYING_INPUTS`): the options given,
     else the ``--params`` file's ``[mortar]``; checked here, so that a file's value is
     refused naming the file and key."""
-    from masonry.mortars import LAYING_INPUTS, stage_laying
+    from masonry.mortars import LAYING_INPUTS
+    from masonry.stages.laying import stage_laying
     from masonry.params import laying_inputs
 
     given = {name: getattr(args, name) for name in LAYING_INPUTS}

@@ -8,7 +8,8 @@ from contextlib import contextmanager
 from pathlib import Path
 
 from masonry.errors import ParameterError
-from masonry.mortars import LAYING_INPUTS, split_laying, stage_laying
+from masonry.mortars import LAYING_INPUTS, split_laying
+from masonry.stages.laying import stage_laying
 from masonry.optional import optional_import
 from masonry.outputs import Outputs, figure_formats
 from masonry.parameters import declarations, read_toml
@@ -286,7 +287,7 @@ def _search_probes(study) -> list:
 
 def _stage_plans() -> dict:
     """``[outputs] stages`` values (``masonry stages --by``) and their laying orders."""
-    from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
+    from masonry.stages.orders import BLOCK_ORDERS, BRICK_ORDERS
 
     return {"course": (), "brick": BRICK_ORDERS, "block": BLOCK_ORDERS}
 
@@ -360,7 +361,7 @@ def _check_variants(study, where, variants=None, mortar=()):
             run_inputs, laying = split_laying(inputs)
             params = validate(Params.of(**run_inputs))
             if study.stages:  # what 'masonry stages' would refuse of the variant
-                from masonry.studies.stages import check_live_load, stage_params
+                from masonry.stages.run import check_live_load, stage_params
 
                 check_live_load(params)
                 stage_laying(stage_params(params, "boundary" in inputs), **laying)

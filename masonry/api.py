@@ -24,7 +24,6 @@ from collections.abc import Iterable
 
 from masonry.errors import MasonryError, NoForcesError, ParameterError
 from masonry.export.csv import HEADERS, column_types, forces_columns, missing_values
-from masonry.mortars import stage_laying
 from masonry.parameters import plain
 from masonry.params import (Params, from_preset, names, section_default, structure_id,
                             validate)
@@ -35,8 +34,10 @@ from masonry.rbe.loads import LOAD_OPTIONS, point_load_spec
 from masonry.rbe.resultants import interface_resultants
 from masonry.scenes import check_size
 from masonry.scenes.imported import AssemblyError, load_assembly
-from masonry.studies.plans import make_plan
-from masonry.studies.stages import STAGE_COLUMNS, analyse_stages, check_live_load
+from masonry.stages.analysis import STAGE_COLUMNS, analyse_stages
+from masonry.stages.laying import stage_laying
+from masonry.stages.plans import make_plan
+from masonry.stages.run import check_live_load
 from masonry.tolerances import Tolerances
 
 

@@ -264,7 +264,7 @@ stage study's file may also give :data:`~masonry.mortars.LAYING_INPUTS`."""
 def laying_inputs(path) -> dict:
     """The :data:`~masonry.mortars.LAYING_INPUTS` a parameter file's ``[mortar]`` table
     gives (``mortar``, ``laying_rate``, ``masons``), unchecked: a stage study checks them
-    (:func:`masonry.mortars.stage_laying`)."""
+    (:func:`masonry.stages.laying.stage_laying`)."""
     _, mortar = _file_tables(path)
     return {key: value for key, value in mortar.items() if key in LAYING_INPUTS}
 

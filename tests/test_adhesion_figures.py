@@ -23,8 +23,9 @@ from masonry.plots.colours import NO_ADHESION
 from masonry.plots.common import Projected
 from masonry.rbe.adhesion import least_adhesion
 from masonry.rbe.boundary import restrict
-from masonry.studies.plans import make_plan
-from masonry.studies.stages import analyse_stages, peak_adhesion_pngs
+from masonry.stages.analysis import analyse_stages
+from masonry.stages.plans import make_plan
+from masonry.stages.run import peak_adhesion_pngs
 from masonry_cli.main import main
 
 THIN = validate(Params.of(scene="arch", arch_thickness=0.4))

@@ -17,7 +17,7 @@ from masonry.rbe.equilibrium import assemble
 from masonry.rbe.sequence import StageSequence, part_system
 from masonry.rbe.solvers import interior_adhesion
 from masonry.rbe.solvers.newton import NewtonSystem
-from masonry.studies.plans import make_plan
+from masonry.stages.plans import make_plan
 
 MU, DENSITY = 0.7, 2000.0
 

@@ -14,7 +14,8 @@ import trimesh
 import masonry
 from masonry.errors import MasonryError
 from masonry.export.csv import _table
-from masonry.studies.stages import STAGE_COLUMNS, stages_csv
+from masonry.stages.analysis import STAGE_COLUMNS
+from masonry.stages.run import stages_csv
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,7 @@ from masonry.export._text import format_floats
 from masonry.export.columns import RUN_COLUMNS, STAGE_COLUMNS
 from masonry.studies.sweep import (Study, column_key, run_summary, summary_csv,
                                    summary_rows)
-from masonry.studies.stage_records import stage_summary
+from masonry.stages.records import stage_summary
 
 
 def test_whole_floats_print_as_floats():

@@ -25,6 +25,7 @@ STAGES = (
     ("masonry.printable", "masonry.plots"),
     ("masonry.export",),
     ("masonry.pipeline",),
+    ("masonry.stages",),
     ("masonry.studies",),
     # the package's __init__ hands out the Python interface (imported when first used)
     ("masonry.api", "masonry"),

@@ -22,13 +22,14 @@ from test_stage_adhesion import ARCH
 from masonry import read_table
 from masonry.blocks import Blocks
 from masonry.contact import ContactLaw, ContactLawError
-from masonry.mortars import MORTARS, Laying, Mortar, MortarError
+from masonry.mortars import MORTARS, Mortar, MortarError
 from masonry.rbe.boundary import Model, analysis_model, restrict
 from masonry.rbe.solve import solve_rbe
 from masonry.scenes import build
-from masonry.studies.plans import StagePlan, make_plan
-from masonry.studies.stages import analyse_stage, analyse_stages
 from masonry.rbe.sequence import StageSequence
+from masonry.stages.analysis import analyse_stage, analyse_stages
+from masonry.stages.laying import Laying
+from masonry.stages.plans import StagePlan, make_plan
 from masonry_cli.main import main
 
 MU = 0.7
@@ -236,7 +237,7 @@ def test_the_cli_names_the_mortar_and_the_rate(tmp_path, capsys):
 def test_the_law_line_of_a_mortar_by_age_names_the_joint_kinds():
     """With --head-joint-ratio 0.5 the one-line law of a stage study with lime says so,
     as the uniform law's does; without ratios it ends with the mortar."""
-    from masonry.studies.stage_records import law_line
+    from masonry.stages.records import law_line
 
     laying = Laying.of(MORTARS["lime"], 60.0)
     halved = dataclasses.replace(ARCH, analysis=dataclasses.replace(

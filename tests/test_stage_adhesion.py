@@ -18,8 +18,8 @@ from masonry.rbe.adhesion import least_adhesion
 from masonry.rbe.boundary import analysis_model, restrict
 from masonry.rbe.solve import solve_rbe
 from masonry.scenes import build
-from masonry.studies.plans import StagePlan, make_plan
-from masonry.studies.stages import analyse_stage, analyse_stages
+from masonry.stages.analysis import analyse_stage, analyse_stages
+from masonry.stages.plans import StagePlan, make_plan
 from masonry_cli.main import main
 
 ARCH = validate(Params.of(scene="arch"))

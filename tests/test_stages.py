@@ -17,9 +17,9 @@ from masonry.params import ParameterError, Params, from_preset, validate
 from masonry.rbe.boundary import Model, analysis_model, restrict
 from masonry.rbe.solve import RBEProblem
 from masonry.scenes import build
-from masonry.studies.plans import (NOT_LAID, StagePlan, block_plan, brick_plan, course_plan,
+from masonry.stages.analysis import analyse_stage, analyse_stages, loose_blocks
+from masonry.stages.plans import (NOT_LAID, StagePlan, block_plan, brick_plan, course_plan,
                                    make_plan)
-from masonry.studies.stages import analyse_stage, analyse_stages, loose_blocks
 from masonry_cli.main import main
 
 PATTERN = BLOCK_CLASSES.index("pattern")

@@ -6,7 +6,7 @@ run's or a stage study's ``run.json`` record by their ``source``; the other tabl
 that are not floats (:data:`TABLE_COLUMNS`) are written by their exporters. The CSV types
 (:func:`masonry.export.csv.column_types`), the headers that name a unit
 (:data:`masonry.export.csv.HEADERS`) and a summary row
-(:func:`masonry.studies.sweep.run_summary`, :func:`masonry.studies.stage_records.
+(:func:`masonry.studies.sweep.run_summary`, :func:`masonry.stages.records.
 stage_summary`) all follow from these rows: a new column is one row here.
 """
 

@@ -33,9 +33,9 @@ from masonry.errors import ParameterError
 from masonry.mortars import LAYING_INPUTS, split_laying
 from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run, versions
-from masonry.studies.stage_records import (STAGE_SUMMARY_COLUMNS, STANDS_THROUGHOUT,
+from masonry.stages.records import (STAGE_SUMMARY_COLUMNS, STANDS_THROUGHOUT,
                                            stage_summary)
-from masonry.studies.stages import run_stages, stage_params
+from masonry.stages.run import run_stages, stage_params
 from masonry.runfolder import Publication, source_file
 from masonry.forking import use_one_blas_thread
 from masonry.optional import optional_import, raise_interrupt
@@ -46,7 +46,7 @@ log = logging.getLogger(__name__)
 SUMMARY_COLUMNS = column_names(RUN_COLUMNS)
 """Result columns of the summary (:data:`masonry.export.columns.RUN_COLUMNS`: their
 sources in ``run.json``, types, units and meanings); the swept inputs come first. A study
-of stages adds :data:`~masonry.studies.stage_records.STAGE_SUMMARY_COLUMNS`."""
+of stages adds :data:`~masonry.stages.records.STAGE_SUMMARY_COLUMNS`."""
 
 def measure(row: dict, column: str):
     """A result column of a variant's row as a number, for an optimisation: a boolean as
@@ -126,7 +126,7 @@ class Study:
         The figures' files and where ``dome.html`` finds plotly.js
         (:class:`masonry.outputs.Outputs`).
     stages : str or None
-        Also a stage study of every variant (:func:`masonry.studies.stages.run_stages`),
+        Also a stage study of every variant (:func:`masonry.stages.run.run_stages`),
         laid by ``course``, ``brick`` or ``block``; its results add
         :data:`STAGE_SUMMARY_COLUMNS` to the summary. Its mortar by age
         (:data:`~masonry.mortars.LAYING_INPUTS`) is among the inputs of ``base``,
@@ -260,7 +260,7 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
         (:class:`masonry.outputs.Outputs`).
     stages : dict or None
         ``by``, ``course`` and ``order`` of a stage study of the variant
-        (:func:`masonry.studies.stages.run_stages`, in its own run folder; a section
+        (:func:`masonry.stages.run.run_stages`, in its own run folder; a section
         laid cyclic unless the inputs give a boundary, as ``masonry stages`` does).
 
     Returns

@@ -1,5 +1,5 @@
 """The laying orders of construction stages (docs/model.md 4.7), by name: what
-:mod:`masonry.studies.stages` lays and what the command line offers, without loading the
+:mod:`masonry.stages.analysis` lays and what the command line offers, without loading the
 study."""
 
 BRICK_ORDERS = {
@@ -9,10 +9,10 @@ BRICK_ORDERS = {
     "along": "every brick of the course by its position along the course, from the "
              "corner at -pi/n to the corner at +pi/n",
 }
-"""Laying orders of :func:`~masonry.studies.plans.brick_plan` (docs/model.md 4.7)."""
+"""Laying orders of :func:`~masonry.stages.plans.brick_plan` (docs/model.md 4.7)."""
 
 BLOCK_ORDERS = {
     "names": "one block at a time, by name (digits compared as numbers)",
     "z": "from the bottom up by centroid height; blocks at one height together",
 }
-"""Laying orders of :func:`~masonry.studies.plans.block_plan`."""
+"""Laying orders of :func:`~masonry.stages.plans.block_plan`."""

@@ -1,11 +1,11 @@
 """Stage plans: when each block of a construction is laid (docs/model.md 4.7), for
-:mod:`masonry.studies.stages`.
+:mod:`masonry.stages.analysis`.
 
 - :func:`course_plan`: stage ``k`` holds every brick that starts on courses ``1..k`` (a
   pattern brick belongs to the course it starts on), in every web.
 - :func:`brick_plan`: courses ``1..K-1`` complete, then the bricks of course ``K`` one at
   a time, the same step in every web (``pattern-first`` or ``along``, see
-  :data:`~masonry.studies.orders.BRICK_ORDERS`); without ``K``, every course so, bottom
+  :data:`~masonry.stages.orders.BRICK_ORDERS`); without ``K``, every course so, bottom
   to top: the whole construction.
 - :func:`block_plan`: any assembly, one block at a time by name (``names``) or from the
   bottom up (``z``: blocks whose centroids lie at one height are laid together, so a
@@ -19,7 +19,7 @@ import numpy as np
 
 from masonry.blocks import BLOCK_CLASSES
 from masonry.errors import ParameterError
-from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
+from masonry.stages.orders import BLOCK_ORDERS, BRICK_ORDERS
 from masonry.tolerances import Tolerances
 
 NOT_LAID = -1

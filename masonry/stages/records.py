@@ -1,12 +1,12 @@
-"""What a stage study reports (:mod:`masonry.studies.stages`): the extremes over its
-stages, its ``run.json`` record, and the columns a parameter study's summary takes from
-that record (docs/stages.md)."""
+"""What a stage study reports (:mod:`masonry.stages.run`): the extremes over its stages
+(:func:`masonry.stages.analysis.analyse_stages`' rows), its ``run.json`` record, and the
+columns a parameter study's summary takes from that record (docs/stages.md)."""
 
 from masonry.export.columns import STAGE_COLUMNS, column_names, summary_row
 from masonry.params import structure_id
 from masonry.pipeline import model_record
-from masonry.studies.orders import BLOCK_ORDERS, BRICK_ORDERS
-from masonry.studies.plans import StagePlan
+from masonry.stages.orders import BLOCK_ORDERS, BRICK_ORDERS
+from masonry.stages.plans import StagePlan
 from masonry.tolerances import ADHESION_TIE_REL
 
 STAGE_SUMMARY_COLUMNS = column_names(STAGE_COLUMNS)
@@ -79,7 +79,7 @@ def adhesion_peak(rows) -> dict | None:
 def stage_record(params, scene, model, plan: StagePlan, rows, cached, source,
                  laying=None) -> dict:
     """run.json of a stage study, before timings; ``mortar``: the
-    :class:`~masonry.mortars.Laying` (its mortar's table and source, the rate, the
+    :class:`~masonry.stages.laying.Laying` (its mortar's table and source, the rate, the
     masons) and ``law``, the contact law in one line; None without one (``params``'
     contact law at every joint, in ``params``)."""
     first = first_unsupported(rows)
