@@ -136,10 +136,11 @@ def test_an_optimisation_on_the_cluster_equals_the_serial_one(cluster, serial, t
 def test_a_worker_killed_mid_study_loses_nothing(cluster, serial, tmp_path):
     from masonry.studies.sweep import execute, publish_summary, summary_rows
 
-    from masonry_cli.sweep import load_study
+    from masonry.studies.study_file import load_study
+    from masonry_cli.sweep import run_option_names
 
     study_file, expected = serial
-    study = load_study(study_file)
+    study = load_study(study_file, run_option_names())
     client = cluster.client(2)
     try:
         pids = client.run(os.getpid)
