@@ -20,7 +20,7 @@ HELP = ("measure time, iterations and accuracy of every solver preset on the the
 
 
 def register(subparsers):
-    # the benches (masonry_benchmarks) load the whole pipeline: imported when this command runs (masonry_cli.app)
+    # the benches load the whole pipeline: imported when this command runs (masonry_cli.app)
     from masonry_benchmarks.bench import FRICTION_MODELS, SCENES
 
     parser = subparsers.add_parser(NAME, help=HELP)
