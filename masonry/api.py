@@ -63,7 +63,7 @@ class Structure:
     model: object
     source: dict | None = None
 
-    @property
+    @functools.cached_property
     def id(self) -> str:
         """The structure id: the name of its run folder."""
         return structure_id(self.params)

@@ -367,7 +367,8 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     wanted = {"analyse": analyse, "centering": analyse, "adhesion": analyse,
               "3dm": rhino.available(),
               **{name: getattr(out, name) for name in FILE_OUTPUTS}, "html": out.writes_html}
-    job = Publication(out_root, structure_id(params), {"params": identity(params)}, wanted,
+    name = structure_id(params)  # the run folder's name, the figures' titles, the record's
+    job = Publication(out_root, name, {"params": identity(params)}, wanted,
                       force=force, identify=_identify)
     reused = job.reusable()
     if reused is not None:
@@ -377,7 +378,7 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     params = with_outputs(params, outputs)
     timer = Timer()
     scene, model, cached = run_model(params, out_root, timer, scene)
-    record = run_record(params, scene, model, outputs, cached, source)
+    record = run_record(params, name, scene, model, outputs, cached, source)
     result = solve(model, params, timer) if outputs["analyse"] else None
     centering = collapse = None
     if result is not None and not result.feasible:
@@ -393,7 +394,7 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     record.update(results_record(result, collapse, centering, scene.blocks.block_name,
                                  adhesion))
     made = RunOutputs(params, scene, model, result, collapse=collapse, centering=centering,
-                      adhesion=adhesion, title=structure_id(params))
+                      adhesion=adhesion, title=name)
     share_plotly(out_root, outputs)  # once the run has a page, before it is published
     folder = job.publish(lambda folder: write_run(folder, made, record, timer))
     if cached == "computed":  # only a model whose run completed is cached
@@ -458,13 +459,15 @@ def _held(coordinates: dict, folder: RunFolder) -> dict:
             if isinstance(value, list) else value for key, value in coordinates.items()}
 
 
-def run_record(params: Params, scene: Scene, model: Model, outputs: dict, cached: str,
-               source=None) -> dict:
+def run_record(params: Params, name: str, scene: Scene, model: Model, outputs: dict,
+               cached: str, source=None) -> dict:
     """The run.json record of a built model, before any solve.
 
     Parameters
     ----------
     params : Params
+    name : str
+        Its structure id (:func:`masonry.params.structure_id`).
     scene : masonry.scenes.base.Scene
     model : masonry.rbe.boundary.Model
         Its analysis model; its interface counts by kind go into ``counts``.
@@ -483,7 +486,7 @@ def run_record(params: Params, scene: Scene, model: Model, outputs: dict, cached
         state and source.
     """
     record = {
-        "structure_id": structure_id(params),
+        "structure_id": name,
         "scene": params.scene,
         "params": params.record(),
         "outputs": {name: outputs[name] for name in ("analyse", "centering", "adhesion",

@@ -101,7 +101,7 @@ def test_the_stage_where_the_adhesion_peaks_is_drawn_from_its_own_program(drawn)
     scene, model = build_model(params)
     plan = make_plan(scene, "block", "z")
     rows = analyse_stages(model, params, plan)
-    files = peak_adhesion_pngs(params, model, plan, rows)
+    files = peak_adhesion_pngs(params, "arch", model, plan, rows)
     assert sorted(files) == [f"adhesion_peak/{view}.png" for view in VIEWS]
     part = restrict(model, plan.is_present(7))
     alone = _least(part, params)

@@ -3,7 +3,6 @@
 columns a parameter study's summary takes from that record (docs/stages.md)."""
 
 from masonry.export.columns import STAGE_COLUMNS, column_names, summary_row
-from masonry.params import structure_id
 from masonry.pipeline import model_record
 from masonry.stages.orders import BLOCK_ORDERS, BRICK_ORDERS
 from masonry.stages.plans import StagePlan
@@ -76,9 +75,9 @@ def adhesion_peak(rows) -> dict | None:
     return next(row for row in rows if row["adhesion_kPa"] >= top * (1 - ADHESION_TIE_REL))
 
 
-def stage_record(params, scene, model, plan: StagePlan, rows, cached, source,
+def stage_record(params, name: str, scene, model, plan: StagePlan, rows, cached, source,
                  laying=None) -> dict:
-    """run.json of a stage study, before timings; ``mortar``: the
+    """run.json of a stage study of structure id ``name``, before timings; ``mortar``: the
     :class:`~masonry.stages.laying.Laying` (its mortar's table and source, the rate, the
     masons) and ``law``, the contact law in one line; None without one (``params``'
     contact law at every joint, in ``params``)."""
@@ -87,7 +86,7 @@ def stage_record(params, scene, model, plan: StagePlan, rows, cached, source,
         {"block": block, "name": str(scene.blocks.block_name[block]), "support_N": size,
          "force_N": [float(v) for v in force]} for block, force, size in first["held"]]
     record = {
-        "structure_id": structure_id(params),
+        "structure_id": name,
         "scene": params.scene,
         "params": params.record(),
         "outputs": {"plots": params.outputs.plots, "quick": params.outputs.quick,

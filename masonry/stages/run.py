@@ -51,11 +51,11 @@ def stages_csv(rows) -> bytes:
 
 
 # ---------------------------------------------------------------------- the run
-def stages_folder_name(params, plan: StagePlan, laying: Laying | None = None) -> str:
-    """The run folder of a stage study: the structure id, the plan and a mortar that
-    ages (its name and rate, e.g. ``_lime60``), so it never replaces the folder of
-    ``masonry run``, of another plan or of another mortar."""
-    name = f"{structure_id(params)}_stages_{plan.tag}"
+def stages_folder_name(name: str, plan: StagePlan, laying: Laying | None = None) -> str:
+    """The run folder of a stage study: the structure id (``name``), the plan and a
+    mortar that ages (its name and rate, e.g. ``_lime60``), so it never replaces the
+    folder of ``masonry run``, of another plan or of another mortar."""
+    name = f"{name}_stages_{plan.tag}"
     if laying is not None and laying.mortar.name != "constant":
         name += f"_{laying.mortar.name}{laying.rate_per_hour:g}"
         name += "" if laying.masons == 1 else f"x{laying.masons}"
@@ -132,7 +132,8 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
 
     scene, model, cached = run_model(params, out_root, timer, scene, check=check)
     out = params.outputs
-    job = Publication(out_root, stages_folder_name(params, plan, laying),
+    name = structure_id(params)  # the folder's name, the figures' titles, the record's
+    job = Publication(out_root, stages_folder_name(name, plan, laying),
                       {"params": identity(params), "plan": _plan_identity(plan),
                        "mortar": None if laying is None else laying.record()},
                       {"plots": out.plots, "quick": out.quick, "centering": True,
@@ -148,10 +149,10 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
         out, **{name: grown[name] for name in ("plots", "quick", "figure_format")}))
     with timer.stage("stages"):
         rows = analyse_stages(model, params, plan, laying=laying)
-    record = stage_record(params, scene, model, plan, rows, cached, source, laying)
+    record = stage_record(params, name, scene, model, plan, rows, cached, source, laying)
     record["stages"]["wall_s"] = timer.seconds["stages"]
-    folder = job.publish(lambda folder: _write(folder, params, scene, model, plan, rows,
-                                               record, timer))
+    folder = job.publish(lambda folder: _write(folder, params, name, scene, model, plan,
+                                               rows, record, timer))
     if cached == "computed":  # only a model whose study completed is cached
         write_cache(params, out_root, scene, model)
     return {**record, "path": str(folder.target), "rows": rows}
@@ -171,16 +172,17 @@ def _identify(record) -> dict:
             {k: v for k, v in mortar.items() if k != "law"}}
 
 
-def _write(folder, params, scene, model, plan, rows, record, timer):
-    """Every file of a stage study and, last, its ``run.json``."""
-    folder.write("00_parameters.txt", parameters_text(params, structure_id(params)))
+def _write(folder, params, name, scene, model, plan, rows, record, timer):
+    """Every file of a stage study (of structure id ``name``) and, last, its
+    ``run.json``."""
+    folder.write("00_parameters.txt", parameters_text(params, name))
     folder.write("stages.csv", stages_csv(rows))
     first = first_unsupported(rows)
     if first is not None:
         folder.write("first_unsupported/held.csv", held_csv(scene.blocks, first["held"]))
     if params.outputs.plots:
         with timer.stage("plots"):
-            figures = stage_pngs(params, scene, model, plan, rows)
+            figures = stage_pngs(params, name, scene, model, plan, rows)
             for name, data in figures.items():
                 folder.write(name, data)
             record["figures"] = {"files": sorted(figures)}
@@ -190,19 +192,20 @@ def _write(folder, params, scene, model, plan, rows, record, timer):
     folder.write_json("run.json", record)
 
 
-def stage_pngs(params, scene, model: Model, plan: StagePlan, rows) -> dict:
+def stage_pngs(params, name: str, scene, model: Model, plan: StagePlan, rows) -> dict:
     """``stages.png`` (the centering force of every stage as a fraction of its weight,
     which stages stand), ``adhesion.png`` (the least adhesion of every stage, kPa) and,
     when a stage needs support, ``first_unsupported/<view>.png``:
     that stage, its bricks coloured by the support force they need, and
     ``adhesion_peak/<view>.png`` (:func:`peak_adhesion_pngs`); each figure in the
-    formats the outputs ask (``.png``, ``.svg``, ``.pdf``): path -> bytes."""
+    formats the outputs ask (``.png``, ``.svg``, ``.pdf``): path -> bytes. ``name``: the
+    structure id, in the titles."""
     from masonry import plots  # matplotlib, imported only by the runs that draw
 
     bricks = "every course" if plan.course is None else f"course {plan.course}"
     what = {"course": "course stages", "brick": f"{bricks} brick by brick ({plan.order})",
             "block": f"block by block ({plan.order})"}[plan.by]
-    title = f"{structure_id(params)}: {what}, {sum(bool(r['feasible']) for r in rows)} of " \
+    title = f"{name}: {what}, {sum(bool(r['feasible']) for r in rows)} of " \
             f"{len(rows)} stages stand (mu {params.analysis.mu:g})"
     xlabel = {"course": "stage (courses laid)",
               "brick": f"stage (bricks of {bricks} laid, per web)"}.get(plan.by, "stage")
@@ -215,12 +218,12 @@ def stage_pngs(params, scene, model: Model, plan: StagePlan, rows) -> dict:
         loose=[r["loose"] for r in rows], title=title, xlabel=xlabel, render=render),
         "adhesion.png": plots.stage_adhesion_png(
         stage, [np.nan if r["adhesion_kPa"] is None else r["adhesion_kPa"] for r in rows],
-        feasible, title=f"{structure_id(params)}: {what}, the least adhesion of every "
+        feasible, title=f"{name}: {what}, the least adhesion of every "
                         f"stage (mu {params.analysis.mu:g})", xlabel=xlabel,
         ratio=params.analysis.adhesion_tension_ratio, render=render)}
     out = {path: data for name, figure in out.items()
            for path, data in plots.as_files(name, figure).items()}
-    out.update(peak_adhesion_pngs(params, model, plan, rows))
+    out.update(peak_adhesion_pngs(params, name, model, plan, rows))
     first = first_unsupported(rows)
     if first is None:
         return out
@@ -239,18 +242,18 @@ def stage_pngs(params, scene, model: Model, plan: StagePlan, rows) -> dict:
         value_label="support force on the brick, at its centroid [N] (centering force)",
         is_outlined=plan.block_stage == first["stage"],
         outline_label=f"laid at stage {first['stage']}", fast=params.outputs.quick,
-        subtitle=f"{scene.kind.describe(params.analysis.boundary)} | {structure_id(params)}",
+        subtitle=f"{scene.kind.describe(params.analysis.boundary)} | {name}",
         render=render)
     out.update({f"first_unsupported/{name}": png for name, png in views.items()})
     return out
 
 
-def peak_adhesion_pngs(params, model: Model, plan: StagePlan, rows) -> dict:
+def peak_adhesion_pngs(params, name: str, model: Model, plan: StagePlan, rows) -> dict:
     """``adhesion_peak/<view>.png``: the stage whose least adhesion peaks
     (:func:`~masonry.stages.records.adhesion_peak`), its joints coloured by the
     adhesion they use there (the values its program gave, ``adhesion_used``: no other
-    solve), its blocks outlined in the whole structure's frame; none when no stage needs
-    adhesion or a stage has none."""
+    solve), its blocks outlined in the whole structure's frame, titled with the structure
+    id ``name``; none when no stage needs adhesion or a stage has none."""
     from masonry import plots
 
     peak = adhesion_peak(rows)
@@ -264,5 +267,5 @@ def peak_adhesion_pngs(params, model: Model, plan: StagePlan, rows) -> dict:
     views = plots.adhesion_pngs(
         model.blocks, model.interfaces.subset(chosen), used[chosen], peak["adhesion_kPa"],
         params.outputs.quick, f"stage {stage} of {plan.n_stages}, where the least adhesion "
-        f"peaks | {structure_id(params)}", plots.Render.of(params.outputs), drawn=present)
+        f"peaks | {name}", plots.Render.of(params.outputs), drawn=present)
     return {f"adhesion_peak/{name}": data for name, data in views.items()}
