@@ -52,9 +52,10 @@ from pathlib import Path
 import numpy as np
 
 from masonry.blocks import BLOCK_CLASSES, PATTERN
+from masonry.cache import geometry_code_digest
 from masonry.errors import ParameterError
 from masonry.params import Params, validate
-from masonry.pipeline import build_model, collapse_of, geometry_code_digest
+from masonry.pipeline import build_model, collapse_of
 from masonry.rbe.solve import ACCURACY, RBEProblem
 from masonry.stages.analysis import analyse_stages
 from masonry.stages.orders import BRICK_ORDERS

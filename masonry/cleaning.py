@@ -34,7 +34,7 @@ SHARED_PLOTLY = re.compile(r"^plotly-[0-9A-Za-z.\-]+\.min\.js$")
 """The shared plotly.js files of the root (:func:`masonry.export.html.plotly_file`)."""
 
 CACHE = ".cache"
-"""The geometry cache's folder in the root (:func:`masonry.pipeline.write_cache`)."""
+"""The geometry cache's folder in the root (:func:`masonry.cache.write_cache`)."""
 
 WRITING = re.compile(r"^\..+\.tmp-")
 """A run folder being written (:class:`masonry.runfolder.RunFolder`): while one is, the

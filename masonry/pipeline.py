@@ -1,30 +1,24 @@
 """A whole run: parameters to bricks, interfaces, forces and exports in a run folder.
 
 The library logs progress; it never prints. Timings of every stage go into ``run.json``.
-Geometry and interfaces are cached under ``<out>/.cache`` keyed by the geometric inputs
-and the source of the code that builds them, so a run that changes only ``mu``,
-``friction``, ``density`` or the solver reuses them, and an edited geometry stage does not.
+Geometry and interfaces are cached under ``<out>/.cache`` (:mod:`masonry.cache`), so a run
+that changes only ``mu``, ``friction``, ``density`` or the solver reuses them.
 """
 
 import dataclasses
-import functools
-import hashlib
 import importlib
-import json
 import logging
-import pickle
 import threading
 import time
 from contextlib import contextmanager
 from importlib import metadata
 from pathlib import Path
 
-import masonry
 from masonry import __version__, forking
 from masonry.blocks import BLOCK_CLASSES
+from masonry.cache import read_cache, write_cache
 from masonry.export import EXPORTERS, RunOutputs, html, rhino
-from masonry.params import (FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, geometry_key, structure_id,
-                            validate)
+from masonry.params import FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, structure_id, validate
 from masonry.rbe.adhesion import AdhesionResult, least_adhesion, stands_dry
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.centering import CenteringResult, centering_force
@@ -160,39 +154,6 @@ def model_record(scene, density: float) -> dict:
     return record
 
 
-# ---------------------------------------------------------------------------- cache
-GEOMETRY_SOURCES = ("params.py", "parameters.py", "tolerances.py", "blocks.py", "meshing.py",
-                    "interfaces.py", "dome", "scenes", "rbe/boundary.py")
-"""The package's files (or folders) whose code decides a cached scene and model."""
-
-
-@functools.cache
-def geometry_code_digest() -> str:
-    """SHA-1 of the source of :data:`GEOMETRY_SOURCES`: part of the cache key, so an edited
-    geometry stage never reuses a stale cache at the same version number.
-
-    Returns
-    -------
-    str
-        40 hex digits over every file's path and bytes, in sorted order; computed once
-        per process.
-    """
-    root = Path(masonry.__file__).parent
-    digest = hashlib.sha1()
-    for name in GEOMETRY_SOURCES:
-        path = root / name
-        for file in sorted(path.rglob("*.py")) if path.is_dir() else [path]:
-            digest.update(file.relative_to(root).as_posix().encode())
-            digest.update(file.read_bytes())
-    return digest.hexdigest()
-
-
-def _geometry_key(params: Params) -> str:
-    key = json.dumps({"geometry": geometry_key(params), "version": __version__,
-                      "code": geometry_code_digest()}, sort_keys=True)
-    return hashlib.sha1(key.encode()).hexdigest()[:16]
-
-
 def build_model(params: Params) -> tuple:
     """``(scene, model)``: the scene of ``params`` and its analysis model, with the
     analysis's boundary (no cache)."""
@@ -221,7 +182,7 @@ def _cached_model(params: Params, out_root, timer: Timer, check=None):
     given, runs on the scene before the interfaces are detected (it raises on bad input).
     A computed model is not cached here: :func:`write_cache` does it once the run's
     folder is published."""
-    cached = _read_cache(_cache_path(params, out_root))
+    cached = read_cache(params, out_root)
     if cached is not None:
         with timer.stage("model (cached)"):
             scene, model = cached
@@ -237,69 +198,6 @@ def _cached_model(params: Params, out_root, timer: Timer, check=None):
     return scene, model, "computed"
 
 
-def _cache_path(params: Params, out_root) -> Path:
-    return Path(out_root) / ".cache" / f"{_geometry_key(params)}.pickle"
-
-
-NUMPY_REBUILDERS = {("numpy._core.multiarray", "_reconstruct"),
-                    ("numpy._core.multiarray", "scalar"),
-                    ("numpy._core.numeric", "_frombuffer"),
-                    ("numpy.core.multiarray", "_reconstruct"),
-                    ("numpy.core.multiarray", "scalar"),
-                    ("numpy.core.numeric", "_frombuffer")}
-"""The functions a pickled numpy array or scalar is rebuilt by (numpy 2 and 1.26)."""
-
-
-class _CacheUnpickler(pickle.Unpickler):
-    """Loads this package's classes and numpy's arrays only: a cache file put in an output
-    folder by someone else cannot name a function to run (the pickle module's
-    "Restricting Globals"); anything else is refused before its module is imported."""
-
-    def find_class(self, module, name):
-        ours = module.startswith("masonry.") or module in ("numpy", "numpy.dtypes")
-        if (module, name) in NUMPY_REBUILDERS:
-            return super().find_class(module, name)
-        found = super().find_class(module, name) if ours else None
-        if not isinstance(found, type):
-            raise pickle.UnpicklingError(f"{module}.{name} is not allowed in a geometry "
-                                         f"cache")
-        return found
-
-
-def _read_cache(path: Path):
-    """``(scene, model)`` from a cache file, or None when there is none or it is unusable
-    (truncated, corrupt, naming anything but this package's classes and numpy arrays, or
-    not a cache of this code): then it is rebuilt, with a warning."""
-    try:
-        with open(path, "rb") as f:
-            content = _CacheUnpickler(f).load()
-    except (FileNotFoundError, NotADirectoryError):
-        return None
-    except Exception as error:  # unpickling garbage can raise anything
-        log.warning("the geometry cache %s is unreadable (%s: %s): rebuilding the model",
-                    path, type(error).__name__, error)
-        return None
-    if not (isinstance(content, tuple) and len(content) == 2
-            and isinstance(content[0], Scene) and isinstance(content[1], Model)):
-        log.warning("the geometry cache %s holds something else: rebuilding the model", path)
-        return None
-    return content
-
-
-def write_cache(params: Params, out_root, scene: Scene, model: Model):
-    """Cache a model computed by :func:`_cached_model` for ``params`` under ``out_root``;
-    called once the run's folder is published, so a failed run caches nothing. A cache
-    that cannot be written only costs the next run the rebuild (warned), never this
-    run's results."""
-    path = _cache_path(params, out_root)
-    try:
-        write_file_atomically(path, pickle.dumps((scene, model),
-                                                 protocol=pickle.HIGHEST_PROTOCOL))
-    except OSError as error:
-        log.warning("the geometry cache %s was not written (%s): the next run rebuilds the "
-                    "model", path, error.strerror or error)
-
-
 def identity(params: Params) -> dict:
     """What makes a run's result: its inputs as ``run.json`` records them, without those
     that only choose files (:data:`~masonry.params.FILE_OUTPUTS`)."""
@@ -313,9 +211,78 @@ def _identify(record) -> dict:
 
 
 def with_outputs(params: Params, outputs: dict) -> Params:
-    """``params`` writing ``outputs`` (:meth:`masonry.runfolder.Publication.outputs`)."""
-    chosen = {name: outputs[name] for name in FILE_OUTPUTS}
+    """``params`` writing ``outputs`` (:meth:`masonry.runfolder.Publication.outputs`;
+    the :data:`~masonry.params.FILE_OUTPUTS` it names)."""
+    chosen = {name: outputs[name] for name in FILE_OUTPUTS if name in outputs}
     return dataclasses.replace(params, outputs=dataclasses.replace(params.outputs, **chosen))
+
+
+# ---------------------------------------------------------------------------- a job
+@dataclasses.dataclass
+class Job:
+    """A command's run folder in the making: what :func:`run` and
+    :func:`masonry.stages.run.run_stages` do before and after their own analysis.
+
+    :meth:`open` checks the inputs, the output root and the model's size before anything
+    is built or written, and names the structure once; :meth:`publication` opens its run
+    folder by the run-folder protocol (:class:`~masonry.runfolder.Publication`);
+    :meth:`publish` writes it and then caches a model the job computed.
+
+    Attributes
+    ----------
+    params : Params
+        Validated; after :meth:`publication`, writing the folder's outputs.
+    out_root : str or Path
+        The output root.
+    structure_id : str
+        :func:`masonry.params.structure_id` of ``params``: the run folder's name (or its
+        start), in the record and the figures' titles.
+    timer : Timer
+        The job's stages' times.
+    outputs : dict or None
+        After :meth:`publication`: what the folder gets (those asked for and those it
+        held, :meth:`~masonry.runfolder.Publication.outputs`).
+    """
+
+    params: Params
+    out_root: object
+    structure_id: str
+    timer: Timer
+    outputs: dict | None = None
+    folder: Publication | None = None
+
+    @classmethod
+    def open(cls, params: Params, out_root, scene=None, max_bricks=MAX_BRICKS) -> "Job":
+        """``params`` validated, ``out_root`` checked and, unless ``scene`` is given
+        (blocks read from files), a model estimated larger than ``max_bricks`` refused
+        (:func:`masonry.scenes.check_size`): raises before anything is built."""
+        params = validate(params)
+        check_output_root(out_root)
+        if scene is None:
+            check_size(params, max_bricks)
+        return cls(params, out_root, structure_id(params), Timer())
+
+    def publication(self, name: str, identity: dict, wanted: dict, *, force=False,
+                    identify=None) -> dict | None:
+        """The run folder ``out_root/name`` (:class:`~masonry.runfolder.Publication`'s
+        arguments): its earlier record when it holds what is ``wanted`` (the job then
+        writes nothing), else None, and :attr:`params` writes :attr:`outputs`."""
+        folder = Publication(self.out_root, name, identity, wanted, force=force,
+                             identify=identify)
+        reused = folder.reusable()
+        if reused is None:
+            self.folder, self.outputs = folder, folder.outputs()
+            self.params = with_outputs(self.params, self.outputs)
+        return reused
+
+    def publish(self, write, scene: Scene, model: Model, cached: str):
+        """The folder written by ``write(folder)`` and published
+        (:meth:`~masonry.runfolder.Publication.publish`); then a model the job computed
+        (``cached``, :func:`run_model`) is cached: only a model whose job completed."""
+        folder = self.folder.publish(write)
+        if cached == "computed":
+            write_cache(self.params, self.out_root, scene, model)
+        return folder
 
 
 # ---------------------------------------------------------------------------- the run
@@ -357,28 +324,21 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     dict
         The run record (the content of ``run.json``) and its ``path``.
     """
-    params = validate(params)
-    check_output_root(out_root)
-    if scene is None:
-        check_size(params, max_bricks)
-    out = params.outputs
+    job = Job.open(params, out_root, scene, max_bricks)
+    out = job.params.outputs
     # bricks.3dm whenever rhino3dm is there: a folder written without it is not up to
     # date once it is
     wanted = {"analyse": analyse, "centering": analyse, "adhesion": analyse,
               "3dm": rhino.available(),
               **{name: getattr(out, name) for name in FILE_OUTPUTS}, "html": out.writes_html}
-    name = structure_id(params)  # the run folder's name, the figures' titles, the record's
-    job = Publication(out_root, name, {"params": identity(params)}, wanted,
-                      force=force, identify=_identify)
-    reused = job.reusable()
+    reused = job.publication(job.structure_id, {"params": identity(job.params)}, wanted,
+                             force=force, identify=_identify)
     if reused is not None:
         share_plotly(out_root, reused["outputs"])
         return reused
-    outputs = job.outputs()
-    params = with_outputs(params, outputs)
-    timer = Timer()
+    params, outputs, timer = job.params, job.outputs, job.timer
     scene, model, cached = run_model(params, out_root, timer, scene)
-    record = run_record(params, name, scene, model, outputs, cached, source)
+    record = run_record(params, job.structure_id, scene, model, outputs, cached, source)
     result = solve(model, params, timer) if outputs["analyse"] else None
     centering = collapse = None
     if result is not None and not result.feasible:
@@ -394,11 +354,10 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     record.update(results_record(result, collapse, centering, scene.blocks.block_name,
                                  adhesion))
     made = RunOutputs(params, scene, model, result, collapse=collapse, centering=centering,
-                      adhesion=adhesion, title=name)
+                      adhesion=adhesion, title=job.structure_id)
     share_plotly(out_root, outputs)  # once the run has a page, before it is published
-    folder = job.publish(lambda folder: write_run(folder, made, record, timer))
-    if cached == "computed":  # only a model whose run completed is cached
-        write_cache(params, out_root, scene, model)
+    folder = job.publish(lambda folder: write_run(folder, made, record, timer), scene, model,
+                         cached)
     return {**record, "path": str(folder.target)}
 
 

@@ -24,7 +24,7 @@ STAGES = (
     ("masonry.params",),
     ("masonry.printable", "masonry.plots"),
     ("masonry.export",),
-    ("masonry.pipeline",),
+    ("masonry.cache", "masonry.pipeline"),
     ("masonry.stages",),
     ("masonry.studies",),
     # the package's __init__ hands out the Python interface (imported when first used)

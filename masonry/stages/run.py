@@ -6,7 +6,6 @@ support must have held, and the figures.
 """
 
 import csv
-import dataclasses
 import io
 
 import numpy as np
@@ -15,12 +14,10 @@ from masonry.errors import ParameterError
 from masonry.export._text import format_float
 from masonry.export.csv import header, held_csv
 from masonry.export.summaries import parameters_text
-from masonry.params import FILE_OUTPUTS, structure_id, validate
-from masonry.pipeline import Timer, identity, run_model, versions, write_cache
+from masonry.params import FILE_OUTPUTS, validate
+from masonry.pipeline import Job, identity, run_model, versions
 from masonry.rbe.boundary import Model, kept_blocks
 from masonry.rbe.loads import Lateral
-from masonry.runfolder import Publication, check_output_root
-from masonry.scenes import check_size
 from masonry.stages.analysis import STAGE_COLUMNS, analyse_stages
 from masonry.stages.laying import Laying, stage_laying
 from masonry.stages.plans import StagePlan, make_plan
@@ -117,44 +114,33 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
         The record written as ``run.json``, its ``path``, and ``rows`` (one dict per
         stage, :data:`STAGE_COLUMNS`, ``loose_blocks`` and ``held``).
     """
-    params = validate(params)
-    check_live_load(params)
-    laying = stage_laying(params, mortar, laying_rate, masons)
-    check_output_root(out_root)
-    if scene is None:
-        check_size(params, max_bricks)
-    timer = Timer()
+    job = Job.open(params, out_root, scene, max_bricks)
+    check_live_load(job.params)
+    laying = stage_laying(job.params, mortar, laying_rate, masons)
     plan = None
 
     def check(built):  # bad plan options are refused before anything is written
         nonlocal plan
         plan = make_plan(built, by, order, course)
 
-    scene, model, cached = run_model(params, out_root, timer, scene, check=check)
-    out = params.outputs
-    name = structure_id(params)  # the folder's name, the figures' titles, the record's
-    job = Publication(out_root, stages_folder_name(name, plan, laying),
-                      {"params": identity(params), "plan": _plan_identity(plan),
-                       "mortar": None if laying is None else laying.record()},
-                      {"plots": out.plots, "quick": out.quick, "centering": True,
-                       "adhesion": True, "figure_format": out.figure_format,
-                       "dpi": out.dpi},
-                      force=force,
-                      identify=_identify)
-    reused = job.reusable()
+    scene, model, cached = run_model(job.params, out_root, job.timer, scene, check=check)
+    out = job.params.outputs
+    reused = job.publication(
+        stages_folder_name(job.structure_id, plan, laying),
+        {"params": identity(job.params), "plan": _plan_identity(plan),
+         "mortar": None if laying is None else laying.record()},
+        {"plots": out.plots, "quick": out.quick, "centering": True, "adhesion": True,
+         "figure_format": out.figure_format, "dpi": out.dpi},
+        force=force, identify=_identify)
     if reused is not None:
         return reused
-    grown = job.outputs()
-    params = dataclasses.replace(params, outputs=dataclasses.replace(
-        out, **{name: grown[name] for name in ("plots", "quick", "figure_format")}))
+    params, name, timer = job.params, job.structure_id, job.timer
     with timer.stage("stages"):
         rows = analyse_stages(model, params, plan, laying=laying)
     record = stage_record(params, name, scene, model, plan, rows, cached, source, laying)
     record["stages"]["wall_s"] = timer.seconds["stages"]
     folder = job.publish(lambda folder: _write(folder, params, name, scene, model, plan,
-                                               rows, record, timer))
-    if cached == "computed":  # only a model whose study completed is cached
-        write_cache(params, out_root, scene, model)
+                                               rows, record, timer), scene, model, cached)
     return {**record, "path": str(folder.target), "rows": rows}
 
 
