@@ -1,7 +1,5 @@
 """``masonry analyze``: interfaces and rigid block equilibrium of blocks read from files."""
 
-from masonry.params import Params, validate
-
 from .options import (add_analysis_options, add_live_load_options, add_output_options,
                       add_overlap_option,
                       check_print_size, collapse_summary, given_inputs, rbe_summary, summary)
@@ -38,18 +36,15 @@ def register(subparsers):
 
 
 def handle(args, report):
-    # the inputs are checked before any file is read: a placeholder name until then
-    given = given_inputs(args)
-    check_print_size(args, validate(Params.of(scene="assembly", assembly="-", **given)))
-    from masonry.api import assembly_inputs
-    from masonry.pipeline import run  # the whole pipeline: once the options are read
-    from masonry.scenes.imported import load_assembly
+    from masonry.assembly import read_assembly
 
-    scene, source = load_assembly(args.files, supports=args.support,
-                                  support_below=args.support_below, ground=args.ground,
-                                  overlap_tolerance=args.overlap_tolerance)
-    inputs = assembly_inputs(scene.blocks, source, given)  # the options win over a Problem's
-    params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **inputs))
+    # the options are checked before any file is read; they win over a Problem's
+    params, scene, source = read_assembly(
+        args.files, support=args.support, support_below=args.support_below,
+        ground=args.ground, overlap_tolerance=args.overlap_tolerance,
+        inputs=given_inputs(args), check=lambda params: check_print_size(args, params))
+    from masonry.pipeline import run  # the whole pipeline: once the options are read
+
     record = run(params, args.out, analyse=True, force=args.force, scene=scene,
                  source=source)
     report(f"read {scene.blocks.n_blocks} blocks ({source['supports']} supports) from "

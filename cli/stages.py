@@ -1,7 +1,6 @@
 """``masonry stages``: does the structure stand at every stage of its laying (docs/model.md 4.7)?"""
 
 from masonry.errors import ParameterError
-from masonry.params import Params, validate
 
 from .options import (add_analysis_options, add_figure_options, add_model_options,
                       add_overlap_option, add_verbosity, centering_line, given_inputs,
@@ -110,17 +109,14 @@ def _refuse_inapplicable(args):
 
 def handle(args, report):
     _refuse_inapplicable(args)
-    from masonry.scenes.imported import load_assembly
+    from masonry.assembly import read_assembly
     from masonry.stages.run import run_stages, stage_params
 
     if args.files:
-        given = given_inputs(args)
-        validate(Params.of(scene="assembly", assembly="-", **given))  # before any reading
-        scene, source = load_assembly(args.files, supports=args.support,
-                                      support_below=args.support_below, ground=args.ground,
-                                      overlap_tolerance=args.overlap_tolerance)
-        params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly,
-                                    **given))
+        params, scene, source = read_assembly(
+            args.files, support=args.support, support_below=args.support_below,
+            ground=args.ground, overlap_tolerance=args.overlap_tolerance,
+            inputs=given_inputs(args))
         by = args.by or "block"
     else:
         scene = source = None

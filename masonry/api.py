@@ -22,23 +22,21 @@ import numbers
 import os
 from collections.abc import Iterable
 
+from masonry.assembly import read_assembly
 from masonry.errors import MasonryError, NoForcesError, ParameterError
 from masonry.export.csv import HEADERS, column_types, forces_columns, missing_values
-from masonry.parameters import plain
 from masonry.params import (Params, from_preset, names, section_default, structure_id,
                             validate)
 from masonry.pipeline import (Timer, adhesion_of, build_model, centering_of, collapse_of, run,
                               solve)
 from masonry.rbe.boundary import analysis_model
-from masonry.rbe.loads import LOAD_OPTIONS, point_load_spec
+from masonry.rbe.loads import LOAD_OPTIONS
 from masonry.rbe.resultants import interface_resultants
 from masonry.scenes import check_size
-from masonry.scenes.imported import AssemblyError, load_assembly
 from masonry.stages.analysis import STAGE_COLUMNS, analyse_stages
 from masonry.stages.laying import stage_laying
 from masonry.stages.plans import make_plan
 from masonry.stages.run import check_live_load
-from masonry.tolerances import Tolerances
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
@@ -310,7 +308,8 @@ def read(*paths, support=(), support_below=None, ground=False, overlap_tolerance
         size (default :data:`masonry.tolerances.INTERPENETRATION_REL`; docs/assemblies.md).
     **inputs
         Analysis, live-load and output inputs (``mu``, ``density``, ``lateral`` ...);
-        they win over a compas_dem Problem's (:func:`assembly_inputs`).
+        they win over a compas_dem Problem's
+        (:func:`masonry.assembly.assembly_inputs`).
 
     Raises
     ------
@@ -321,49 +320,10 @@ def read(*paths, support=(), support_below=None, ground=False, overlap_tolerance
         ``scene`` (the blocks are the scene).
     """
     supports = _checked_supports(paths, support, support_below, ground, inputs)
-    validate(Params.of(scene="assembly", assembly="-", **inputs))  # before any file is read
-    scene, source = load_assembly(paths, supports=supports,
-                                  support_below=plain(support_below), ground=ground,
-                                  overlap_tolerance=overlap_tolerance)
-    inputs = assembly_inputs(scene.blocks, source, inputs)
-    params = validate(Params.of(scene="assembly", assembly=scene.geometry.assembly, **inputs))
+    params, scene, source = read_assembly(paths, support=supports, support_below=support_below,
+                                          ground=ground, overlap_tolerance=overlap_tolerance,
+                                          inputs=inputs)
     return Structure(params, scene, analysis_model(scene, params.analysis.boundary), source)
-
-
-def assembly_inputs(blocks, source: dict, given: dict) -> dict:
-    """The analysis inputs of read blocks: a compas_dem Problem's (``source["problem"]``,
-    :func:`masonry.scenes.imported.load_assembly`), then ``given`` (the caller's) over
-    them; a live load given drops the Problem's point loads.
-
-    Raises
-    ------
-    masonry.scenes.imported.AssemblyError
-        A point load of the Problem that masonry cannot state, naming the file and load.
-    """
-    problem = (source or {}).get("problem")
-    given = {k: v for k, v in given.items() if v is not None and not (
-        isinstance(v, (list, tuple)) and not v)}
-    if problem is None:
-        return given
-    stated = {"mu": problem["mu"], "density": problem["density"],
-              "cohesion_kpa": _kilo(problem["cohesion_Pa"]),
-              "tensile_kpa": _kilo(problem["tensile_Pa"])}
-    if not any(name in given for name in LOAD_OPTIONS):
-        tol = Tolerances.for_points(blocks.vertices)
-        specs = []
-        for load in problem["point_loads"]:
-            try:
-                specs.append(point_load_spec(blocks, load["block"], load["force"],
-                                             load["point"], tol.length))
-            except ValueError as error:
-                raise AssemblyError(f"{problem['file']}: {load['where']}: {error}; not "
-                                    "supported") from None
-        stated["point_loads"] = tuple(specs)
-    return {**{k: v for k, v in stated.items() if v is not None and v != ()}, **given}
-
-
-def _kilo(pascals):
-    return None if pascals is None else pascals / 1000.0
 
 
 def _checked_supports(paths, support, support_below, ground, inputs) -> tuple:

@@ -21,7 +21,7 @@ STAGES = (
     ("masonry.scenes",),
     ("masonry.interfaces",),
     ("masonry.rbe",),
-    ("masonry.params",),
+    ("masonry.params", "masonry.assembly"),
     ("masonry.printable", "masonry.plots"),
     ("masonry.export",),
     ("masonry.cache", "masonry.pipeline"),
