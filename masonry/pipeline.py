@@ -495,9 +495,7 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
             half = half_model(model, mirrors[0])
         solved = model if half is None else half.model
         problem = RBEProblem(solved.blocks, solved.interfaces, **solved.assembly)
-    options = dict(mu=analysis.mu, density=analysis.density, friction=analysis.friction,
-                   solver=analysis.solver, accuracy=analysis.accuracy,
-                   cone=analysis.friction_cone, **mortar(analysis, model.interfaces))
+    options = dict(**analysis.rbe_options(), **analysis.mortar_on(model.interfaces))
     with timer.stage("solve"):
         result = problem.solve(**options)
         if half is None:
@@ -513,21 +511,13 @@ def solve(model: Model, params: Params, timer: Timer) -> RBEResult:
         return dataclasses.replace(result, solved_on="whole, the half rejected")
 
 
-def mortar(analysis, interfaces) -> dict:
-    """The analyses' keyword arguments of the run's mortar at ``interfaces``: cohesion and
-    tensile strength, pascals, numbers or per vertex where the joint kinds differ
-    (:meth:`~masonry.rbe.settings.Analysis.law_on`)."""
-    law = analysis.law_on(interfaces)
-    return dict(cohesion=law.cohesion_Pa, tensile=law.tensile_Pa)
-
-
 def centering_of(model: Model, params: Params) -> CenteringResult:
     """The centering force of a run's model (docs/model.md 6.10): the least force that
     supports at the blocks' centroids must give for it to stand, under the run's friction
     model. A run computes it when the structure cannot stand."""
     analysis = params.analysis
-    return centering_force(model, mu=analysis.mu, density=analysis.density,
-                           cone=analysis.cone, **mortar(analysis, model.interfaces))
+    return centering_force(model, **analysis.material_options(),
+                           **analysis.mortar_on(model.interfaces))
 
 
 def adhesion_of(model: Model, params: Params, rbe: RBEResult | None = None) -> AdhesionResult:
@@ -538,10 +528,7 @@ def adhesion_of(model: Model, params: Params, rbe: RBEResult | None = None) -> A
     law = analysis.law
     if rbe is not None and rbe.feasible and law.is_dry:
         return stands_dry(model.interfaces, law, analysis.adhesion_tension_ratio)
-    return least_adhesion(model, mu=analysis.mu, density=analysis.density, cone=analysis.cone,
-                          ratio=analysis.adhesion_tension_ratio,
-                          head_ratio=analysis.head_joint_ratio,
-                          support_ratio=analysis.support_joint_ratio)
+    return least_adhesion(model, **analysis.adhesion_options())
 
 
 def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> CollapseResult:
@@ -553,13 +540,13 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     reported on the whole (docs/model.md 6.11), with associated friction."""
     known = True if rbe is not None and rbe.feasible else None
     analysis, load = params.analysis, params.load
-    options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone)
+    options = analysis.material_options()
     symmetry = params.kind.symmetry(params.geometry)
     copies = symmetry.order if symmetry.unit else 1
     if isinstance(load, Lateral) and load.azimuth_deg == "all":
         result = worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
                                mirrors=symmetry.mirrors, dead_load_feasible=known, **options,
-                               **mortar(analysis, model.interfaces))
+                               **analysis.mortar_on(model.interfaces))
         return _checked_collapse(model, params, result, 1, known)
     plane = symmetric_plane(load, symmetry.mirrors)
     if (plane is not None and analysis.friction_law == "associated"
@@ -569,7 +556,7 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     else:
         result = collapse_load(model, load.on(model, analysis.density, copies=copies),
                                dead_load_feasible=known, friction=analysis.friction_law,
-                               **options, **mortar(analysis, model.interfaces))
+                               **options, **analysis.mortar_on(model.interfaces))
     if isinstance(load, Lateral) and load.azimuth_deg != "all":
         result = dataclasses.replace(result, azimuth_deg=float(load.azimuth_deg))
     return _checked_collapse(model, params, result, copies, known)
@@ -589,8 +576,7 @@ def _checked_collapse(model, params, result, copies, known) -> CollapseResult:
         load = Lateral(result.azimuth_deg)
     whole = collapse_load(model, load.on(model, analysis.density, copies=copies),
                           dead_load_feasible=known, friction=analysis.friction_law,
-                          mu=analysis.mu, density=analysis.density, cone=analysis.cone,
-                          **mortar(analysis, model.interfaces))
+                          **analysis.material_options(), **analysis.mortar_on(model.interfaces))
     return dataclasses.replace(whole, azimuth_deg=result.azimuth_deg,
                                azimuths=result.azimuths, solved_on="whole, the half rejected")
 

@@ -133,3 +133,33 @@ class Analysis:
         """The friction model: :attr:`friction_cone`, else the accuracy preset's."""
         return FrictionCone.parse(ACCURACY[self.accuracy].cone if self.friction_cone is None
                                   else self.friction_cone)
+
+    # the analyses' keyword arguments, unpacked here once for every caller
+    def rbe_options(self) -> dict:
+        """The keyword arguments of the rigid block equilibrium
+        (:meth:`masonry.rbe.solve.RBEProblem.solve`,
+        :meth:`masonry.rbe.sequence.StageSequence.solve`): ``mu``, ``density``,
+        ``friction``, ``solver``, ``accuracy`` and ``cone`` (:attr:`friction_cone`: None
+        leaves the preset's), without the mortar (:meth:`mortar_on`)."""
+        return dict(mu=self.mu, density=self.density, friction=self.friction,
+                    solver=self.solver, accuracy=self.accuracy, cone=self.friction_cone)
+
+    def material_options(self) -> dict:
+        """``mu``, ``density`` and ``cone`` (:attr:`cone`): the keyword arguments the
+        centering force, the collapse load factor and the least adhesion share."""
+        return dict(mu=self.mu, density=self.density, cone=self.cone)
+
+    def adhesion_options(self) -> dict:
+        """The keyword arguments of the least adhesion
+        (:func:`masonry.rbe.adhesion.least_adhesion`,
+        :meth:`masonry.rbe.sequence.StageSequence.adhesion`): :meth:`material_options`,
+        the tension ratio and the joint kinds' ratios."""
+        return dict(**self.material_options(), ratio=self.adhesion_tension_ratio,
+                    head_ratio=self.head_joint_ratio, support_ratio=self.support_joint_ratio)
+
+    def mortar_on(self, interfaces) -> dict:
+        """The mortar at ``interfaces`` as the analyses' keyword arguments: ``cohesion``
+        and ``tensile``, pascals, numbers or per vertex where the joint kinds differ
+        (:meth:`law_on`)."""
+        law = self.law_on(interfaces)
+        return dict(cohesion=law.cohesion_Pa, tensile=law.tensile_Pa)

@@ -126,28 +126,12 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
     if len(loose) or len(part.interfaces) == 0:  # no equilibrium: nothing to solve
         row.update(feasible=False, moi=None, moi_factor=None)
     else:
-        analysis = params.analysis
-        options = dict(mu=analysis.mu, density=analysis.density, friction=analysis.friction,
-                       solver=analysis.solver, accuracy=analysis.accuracy,
-                       cone=analysis.friction_cone)
-        if sequence is None:
-            result = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
-                                side_rotation=part.side_rotation).solve(**options, **own)
-        else:
-            result = sequence.solve(plan.is_present(stage), plan.local(stage),
-                                    plan.is_present(plan.course_end(stage)), **options,
-                                    **mortar)
-        row.update(feasible=result.feasible, moi=_number(result.moi),
-                   moi_factor=_number(result.moi_factor))
-        if result.feasible:
-            row["load_factor"] = stage_load_factor(part, params, own)
+        row.update(_equilibrium(part, params, plan, stage, sequence, mortar, own))
     centering = None
     if sequence is not None and not row["feasible"] and not len(loose):
-        analysis = params.analysis
         centering = sequence.centering(plan.is_present(stage), plan.local(stage),
-                                       mu=analysis.mu, density=analysis.density,
-                                       accuracy=analysis.accuracy, cone=analysis.friction_cone,
-                                       **mortar)
+                                       **params.analysis.material_options(),
+                                       accuracy=params.analysis.accuracy, **mortar)
     row.update(stage_centering(part, params, row["feasible"], centering, own))
     dry = not any(np.any(value) for value in mortar.values())
     row.update(stage_adhesion(part, params, plan, stage, row, sequence, dry))
@@ -157,6 +141,26 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
         joints, used = row["adhesion_used"]
         row["adhesion_used"] = (np.flatnonzero(chosen)[joints], used)
     row["solve_s"] = round(time.perf_counter() - start, 4)
+    return row
+
+
+def _equilibrium(part: Model, params, plan: StagePlan, stage: int, sequence, mortar,
+                 own) -> dict:
+    """A stage's ``feasible``, ``moi``, ``moi_factor`` and, where it stands, its
+    ``load_factor``: solved on ``part`` with its joints' strengths ``own``, or by
+    ``sequence`` with the whole model's ``mortar`` (:func:`analyse_stage`)."""
+    options = params.analysis.rbe_options()
+    if sequence is None:
+        result = RBEProblem(part.blocks, part.interfaces, side_block=part.side_block,
+                            side_rotation=part.side_rotation).solve(**options, **own)
+    else:
+        result = sequence.solve(plan.is_present(stage), plan.local(stage),
+                                plan.is_present(plan.course_end(stage)), **options,
+                                **mortar)
+    row = {"feasible": result.feasible, "moi": _number(result.moi),
+           "moi_factor": _number(result.moi_factor)}
+    if result.feasible:
+        row["load_factor"] = stage_load_factor(part, params, own)
     return row
 
 
@@ -182,7 +186,7 @@ def joint_strength(model: Model, params, plan: StagePlan, stage: int,
     """
     factor = params.analysis.joint_factor(model.interfaces)
     if laying is None:
-        return _law_mortar(params, model), None
+        return params.analysis.mortar_on(model.interfaces), None
     if laying.rate_per_hour is None:
         cohesion, tensile = laying.mortar.strength_kPa(0.0)
         return {"cohesion": 1e3 * float(cohesion) * factor,
@@ -241,11 +245,7 @@ def stage_adhesion(part: Model, params, plan: StagePlan, stage: int, row,
         return {"adhesion_kPa": None, "adhesion_joint": None, "adhesion_used": None,
                 "adhesion_reason": "a block touches nothing that joins it to a support: "
                                    "no adhesion holds it"}
-    analysis = params.analysis
-    options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone,
-                   ratio=analysis.adhesion_tension_ratio,
-                   head_ratio=analysis.head_joint_ratio,
-                   support_ratio=analysis.support_joint_ratio)
+    options = params.analysis.adhesion_options()
     if sequence is None:
         result, source = least_adhesion(part, **options), part.block_source
     else:
@@ -297,8 +297,8 @@ def stage_centering(part: Model, params, stands: bool, result=None, mortar=None)
     source = None  # a given result's blocks are the scene's
     if result is None:
         analysis = params.analysis
-        result = centering_force(part, mu=analysis.mu, density=analysis.density,
-                                 cone=analysis.cone, **(mortar or _law_mortar(params, part)))
+        result = centering_force(part, **analysis.material_options(),
+                                 **(mortar or analysis.mortar_on(part.interfaces)))
         source = part.block_source
     return {"centering_N": result.total_N, "centering_fraction": result.fraction,
             "held": result.held_forces(source)}
@@ -322,13 +322,6 @@ def loose_blocks(part: Model) -> np.ndarray:
     return np.unique(source[loose])
 
 
-def _law_mortar(params, model: Model) -> dict:
-    """``params``' contact law at ``model``'s joints as the solvers' keyword arguments
-    (:meth:`~masonry.rbe.settings.Analysis.law_on`)."""
-    law = params.analysis.law_on(model.interfaces)
-    return {"cohesion": law.cohesion_Pa, "tensile": law.tensile_Pa}
-
-
 def stage_load_factor(part: Model, params, mortar=None) -> float | None:
     """The collapse load factor of a stage (docs/model.md 6.8) under the lateral load at
     ``params.lateral`` degrees, built on the stage's own blocks; None without a lateral
@@ -348,9 +341,9 @@ def stage_load_factor(part: Model, params, mortar=None) -> float | None:
         return None
     analysis = params.analysis
     live = params.load.on(part, analysis.density)
-    result = collapse_load(part, live, mu=analysis.mu, density=analysis.density,
-                           cone=analysis.cone, friction=analysis.friction_law,
-                           dead_load_feasible=True, **(mortar or _law_mortar(params, part)))
+    result = collapse_load(part, live, **analysis.material_options(),
+                           friction=analysis.friction_law, dead_load_feasible=True,
+                           **(mortar or analysis.mortar_on(part.interfaces)))
     return result.load_factor
 
 
