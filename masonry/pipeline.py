@@ -311,7 +311,7 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
         Recompute even when the folder holds a complete run of the same input.
     scene : Scene, optional
         An already built scene (``masonry analyze``: blocks read from files, see
-        :func:`masonry.scenes.imported.load_assembly`), used as is instead of building
+        :func:`masonry.assembly.read_assembly`), used as is instead of building
         ``params``, and never cached.
     source : dict, optional
         Where such a scene came from (files, supports), recorded in run.json.

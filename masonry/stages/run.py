@@ -98,7 +98,7 @@ def run_stages(params, out_root="exports", *, by="course", order=None, course=No
     force : bool
         Recompute when the folder holds this input's complete study.
     scene : Scene, optional
-        An already built scene (imported blocks, :func:`masonry.scenes.imported.load_assembly`).
+        An already built scene (imported blocks, :func:`masonry.assembly.read_assembly`).
     source : dict, optional
         Where such a scene came from, recorded in run.json.
     max_bricks : int
