@@ -50,3 +50,19 @@ def test_bad_input_is_one_line_and_exit_2(study, tmp_path, capsys, given, named)
     assert stop.value.code == 2
     assert named in capsys.readouterr().err
     assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("name", ["pattern_search_preset1.toml",
+                                  "pattern_search_hemisphere.toml"])
+def test_the_pattern_searches_are_studies_of_the_whole_construction(name):
+    """The study files of docs/pattern-study.md's search read as studies: a dome of
+    revolution's sector (cyclic), its pattern's three inputs sampled, every brick laid
+    pattern-first."""
+    from masonry.studies.study_file import load_study
+    from masonry_cli.sweep import run_option_names
+
+    study = load_study(EXAMPLE.parent / name, run_option_names(), draws=False)
+    assert set(study.sample) == {"p", "spirals", "helix_angle"}
+    assert study.base["scene"] == "sector" and study.base["boundary"] == "cyclic"
+    assert (study.stages, study.stages_course, study.stages_order) == (
+        "brick", None, "pattern-first")
