@@ -36,6 +36,11 @@ PROFILES = {
 courses whose beds are steeper than about 35 degrees (atan 0.7), where a brick alone
 needs adhesion."""
 
+TITLES = {"preset1": "preset 1, polygonal", "hemisphere": "hemisphere, polygonal",
+          "preset1-revolution": "preset 1, of revolution",
+          "hemisphere-revolution": "hemisphere, of revolution"}
+"""The figure's panel titles (a profile of one's own is titled by its name)."""
+
 PATTERNS = ("herringbone", "none")
 ORDERS = ("pattern-first", "along")
 COLUMNS = ("profile", "pattern", "order", "mu", "course", "adhesion_max_kPa",
@@ -175,7 +180,7 @@ def write(rows, out: Path) -> None:
                 if picked:
                     axis.plot(*_gapped(picked), line, color=colour, markersize=3,
                               label=f"{label}, mu {mu:g}")
-        axis.set_title(profile)
+        axis.set_title(TITLES.get(profile, profile))
         axis.set_xlabel("course laid brick by brick")
         axis.grid(alpha=0.3)
     axes[0][0].set_ylabel("least adhesion over the course's stages, kPa")
