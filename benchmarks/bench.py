@@ -22,20 +22,21 @@ import statistics
 import time
 
 import numpy as np
+from masonry_benchmarks.markdown import markdown_table
 
-from masonry.rbe.boundary import analysis_model
+from masonry.dome.levels import Dimensions
 from masonry.export import force_tables
 from masonry.export.csv import header, interfaces_csv, locations_csv
 from masonry.export.obj import blocks_obj
-from masonry.dome.levels import Dimensions
 from masonry.params import Params, from_preset, validate
 from masonry.pipeline import build_model
-from masonry.scenes import build
+from masonry.rbe.boundary import analysis_model
 from masonry.rbe.collapse import CollapseLP, collapse_on_half
 from masonry.rbe.lateral_search import lateral_azimuths, worst_lateral
 from masonry.rbe.loads import Lateral, lateral
 from masonry.rbe.mirror import half_model
 from masonry.rbe.solve import ACCURACY, RBEProblem
+from masonry.scenes import build
 
 log = logging.getLogger(__name__)
 
@@ -462,12 +463,7 @@ def _search_row(model, symmetry, options, **common) -> dict:
 
 def collapse_markdown(rows) -> str:
     """A Markdown table of collapse bench rows, and what its columns hold."""
-    lines = ["| " + " | ".join(COLLAPSE_COLUMNS) + " |", "|" + "---|" * len(COLLAPSE_COLUMNS)]
-    for row in rows:
-        cells = [f"{row[c]:.4g}" if isinstance(row[c], float) else str(row[c])
-                 for c in COLLAPSE_COLUMNS]
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n\n" + COLLAPSE_NOTE + "\n"
+    return markdown_table(rows, COLLAPSE_COLUMNS, COLLAPSE_NOTE)
 
 
 FRICTION_MODELS = ("circle", "polygon:16", "square")
@@ -548,9 +544,4 @@ def friction_bench(structures, models=FRICTION_MODELS, azimuth=0.0, repeats=1,
 
 def friction_markdown(rows) -> str:
     """A Markdown table of friction-model bench rows, and what its columns hold."""
-    lines = ["| " + " | ".join(FRICTION_COLUMNS) + " |", "|" + "---|" * len(FRICTION_COLUMNS)]
-    for row in rows:
-        cells = ["" if row[c] is None else f"{row[c]:.4g}" if isinstance(row[c], float)
-                 else str(row[c]) for c in FRICTION_COLUMNS]
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n\n" + FRICTION_NOTE + "\n"
+    return markdown_table(rows, FRICTION_COLUMNS, FRICTION_NOTE)

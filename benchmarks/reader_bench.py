@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from masonry_benchmarks.markdown import markdown_table
 
 from masonry.scenes.mesh_files import read_mesh
 
@@ -93,12 +94,7 @@ def _reader_rows(file, times, results, failures) -> list:
 
 def readers_markdown(rows) -> str:
     """A Markdown table of reader bench rows, and what its columns hold."""
-    lines = ["| " + " | ".join(READER_COLUMNS) + " |", "|" + "---|" * len(READER_COLUMNS)]
-    for row in rows:
-        cells = ["" if row[c] is None else f"{row[c]:.3g}" if isinstance(row[c], float)
-                 else str(row[c]) for c in READER_COLUMNS]
-        lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n\n" + READER_NOTE + "\n"
+    return markdown_table(rows, READER_COLUMNS, READER_NOTE, digits=3)
 
 
 def _corner_set(vertices, triangles) -> np.ndarray:

@@ -10,6 +10,8 @@ import statistics
 import tempfile
 import time
 
+from masonry_benchmarks.markdown import markdown_table
+
 from masonry.params import validate
 from masonry.pipeline import build_model, run
 from masonry.rbe.adhesion import INTERIOR, SOLVER
@@ -101,21 +103,10 @@ def _agreement(ours, theirs) -> dict:
 
 def stages_markdown(rows) -> str:
     """The rows as a markdown table, then :data:`STAGES_NOTE`."""
-    return _markdown(rows, STAGES_COLUMNS, {
+    return markdown_table(rows, STAGES_COLUMNS, STAGES_NOTE, formats={
         "moi_factor_diff": "{:.1e}", "sequence_s": "{:.1f}", "alone_s": "{:.1f}",
         "speedup": "{:.2f}", "run_s": "{:.2f}", "sequence_runs": "{:.1f}",
-        "alone_runs": "{:.1f}"}, STAGES_NOTE)
-
-
-def _markdown(rows, columns, formats, note) -> str:
-    """``rows`` as a markdown table of ``columns`` (each cell by its format in
-    ``formats``, else as it is; empty for None), then ``note``."""
-    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
-    for row in rows:
-        lines.append("| " + " | ".join(
-            "" if row.get(c) is None else formats.get(c, "{}").format(row[c])
-            for c in columns) + " |")
-    return "\n".join(lines) + "\n\n" + note + "\n"
+        "alone_runs": "{:.1f}"})
 
 
 ADHESION_COLUMNS = ("structure", "course", "order", "stages", "needing", "rbe_s",
@@ -204,7 +195,7 @@ def _adhesion_stages(sequence, plan, analysis) -> list:
 
 def adhesion_markdown(rows) -> str:
     """The rows as a markdown table, then :data:`ADHESION_NOTE`."""
-    return _markdown(rows, ADHESION_COLUMNS, {
+    return markdown_table(rows, ADHESION_COLUMNS, ADHESION_NOTE, formats={
         "rbe_s": "{:.2f}", "adhesion_s": "{:.2f}", "ratio_median": "{:.2f}",
         "ratio_max": "{:.2f}", "clarabel_s": "{:.2f}", "clarabel_ratio_median": "{:.2f}",
-        "diff_max": "{:.1e}", "adhesion_max_kPa": "{:.4g}"}, ADHESION_NOTE)
+        "diff_max": "{:.1e}", "adhesion_max_kPa": "{:.4g}"})
