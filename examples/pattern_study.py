@@ -163,6 +163,7 @@ def write(rows, out: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     named = {r["profile"] for r in rows}
     profiles = [name for name in PROFILES if name in named] + sorted(named - set(PROFILES))
@@ -182,6 +183,7 @@ def write(rows, out: Path) -> None:
                               label=f"{label}, mu {mu:g}")
         axis.set_title(TITLES.get(profile, profile))
         axis.set_xlabel("course laid brick by brick")
+        axis.xaxis.set_major_locator(MaxNLocator(integer=True))
         axis.grid(alpha=0.3)
     axes[0][0].set_ylabel("least adhesion over the course's stages, kPa")
     axes[0][-1].legend(fontsize=8)
