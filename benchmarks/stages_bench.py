@@ -172,21 +172,19 @@ def adhesion_bench(structures, course, orders=tuple(BRICK_ORDERS), progress=None
 def _adhesion_stages(sequence, plan, analysis) -> list:
     """Per stage that cannot stand dry, in order: ``(RBE s, least adhesion s, Clarabel s,
     a* kPa, Clarabel's a* kPa, solver)``."""
-    options = dict(mu=analysis.mu, density=analysis.density, cone=analysis.cone)
     out = []
     for stage in range(1, plan.n_stages + 1):
         start = time.perf_counter()
         result = sequence.solve(plan.is_present(stage), plan.local(stage),
                                 plan.is_present(plan.course_end(stage)),
-                                friction=analysis.friction, accuracy=analysis.accuracy,
-                                **options)
+                                **analysis.rbe_options())
         solved = time.perf_counter()
         if result.feasible:
             continue
         found, ends = [], []
         for solver in (INTERIOR, SOLVER):
             found.append(sequence.adhesion(plan.is_present(stage), solver=solver,
-                                           ratio=analysis.adhesion_tension_ratio, **options))
+                                           **analysis.adhesion_options()))
             ends.append(time.perf_counter())
         out.append((solved - start, ends[0] - solved, ends[1] - ends[0], found[0].a_kPa,
                     found[1].a_kPa, found[0].solver))

@@ -43,7 +43,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from masonry.contact import TENSION_RATIO, ContactLaw, joint_factor
-from masonry.errors import MasonryError
+from masonry.errors import MasonryError, ParameterError
 from masonry.interfaces import INTERFACE_KINDS
 from masonry.rbe.collapse import friction_columns
 from masonry.rbe.equilibrium import EquilibriumSystem, assemble
@@ -222,7 +222,7 @@ def solve_adhesion(system: EquilibriumSystem, interfaces, *, ratio=TENSION_RATIO
     start = time.perf_counter()
     ratio = check_ratio(ratio)
     if solver not in SOLVERS:
-        raise ValueError(f"solver {solver!r}: expected one of {', '.join(SOLVERS)}")
+        raise ParameterError("solver", solver, f"one of {', '.join(SOLVERS)}")
     system = system.with_material(cohesion=0.0, tensile=0.0)
     area_ref, held = _held(system, interfaces, head_ratio, support_ratio)
     if solver == SOLVER:

@@ -78,8 +78,8 @@ class AdhesionOptions:
         dual rows hold) at most ``gap_tol`` times ``a`` (``gap_floor`` at least).
     reduced : tuple of float
         ``(tol, dual_tol, gap_tol)`` of a point accepted as ``optimal_inaccurate`` where
-        the method cannot go on (a stalled step, a reduced matrix that factors only with
-        a raised shift): near the optimum the scalings span 20 decades and the reduced
+        the method cannot go on (a stalled step, a reduced matrix that does not factor):
+        near the optimum the scalings span 20 decades and the reduced
         matrix loses its small directions (the point is then checked as every other).
     gap_floor : float
         The least ``a`` the gap is relative to (units of ``W_ref / A_ref``).
@@ -105,8 +105,8 @@ class AdhesionOptions:
 
 @dataclass
 class Point:
-    """An iterate: ``x`` (V, 3), ``a``, ``y`` (6 F,), per cone ``s`` and ``z`` (lists of
-    (V, m) arrays: the vertex cones', then ``a >= 0``'s as (1, 1))."""
+    """An iterate: ``x~`` (V, 3), ``a``, ``y`` (6 F,), per cone ``s`` and ``z`` (lists of
+    (V, m) arrays: the friction model's, then the cut-off's where there is one)."""
 
     x: np.ndarray
     a: float
@@ -137,7 +137,7 @@ class _Program:
     every vertex per unit ``a``, ``ratio`` the tension cut-off's ``r``."""
 
     def __init__(self, ns: NewtonSystem, held, ratio):
-        self.ns = ns
+        self.ns, self.held, self.ratio = ns, held, ratio
         self.friction = vertex_cones(ns.components, ns.cone, ns.mu)[0]
         self.shift = held / ns.mu                      # n = n~ - a A_v / mu
         shift = np.zeros((len(held), 3))
@@ -151,7 +151,7 @@ class _Program:
 
     def residuals(self, p: Point):
         """``(r_x, r_a, r_primal, r_cones)``: the dual rows of ``x~`` and ``a``, the
-        equilibrium rows and the cone rows (friction, cut-off, ``a >= 0``)."""
+        equilibrium rows and the cone rows (friction, then cut-off)."""
         ns = self.ns
         r_x = -(ns.AT @ p.y).reshape(p.x.shape) + p.z[0] @ self.friction.G
         r_a = 1.0 - float(self.load @ p.y)
@@ -188,6 +188,9 @@ class _Iterate:
         self.w2_inverse = [w * w if w.ndim == 2 else w @ w for w in w_inverse]
         self.D, self.Dv, self.sigma = _reduced(program, self.scalings, w_inverse,
                                                self.w2_inverse)
+        # v = G_2^T W_2^-2 q: the cut-off's column of a (zero without one)
+        self.v = (np.zeros((program.n, 3)) if program.cutoff is None else
+                  (self.w2_inverse[1] * program.cutoff[:, None]) @ CUTOFF.G)
         self.factor = _factor(ns, self.D, shift)
         self.w = ns.A @ self.Dv.ravel() - program.load
         self.t = None
@@ -255,7 +258,7 @@ class _Iterate:
         rhs_a = qa - float(np.sum(self.Dv * qx))
         dy, da = self._bordered(rhs_y, rhs_a)
         dx = np.einsum("vij,vj->vi", self.D,
-                       qx - da * self._v() + (ns.AT @ dy).reshape(qx.shape))
+                       qx - da * self.v + (ns.AT @ dy).reshape(qx.shape))
         dz = [wq[0] + self._w2i(0, r_cones[0] + dx @ program.friction.G.T)]
         if cut is not None:
             dz.append(wq[1] + self._w2i(1, r_cones[1] + dx @ CUTOFF.G.T
@@ -265,12 +268,6 @@ class _Iterate:
         if cut is not None:
             ds.append(-r_cones[1] - dx @ CUTOFF.G.T - cut[:, None] * da)
         return dx, da, dy, ds, dz
-
-    def _v(self):
-        """``v`` (V, 3): the cut-off's ``G^T W^-2 q`` (zero without one)."""
-        if self.program.cutoff is None:
-            return np.zeros((self.program.n, 3))
-        return (self.w2_inverse[1] * self.program.cutoff[:, None]) @ CUTOFF.G
 
 
 REFINEMENTS = 1
@@ -346,9 +343,9 @@ def _cold(program: _Program, shift) -> Point:
     force = program.physical(Point(x, a, y, [], []))
     margin = START_MARGIN * float(np.sqrt(np.mean(np.sum(force * force, axis=1))))
     a = _least_inside(program, force, margin)
-    p = Point(force, a, y, [], [])
-    p.x[:, 0] += a * program.shift                      # x~ of the physical forces
-    s = program.slacks(p.x, a)
+    x = force.copy()
+    x[:, 0] += a * program.shift                        # x~ of the physical forces
+    s = program.slacks(x, a)
     s = [sb + np.maximum(0.0, margin - cone.min_eigenvalue(sb))[:, None]
          * cone.identity(len(sb)) for cone, sb in zip(cones, s)]
     least = min(float(cone.min_eigenvalue(zb).min()) for cone, zb in zip(cones, z))
@@ -356,7 +353,7 @@ def _cold(program: _Program, shift) -> Point:
     product = sum(float(np.sum(sb * zb)) for sb, zb in zip(s, z))
     trace = sum(cone.trace(sb) for cone, sb in zip(cones, s))
     z = [zb + (0.5 * product / trace) * cone.identity(len(zb)) for cone, zb in zip(cones, z)]
-    return Point(p.x, a, y, s, z)
+    return Point(x, a, y, s, z)
 
 
 START_MARGIN = 0.1
@@ -373,8 +370,7 @@ rows left off: a start at the largest ``a`` took one to three more iterations on
 def _least_inside(program, force, margin) -> float:
     """The least ``a >= 0`` with which the :data:`START_QUANTILE` of the vertices some
     ``a`` helps have their slacks of ``force`` ``margin`` inside their cones."""
-    friction = program.friction
-    held = program.shift * program.ns.mu
+    friction, held = program.friction, program.held
     slack = -(force @ friction.G.T)                      # at a = 0
     rate = -friction.G[:, 0][None, :] * program.shift[:, None]   # d slack / d a
     helped = held > 0
@@ -382,9 +378,9 @@ def _least_inside(program, force, margin) -> float:
         need = np.max((margin - slack) / np.where(rate > 0, rate, np.inf), axis=1)
     else:  # the second-order cone's least eigenvalue grows by rate[:, 0]
         need = (margin - friction.cone.min_eigenvalue(slack)) / np.where(helped, held, np.inf)
-    if program.cutoff is not None:
-        ratio = 1.0 / program.ns.mu - program.cutoff / np.where(helped, held, np.inf)
-        tension = (margin - force[:, 0]) / np.where(helped & (ratio > 0), ratio * held, np.inf)
+    if program.cutoff is not None:  # n + r A_v a >= margin
+        tension = (margin - force[:, 0]) / np.where(helped & (program.ratio > 0),
+                                                     program.ratio * held, np.inf)
         need = np.maximum(need, tension)
     need = need[np.isfinite(need)]
     return max(0.0, float(np.quantile(need, START_QUANTILE))) if len(need) else 0.0
