@@ -113,9 +113,10 @@ def commands(args) -> list:
 def run(args) -> int:
     ledger_path = args.out / "pattern_study.json"
     ledger = json.loads(ledger_path.read_text()) if ledger_path.exists() else {}
-    todo = [(key, argv) for key, argv in commands(args)
+    every = commands(args)
+    todo = [(key, argv) for key, argv in every
             if key not in ledger or not Path(ledger[key]).is_dir()]
-    print(f"{len(commands(args)) - len(todo)} done, {len(todo)} to run", flush=True)
+    print(f"{len(every) - len(todo)} done, {len(todo)} to run", flush=True)
     for number, (key, argv) in enumerate(todo, 1):
         print(f"[{number}/{len(todo)}] {shlex.join(argv)}", flush=True)
         if args.dry_run:
