@@ -5,22 +5,24 @@ import math
 import shlex
 
 from masonry.errors import ParameterError
-from masonry.outputs import DPI_RANGE, FIGURE_FORMATS, PLOTLY_SOURCES, Outputs
+from masonry.outputs import Outputs
 from masonry.parameters import declarations, defaults, read_toml
 from masonry.params import (PRESETS, Params, applies, from_preset, load, names,
                             section_default, validate)
 from masonry.rbe.collapse_result import VERDICTS
-from masonry.rbe.settings import BOUNDARIES, FRICTION_LAWS, FRICTIONS, Analysis
-from masonry.rbe.accuracy import ACCURACY
-from masonry.rbe.solvers import RBE, names as solver_names
+from masonry.rbe.settings import Analysis
 from masonry.scenes import KINDS, kind_of
 from masonry.tolerances import (BYTES_PER_BRICK, INTERPENETRATION_REL, MAX_BRICKS,
                                 OVERLAP_TOLERANCE_RANGE)
 
-ACCURACIES, SOLVERS = tuple(ACCURACY), solver_names(RBE)
-PARTS = (Analysis, Outputs, *(kind.geometry for kind in KINDS.values()))
-"""The declared parts whose defaults and ranges the options' help quotes."""
-DEFAULTS = {name: value for part in PARTS for name, value in defaults(part).items()}
+MATERIAL_OPTIONS = ("mu", "friction_cone", "density", "cohesion_kpa", "tensile_kpa",
+                    "head_joint_ratio", "support_joint_ratio", "adhesion_tension_ratio")
+"""The analysis's inputs of the material (``masonry arch-thickness`` takes these only)."""
+SOLVER_OPTIONS = ("friction", "accuracy", "solver")
+"""The analysis's inputs of the solve; ``boundary`` and ``friction_law`` have groups of
+their own (a section's, a live load's)."""
+FIGURE_OPTIONS = ("figure_format", "dpi")
+"""The outputs' inputs of the figures' files (``masonry stages`` takes these only)."""
 
 
 class Parser(argparse.ArgumentParser):
@@ -28,13 +30,6 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message):
         self.exit(2, f"masonry: error: {' '.join(message.split())}\n")
-
-
-def _range(name) -> str:
-    """``low to high`` of an input, from its declaration."""
-    declaration = next(declarations(part)[name] for part in PARTS
-                       if name in declarations(part))
-    return f"{declaration.low:g} to {declaration.high:g}"
 
 
 def option_names(parser) -> dict:
@@ -157,19 +152,44 @@ def add_scene_options(parser, kinds=None, skip=()):
     for geometry, scenes in groups.items():
         g = parser.add_argument_group(f"{' and '.join(scenes)} scene"
                                       f"{'s' if len(scenes) > 1 else ''}")
-        for name, declaration in declarations(geometry).items():
-            if name in added:
-                continue
-            added.add(name)
-            option = declaration.option or f"--{name.replace('_', '-')}"
-            g.add_argument(option, dest=name, choices=declaration.choices,
+        names = [name for name in declarations(geometry) if name not in added]
+        added.update(names)
+        add_declared_options(g, geometry, names, groups)
+
+
+def add_declared_options(group, part, names, groups=None):
+    """The options of the declared fields ``names`` of ``part`` (a declared dataclass:
+    a scene's geometry, :class:`Analysis`, :class:`Outputs`), each from its declaration
+    (:class:`masonry.parameters.Declaration`): ``--name`` with dashes (or its
+    ``option``), typed by its kind, its values' name its ``metavar`` (else the option's,
+    upper case), its help its ``help`` (else what it is, its range and default); a
+    switch (a boolean) is ``--name`` when it defaults to false, ``--no-name`` when it
+    defaults to true, both when it is optional. ``groups``: geometry -> the scenes that
+    share it, for a scene option's help. A new declared field is an option without a
+    line here."""
+    for name in names:
+        declaration = declarations(part)[name]
+        option = declaration.option or f"--{name.replace('_', '-')}"
+        if declaration.kind == "bool":
+            default = defaults(part)[name]
+            if default is not True:
+                group.add_argument(option, dest=name, action="store_true", default=None,
+                                   help=declaration.help.replace("%", "%%"))
+            if default is not False:
+                group.add_argument(f"--no-{option[2:]}", dest=name, action="store_false",
+                                   default=None,
+                                   help=declaration.off_help.replace("%", "%%"))
+            continue
+        metavar = declaration.metavar or (None if declaration.choices else
+                                          option[2:].replace("-", "_").upper())
+        group.add_argument(option, dest=name, choices=declaration.choices,
                            type={"int": int, "float": float}.get(declaration.kind, str),
-                           metavar=None if declaration.choices else
-                           option[2:].replace("-", "_").upper(),
-                           help=_scene_help(name, declaration, geometry, groups))
+                           action="append" if declaration.repeat else None,
+                           metavar=metavar,
+                           help=_declared_help(name, declaration, part, groups or {}))
 
 
-def _scene_help(name, declaration, geometry, groups) -> str:
+def _declared_help(name, declaration, part, groups) -> str:
     """An option's help from its declaration: what it is, the values it takes, its
     default (and the values of the presets of its scenes), and the other scenes that
     take it."""
@@ -178,15 +198,15 @@ def _scene_help(name, declaration, geometry, groups) -> str:
     else:
         values = "" if declaration.choices else \
             (declaration.expected or declaration._expected()).split(" (")[0] + "; "
-        text = f"{declaration.doc} ({values}default {_text(defaults(geometry)[name])}"
+        text = f"{declaration.doc} ({values}default {_text(defaults(part)[name])}"
         presets = [key for key, inputs in PRESETS.items() if name in inputs
-                   and kind_of(inputs.get("scene", "section")).geometry is geometry]
+                   and kind_of(inputs.get("scene", "section")).geometry is part]
         if len(presets) > 1:
             text += (f"; presets {' / '.join(presets)}: "
                      f"{' / '.join(_text(PRESETS[k][name]) for k in presets)}")
         text += ")"
-    others = [scene for part, scenes in groups.items() if part is not geometry
-              and name in declarations(part) for scene in scenes]
+    others = [scene for geometry, scenes in groups.items() if geometry is not part
+              and name in declarations(geometry) for scene in scenes]
     if others:
         text += f"; also the {', '.join(others)} scenes"
     return text.replace("%", "%%")
@@ -208,27 +228,14 @@ def add_analysis_options(parser, boundary=True):
     """Friction, density and solver options; ``boundary`` adds a section's boundary."""
     g = parser.add_argument_group("analysis")
     add_material_options(g)
-    g.add_argument("--friction", choices=FRICTIONS,
-                   help="net, plus, or auto (net, then plus if infeasible; default)")
-    g.add_argument("--accuracy", choices=ACCURACIES,
-                   help="solver preset: fast, balanced (default; fast with --fast) or "
-                        "accurate (interior point, tight tolerances, LP check); see "
-                        "'masonry bench'")
-    g.add_argument("--solver", choices=SOLVERS,
-                   help="override the preset's QP solver: newton (semismooth Newton, "
-                        "friction-net), interior (own primal-dual interior point, "
-                        "friction+), clarabel (interior point), osqp (ADMM), or "
-                        "clarabel-cvxpy / osqp-cvxpy (through cvxpy, the reference)")
+    add_declared_options(g, Analysis, SOLVER_OPTIONS)
     if boundary:
         add_boundary_options(g)
 
 
 def add_boundary_options(g):
     """``--boundary`` and ``--dome``: what a section's end bricks bear on."""
-    g.add_argument("--boundary", choices=BOUNDARIES,
-                   help="what a section's end bricks bear on: cyclic (its neighbours by "
-                        "exact rotational symmetry: the whole dome; the default), free "
-                        "(nothing: the web alone) or rigid (immovable neighbouring webs)")
+    add_declared_options(g, Analysis, ("boundary",))
     g.add_argument("--dome", action="store_true",
                    help="dome mode, the default of a section: --boundary cyclic")
 
@@ -250,11 +257,7 @@ def add_live_load_options(parser):
     g.add_argument("--crown-load", dest="crown_load", type=float, metavar="NEWTONS",
                    help="domes: a downward load on the top course, shared by brick top "
                         "area (a lantern; a section carries its 1/n share)")
-    g.add_argument("--friction-law", dest="friction_law", choices=FRICTION_LAWS,
-                   help="associated (default: the LP; sliding joints dilate, which can "
-                        "overestimate the factor) or non-associative (an estimate with "
-                        "joints that slide without dilating: friction capacities fixed "
-                        "from the last collapse and solved again)")
+    add_declared_options(g, Analysis, ("friction_law",))
 
 
 def collapse_summary(record, report) -> int:
@@ -292,60 +295,18 @@ def collapse_summary(record, report) -> int:
 
 
 def add_material_options(group):
-    """``--mu``, ``--friction-cone`` and ``--density``, with their ranges and defaults."""
-    group.add_argument("--mu", type=float, help=f"friction coefficient ({_range('mu')}; "
-                                                f"default {DEFAULTS['mu']:g})")
-    group.add_argument("--friction-cone", dest="friction_cone",
-                       metavar="circle|polygon:K|square",
-                       help="friction model: circle (Coulomb's isotropic cone, exact; the "
-                            "default), polygon:K (the inscribed K-sided pyramid, 8 <= K <= "
-                            "256: safe, within 1 - cos(pi/K) of Coulomb; for linear "
-                            "solvers) or square (the thesis's pyramid |f1|, |f2| <= mu c: "
-                            "up to 41 %% more friction than Coulomb, direction dependent; "
-                            "to reproduce the thesis only)")
-    group.add_argument("--density", type=float, help=f"kg/m^3 ({_range('density')}; "
-                                                     f"default {DEFAULTS['density']:g})")
-    group.add_argument("--cohesion-kpa", dest="cohesion_kpa", type=float, metavar="KPA",
-                       help="the mortar's cohesion at every joint, kPa (|f| <= mu n + c A "
-                            "at a vertex of tributary area A; default 0: dry joints)")
-    group.add_argument("--tensile-kpa", dest="tensile_kpa", type=float, metavar="KPA",
-                       help="the mortar's tensile strength at every joint, kPa (n >= -t A; "
-                            "cut off at cohesion/mu; default 0)")
-    group.add_argument("--head-joint-ratio", dest="head_joint_ratio", type=float,
-                       metavar="R", help="head joints hold R times the bed joints' cohesion "
-                                         "and tensile strength (0 to 1; default 1; a "
-                                         "joint between two webs is a head joint)")
-    group.add_argument("--support-joint-ratio", dest="support_joint_ratio", type=float,
-                       metavar="R", help="joints with a support hold R times the bed "
-                                         "joints' strengths (default 1; 0: dry on the "
-                                         "supports)")
-    group.add_argument("--adhesion-tension-ratio", dest="adhesion_tension_ratio", type=float,
-                       metavar="R", help="t_c / c of the least adhesion a structure needs "
-                                         "(c = a, t_c = R a; 0 to 100; default 0.5, "
-                                         "0: no tension)")
+    """The material's options (:data:`MATERIAL_OPTIONS`), with their ranges and
+    defaults."""
+    add_declared_options(group, Analysis, MATERIAL_OPTIONS)
 
 
 def add_output_options(parser):
     g = parser.add_argument_group("output")
     g.add_argument("--out", default="exports", metavar="DIR",
                    help="output root; the run folder is DIR/<structure id> (default exports)")
-    g.add_argument("--no-plots", dest="plots", action="store_false", default=None,
-                   help="skip all plots")
-    g.add_argument("--no-printable", dest="printable", action="store_false", default=None,
-                   help="skip the printable body (dome.stl, dome.obj)")
-    g.add_argument("--html", dest="html", action="store_true", default=None,
-                   help="write dome.html (the bricks in 3D, for a browser) also with "
-                        "--no-plots (default: with the figures)")
-    g.add_argument("--no-html", dest="html", action="store_false", default=None,
-                   help="skip dome.html (default: with the figures)")
-    g.add_argument("--html-plotly", dest="html_plotly", choices=PLOTLY_SOURCES,
-                   help="where dome.html finds plotly.js: shared, one file beside the run "
-                        "folders, written once per --out (the default); inline, inside "
-                        "the page (4.8 MB more), which then opens wherever it is copied")
+    add_declared_options(g, Outputs, [name for name in declarations(Outputs)
+                                      if name not in FIGURE_OPTIONS])
     add_figure_options(g)
-    g.add_argument("--print-size", dest="print_size", type=float, metavar="MM",
-                   help=f"also write dome.3mf for a slicer, in millimetres, its largest "
-                        f"dimension MM ({_range('print_size')}; default: no 3MF)")
     g.add_argument("--force", action="store_true",
                    help="recompute even if the run folder holds this input's results")
     add_verbosity(g)
@@ -353,16 +314,7 @@ def add_output_options(parser):
 
 def add_figure_options(group):
     """``--figure-format`` and ``--dpi``: the files every figure is written as."""
-    group.add_argument("--figure-format", dest="figure_format", action="append",
-                       metavar="|".join(FIGURE_FORMATS),
-                       help="the files of every figure: png (raster), svg or pdf (vector, "
-                            "text as text, for a paper); several separated by commas or "
-                            "the option repeated (default png)")
-    group.add_argument("--dpi", type=int, metavar="N",
-                       help=f"dots per inch of the PNG figures, {DPI_RANGE[0]} to "
-                            f"{DPI_RANGE[1]} (default: each figure's own, 110 for most, "
-                            f"130 to 150 for the pattern, the whole dome and the thrust "
-                            f"line; lower with --fast)")
+    add_declared_options(group, Outputs, FIGURE_OPTIONS)
 
 
 def add_verbosity(parser):

@@ -56,7 +56,14 @@ class Declaration:
         (``--blocks`` for ``arch_blocks``).
     help : str
         The command line's help when it says more than ``doc``, the range and the
-        default.
+        default (of a switch, its option that turns it on).
+    off_help : str
+        The help of a switch's ``--no-`` option (a boolean that defaults to true, or
+        an optional one).
+    metavar : str, optional
+        The command line's name of the value (default: the option's, upper case).
+    repeat : bool
+        The option may be given several times, its values collected in a list.
     """
 
     doc: str
@@ -72,6 +79,9 @@ class Declaration:
     names_geometry: bool = False
     option: str | None = None
     help: str = ""
+    off_help: str = ""
+    metavar: str | None = None
+    repeat: bool = False
 
     def refusal(self, name, value) -> ParameterError | None:
         """The error for ``value`` of parameter ``name``, or None when it is valid."""

@@ -46,36 +46,70 @@ class Analysis:
                              expected="1 to 1e+07 (kg/m^3: forces scale with it exactly; "
                                       "masonry is 1500 to 3000)")
     friction: str = declare("auto", "net | plus | auto (net, then plus if infeasible)",
-                            kind="str", choices=FRICTIONS)
-    friction_cone: str | None = declare(None, "the friction model", kind="any",
-                                        optional=True, tag="cone")
-    accuracy: str = declare("balanced", "solver preset", kind="str",
-                            choices=tuple(ACCURACY), tag="")
-    solver: str | None = declare(None, "a solver in place of the preset's", kind="str",
-                                 choices=names(RBE), optional=True, tag="")
-    boundary: str = declare("free", "what the section's end bricks bear on", kind="str",
-                            choices=BOUNDARIES, tag="b", names_geometry=True)
-    friction_law: str = declare("associated", "of the collapse load factor", kind="str",
-                                choices=FRICTION_LAWS)
-    cohesion_kpa: float = declare(0.0, "kPa, the mortar's cohesion at every joint", low=0.0,
-                                  high=1e6, tag="coh",
-                                  expected="0 to 1e+06 (kPa: fresh mortar 0.1 to a few, "
-                                           "hardened lime mortar 100 to 300)")
-    tensile_kpa: float = declare(0.0, "kPa, the mortar's tensile strength at every joint",
-                                 low=0.0, high=1e6, tag="ten",
-                                 expected="0 to 1e+06 (kPa; cut off at cohesion/mu)")
+                            kind="str", choices=FRICTIONS,
+                            help="net, plus, or auto (net, then plus if infeasible; "
+                                 "default)")
+    friction_cone: str | None = declare(
+        None, "the friction model", kind="any", optional=True, tag="cone",
+        metavar="circle|polygon:K|square",
+        help="friction model: circle (Coulomb's isotropic cone, exact; the default), "
+             "polygon:K (the inscribed K-sided pyramid, 8 <= K <= 256: safe, within "
+             "1 - cos(pi/K) of Coulomb; for linear solvers) or square (the thesis's "
+             "pyramid |f1|, |f2| <= mu c: up to 41 % more friction than Coulomb, "
+             "direction dependent; to reproduce the thesis only)")
+    accuracy: str = declare(
+        "balanced", "solver preset", kind="str", choices=tuple(ACCURACY), tag="",
+        help="solver preset: fast, balanced (default; fast with --fast) or accurate "
+             "(interior point, tight tolerances, LP check); see 'masonry bench'")
+    solver: str | None = declare(
+        None, "a solver in place of the preset's", kind="str", choices=names(RBE),
+        optional=True, tag="",
+        help="override the preset's QP solver: newton (semismooth Newton, friction-net), "
+             "interior (own primal-dual interior point, friction+), clarabel (interior "
+             "point), osqp (ADMM), or clarabel-cvxpy / osqp-cvxpy (through cvxpy, the "
+             "reference)")
+    boundary: str = declare(
+        "free", "what the section's end bricks bear on", kind="str", choices=BOUNDARIES,
+        tag="b", names_geometry=True,
+        help="what a section's end bricks bear on: cyclic (its neighbours by exact "
+             "rotational symmetry: the whole dome; the default), free (nothing: the web "
+             "alone) or rigid (immovable neighbouring webs)")
+    friction_law: str = declare(
+        "associated", "of the collapse load factor", kind="str", choices=FRICTION_LAWS,
+        help="associated (default: the LP; sliding joints dilate, which can overestimate "
+             "the factor) or non-associative (an estimate with joints that slide without "
+             "dilating: friction capacities fixed from the last collapse and solved "
+             "again)")
+    cohesion_kpa: float = declare(
+        0.0, "kPa, the mortar's cohesion at every joint", low=0.0, high=1e6, tag="coh",
+        expected="0 to 1e+06 (kPa: fresh mortar 0.1 to a few, hardened lime mortar 100 "
+                 "to 300)", metavar="KPA",
+        help="the mortar's cohesion at every joint, kPa (|f| <= mu n + c A at a vertex of "
+             "tributary area A; default 0: dry joints)")
+    tensile_kpa: float = declare(
+        0.0, "kPa, the mortar's tensile strength at every joint", low=0.0, high=1e6,
+        tag="ten", expected="0 to 1e+06 (kPa; cut off at cohesion/mu)", metavar="KPA",
+        help="the mortar's tensile strength at every joint, kPa (n >= -t A; cut off at "
+             "cohesion/mu; default 0)")
     head_joint_ratio: float = declare(
         1.0, "head joints' strength over the bed joints'", low=0.0, high=1.0, tag="hj",
         expected="0 to 1 (a fraction of the bed joints' cohesion and tensile strength; "
-                 "EN 1996-1-1 halves the shear strength of unfilled perpends)")
+                 "EN 1996-1-1 halves the shear strength of unfilled perpends)",
+        metavar="R", help="head joints hold R times the bed joints' cohesion and tensile "
+                          "strength (0 to 1; default 1; a joint between two webs is a "
+                          "head joint)")
     support_joint_ratio: float = declare(
         1.0, "the strength of joints with a support over the bed joints'", low=0.0,
         high=1e6, tag="sj", expected="0 to 1e+06 (a factor on the bed joints' cohesion "
-                                     "and tensile strength; 0: dry on its supports)")
+                                     "and tensile strength; 0: dry on its supports)",
+        metavar="R", help="joints with a support hold R times the bed joints' strengths "
+                          "(default 1; 0: dry on the supports)")
     adhesion_tension_ratio: float = declare(
         TENSION_RATIO, "t_c / c of the least adhesion", low=0.0, high=100.0, tag="atr",
         expected="0 to 100 (the least adhesion's tensile strength over its cohesion; "
-                 "0.5 by default, 0: no tension)")
+                 "0.5 by default, 0: no tension)", metavar="R",
+        help="t_c / c of the least adhesion a structure needs (c = a, t_c = R a; 0 to "
+             "100; default 0.5, 0: no tension)")
 
     def checked(self) -> "Analysis":
         """This analysis validated, the friction model in its canonical spelling; raises
