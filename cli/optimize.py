@@ -11,7 +11,7 @@ from masonry.studies.optimize import SAMPLERS, Search
 from masonry.studies.study_file import load_study
 
 from .sweep import (add_cluster_options, check_workers, progress_bar, quiet_progress,
-                    resolve_cluster, run_option_names)
+                    resolve_cluster)
 
 log = logging.getLogger("masonry")
 
@@ -63,7 +63,7 @@ def register(subparsers):
 def handle(args, report):
     check_workers(args)
     check_output_root(args.out)
-    study = load_study(args.study, run_option_names(), draws=False)
+    study = load_study(args.study, draws=False)
     seed = args.seed if args.seed is not None else study.seed
     search = Search(study, tuple(args.objectives), args.trials, seed, args.batch,
                     args.sampler).checked()

@@ -7,7 +7,7 @@ import shlex
 from masonry.errors import ParameterError
 from masonry.outputs import Outputs
 from masonry.parameters import declarations, defaults, read_toml
-from masonry.params import (PRESETS, Params, applies, from_preset, load, names,
+from masonry.params import (PRESETS, Params, applies, from_preset, load, names, option_of,
                             section_default, validate)
 from masonry.rbe.collapse_result import VERDICTS
 from masonry.rbe.settings import Analysis
@@ -250,7 +250,7 @@ def add_live_load_options(parser):
                         "dome's symmetry directions for the worst and refines it "
                         "between them (Brent's method, to 1e-7 of lambda; not on a "
                         "cyclic section: use --scene dome)")
-    g.add_argument("--point-load", dest="point_loads", action="append",
+    g.add_argument(f"--{option_of('point_loads')}", dest="point_loads", action="append",
                    metavar="NAME_OR_PATTERN:FX,FY,FZ",
                    help="force in newtons at the centre of the top face of every block "
                         "the name or fnmatch pattern matches (repeatable)")

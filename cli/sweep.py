@@ -7,12 +7,10 @@ from pathlib import Path
 
 from masonry.errors import ParameterError
 from masonry.optional import optional_import
-from masonry.params import names
 from masonry.runfolder import check_output_root, check_study_folder
-from masonry.studies.study_file import FIGURE_OUTPUTS, load_study
+from masonry.studies.study_file import load_study
 
-from . import run as run_command
-from .options import Parser, add_verbosity
+from .options import add_verbosity
 
 log = logging.getLogger("masonry")
 
@@ -84,26 +82,6 @@ def resolve_cluster(args, bricks):
     return workers, scheduler
 
 
-def run_option_names() -> dict:
-    """``masonry run``'s long option names (dashes or underscores) -> ``(destination,
-    input)``: the Params field it sets, and whether it is a run's input (``--dome`` is:
-    the boundary; ``--out``, ``--force``, and ``--no-plots``, whose value would read
-    backwards, are not): the ``options`` a study file is read with
-    (:func:`masonry.studies.study_file.load_study`)."""
-    parser = Parser(prog="masonry")
-    run_command.register(parser.add_subparsers())
-    run_parser = parser._subparsers._group_actions[0].choices["run"]
-    inputs = {"scene", "fast", "dome", *names()} - {*FIGURE_OUTPUTS}
-    found = {}
-    for action in run_parser._actions:
-        is_input = action.dest in inputs and action.const is not False
-        for option in action.option_strings:
-            if option.startswith("--"):
-                long = option[2:]
-                found[long] = found[long.replace("-", "_")] = (action.dest, is_input)
-    return found
-
-
 def progress_bar(done, total, failed):
     """One line on stderr, redrawn: the variants done of ``total``, and failed ones."""
     width = 30
@@ -130,7 +108,7 @@ def quiet_progress(show: bool):
 def handle(args, report):
     check_workers(args)
     check_output_root(args.out)
-    study = load_study(args.study, run_option_names())
+    study = load_study(args.study)
     from masonry.studies.sweep import execute, publish_summary, summary_rows
     from masonry.studies.workers import estimated_bricks
 

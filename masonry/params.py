@@ -42,10 +42,14 @@ WRITTEN_OUTPUTS = ("plots", "printable", "html")
 """The outputs a run writes or not, recorded in ``run.json``'s ``outputs`` (what the run
 wrote), not among its parameters."""
 
-FILE_OUTPUTS = (*WRITTEN_OUTPUTS, "quick", "print_size", "figure_format", "dpi",
-                "html_plotly")
-"""Inputs that choose files, not results: a folder whose run differs only in them holds
-the same input (not in the structure id)."""
+FILE_OUTPUTS = tuple(name for name, declaration in declarations(Outputs).items()
+                     if declaration.tag is None)
+"""Inputs that choose files, not results (the outputs without a tag in the structure id):
+a folder whose run differs only in them holds the same input; a study chooses them once
+for every variant, in its ``[outputs]`` table."""
+
+LOAD_SPELLINGS = {"point_loads": "point-load"}
+"""The load options spelled otherwise than their input: one point load per option."""
 
 @dataclass(frozen=True)
 class Params:
@@ -129,6 +133,19 @@ def names(kind=None) -> dict:
     return {**geometry, **dict.fromkeys(declarations(Analysis), "analysis"),
             **dict.fromkeys(LOAD_OPTIONS, "load"),
             **dict.fromkeys(declarations(Outputs), "outputs")}
+
+
+def option_of(name: str) -> str:
+    """The command line's option of input ``name`` (:func:`names`), without its dashes:
+    its declaration's ``option`` (``arch_blocks`` -> ``blocks``), a load's spelling
+    (:data:`LOAD_SPELLINGS`), else the name with dashes (``cohesion_kpa`` ->
+    ``cohesion-kpa``)."""
+    if name in LOAD_SPELLINGS:
+        return LOAD_SPELLINGS[name]
+    parts = (*(kind.geometry for kind in KINDS.values()), Analysis, Outputs)
+    option = next((declarations(part)[name].option for part in parts
+                   if name in declarations(part)), None)
+    return option[2:] if option else name.replace("_", "-")
 
 
 def input_dtypes() -> dict:

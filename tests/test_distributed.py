@@ -137,10 +137,9 @@ def test_a_worker_killed_mid_study_loses_nothing(cluster, serial, tmp_path):
     from masonry.studies.sweep import execute, publish_summary, summary_rows
 
     from masonry.studies.study_file import load_study
-    from masonry_cli.sweep import run_option_names
 
     study_file, expected = serial
-    study = load_study(study_file, run_option_names())
+    study = load_study(study_file)
     client = cluster.client(2)
     try:
         pids = client.run(os.getpid)

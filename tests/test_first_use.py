@@ -80,12 +80,14 @@ def test_a_lateral_load_on_the_default_section_names_the_scene_that_takes_it(
 
 
 @pytest.mark.parametrize("table, key, value, expected", [
-    ("base", "no-plots", "true", "the figures are chosen in the [outputs] table "
-                                 "(plots = false)"),
-    ("base", "no-printable", "true", "the printable body is chosen in the [outputs] table "
-                                     "(printable = false)"),
+    ("base", "no-plots", "true", "the [outputs] table chooses it for all variants "
+                                 "(outputs.plots)"),
+    ("base", "no-printable", "true", "the [outputs] table chooses it for all variants "
+                                     "(outputs.printable)"),
+    ("grid", "dpi", "[100, 200]", "the [outputs] table chooses it for all variants "
+                                  "(outputs.dpi)"),
     ("base", "out", '"x"', "the study's output root is masonry sweep's --out"),
-    ("grid", "force", "[true]", "not an option of the command"),
+    ("grid", "force", "[true]", "not an option of the command)"),
 ])
 def test_a_study_table_refuses_a_run_option_that_is_no_input(tmp_path, capsys, table, key,
                                                              value, expected):

@@ -216,11 +216,10 @@ def test_columns_are_named_as_summary_csv_names_them(tmp_path):
     from masonry.studies.optimize import Search
 
     from masonry.studies.study_file import load_study
-    from masonry_cli.sweep import run_option_names
 
     path = tmp_path / "named.toml"
     path.write_text(ARCHES + "[constraints]\nmoi_N = [0, 1e6]\n")
-    study = load_study(path, run_option_names(), draws=False)
+    study = load_study(path, draws=False)
     assert study.constraints == {"moi": [0, 1e6]}
     search = Search(study, (("moi_N", "minimize"), ("bricks", "maximize"))).checked()
     assert search.objectives == (("moi", "minimize"), ("bricks", "maximize"))

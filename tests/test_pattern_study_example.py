@@ -59,9 +59,8 @@ def test_the_pattern_searches_are_studies_of_the_whole_construction(name):
     revolution's sector (cyclic), its pattern's three inputs sampled, every brick laid
     pattern-first."""
     from masonry.studies.study_file import load_study
-    from masonry_cli.sweep import run_option_names
 
-    study = load_study(EXAMPLE.parent / name, run_option_names(), draws=False)
+    study = load_study(EXAMPLE.parent / name, draws=False)
     assert set(study.sample) == {"p", "spirals", "helix_angle"}
     assert study.base["scene"] == "sector" and study.base["boundary"] == "cyclic"
     assert (study.stages, study.stages_course, study.stages_order) == (

@@ -259,11 +259,10 @@ def test_the_pattern_figure_says_there_is_none():
 def test_a_study_and_the_python_interface_take_the_pattern(tmp_path):
     import masonry
     from masonry.studies.study_file import load_study
-    from masonry_cli.sweep import run_option_names
 
     path = tmp_path / "study.toml"
     path.write_text('[base]\npreset = 1\n[grid]\npattern = ["herringbone", "none"]\n')
-    study = load_study(path, run_option_names())
+    study = load_study(path)
     assert [v["pattern"] for v in study.variants()] == ["herringbone", "none"]
     structure = masonry.build(preset="1", pattern="none")
     assert structure.id.endswith("_patnone")

@@ -138,10 +138,8 @@ def test_samples_are_seeded_and_bad_names_refused(tmp_path, capsys):
     path = tmp_path / "sampled.toml"
     path.write_text(STUDY + "\n[sample]\ncount = 2\nseed = 3\ndensity = [1000.0, 3000.0]\n")
     from masonry.studies.study_file import load_study
-    from masonry_cli.sweep import run_option_names
 
-    options = run_option_names()
-    first, again = load_study(path, options).variants(), load_study(path, options).variants()
+    first, again = load_study(path).variants(), load_study(path).variants()
     assert first == again and len(first) == 8
     assert all(1000 <= v["density"] <= 3000 for v in first)
     # steps of 1 for a range 2000 wide: three digits finer than its width

@@ -444,10 +444,12 @@ def draw_best(search: Search, rows, out_root) -> list:
     """
     from masonry.studies.sweep import run_variant
 
+    options = search.study.options()
+    options["outputs"] = {**options["outputs"], "plots": True}
     out = []
     for row in (r for r in rows if r["best"]):
         inputs = {**search.study.base, **{k: row[k] for k in search.inputs}}
-        out.append(run_variant(inputs, out_root, **{**search.study.options(), "plots": True}))
+        out.append(run_variant(inputs, out_root, **options))
     return out
 
 

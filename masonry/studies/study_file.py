@@ -2,10 +2,10 @@
 tables checked, one line naming the file and the table and key at fault, into a
 :class:`masonry.studies.sweep.Study` (docs/cli.md, "Parameter studies").
 
-The file names its inputs as 'masonry run' options without their dashes; the command
-line gives the options it declares (:func:`load_study`'s ``options``). Every variant is
-checked as ``masonry run`` (and, for a study of stages, ``masonry stages``) checks its
-inputs before anything runs.
+The file names its inputs as 'masonry run' options without their dashes, the names that
+follow from their declarations (:func:`masonry.params.option_of`): a new declared input
+is a study's key without a line here. Every variant is checked as ``masonry run`` (and,
+for a study of stages, ``masonry stages``) checks its inputs before anything runs.
 """
 
 import dataclasses
@@ -15,29 +15,54 @@ from masonry.errors import ParameterError
 from masonry.mortars import LAYING_INPUTS, split_laying
 from masonry.outputs import Outputs, figure_formats
 from masonry.parameters import declarations, read_toml
-from masonry.params import MORTAR_KEYS, PRESETS, Params, validate
+from masonry.params import (FILE_OUTPUTS, MORTAR_KEYS, PRESETS, Params, names, option_of,
+                            validate)
 from masonry.stages.laying import stage_laying
 from masonry.stages.orders import BLOCK_ORDERS, BRICK_ORDERS
 
 
 NOT_AN_INPUT = {
-    "plots": "an input of each variant: the figures are chosen in the [outputs] table "
-             "(plots = false)",
-    "printable": "an input of each variant: the printable body is chosen in the [outputs] "
-                 "table (printable = false)",
-    "html": "an input of each variant: dome.html is chosen in the [outputs] table "
-            "(html = false)",
-    "html_plotly": "an input of each variant: where dome.html finds plotly.js is chosen "
-                   "in the [outputs] table (html_plotly = \"inline\")",
-    "figure_format": "an input of each variant: the figures' formats are chosen in the "
-                     "[outputs] table (figure_format = [\"png\", \"pdf\"])",
-    "dpi": "an input of each variant: the figures' resolution is chosen in the [outputs] "
-           "table (dpi = 300)",
     "out": "an input of each variant: the study's output root is masonry sweep's --out",
     "preset": "an input of [base] (preset = 3), not of another table",
     "params": "an input of each variant: a study names the inputs themselves",
 }
-"""Why a study table refuses a run option that is not an input, by its destination."""
+"""Why a study table refuses an option of 'masonry run' that is not an input."""
+
+SHORTHANDS = ("scene", "fast", "dome")
+"""Study keys that are no declared input, as 'masonry run' has them: the scene, the fast
+preset, and ``dome`` (the boundary: true is cyclic, false free)."""
+
+STAGE_OUTPUTS = ("stages", "stages_course", "stages_order")
+"""The ``[outputs]`` keys of a study of stages (:func:`_stage_outputs`)."""
+
+
+def _spellings(name) -> set:
+    """The keys that name input ``name``: it and its option, with dashes or
+    underscores."""
+    option = option_of(name)
+    return {name, option, option.replace("-", "_")}
+
+
+def input_keys() -> dict:
+    """The keys of a study's ``[base]``, ``[grid]`` and ``[sample]`` -> the input each
+    gives: every input of a run (:func:`masonry.params.names`) but the outputs that
+    ``[outputs]`` chooses (:data:`~masonry.params.FILE_OUTPUTS`), the
+    :data:`SHORTHANDS` and a stage study's mortar by age, each spelled as its name or as
+    its 'masonry run' option without the dashes."""
+    return {key: name for name in (*SHORTHANDS, *names(), *LAYING_INPUTS)
+            if name not in FILE_OUTPUTS for key in _spellings(name)}
+
+
+def output_keys() -> dict:
+    """The spellings of the outputs ``[outputs]`` chooses (their names, options and a
+    switch's ``no-`` option) -> the output, which the other tables refuse by name."""
+    keys = {}
+    for name in FILE_OUTPUTS:
+        for key in _spellings(name):
+            keys[key] = name
+            if declarations(Outputs)[name].kind == "bool":
+                keys[f"no-{key}"] = keys[f"no_{key}"] = name
+    return keys
 
 
 TABLES = ("base", "grid", "sample", "mortar", "outputs", "constraints")
@@ -45,12 +70,9 @@ MAX_VARIANTS = 100_000
 """Largest study (grid points times samples): a study file asking for more is refused."""
 
 
-def load_study(path, options, draws=True):
-    """Read a study file; names are 'masonry run' options without their dashes.
-
-    ``options``: 'masonry run''s long options (with dashes or underscores, without the
-    leading ``--``) -> ``(Params field, whether it is a run's input)``, as the command
-    line declares them (``masonry_cli.sweep.run_option_names``). ``draws``: the
+def load_study(path, draws=True):
+    """Read a study file; names are 'masonry run' options without their dashes
+    (:func:`input_keys`, :func:`output_keys`). ``draws``: the
     ``[sample]`` ranges are drawn ``count`` times (a sweep: ``count`` required with them);
     False for an optimisation, which searches them.
 
@@ -100,24 +122,20 @@ def load_study(path, options, draws=True):
     size = math.prod(len(v) for v in grid.values()) * max(count, 1)
     if size > MAX_VARIANTS and draws:
         refuse("grid", f"{size} variants", f"at most {MAX_VARIANTS} variants")
-    names = {**options, **{spelling: (name, True) for name in LAYING_INPUTS
-                                      for spelling in (name, name.replace("_", "-"))}}
     from masonry.studies.sweep import Study  # the pipeline: once the file is read
 
-    tables = {"base": _fields(base, "base", names, where),
-              "grid": _fields(grid, "grid", names, where, lists=True),
-              "sample": _fields(sample, "sample", names, where), "mortar": mortar}
+    tables = {"base": _fields(base, "base", where),
+              "grid": _fields(grid, "grid", where, lists=True),
+              "sample": _fields(sample, "sample", where), "mortar": mortar}
     _check_laying(tables, stages, where)
     study = Study(
         base={**(PRESETS[str(preset)] if preset is not None else {}), **tables["base"],
               **mortar},
         grid=tables["grid"], sample=tables["sample"], count=count, seed=seed,
-        plots=outputs.get("plots", False), printable=outputs.get("printable", False),
-        html=outputs.get("html"), constraints=constraints, **stages,
-        **_figure_outputs(outputs, refuse))
+        outputs={**Study.outputs_default(), **_outputs_table(outputs, refuse)},
+        constraints=constraints, **stages)
     study = _checked_constraints(study, where)
-    _check_variants(study, where, options, None if draws else _search_probes(study),
-                    mortar)
+    _check_variants(study, where, None if draws else _search_probes(study), mortar)
     return study
 
 
@@ -206,38 +224,30 @@ def _stage_plans() -> dict:
     return {"course": (), "brick": BRICK_ORDERS, "block": BLOCK_ORDERS}
 
 
-FIGURE_OUTPUTS = ("figure_format", "dpi", "html_plotly")
-"""The ``[outputs]`` keys of the figures' and the page's files, checked by their declarations
-(:class:`masonry.outputs.Outputs`)."""
-
-
-def _figure_outputs(outputs, refuse) -> dict:
-    """``[outputs] figure_format`` (a name or a list of names) and ``dpi``, checked as
-    ``masonry run`` checks its options; returns :class:`Study`'s fields they give."""
+def _outputs_table(outputs, refuse) -> dict:
+    """``[outputs]``'s outputs (:data:`~masonry.params.FILE_OUTPUTS`), each checked by its
+    declaration (:class:`masonry.outputs.Outputs`) as ``masonry run`` checks its option;
+    a key of neither them nor :data:`STAGE_OUTPUTS` is refused. Returns them by name."""
     given = {}
-    for key in FIGURE_OUTPUTS:
-        if key in outputs:
-            value = figure_formats(outputs[key]) if key == "figure_format" else outputs[key]
-            error = declarations(Outputs)[key].refusal(key, value)
-            if error is not None:
-                refuse(f"outputs.{key}", outputs[key], error.expected)
-            given[key] = value
+    for key, value in outputs.items():
+        if key in STAGE_OUTPUTS:
+            continue
+        name = key.replace("-", "_")
+        if name not in FILE_OUTPUTS:
+            refuse(f"outputs.{key}", value, f"one of {', '.join(FILE_OUTPUTS)}, "
+                                            f"{', '.join(STAGE_OUTPUTS)}")
+        value = figure_formats(value) if name == "figure_format" else value
+        error = declarations(Outputs)[name].refusal(name, value)
+        if error is not None:
+            refuse(f"outputs.{key}", outputs[key], error.expected)
+        given[name] = value
     return given
 
 
 def _stage_outputs(outputs, refuse) -> dict:
-    """The ``[outputs]`` table checked: ``plots``, ``printable``, ``html`` (true or
-    false) and a stage study's ``stages`` (``course``, ``brick`` or ``block``),
-    ``stages_course`` (the course of ``brick``; none: every course) and ``stages_order``; returns
-    :class:`Study`'s ``stages*``."""
-    for key, value in outputs.items():
-        if key in ("plots", "printable", "html"):
-            if not isinstance(value, bool):
-                refuse(f"outputs.{key}", value, "true or false")
-        elif key not in ("stages", "stages_course", "stages_order", *FIGURE_OUTPUTS):
-            refuse(f"outputs.{key}", value, "plots, printable, html, figure_format, dpi, "
-                                            "html_plotly, stages, stages_course or "
-                                            "stages_order")
+    """A stage study's ``[outputs]`` checked: ``stages`` (``course``, ``brick`` or
+    ``block``), ``stages_course`` (the course of ``brick``; none: every course) and
+    ``stages_order``; returns :class:`Study`'s ``stages*``."""
     by, course = outputs.get("stages"), outputs.get("stages_course")
     order = outputs.get("stages_order")
     if by is None:
@@ -263,7 +273,7 @@ def _stage_outputs(outputs, refuse) -> dict:
     return {"stages": by, "stages_course": course, "stages_order": order}
 
 
-def _check_variants(study, where, options, variants=None, mortar=()):
+def _check_variants(study, where, variants=None, mortar=()):
     """Every variant's inputs (or ``variants``) checked as ``masonry run`` (and for a
     study of stages ``masonry stages``, its mortar by age too) checks them, before any
     runs: a value out of range names the table and key it came from (the input refused,
@@ -285,7 +295,7 @@ def _check_variants(study, where, options, variants=None, mortar=()):
                       "base": study.base}
             table, name = next(((t, n) for n in names for t in tables if n in tables[t]),
                                (None, error.name))
-            key = name if table == "mortar" else _option_of(name, options)
+            key = name if table == "mortar" else option_of(name)
             raise ParameterError(f"{table}.{key}" if table else f"{key} (the default)",
                                  inputs.get(name, error.value), error.expected,
                                  where=where) from None
@@ -294,28 +304,21 @@ def _check_variants(study, where, options, variants=None, mortar=()):
                                  f"{params.scene} is not laid in courses", where=where)
 
 
-def _option_of(field: str, options) -> str:
-    """The 'masonry run' option (without dashes) a study names a Params field by
-    (``arch_thickness`` -> ``thickness``), of ``options`` (:func:`load_study`)."""
-    spelled = {}
-    for option, (dest, _) in options.items():
-        spelled.setdefault(dest, option)
-    return spelled.get(field, field.replace("_", "-"))
-
-
-def _fields(table, name, names, where, lists=False) -> dict:
-    """A study table's 'masonry run' option names -> Params fields (``dome`` is the
+def _fields(table, name, where, lists=False) -> dict:
+    """A study table's keys (:func:`input_keys`) -> the inputs they give (``dome`` is the
     boundary: true is cyclic); ``lists``: the values are lists of values."""
+    inputs, outputs = input_keys(), output_keys()
     out = {}
     for key, value in table.items():
-        if key not in names:
-            raise ParameterError(f"{name}.{key}", value, "a 'masonry run' option (without "
-                                 "its dashes)", where=where)
-        dest, is_input = names[key]
-        if not is_input:
+        if key in outputs:
+            raise ParameterError(f"{name}.{key}", value, f"an input of each variant: the "
+                                 f"[outputs] table chooses it for all variants "
+                                 f"(outputs.{outputs[key]})", where=where)
+        if key not in inputs:
             raise ParameterError(f"{name}.{key}", value, NOT_AN_INPUT.get(
-                dest, "an input of each variant, not an option of the command"),
-                where=where)
+                key, "an input of each variant, named as its 'masonry run' option "
+                     "without the dashes (not an option of the command)"), where=where)
+        dest = inputs[key]
         if dest == "dome":
             def boundary(flag):
                 if not isinstance(flag, bool):

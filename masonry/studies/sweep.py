@@ -31,6 +31,7 @@ from masonry.export.columns import COLUMNS, RUN_COLUMNS, column_names, summary_r
 from masonry.export.csv import HEADERS, header
 from masonry.errors import ParameterError
 from masonry.mortars import LAYING_INPUTS, split_laying
+from masonry.outputs import Outputs
 from masonry.params import Params, geometry_key, names, validate
 from masonry.pipeline import run, versions
 from masonry.stages.records import (STAGE_SUMMARY_COLUMNS, STANDS_THROUGHOUT,
@@ -81,6 +82,10 @@ def column_key(name: str) -> str:
     return {column: key for key, column in HEADERS.items()}.get(name, name)
 
 
+STUDY_OUTPUTS = {"plots": False, "printable": False}
+"""What every variant of a study writes unless the study's ``[outputs]`` says otherwise:
+no figures (and so no ``dome.html``) and no printable body, the files a study of many
+variants does not read."""
 
 SAMPLE_DIGITS = 3
 """A float drawn from a ``[sample]`` range (a sweep's draw, an optimisation's trial) lies
@@ -119,12 +124,13 @@ class Study:
         Inputs drawn uniformly at random, ``count`` draws (integers where both bounds are
         integers), seeded by ``seed``; combined with every grid point.
     count, seed : int
-    analyse, plots, printable, html : bool
-        What each run does and writes (defaults: solve, no plots, no printable body,
-        ``dome.html`` with the plots; ``html`` None: with the plots).
-    figure_format, dpi, html_plotly :
-        The figures' files and where ``dome.html`` finds plotly.js
-        (:class:`masonry.outputs.Outputs`).
+    analyse : bool
+        Whether each run solves.
+    outputs : dict
+        What each run writes: the outputs a study chooses for all its variants
+        (:data:`~masonry.params.FILE_OUTPUTS`, as :class:`masonry.outputs.Outputs` takes
+        them; :data:`STUDY_OUTPUTS` unless given: no plots, no printable body, and
+        ``dome.html`` with the plots).
     stages : str or None
         Also a stage study of every variant (:func:`masonry.stages.run.run_stages`),
         laid by ``course``, ``brick`` or ``block``; its results add
@@ -148,12 +154,7 @@ class Study:
     count: int = 0
     seed: int = 0
     analyse: bool = True
-    plots: bool = False
-    printable: bool = False
-    html: bool | None = None
-    figure_format: tuple = ("png",)
-    dpi: int | None = None
-    html_plotly: str = "shared"
+    outputs: dict = dataclasses.field(default_factory=lambda: dict(STUDY_OUTPUTS))
     stages: str | None = None
     stages_course: int | None = None
     stages_order: str | None = None
@@ -177,9 +178,12 @@ class Study:
         """:func:`run_variant`'s keyword arguments: what each variant does and writes."""
         stages = None if self.stages is None else {
             "by": self.stages, "course": self.stages_course, "order": self.stages_order}
-        return dict(analyse=self.analyse, plots=self.plots, printable=self.printable,
-                    html=self.html, figure_format=self.figure_format, dpi=self.dpi,
-                    html_plotly=self.html_plotly, stages=stages)
+        return dict(analyse=self.analyse, outputs=self.outputs, stages=stages)
+
+    @staticmethod
+    def outputs_default() -> dict:
+        """:data:`STUDY_OUTPUTS`, what a study writes unless its ``[outputs]`` says."""
+        return dict(STUDY_OUTPUTS)
 
     def variants(self) -> list:
         """One dict of inputs per variant (base, then grid point, then sample).
@@ -239,9 +243,7 @@ class Study:
         return all(v == 0.0 for v in self.violations(row).values())
 
 
-def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=False,
-                html=None, stages=None, figure_format=("png",), dpi=None,
-                html_plotly="shared") -> dict:
+def run_variant(inputs: dict, out_root, analyse=True, outputs=None, stages=None) -> dict:
     """Run one variant (and its stage study); never raises: a failure becomes a row with
     its error.
 
@@ -252,12 +254,11 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
         by age (:func:`~masonry.mortars.split_laying`).
     out_root : str or Path
         The study's output root; the variant's run folder is named by its structure id.
-    analyse, plots, printable, html : bool
-        What the run does and writes (:func:`masonry.pipeline.run`; ``plots``,
-        ``printable`` and ``html`` unless the variant's inputs say otherwise).
-    figure_format, dpi, html_plotly :
-        The figures' formats and resolution, and where ``dome.html`` finds plotly.js
-        (:class:`masonry.outputs.Outputs`).
+    analyse : bool
+        Whether the run solves (:func:`masonry.pipeline.run`).
+    outputs : dict, optional
+        What the run writes (:class:`masonry.outputs.Outputs`' inputs by name; None:
+        :data:`STUDY_OUTPUTS`).
     stages : dict or None
         ``by``, ``course`` and ``order`` of a stage study of the variant
         (:func:`masonry.stages.run.run_stages`, in its own run folder; a section
@@ -278,9 +279,7 @@ def run_variant(inputs: dict, out_root, analyse=True, plots=False, printable=Fal
     row = {"status": "failed", "error": ""}
     inputs, laying = split_laying(inputs)
     try:
-        params = validate(Params.of(**{"plots": plots, "printable": printable,
-                                       "html": html, "figure_format": figure_format,
-                                       "dpi": dpi, "html_plotly": html_plotly, **inputs}))
+        params = validate(Params.of(**{**STUDY_OUTPUTS, **(outputs or {}), **inputs}))
         record = run(params, out_root, analyse=analyse)
         staged = None if stages is None else run_stages(
             stage_params(params, "boundary" in inputs), out_root, **stages, **laying)
@@ -573,7 +572,7 @@ def summary_figures(study: Study, rows, label="") -> dict:
     fixed = _fixed_inputs(study)
     title = (f"{label + ': ' if label else ''}{len(rows) - failed} variants ({failed} "
              f"failed)" + (f"\nfixed: {fixed}" if fixed else ""))
-    return figures(study.swept, rows, title, Render(tuple(study.figure_format), study.dpi))
+    return figures(study.swept, rows, title, Render.of(Outputs(**study.outputs)))
 
 
 def _fixed_inputs(study: Study) -> str:
