@@ -14,6 +14,11 @@ PLOTLY_SOURCES = ("shared", "inline")
 output root (:data:`masonry.export.html.PLOTLY_FILE`), written once for all of them;
 ``inline``, inside the page (4.8 MB), which then opens wherever it is copied."""
 
+WRITTEN_OUTPUTS = ("plots", "printable", "html")
+"""The switches of files a run writes or not (each the ``output`` of its exporters'
+rows, :data:`masonry.export.EXPORTERS`): ``run.json``'s ``outputs`` records them as what
+the run wrote, not among its parameters."""
+
 DPI_RANGE = (50, 600)
 """Resolutions a raster figure may ask for: below 50 dpi a figure's labels do not read,
 600 dpi is what a printer prints (a 7 inch figure 4,200 pixels wide)."""

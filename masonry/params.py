@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from masonry.errors import ParameterError
 from masonry.mortars import LAYING_INPUTS
-from masonry.outputs import Outputs
+from masonry.outputs import WRITTEN_OUTPUTS, Outputs
 from masonry.parameters import (check_fields, declarations, defaults, plain, read_toml, text_of,
                                 values)
 from masonry.rbe.loads import LOAD_OPTIONS, Lateral, live_load
@@ -32,15 +32,6 @@ PRESETS = {
     # thesis 3.3.6 straight wall test: 10 courses of 8 regular bricks, about 12.5 kN
     "wall": dict(scene="wall", wall_length=32.0, wall_courses=10),
 }
-
-RECORDED_OUTPUTS = ("quick", "print_size", "figure_format", "dpi", "html_plotly",
-                    "cad_offset")
-"""The outputs' inputs a run records among its parameters (those of
-:data:`WRITTEN_OUTPUTS` are recorded as what the run wrote)."""
-
-WRITTEN_OUTPUTS = ("plots", "printable", "html")
-"""The outputs a run writes or not, recorded in ``run.json``'s ``outputs`` (what the run
-wrote), not among its parameters."""
 
 FILE_OUTPUTS = tuple(name for name, declaration in declarations(Outputs).items()
                      if declaration.tag is None)
@@ -115,7 +106,7 @@ class Params:
 
     def record(self) -> dict:
         """The inputs ``run.json`` records (:func:`inputs` but the outputs that are
-        recorded as what the run wrote, :data:`WRITTEN_OUTPUTS`)."""
+        recorded as what the run wrote, :data:`~masonry.outputs.WRITTEN_OUTPUTS`)."""
         return {name: value for name, value in self.inputs().items()
                 if name not in WRITTEN_OUTPUTS}
 

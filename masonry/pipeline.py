@@ -17,8 +17,9 @@ from pathlib import Path
 from masonry import __version__, forking
 from masonry.blocks import BLOCK_CLASSES
 from masonry.cache import read_cache, write_cache
-from masonry.export import EXPORTERS, RunOutputs, html, rhino
-from masonry.params import FILE_OUTPUTS, WRITTEN_OUTPUTS, Params, structure_id, validate
+from masonry.export import EXPORTERS, RunOutputs, html, rhino, written_outputs
+from masonry.outputs import WRITTEN_OUTPUTS
+from masonry.params import FILE_OUTPUTS, Params, structure_id, validate
 from masonry.rbe.adhesion import AdhesionResult, least_adhesion, stands_dry
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.centering import CenteringResult, centering_force
@@ -400,21 +401,22 @@ def results_record(result: RBEResult | None, collapse: CollapseResult | None,
 
 def write_run(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer):
     """Every file of a run and, last, its ``run.json`` (``record``, completed)."""
-    write_exports(folder, made, record, timer)
-    record["outputs"]["3dm"] = (folder.tmp / "bricks.3dm").exists()
-    if record["outputs"]["printable"] and not (folder.tmp / "dome.stl").exists():
-        record["outputs"]["printable"] = False  # skipped: run.json's printable says why
-    record["coordinates"] = _held(record["coordinates"], folder)
+    written = write_exports(folder, made, record, timer)
+    # what was written, as the exporters say (a printable body skipped: run.json's
+    # printable says why)
+    record["outputs"].update(written_outputs(written))
+    files = {path for paths in written.values() for path in paths}
+    record["coordinates"] = _held(record["coordinates"], files)
     record["timings_s"] = timer.seconds
     record["versions"] = versions()
     record["complete"] = True
     folder.write_json("run.json", record)
 
 
-def _held(coordinates: dict, folder: RunFolder) -> dict:
-    """``coordinates`` with the files ``folder`` holds only (no 3DM without rhino3dm, no
+def _held(coordinates: dict, files: set) -> dict:
+    """``coordinates`` with the run's written ``files`` only (no 3DM without rhino3dm, no
     3MF without a size, no forces in a build)."""
-    return {key: [name for name in value if (folder.tmp / name).exists()]
+    return {key: [name for name in value if name in files]
             if isinstance(value, list) else value for key, value in coordinates.items()}
 
 
@@ -432,7 +434,7 @@ def run_record(params: Params, name: str, scene: Scene, model: Model, outputs: d
         Its analysis model; its interface counts by kind go into ``counts``.
     outputs : dict str -> bool
         What the run writes (``analyse``, ``centering``,
-        :data:`~masonry.params.WRITTEN_OUTPUTS`, ``quick``).
+        :data:`~masonry.outputs.WRITTEN_OUTPUTS`, ``quick``).
     cached : str
         ``'reused'``, ``'computed'`` or ``'given'``: where the geometry came from.
     source : dict, optional
@@ -581,9 +583,10 @@ def _checked_collapse(model, params, result, copies, known) -> CollapseResult:
                                azimuths=result.azimuths, solved_on="whole, the half rejected")
 
 
-def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer):
+def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Timer) -> dict:
     """Every wanted exporter of :data:`masonry.export.EXPORTERS` into ``folder``; their
-    records go into ``record`` under their names.
+    records go into ``record`` under their names. Returns what each wrote: its name ->
+    the paths of its files in the folder (:func:`masonry.export.written_outputs`).
 
     The forces (what a user waits for) are made here first; where processes fork (Linux)
     and the process has two cores, this process and a forked copy then share the others,
@@ -604,10 +607,12 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
         Each exporter's time counts towards its stage.
     """
     wanted = [exporter for exporter in EXPORTERS if exporter.wanted(made)]
+    written = {}
 
     def write(exporter, export):
         for relative, data in export.files.items():
             folder.write(relative, data)
+        written[exporter.name] = tuple(export.files)
         if export.record is not None:
             _merge(record, exporter.key, export.record)
 
@@ -626,6 +631,7 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
             with timer.stage("other_process"):
                 for index, export in sorted(shared.theirs().items()):
                     write(rest[index], export)
+    return written
 
 
 def _merge(record: dict, key: str, part: dict):

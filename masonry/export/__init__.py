@@ -148,6 +148,11 @@ class Exporter:
     imports : tuple of str
         Modules its ``make`` imports when it runs: a run imports them once before its
         two processes part (:func:`masonry.pipeline.write_exports`), not once in each.
+    output : str
+        The key of run.json's ``outputs`` that says whether the run wrote its files
+        (an output switch of :class:`masonry.outputs.Outputs`, or ``3dm``): true when
+        it, or another exporter of that key, wrote one (:func:`written_outputs`); ''
+        for the files every run writes when it can.
     """
 
     name: str
@@ -156,6 +161,7 @@ class Exporter:
     wanted: Callable = field(default=lambda made: True)
     record_key: str = ""
     imports: tuple = ()
+    output: str = ""
 
     @property
     def key(self) -> str:
@@ -430,23 +436,37 @@ EXPORTERS = (
     # (masonry.pipeline.write_exports), and finish about together
     Exporter("force_plots", "plots", _force_plot_files,
              wanted=lambda made: made.outputs.plots and made.forces is not None,
-             record_key="figures", imports=("masonry.plots",)),
+             record_key="figures", imports=("masonry.plots",), output="plots"),
     Exporter("adhesion_plots", "plots", _adhesion_plot_files,
              wanted=lambda made: made.outputs.plots and _needs_adhesion(made),
-             record_key="figures", imports=("masonry.plots",)),
+             record_key="figures", imports=("masonry.plots",), output="plots"),
     Exporter("printable", "printable", _printable_files,
-             wanted=lambda made: made.outputs.printable, imports=("manifold3d", "trimesh")),
+             wanted=lambda made: made.outputs.printable, imports=("manifold3d", "trimesh"),
+             output="printable"),
     Exporter("structure_plots", "plots", _structure_plot_files,
              wanted=lambda made: made.outputs.plots, record_key="figures",
-             imports=("masonry.plots",)),
+             imports=("masonry.plots",), output="plots"),
     Exporter("interface_plots", "plots", _interface_plot_files,
              wanted=lambda made: made.outputs.plots, record_key="figures",
-             imports=("masonry.plots",)),
-    Exporter("rhino", "exports", _rhino_files, wanted=_rhino_wanted),
-    Exporter("html", "html", _html_files, wanted=lambda made: made.outputs.writes_html),
+             imports=("masonry.plots",), output="plots"),
+    Exporter("rhino", "exports", _rhino_files, wanted=_rhino_wanted, output="3dm"),
+    Exporter("html", "html", _html_files, wanted=lambda made: made.outputs.writes_html,
+             output="html"),
     Exporter("collapse", "exports", _collapse_files,
              wanted=lambda made: made.collapse is not None),
     Exporter("compas", "exports", _compas_files, wanted=_is_whole),
     Exporter("model", "exports", _model_files),
 )
 """Every exporter, in the order a run takes them."""
+
+
+def written_outputs(written: dict) -> dict:
+    """run.json's ``outputs`` switches from what the exporters wrote (``written``: an
+    exporter's name -> the paths of its files): a switch (an :attr:`Exporter.output`) is
+    true when one of its exporters wrote a file, in the order of :data:`EXPORTERS`."""
+    out = {}
+    for exporter in EXPORTERS:
+        if exporter.output:
+            out[exporter.output] = (out.get(exporter.output, False)
+                                    or bool(written.get(exporter.name)))
+    return out
