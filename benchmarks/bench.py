@@ -166,8 +166,8 @@ def _run(params, accuracy, solver, exports=True):
     problem = RBEProblem(model.blocks, model.interfaces, **model.assembly)
     seconds["assembly"] = time.perf_counter() - start
     start = time.perf_counter()
-    result = problem.solve(mu=params.analysis.mu, density=params.analysis.density, friction=params.analysis.friction,
-                           solver=solver, accuracy=accuracy)
+    result = problem.solve(**{**params.analysis.rbe_options(), "solver": solver,
+                              "accuracy": accuracy})
     seconds["solve"] = time.perf_counter() - start
     seconds["lp"] = result.lp_time_s
     start = time.perf_counter()
@@ -383,13 +383,13 @@ def collapse_bench(structures, azimuth=0.0, repeats=3, search=False, method=None
         _, model = build_model(params)
         symmetry = params.kind.symmetry(params.geometry)
         analysis = params.analysis
-        options = dict(mu=analysis.mu, density=analysis.density, method=method)
+        options = dict(**analysis.material_options(), method=method)
         bricks = int((~model.blocks.block_is_support).sum())
         rbe = []
         for _ in range(repeats):
             start = time.perf_counter()
             RBEProblem(model.blocks, model.interfaces, **model.assembly).solve(
-                mu=analysis.mu, density=analysis.density, accuracy="balanced")
+                **{**analysis.rbe_options(), "accuracy": "balanced"})
             rbe.append(time.perf_counter() - start)
             if progress:
                 progress(f"{name}: RBE {rbe[-1]:.3g} s")
@@ -517,10 +517,10 @@ def friction_bench(structures, models=FRICTION_MODELS, azimuth=0.0, repeats=1,
             for _ in range(repeats):
                 start = time.perf_counter()
                 result = RBEProblem(model.blocks, model.interfaces, **model.assembly).solve(
-                    mu=params.analysis.mu, density=params.analysis.density, cone=name)
+                    **{**params.analysis.rbe_options(), "cone": name})
                 rbe.append(time.perf_counter() - start)
                 start = time.perf_counter()
-                lp = CollapseLP(model, mu=params.analysis.mu, density=params.analysis.density, cone=name)
+                lp = CollapseLP(model, **{**params.analysis.material_options(), "cone": name})
                 factor = lp.solve(live, dead_load_feasible=result.feasible or None)
                 collapse.append(time.perf_counter() - start)
             if progress:

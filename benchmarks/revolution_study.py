@@ -189,11 +189,9 @@ def self_weight(dome: Dome, settings: Settings) -> dict:
     def verdict(boundary):
         params = dome.params(boundary=boundary, mu=settings.mu, accuracy=settings.accuracy)
         scene, model = dome.model(boundary=boundary)
-        analysis = params.analysis
         result = RBEProblem(model.blocks, model.interfaces, side_block=model.side_block,
                             side_rotation=model.side_rotation).solve(
-            mu=analysis.mu, density=analysis.density, friction=analysis.friction,
-            solver=analysis.solver, accuracy=analysis.accuracy, cone=analysis.friction_cone)
+            **params.analysis.rbe_options())
         return scene, params, result
 
     scene, params, cyclic = verdict("cyclic")

@@ -1,8 +1,8 @@
 """``masonry structures``: the thesis's table 4.1 and friction test, every boundary model
 side by side."""
 
-from masonry.friction import FrictionCone, FrictionModelError
 from masonry.params import ParameterError
+from masonry.rbe.settings import Analysis
 from masonry.runfolder import RunFolder, check_output_root
 
 from .options import add_verbosity
@@ -39,10 +39,8 @@ def handle(args, report):
     if args.lateral and not args.full_dome:
         raise ParameterError("lateral", True, "the full domes, whose factor it is: "
                              "not with --no-full-dome")
-    try:
-        cone = FrictionCone.parse(args.friction_cone or "circle")
-    except FrictionModelError as error:
-        raise ParameterError("friction_cone", args.friction_cone, str(error)) from None
+    # checked as every analysis's friction model (the default: the preset's, Coulomb's)
+    cone = Analysis(friction_cone=args.friction_cone).checked().cone
     check_output_root(args.out)
     from masonry.studies.structures import structures_table, table_csv, table_markdown
 

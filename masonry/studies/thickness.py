@@ -54,10 +54,8 @@ def is_feasible(params: Params) -> bool:
     """Whether the arch of ``params`` stands: friction-net RBE, no LP check."""
     scene = build_arch(params.geometry)
     interfaces = detect(scene.blocks, up=scene.block_up)
-    analysis = params.analysis
-    result = solve_rbe(scene.blocks, interfaces, mu=analysis.mu, density=analysis.density,
-                       friction="net", solver=analysis.solver, cone=analysis.friction_cone,
-                       lp_check=False)
+    result = solve_rbe(scene.blocks, interfaces,
+                       **{**params.analysis.rbe_options(), "friction": "net"}, lp_check=False)
     return bool(result.feasible)
 
 
