@@ -370,7 +370,7 @@ PLAUSIBLE = {
     "--boundary": ["free", "rigid", "cyclic", "open"],
     "--friction": ["net", "plus", "auto", "none"],
     "--accuracy": ["fast", "balanced", "accurate", "best"],
-    "--print-size": ["100", "150", "200"],
+    "--print-size": ["100", "150", "200"], "--cad-offset": ["0", "0.5", "1", "4", "5"],
     "--lateral": ["0", "30", "-90", "all", "east"],
     "--point-load": ["w0_*:1000,0,0", "*:0,0,-500", "w0_b0001*:0,0,-1e4", "w0:1,2", "x"],
     "--crown-load": ["500", "20000", "0", "-100"],
@@ -396,7 +396,7 @@ SCENE_OPTIONS = {
 EVERY_SCENE = ["--mu", "--density", "--friction", "--accuracy", "--print-size", "--lateral",
                "--point-load", "--crown-load", "--friction-law", "--friction-cone",
                "--cohesion-kpa", "--tensile-kpa", "--head-joint-ratio",
-               "--support-joint-ratio", "--adhesion-tension-ratio"]
+               "--support-joint-ratio", "--adhesion-tension-ratio", "--cad-offset"]
 
 
 def test_the_tables_cover_every_option_of_run():
