@@ -25,13 +25,15 @@ less (a longer lever); at the centroid the answer does not depend on where a pro
 
 The Euclidean norm is the physical one (a support gives one force, whatever the axes);
 ``sum |s|_1`` would depend on how the model is turned. The program is a second-order cone
-program whatever the friction model, so Clarabel solves it on the sparse matrices
-(:func:`masonry.rbe.solvers.direct_clarabel.solve_cone_program`): the project's interior point
-method (:mod:`masonry.rbe.solvers.interior_lp`) factors the six-rows-per-block matrix of
-the collapse program with three-dimensional cones and one load column, and has neither
-the four-dimensional cones nor costs on its variables. The program is always feasible
-(every block held by its own weight, no joint loaded) and bounded below by 0: it has an
-optimum, and a structure stands without support exactly when it is 0.
+program whatever the friction model. The project's interior point method solves it on
+the Newton method's matrix (:mod:`masonry.rbe.solvers.interior_centering`: six rows per
+free block, the supports' cones adding a 3 x 3 block to each block's force rows), on the
+symbolic factorization a stage sequence already holds; Clarabel solves it on the sparse
+matrices (:func:`masonry.rbe.solvers.direct_clarabel.solve_cone_program`) where that
+ends without a point that passes the check below, or alone when asked (``solver``). The
+program is always feasible (every block held by its own weight, no joint loaded) and
+bounded below by 0: it has an optimum, and a structure stands without support exactly
+when it is 0.
 
 Scaling: as the RBE's, forces in units of the reference weight ``W_ref``, moment rows
 divided by ``L_ref``; the result is in newtons. The equilibrium residual and the friction
@@ -49,14 +51,21 @@ from masonry.contact import ContactLaw
 from masonry.friction import FrictionCone
 from masonry.rbe.collapse import friction_columns
 from masonry.rbe.equilibrium import EquilibriumSystem, assemble
+from masonry.errors import ParameterError
+from masonry.rbe.solvers import interior_centering
+from masonry.rbe.solvers.base import OPTIMAL, OPTIMAL_INACCURATE
 from masonry.rbe.solvers.direct_clarabel import CENTERING_SETTINGS, solve_cone_program
+from masonry.rbe.solvers.newton import NewtonSystem
 from masonry.rbe.solvers.program import SECOND_ORDER
 from masonry.tolerances import ACCEPT_RESIDUAL, CENTERING_REPORTED_REL, G
 
 log = logging.getLogger(__name__)
 
 SOLVER = "clarabel"
-"""The solver of the program (module docstring)."""
+INTERIOR = "interior"
+SOLVERS = (INTERIOR, SOLVER)
+"""The solvers of the program: the own interior point method (default; Clarabel where it
+ends without a checked optimum), or Clarabel alone (module docstring)."""
 
 RESULT_KEYS = ("total_N", "fraction", "weight_N", "held_count", "status", "solver",
                "iterations", "time_s", "residual_eq", "friction_violation", "mu",
@@ -81,10 +90,12 @@ class CenteringResult:
     force : (F, 3) float or None
         ``s_j``, the force the support gives each of them (global axes), N.
     status : str
-        ``optimal`` or Clarabel's words.
+        ``optimal`` or the solver's words.
     iterations : int
     time_s : float, s
         Assembly of the program and its solve.
+    solver : str
+        The solver whose point this is (:data:`SOLVERS`).
     residual_eq : float
         ``||A_eq x + f_ext + B s||_inf / ||f_ext||_inf``, recomputed (scaled rows).
     friction_violation : float
@@ -112,7 +123,7 @@ class CenteringResult:
     mu: float
     cone: FrictionCone
     x: np.ndarray | None = None
-    solver: str = SOLVER
+    solver: str = INTERIOR
     point: str = "centroid"
     law: ContactLaw = ContactLaw()
 
@@ -174,7 +185,8 @@ class CenteringResult:
 
 
 def centering_force(model, *, mu=0.7, density=2000.0, cone="circle",
-                    time_limit=600.0, cohesion=0.0, tensile=0.0) -> CenteringResult:
+                    time_limit=600.0, cohesion=0.0, tensile=0.0,
+                    solver=INTERIOR) -> CenteringResult:
     """The least total support force that lets ``model`` stand (module docstring).
 
     Parameters
@@ -191,6 +203,8 @@ def centering_force(model, *, mu=0.7, density=2000.0, cone="circle",
         Clarabel's limit.
     cohesion, tensile : float, Pa
         The mortar (:mod:`masonry.contact`); default dry joints.
+    solver : str
+        One of :data:`SOLVERS`.
 
     Returns
     -------
@@ -202,13 +216,35 @@ def centering_force(model, *, mu=0.7, density=2000.0, cone="circle",
     system = assemble(model.blocks, model.interfaces, mu=mu, density=density,
                       side_block=model.side_block, side_rotation=model.side_rotation,
                       cone=cone, cohesion=cohesion, tensile=tensile)
-    return solve_centering(system, time_limit=time_limit)
+    return solve_centering(system, time_limit=time_limit, solver=solver)
 
 
-def solve_centering(system: EquilibriumSystem, *, time_limit=600.0) -> CenteringResult:
-    """:func:`centering_force` on assembled matrices (its friction model, ``mu`` and
-    density)."""
+def solve_centering(system: EquilibriumSystem, *, time_limit=600.0, solver=INTERIOR,
+                    symbolic=None) -> CenteringResult:
+    """:func:`centering_force` on assembled matrices (their friction model, ``mu``,
+    density and mortar): by the own interior point method (on ``symbolic``, the
+    :class:`~masonry.rbe.solvers.cholesky.BlockCholesky` analysis of the system's
+    blocks, made here when None), and by Clarabel where that ends without a checked
+    optimum; by Clarabel alone with ``solver`` ``clarabel``."""
     start = time.perf_counter()
+    if solver not in SOLVERS:
+        raise ParameterError("solver", solver, f"one of {', '.join(SOLVERS)}")
+    if solver == INTERIOR:
+        ns = NewtonSystem(system, "net", symbolic=symbolic)
+        found = interior_centering.solve(ns)
+        if found.status in (OPTIMAL, OPTIMAL_INACCURATE):
+            result = _checked(system, ns.full_vector(found.x, system.layout),
+                              found.support.ravel(), found.status, found.iterations, start,
+                              INTERIOR)
+            if result.total_N is not None:
+                return result
+        log.info("centering force: the interior point method ended %s; Clarabel",
+                 found.status)
+    return _by_clarabel(system, time_limit, start)
+
+
+def _by_clarabel(system, time_limit, start) -> CenteringResult:
+    """The program solved by Clarabel (module docstring)."""
     columns = friction_columns(system)
     free = len(system.free_block)
     A, b, rows, h, cones = _program(system, columns)
@@ -217,33 +253,47 @@ def solve_centering(system: EquilibriumSystem, *, time_limit=600.0) -> Centering
     q[n - free:] = 1.0
     status, z, iterations = solve_cone_program(q, A, b, rows, h, cones, time_limit,
                                                CENTERING_SETTINGS)
-    common = dict(weight_N=system.total_weight, block=system.free_block,
-                  block_weight=system.block_weight[system.free_block],
-                  iterations=iterations, mu=system.mu, cone=system.cone, law=system.law)
     if z is None:
         log.warning("centering force: Clarabel ended %s", status)
         return CenteringResult(None, force=None, status=status, residual_eq=np.nan,
-                               friction_violation=np.nan,
-                               time_s=time.perf_counter() - start, **common)
+                               friction_violation=np.nan, time_s=time.perf_counter() - start,
+                               solver=SOLVER, **_common(system, iterations))
     g, support = z[:columns.edges.shape[1]], z[columns.edges.shape[1]:n - free]
-    x = columns.edges @ g
+    return _checked(system, columns.edges @ g, support, status, iterations, start, SOLVER)
+
+
+def _common(system, iterations) -> dict:
+    return dict(weight_N=system.total_weight, block=system.free_block,
+                block_weight=system.block_weight[system.free_block],
+                iterations=iterations, mu=system.mu, cone=system.cone, law=system.law)
+
+
+def _checked(system, x, support, status, iterations, start, solver) -> CenteringResult:
+    """The result of a solver's point: vertex forces ``x`` (the layout's, solver units)
+    and support forces ``support`` ((3 F,), units of the reference weight), their
+    equilibrium residual and friction violation recomputed; a point beyond
+    :data:`~masonry.tolerances.ACCEPT_RESIDUAL` gives no value."""
     residual, violation = _residuals(system, x, support)
     accepted = max(residual, violation) <= ACCEPT_RESIDUAL
     if not accepted:
-        log.warning("centering force: Clarabel's point (%s) rejected: residual %.1e, "
-                    "friction violation %.1e", status, residual, violation)
+        # the interior point method's is not the last word: Clarabel follows
+        log.log(logging.INFO if solver == INTERIOR else logging.WARNING,
+                "centering force: the point of %s (%s) rejected: residual %.1e, "
+                "friction violation %.1e", solver, status, residual, violation)
     elif status == "AlmostSolved":
         log.warning("centering force: almost solved, kept (residual %.1e)", residual)
     force = support.reshape(-1, 3) * system.weight_ref
     total = float(np.linalg.norm(force, axis=1).sum())
-    log.info("centering force: %.6g N (%.4g of the weight), %d iterations", total,
-             total / system.total_weight, iterations)
+    if accepted:
+        log.info("centering force: %.6g N (%.4g of the weight), %s, %d iterations", total,
+                 total / system.total_weight, solver, iterations)
     return CenteringResult(
         total if accepted else None, force=force if accepted else None,
         status="optimal" if accepted else status, residual_eq=residual,
         friction_violation=violation,
         x=system.to_newtons(system.shifted(x, -1.0)) if accepted else None,
-        time_s=time.perf_counter() - start, **common)
+        time_s=time.perf_counter() - start, solver=solver,
+        **_common(system, iterations))
 
 
 def _held_by_weight(blocks, mu, density, cone) -> CenteringResult:

@@ -15,8 +15,9 @@ normal matrix's pattern of six rows per free block.
 
 - :class:`Orthant`: ``m`` nonnegative numbers per vertex (a pyramid's edge ray weights,
   its face slacks, a tension ``t >= 0``).
-- :class:`Lorentz`: the second-order cone ``u0 >= ||(u1, u2)||`` per vertex (Coulomb's
-  friction cone after scaling ``c`` by ``mu``).
+- :class:`Lorentz`: the second-order cone ``u0 >= ||(u1, ..., u_m-1)||`` per vertex
+  (Coulomb's friction cone after scaling ``c`` by ``mu``, ``m = 3``; a support force and
+  its bound, ``m = 4``).
 
 Every array is ``(V, m)``: one row per vertex. The degree of a vertex (the number of
 complementarity pairs the gap ``u . z`` is divided by) is ``m`` for the orthant and 1 for
@@ -87,25 +88,27 @@ class OrthantScaling:
 
 
 class Lorentz:
-    """The second-order cone ``u0 >= ||(u1, u2)||``, one per vertex (``m = 3``)."""
+    """The second-order cone ``u0 >= ||(u1, ..., u_m-1)||``, one per vertex (``m = 3``
+    unless given)."""
 
-    m = 3
     degree = 1
 
-    @staticmethod
-    def identity(count) -> np.ndarray:
-        e = np.zeros((count, 3))
+    def __init__(self, m: int = 3):
+        self.m = m
+
+    def identity(self, count) -> np.ndarray:
+        e = np.zeros((count, self.m))
         e[:, 0] = 1.0
         return e
 
     @staticmethod
     def min_eigenvalue(u) -> np.ndarray:
         """(V,) float: ``u0 - ||u1||``, the smaller eigenvalue of the Jordan algebra."""
-        return u[:, 0] - np.hypot(u[:, 1], u[:, 2])
+        return u[:, 0] - _norm(u[:, 1:])
 
     @staticmethod
     def trace(u) -> float:
-        """``e . u`` with ``e = (1, 0, 0)``."""
+        """``e . u`` with ``e = (1, 0, ...)``."""
         return float(u[:, 0].sum())
 
     @staticmethod
@@ -119,7 +122,7 @@ class Lorentz:
         rho0 = (unit[:, 0] * du[:, 0] - np.einsum("vi,vi->v", unit[:, 1:], du[:, 1:])) / nu
         rho1 = (du[:, 1:] / nu[:, None]
                 - ((rho0 + du[:, 0] / nu) / (unit[:, 0] + 1.0))[:, None] * unit[:, 1:])
-        return _step_to_one(np.hypot(rho1[:, 0], rho1[:, 1]) - rho0)
+        return _step_to_one(_norm(rho1) - rho0)
 
     @staticmethod
     def scaling(u, z) -> "LorentzScaling":
@@ -144,16 +147,24 @@ class Lorentz:
         return out
 
 
+def _norm(u) -> np.ndarray:
+    """(V,) float: the rows' Euclidean norms (``hypot`` for two columns, the friction
+    cone's, which is faster)."""
+    if u.shape[1] == 2:
+        return np.hypot(u[:, 0], u[:, 1])
+    return np.sqrt(np.einsum("vi,vi->v", u, u))
+
+
 def _jnorm(u) -> np.ndarray:
     """(V,) float: ``sqrt(u0^2 - ||u1||^2)`` without the cancellation of the squares."""
-    radius = np.hypot(u[:, 1], u[:, 2])
+    radius = _norm(u[:, 1:])
     return np.sqrt(np.maximum((u[:, 0] - radius) * (u[:, 0] + radius), 0.0))
 
 
 class LorentzScaling:
     """The Nesterov-Todd scaling of a pair ``(u, z)`` inside the second-order cone.
 
-    With ``u_ = u / sqrt(u^T J u)``, ``z_ = z / sqrt(z^T J z)`` (``J = diag(1, -1, -1)``),
+    With ``u_ = u / sqrt(u^T J u)``, ``z_ = z / sqrt(z^T J z)`` (``J = diag(1, -1, ...)``),
     ``gamma = sqrt((1 + u_ . z_) / 2)`` and the scaling point ``w = (u_ + J z_) / (2
     gamma)`` (``w^T J w = 1``), ``W = beta (2 v v^T - J)`` with ``v = (w + e) /
     sqrt(2 (w0 + 1))`` and ``beta = (u^T J u / z^T J z)^(1/4)``; then ``W^-1 = (2 J v
@@ -165,16 +176,18 @@ class LorentzScaling:
         nu_u, nu_z = _jnorm(u), _jnorm(z)
         u_, z_ = u / nu_u[:, None], z / nu_z[:, None]
         gamma = np.sqrt(0.5 * (1.0 + np.einsum("vi,vi->v", u_, z_)))
-        jz = z_ * np.array([1.0, -1.0, -1.0])
+        signs = np.ones(u.shape[1])
+        signs[1:] = -1.0
+        jz = z_ * signs
         w = (u_ + jz) / (2.0 * gamma[:, None])
         v = w.copy()
         v[:, 0] += 1.0
         v /= np.sqrt(2.0 * (w[:, 0] + 1.0))[:, None]
         beta = np.sqrt(nu_u / nu_z)
-        J = np.diag([1.0, -1.0, -1.0])
+        J = np.diag(signs)
         outer = v[:, :, None] * v[:, None, :]
         self.W = beta[:, None, None] * (2.0 * outer - J)
-        jv = v * np.array([1.0, -1.0, -1.0])
+        jv = v * signs
         self.W_inverse = (2.0 * jv[:, :, None] * jv[:, None, :] - J) / beta[:, None, None]
         self.D = self.W @ self.W
         self.lam = np.einsum("vij,vj->vi", self.W, z)
