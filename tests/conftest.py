@@ -11,7 +11,9 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 from masonry import forking  # noqa: E402
 from masonry.params import from_preset  # noqa: E402
+from masonry.pipeline import build_model  # noqa: E402
 from masonry.scenes import build  # noqa: E402
+from masonry.stages.plans import make_plan  # noqa: E402
 
 FIXTURES = Path(__file__).resolve().parent.parent / "fixtures"
 PRESETS = ("1", "2", "3")
@@ -49,3 +51,13 @@ def support_force(interfaces, forces, mask):
     n, t1, t2 = interfaces.normal[mask], interfaces.t1[mask], interfaces.t2[mask]
     return (-forces["normal"][mask, None] * n + forces["t1"][mask, None] * t1
             + forces["t2"][mask, None] * t2).sum(axis=0)
+
+
+@pytest.fixture(scope="session")
+def top_course():
+    """The last but one course of preset 1's cyclic section at p = 4 (230 blocks, 28
+    courses), laid brick by brick pattern-first: its stages 1 and 3 to 5 cannot stand
+    dry (their beds lean 60 degrees); stage 2 stands."""
+    params = from_preset("1", boundary="cyclic", p=4)
+    scene, model = build_model(params)
+    return model, make_plan(scene, "brick", "pattern-first", 27)

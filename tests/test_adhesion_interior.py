@@ -9,27 +9,14 @@ import pytest
 from test_adhesion import weight
 from test_rbe import cantilever
 
-from masonry.params import from_preset
-from masonry.pipeline import build_model
 from masonry.rbe.adhesion import INTERIOR, SOLVER, least_adhesion, solve_adhesion
 from masonry.rbe.boundary import Model, kept_blocks
 from masonry.rbe.equilibrium import assemble
 from masonry.rbe.sequence import StageSequence, part_system
 from masonry.rbe.solvers import interior_adhesion
 from masonry.rbe.solvers.newton import NewtonSystem
-from masonry.stages.plans import make_plan
 
 MU, DENSITY = 0.7, 2000.0
-
-
-@pytest.fixture(scope="module")
-def top_course():
-    """The last but one course of preset 1's cyclic section at p = 4 (230 blocks, 28
-    courses), laid brick by brick pattern-first: its stages 1 and 3 to 5 cannot stand
-    dry (their beds lean 60 degrees)."""
-    params = from_preset("1", boundary="cyclic", p=4)
-    scene, model = build_model(params)
-    return model, make_plan(scene, "brick", "pattern-first", 27)
 
 
 def _stage_system(model, plan, stage, cone):

@@ -7,7 +7,6 @@ symbolic factorization; and Clarabel where the method ends without a checked poi
 
 import numpy as np
 import pytest
-from test_adhesion_interior import top_course  # noqa: F401  (a fixture)
 from test_rbe import SUPPORT as SUPPORT_KIND
 from test_rbe import box, make_interfaces, rot_y
 

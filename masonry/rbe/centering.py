@@ -48,10 +48,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from masonry.contact import ContactLaw
+from masonry.errors import ParameterError
 from masonry.friction import FrictionCone
 from masonry.rbe.collapse import friction_columns
 from masonry.rbe.equilibrium import EquilibriumSystem, assemble
-from masonry.errors import ParameterError
 from masonry.rbe.solvers import interior_centering
 from masonry.rbe.solvers.base import OPTIMAL, OPTIMAL_INACCURATE
 from masonry.rbe.solvers.direct_clarabel import CENTERING_SETTINGS, solve_cone_program
@@ -263,9 +263,10 @@ def _by_clarabel(system, time_limit, start) -> CenteringResult:
 
 
 def _common(system, iterations) -> dict:
-    return dict(weight_N=system.total_weight, block=system.free_block,
-                block_weight=system.block_weight[system.free_block],
-                iterations=iterations, mu=system.mu, cone=system.cone, law=system.law)
+    return {"weight_N": system.total_weight, "block": system.free_block,
+            "block_weight": system.block_weight[system.free_block],
+            "iterations": iterations, "mu": system.mu, "cone": system.cone,
+            "law": system.law}
 
 
 def _checked(system, x, support, status, iterations, start, solver) -> CenteringResult:
