@@ -24,9 +24,12 @@ leaves ::
 ``B E B^T`` adds a 3 x 3 block to the force rows of each free block's diagonal block, so
 the pattern is the same. Mehrotra's predictor-corrector as :mod:`.interior_adhesion`, from
 a start that meets the equilibrium rows (:func:`_cold`). The multipliers of the supports'
-cones and of Coulomb's cone (``G_1`` invertible) come from their dual rows and their
-slacks from the complementarity: ``W^-2 (W^2 v)`` of a cone at its apex or on its
-boundary keeps no digit of ``v``, and the dual rows were lost in the last iterations.
+cones, and of Coulomb's cone (``G_1`` invertible) where a vertex's multiplier outweighs
+its slack (``W^2`` small), come from their dual rows and their slacks from the
+complementarity; the others' slacks from the cone rows and multipliers through
+``W^-2``: ``W^-2 (W^2 v)`` of a cone near its apex keeps no digit of ``v`` (the dual rows
+were lost in the last iterations), ``W^2 (W^-2 v)`` likewise the other way (the cone
+rows were).
 
 Why it exists: Clarabel factors the whole KKT system (a row per vertex force, cone row
 and support component) at every one of its iterations; this factors the six rows per
@@ -79,7 +82,8 @@ class CenteringOptions:
         ``(tol, dual_tol, gap_tol, gap_floor)`` of a point accepted as
         ``optimal_inaccurate`` where the method cannot go on (a stalled step, a reduced
         matrix that does not factor): its total is then within ``gap_tol`` of itself or
-        ``gap_floor`` of the mean block weight of the optimum.
+        ``gap_floor`` of the mean block weight of the optimum, its rows within the
+        acceptance tolerance the caller checks them to.
     max_iter : int
     step_fraction : float
         Fraction of the largest step to the boundary of the cones that is taken (at
@@ -95,7 +99,7 @@ class CenteringOptions:
     dual_tol: float = 1e-6
     gap_tol: float = 1e-7
     gap_floor: float = 1e-6
-    reduced: tuple = (1e-7, 1e-5, 1e-4, 1e-5)
+    reduced: tuple = (1e-5, 1e-5, 1e-4, 1e-5)
     max_iter: int = 60
     step_fraction: float = 0.95
     regularization: float = 1e-10
@@ -193,6 +197,9 @@ class _Iterate:
         else:
             self.D = vertex_inverse(np.zeros((program.n, 3)), program.vertex, w_inverse[:-1])
         self.E = self.scalings[-1].D                       # W_3^2, (F, 4, 4)
+        # the vertices whose friction slack outweighs its multiplier (W^2 large): their
+        # dz from the cone rows, the others' from the dual rows (_solve)
+        self.slack = np.linalg.norm(s[0], axis=1) > np.linalg.norm(z[0], axis=1)
         blocks = ns.newton_blocks(self.D, shift, incremental=False)
         diagonal = ns.diagonal_blocks
         blocks[diagonal, :3, :3] += self.E[:, 1:, 1:]
@@ -256,9 +263,10 @@ class _Iterate:
             rest = (ns.AT @ dy).reshape(qx.shape) - r_x
             for vc, dzb in zip(program.vertex[1:], dz[1:]):
                 rest = rest - dzb @ vc.G
-            scaling = self.scalings[0]
-            dz[0] = rest @ program.square
-            ds[0] = scaling.times_w(q_c[0]) - scaling.times_w2(dz[0])
+            scaling, keep = self.scalings[0], self.slack[:, None]
+            dual = rest @ program.square
+            dz[0] = np.where(keep, dz[0], dual)
+            ds[0] = np.where(keep, ds[0], scaling.times_w(q_c[0]) - scaling.times_w2(dual))
         # the supports' from their dual rows and the complementarity: W^-2 (W^2 v) of
         # a support at the apex or on the boundary loses every digit of v
         dz_w = r_w.copy()
