@@ -70,7 +70,8 @@ def test_a_stage_that_stands_needs_none(top_course):
 
 
 def test_the_sequence_solves_each_stage_on_its_own_factorization(top_course):
-    """The stage sequence's centering force (the method on the symbolic factorization of
+    """The stage sequence's centering force (the course's bricks alone where the stage
+    carries their supports, else the stage's program on the symbolic factorization of
     the course being laid) against Clarabel on each stage's model built alone
     (restrict): the same totals within :data:`AGREE` and the same held blocks, named
     by the scene's blocks."""
@@ -78,7 +79,7 @@ def test_the_sequence_solves_each_stage_on_its_own_factorization(top_course):
     sequence = StageSequence(model)
     for stage in (1, 3, 5):
         present = plan.is_present(stage)
-        ours = sequence.centering(present, mu=MU, density=DENSITY)
+        ours = sequence.centering(present, plan.local(stage), mu=MU, density=DENSITY)
         part = restrict(model, present)
         alone = centering_force(part, mu=MU, density=DENSITY, solver=SOLVER)
         assert ours.solver == INTERIOR

@@ -126,8 +126,8 @@ def arch():
 def test_a_constant_mortar_is_the_uniform_contact_law(arch):
     """--mortar constant with c = 100 kPa, t_c = 50 kPa at every age: each stage's
     verdict and MoI are those of the RBE of that stage's model with the uniform law
-    (solved alone, from scratch); the sequence's warm starts and local certificate do
-    not change them. (The default arch's stages 3 to 7 need
+    (solved alone, from scratch); the sequence's warm starts, local certificate and
+    local centering force do not change them. (The default arch's stages 3 to 7 need
     7 to 1018 kPa dry, tests/test_stage_adhesion.py: 100 kPa holds some, not all.)"""
     model, plan = arch
     laying = Laying.of(Mortar.constant(100.0, 50.0), rate_per_hour=60.0)

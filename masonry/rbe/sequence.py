@@ -29,6 +29,14 @@ within the solver's accuracy (tests/test_stages.py). What :class:`StageSequence`
   work and no contact resists, is one of the whole part with the other blocks at rest),
   and the part goes straight to friction+ for its measure of infeasibility. Where the
   small problem has a solution nothing follows, and the part is solved as usual.
+- **A local centering force.** The centering force of a part that cannot stand
+  (docs/model.md 6.10) is first sought on the same small problem: the least support
+  force on the local blocks with every other block held fixed is at most the part's
+  (the part's optimum, restricted to the local blocks, is a point of the small
+  program). If the part then carries those support forces as loads, friction-net has
+  a solution (Newton, from the last stage's start), that point with supports on the
+  local blocks alone is one of the part's program with the same total: the least, so
+  the part's centering force. Otherwise the whole part's program is solved.
 - **The centering force** (docs/model.md 6.10) and **the least adhesion** (6.12) of a
   part: their programs on the part's rows and columns of the whole model's matrices
   (:meth:`StageSequence.centering`, :meth:`StageSequence.adhesion`), by the own
@@ -37,8 +45,8 @@ within the solver's accuracy (tests/test_stages.py). What :class:`StageSequence`
 - **Mortar.** A part's strengths (``cohesion``, ``tensile``: one number, or an array
   over the whole model's interface vertices, the joints' ages differing) are sliced
   with its columns and shift its own ``f_ext`` (:meth:`EquilibriumSystem.with_material`);
-  the local certificate and the centering force take the same slice, so both state the
-  part's law. The dual points are starts only: a shifted ``f_ext`` changes the
+  the local certificate and the local centering force take the same slice, so both
+  state the part's law. The dual points are starts only: a shifted ``f_ext`` changes the
   part's optimum, not what Newton accepts.
 """
 
@@ -53,13 +61,17 @@ from masonry.rbe.boundary import Model, kept_blocks
 from masonry.rbe.centering import CenteringResult, solve_centering
 from masonry.rbe.equilibrium import FRICTION_METHODS, EquilibriumSystem, VariableLayout, assemble
 from masonry.rbe.result import RBEResult
-from masonry.rbe.solve import ACCURACY, RBEProblem, friction_model
+from masonry.rbe.solve import ACCURACY, WARM_STALL, WARM_STEPS, RBEProblem, friction_model
 from masonry.rbe.solvers import BACKENDS
 from masonry.rbe.solvers.base import INFEASIBLE
 from masonry.rbe.solvers.cholesky import BlockCholesky, block_graph, fill_reducing_order
 from masonry.rbe.solvers.embedded import Embedded
 
 log = logging.getLogger(__name__)
+
+CHECK_TOL = 0.1
+"""Newton's stop on the check of a local centering force, relative to the preset's
+acceptance tolerance."""
 
 CERTIFICATE = "local-certificate"
 """The local certificate's name in :attr:`RBEResult.attempts`."""
@@ -252,24 +264,69 @@ class StageSequence:
                                                  block_size=6, ordering=order)
         return Embedded(self._within[1], (np.cumsum(self._within[0]) - 1)[rows])
 
-    def centering(self, is_present, *, mu=0.7, density=2000.0, accuracy="balanced",
+    def centering(self, is_present, local, *, mu=0.7, density=2000.0, accuracy="balanced",
                   cone=None, cohesion=0.0, tensile=0.0) -> CenteringResult:
         """The centering force (docs/model.md 6.10) of the part whose scene blocks
-        ``is_present``: :func:`masonry.rbe.centering.solve_centering` on the part's rows
-        and columns of the whole model's matrices, by the own interior point method on
-        the part's symbolic factorization (the one its RBE solve used). ``weight_N`` is
-        the part's; ``block`` the scene's blocks; the mortar as :meth:`solve` takes
-        it."""
+        ``is_present``: from the ``local`` blocks alone where the whole part carries
+        their supports (see the module's notes), else its program on the part's rows and
+        columns of the whole model's matrices, on the part's symbolic factorization (the
+        one its RBE solve used); both by :func:`masonry.rbe.centering.solve_centering`.
+        ``weight_N`` is the part's; ``block`` the scene's blocks; the mortar as
+        :meth:`solve` takes it."""
         keep = kept_blocks(self.model, is_present)
         interfaces = keep[self.model.interfaces.pair].all(axis=1)
         rows = keep[self.whole.free_block]
-        system = self._part(rows, interfaces, mu=mu, density=density,
-                            cone=friction_model(accuracy, cone), cohesion=cohesion,
-                            tensile=tensile)
-        result = solve_centering(system, symbolic=self._symbolic(rows, self._within_of(rows)))
+        local_rows = kept_blocks(self.model, local)[self.whole.free_block] & rows
+        material = dict(mu=mu, density=density, cone=friction_model(accuracy, cone),
+                        cohesion=cohesion, tensile=tensile)
+        system = self._part(rows, interfaces, **material)
+        result = None
+        if local_rows.any():
+            result = self._local_centering(system, rows, local_rows, interfaces, material,
+                                           accuracy)
+        if result is None:
+            result = solve_centering(system,
+                                     symbolic=self._symbolic(rows, self._within_of(rows)))
         source = (np.arange(self.model.blocks.n_blocks) if self.model.block_source is None
                   else self.model.block_source)
-        return dataclasses.replace(result, block=source[result.block])
+        return dataclasses.replace(result, weight_N=system.total_weight,
+                                   block=source[result.block])
+
+    def _local_centering(self, system, rows, local_rows, interfaces, material,
+                         accuracy) -> CenteringResult | None:
+        """The centering force of the ``local_rows`` alone, the rest of the part held
+        fixed, where the whole part ``system`` carries it (Newton, from the last
+        stage's point, within the acceptance tolerance); else None."""
+        small = self._part(local_rows, interfaces & self._touching(local_rows), **material)
+        reduced = solve_centering(small)
+        if reduced.total_N is None:
+            return None
+        load = np.zeros((int(rows.sum()), 6))
+        load[(np.cumsum(rows) - 1)[local_rows], :3] = reduced.force / system.weight_ref
+        load = load.ravel()
+        loaded = dataclasses.replace(  # a mortar's shifted f_ext takes the loads as well
+            system, f_ext=system.f_ext + load,
+            f_weight=None if system.f_weight is None else system.f_weight + load)
+        # the loads are at the limit of what the part carries (the least support), where
+        # Newton creeps: a point within the acceptance tolerance is all the check needs
+        preset = ACCURACY[accuracy]
+        workspace = {"symbolic": self._symbolic(rows, self._within_of(rows))}
+        if self._known["net"][rows].any():
+            workspace["warm"] = {"net": self._start("net", rows)}
+        outcome = BACKENDS["newton"].solve_rbe(loaded, "net", {
+            **preset.options.get("newton", {}), "tol": CHECK_TOL * preset.residual,
+            "stall": WARM_STALL, "max_iter": WARM_STEPS}, workspace)
+        checks = outcome.residuals
+        carried = checks is not None and max(checks.equilibrium,
+                                             checks.friction) <= preset.residual
+        log.debug("local centering force %.6g N: %s on the whole part (Newton, %d steps)",
+                  reduced.total_N, "carried" if carried else "not carried",
+                  outcome.iterations)
+        if not carried:
+            return None
+        self._duals["net"][rows] = outcome.y.reshape(-1, 6)  # the next check's start
+        self._known["net"][rows] = True
+        return reduced
 
     def adhesion(self, is_present, *, mu=0.7, density=2000.0, cone="circle",
                  ratio=TENSION_RATIO, head_ratio=1.0, support_ratio=1.0,

@@ -129,7 +129,7 @@ def analyse_stage(model: Model, params, plan: StagePlan, stage: int,
         row.update(_equilibrium(part, params, plan, stage, sequence, mortar, own))
     centering = None
     if sequence is not None and not row["feasible"] and not len(loose):
-        centering = sequence.centering(plan.is_present(stage),
+        centering = sequence.centering(plan.is_present(stage), plan.local(stage),
                                        **params.analysis.material_options(),
                                        accuracy=params.analysis.accuracy, **mortar)
     row.update(stage_centering(part, params, row["feasible"], centering, own))
