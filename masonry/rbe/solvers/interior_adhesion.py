@@ -26,10 +26,10 @@ perturbed optimality conditions (Nesterov-Todd scalings ``W_b``, :mod:`.cones`) 
 per free block, the same :class:`~.cholesky.BlockCholesky` symbolic analysis, which a
 stage sequence already holds); ``a``'s row borders it (a second solve with ``w`` on the
 same factor), ``v_v = G_2^T W_2v^-2 q_v`` and ``sigma`` its Schur complement, both in
-closed form (:func:`_reduced`). Mehrotra's predictor-corrector, as :mod:`.interior` (the
-form of CVXOPT's ``coneqp``), with iterative refinement of the directions near the
-optimum (:data:`REFINEMENTS`), from a start that meets the equilibrium and cone rows
-(:func:`_cold`).
+closed form (:func:`_reduced`). Mehrotra's predictor-corrector (:mod:`.predictor_corrector`,
+the form of CVXOPT's ``coneqp``), with iterative refinement of the directions near the
+optimum (:attr:`AdhesionOptions.refinements`), from a start that meets the equilibrium
+and cone rows (:func:`_cold`).
 
 Why it exists: Clarabel factors the whole KKT system (a row per vertex force and cone
 row) at every one of its iterations; this factors the six rows per free block that the
@@ -50,16 +50,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.rbe.solvers.base import OPTIMAL, OPTIMAL_INACCURATE, SOLVER_ERROR, USER_LIMIT
+from masonry.rbe.solvers.base import SOLVER_ERROR
 from masonry.rbe.solvers.cones import Orthant
-from masonry.rbe.solvers.interior import (
-    VertexCone,
-    largest_step,
-    scaling_of,
-    vertex_cones,
-    vertex_inverse,
-)
+from masonry.rbe.solvers.interior import VertexCone, vertex_cones, vertex_inverse
 from masonry.rbe.solvers.newton import NewtonSystem
+from masonry.rbe.solvers.predictor_corrector import ConeIterate, inside_start, iterate
 
 log = logging.getLogger(__name__)
 
@@ -77,10 +72,11 @@ class AdhesionOptions:
         coefficient 1) and the gap ``s^T z`` (an upper bound of ``a - a*`` while the
         dual rows hold) at most ``gap_tol`` times ``a`` (``gap_floor`` at least).
     reduced : tuple of float
-        ``(tol, dual_tol, gap_tol)`` of a point accepted as ``optimal_inaccurate`` where
-        the method cannot go on (a stalled step, a reduced matrix that does not factor):
-        near the optimum the scalings span 20 decades and the reduced
-        matrix loses its small directions (the point is then checked as every other).
+        ``(tol, dual_tol, gap_tol, gap_floor)`` of a point accepted as
+        ``optimal_inaccurate`` where the method cannot go on (a stalled step, a reduced
+        matrix that does not factor): near the optimum the scalings span 20 decades and
+        the reduced matrix loses its small directions (the point is then checked as
+        every other); the gap at most ``gap_tol`` times ``a`` or ``gap_floor``.
     gap_floor : float
         The least ``a`` the gap is relative to (units of ``W_ref / A_ref``).
     max_iter : int
@@ -90,17 +86,24 @@ class AdhesionOptions:
         Shift of the reduced matrix relative to its mean diagonal.
     min_step : float
         Stop when a step falls below this.
+    refinements, refine_gap : int, float
+        Passes of iterative refinement of a direction (CVXOPT's) once the gap is below
+        ``refine_gap`` times ``a`` (``gap_floor`` at least): near the optimum ``W^-2``
+        amplifies the rounding of ``dx`` in ``dz`` by up to 1e20, and the dual rows are
+        lost without them (before, a direction's error is corrected by the next one).
     """
 
     tol: float = 1e-8
     dual_tol: float = 1e-6
     gap_tol: float = 1e-7
-    reduced: tuple = (1e-7, 1e-4, 1e-2)
+    reduced: tuple = (1e-7, 1e-4, 1e-2, 1e-8)
     gap_floor: float = 1e-6
     max_iter: int = 60
     step_fraction: float = 0.99
     regularization: float = 1e-12
     min_step: float = 1e-6
+    refinements: int = 1
+    refine_gap: float = 1.0
 
 
 @dataclass
@@ -136,8 +139,10 @@ class _Program:
     """The program (module docstring) on ``ns``: ``held`` ((V,) float) the strength of
     every vertex per unit ``a``, ``ratio`` the tension cut-off's ``r``."""
 
-    def __init__(self, ns: NewtonSystem, held, ratio):
+    def __init__(self, ns: NewtonSystem, held, ratio, options: AdhesionOptions):
         self.ns, self.held, self.ratio = ns, held, ratio
+        self.diagonal_shift = options.regularization * ns.diagonal_scale
+        self.gap_floor = options.gap_floor
         self.friction = vertex_cones(ns.components, ns.cone, ns.mu)[0]
         self.shift = held / ns.mu                      # n = n~ - a A_v / mu
         shift = np.zeros((len(held), 3))
@@ -162,6 +167,22 @@ class _Program:
         r_primal = ns.A @ p.x.ravel() + self.load * p.a - ns.b
         return r_x, r_a, r_primal, r_cones
 
+    def measures(self, p: Point, residuals) -> tuple:
+        """``(primal, dual, gap)`` of ``p`` (:class:`AdhesionOptions`)."""
+        r_x, r_a, r_primal, r_cones = residuals
+        b_inf = float(np.abs(self.ns.b).max())
+        primal = max(float(np.abs(r_primal).max()),
+                     max(float(np.abs(rc).max()) for rc in r_cones)) / b_inf
+        dual = max(float(np.abs(r_x).max()) / max(1.0, float(np.abs(p.y).max())), abs(r_a))
+        return primal, dual, float(sum(np.sum(sb * zb) for sb, zb in zip(p.s, p.z)))
+
+    @staticmethod
+    def objective(p: Point) -> float:
+        return p.a
+
+    def iterate_at(self, s, z) -> "_Iterate":
+        return _Iterate(self, s, z, self.diagonal_shift)
+
     def slacks(self, x, a) -> list:
         """The cone rows' slacks of ``(x~, a)``: ``-(G_b x~ + q_b a)``."""
         out = [-(x @ self.friction.G.T)]
@@ -176,16 +197,14 @@ class _Program:
         return x
 
 
-class _Iterate:
+class _Iterate(ConeIterate):
     """The reduced system at one point (module docstring): factored once, solved for the
     predictor and the corrector."""
 
     def __init__(self, program: _Program, s, z, shift):
-        self.program = program
+        super().__init__(program.cones, s, z)
+        self.program, w_inverse = program, self.w_inverse
         ns = program.ns
-        self.scalings, w_inverse = zip(*(scaling_of(cone, sb, zb) for cone, sb, zb in
-                                         zip(program.cones, s, z)))
-        self.w2_inverse = [w * w if w.ndim == 2 else w @ w for w in w_inverse]
         self.D, self.Dv, self.sigma = _reduced(program, self.scalings, w_inverse,
                                                self.w2_inverse)
         # v = G_2^T W_2^-2 q: the cut-off's column of a (zero without one)
@@ -205,24 +224,6 @@ class _Iterate:
             u = self.factor.solve(rhs_y)
         da = (rhs_a - float(self.w @ u)) / (self.sigma + float(self.w @ self.t))
         return u + da * self.t, da
-
-    def _w2i(self, b, v):
-        """``W_b^-2 v`` per vertex."""
-        w = self.w2_inverse[b]
-        return w * v if w.ndim == 2 else np.einsum("vij,vj->vi", w, v)
-
-    def direction(self, r_x, r_a, r_primal, r_cones, r_comp, refinements=0):
-        """``(dx, da, dy, ds, dz)`` for the residuals of :meth:`_Program.residuals` and
-        the scaled complementarity ``lam o (W^-1 ds + W dz) = -r_comp`` (per cone), with
-        ``refinements`` passes of iterative refinement on the unreduced rows."""
-        cones = self.program.cones
-        q_c = [-cone.divide(sc.lam, rc) for cone, sc, rc in zip(cones, self.scalings, r_comp)]
-        target = (r_x, r_a, r_primal, r_cones, q_c)
-        d = self._solve(*target)
-        for _ in range(refinements):
-            left = self._left(d, target)
-            d = tuple(_add(u, v) for u, v in zip(d, self._solve(*left)))
-        return d
 
     def _left(self, d, target) -> tuple:
         """What ``d`` leaves of the rows it solves: the right-hand side of its
@@ -248,7 +249,7 @@ class _Iterate:
         program, ns = self.program, self.program.ns
         cones, cut = program.cones, program.cutoff
         wq = [sc.times_w_inverse(q) for sc, q in zip(self.scalings, q_c)]
-        pulled = [wq[b] + self._w2i(b, r_cones[b]) for b in range(len(cones))]
+        pulled = [wq[b] + self.w2i(b, r_cones[b]) for b in range(len(cones))]
         qx = -r_x - pulled[0] @ program.friction.G
         qa = -r_a
         if cut is not None:
@@ -259,29 +260,15 @@ class _Iterate:
         dy, da = self._bordered(rhs_y, rhs_a)
         dx = np.einsum("vij,vj->vi", self.D,
                        qx - da * self.v + (ns.AT @ dy).reshape(qx.shape))
-        dz = [wq[0] + self._w2i(0, r_cones[0] + dx @ program.friction.G.T)]
+        dz = [wq[0] + self.w2i(0, r_cones[0] + dx @ program.friction.G.T)]
         if cut is not None:
-            dz.append(wq[1] + self._w2i(1, r_cones[1] + dx @ CUTOFF.G.T
+            dz.append(wq[1] + self.w2i(1, r_cones[1] + dx @ CUTOFF.G.T
                                         + cut[:, None] * da))
         # ds from the cone rows, which keeps them exact (W^2 dz loses their digits)
         ds = [-r_cones[0] - dx @ program.friction.G.T]
         if cut is not None:
             ds.append(-r_cones[1] - dx @ CUTOFF.G.T - cut[:, None] * da)
         return dx, da, dy, ds, dz
-
-
-REFINEMENTS = 1
-REFINE_GAP = 1.0
-"""Passes of iterative refinement of a direction (CVXOPT's) once the gap is below this
-times ``a``: near the optimum ``W^-2`` amplifies the rounding of ``dx`` in ``dz`` by up to
-1e20, and the dual rows are lost without them (before, a direction's error is corrected
-by the next one)."""
-
-
-def _add(u, v):
-    if isinstance(u, list):
-        return [a + b for a, b in zip(u, v)]
-    return u + v
 
 
 def _factor(ns, D, shift):
@@ -327,7 +314,7 @@ STIFF = 1e4
 update (which loses about ``log10(d gamma)`` of its digits along the cut-off's row)."""
 
 
-def _cold(program: _Program, shift) -> Point:
+def _cold(program: _Program) -> Point:
     """A start that meets the equilibrium rows and nearly every cone row: the
     least-squares vertex forces of the unit scaling (``A x = b``), with the ``a`` of
     :func:`_least_inside` (a vertex it leaves outside is shifted inside); the
@@ -335,7 +322,7 @@ def _cold(program: _Program, shift) -> Point:
     slacks (:func:`~.cones.centred_start`'s rule, the slacks kept)."""
     cones = program.cones
     units = [cone.identity(program.n) for cone in cones]
-    first = _Iterate(program, units, units, shift)
+    first = program.iterate_at(units, units)
     zero = [np.zeros_like(u) for u in units]
     x, a, _, _, _ = first.direction(np.zeros((program.n, 3)), 0.0, -program.ns.b, zero, zero)
     _, _, y, _, z = first.direction(np.zeros((program.n, 3)), 1.0,
@@ -345,14 +332,7 @@ def _cold(program: _Program, shift) -> Point:
     a = _least_inside(program, force, margin)
     x = force.copy()
     x[:, 0] += a * program.shift                        # x~ of the physical forces
-    s = program.slacks(x, a)
-    s = [sb + np.maximum(0.0, margin - cone.min_eigenvalue(sb))[:, None]
-         * cone.identity(len(sb)) for cone, sb in zip(cones, s)]
-    least = min(float(cone.min_eigenvalue(zb).min()) for cone, zb in zip(cones, z))
-    z = [zb + max(0.0, -1.5 * least) * cone.identity(len(zb)) for cone, zb in zip(cones, z)]
-    product = sum(float(np.sum(sb * zb)) for sb, zb in zip(s, z))
-    trace = sum(cone.trace(sb) for cone, sb in zip(cones, s))
-    z = [zb + (0.5 * product / trace) * cone.identity(len(zb)) for cone, zb in zip(cones, z)]
+    s, z = inside_start(cones, program.slacks(x, a), z, margin)
     return Point(x, a, y, s, z)
 
 
@@ -392,74 +372,13 @@ def solve(ns: NewtonSystem, held, ratio,
     (its friction model, ``mu`` and ``b``): ``held`` ((V,) float) every vertex's strength
     per unit ``a``, ``ratio`` ``t_c / c``."""
     begin = time.perf_counter()
-    program = _Program(ns, np.asarray(held, dtype=float), ratio)
-    shift = options.regularization * ns.diagonal_scale
+    program = _Program(ns, np.asarray(held, dtype=float), ratio, options)
     try:
-        p = _cold(program, shift)
+        p = _cold(program)
     except np.linalg.LinAlgError as error:
         log.warning("least adhesion: reduced matrix not positive definite: %s", error)
         return Solution(SOLVER_ERROR, None, None, 0, time.perf_counter() - begin)
-    status, iterations, best = USER_LIMIT, 0, None
-    for iterations in range(options.max_iter + 1):
-        residuals = program.residuals(p)
-        measures = _measures(program, p, residuals)
-        if _within(measures, (options.tol, options.dual_tol, options.gap_tol), p.a, options):
-            status = OPTIMAL
-            break
-        if _within(measures, options.reduced, p.a, options):
-            best = p
-        if iterations == options.max_iter:
-            break
-        try:
-            step, direction = _step(program, p, residuals, measures[2], shift, options)
-        except np.linalg.LinAlgError as error:
-            log.debug("least adhesion: reduced matrix not positive definite: %s", error)
-            step = 0.0
-        if step < options.min_step:
-            log.debug("least adhesion: stopped at iteration %d (step %.1e; primal %.1e, "
-                      "dual %.1e, gap %.1e)", iterations, step, *measures)
-            if best is not None:  # the last point within the reduced tolerances
-                status, p = OPTIMAL_INACCURATE, best
-            break
-        p = Point(*(old + step * d for old, d in zip((p.x, p.a, p.y), direction[:3])),
-                  [sb + step * d for sb, d in zip(p.s, direction[3])],
-                  [zb + step * d for zb, d in zip(p.z, direction[4])])
-        log.debug("least adhesion %d: a %.6e, primal %.1e, dual %.1e, gap %.1e, step %.3f",
-                  iterations, p.a, *measures, step)
+    status, p, iterations = iterate(
+        program, p, options, (options.tol, options.dual_tol, options.gap_tol,
+                              options.gap_tol * options.gap_floor), "least adhesion")
     return Solution(status, p, program.physical(p), iterations, time.perf_counter() - begin)
-
-
-def _measures(program, p: Point, residuals) -> tuple:
-    """``(primal, dual, gap)`` of ``p`` (:class:`AdhesionOptions`)."""
-    r_x, r_a, r_primal, r_cones = residuals
-    b_inf = float(np.abs(program.ns.b).max())
-    primal = max(float(np.abs(r_primal).max()),
-                 max(float(np.abs(rc).max()) for rc in r_cones)) / b_inf
-    dual = max(float(np.abs(r_x).max()) / max(1.0, float(np.abs(p.y).max())), abs(r_a))
-    return primal, dual, float(sum(np.sum(sb * zb) for sb, zb in zip(p.s, p.z)))
-
-
-def _within(measures, tolerances, a, options) -> bool:
-    primal, dual, gap = measures
-    tol, dual_tol, gap_tol = tolerances
-    return primal <= tol and dual <= dual_tol \
-        and gap <= gap_tol * max(abs(a), options.gap_floor)
-
-
-def _step(program, p: Point, residuals, gap, shift, options) -> tuple:
-    """``(step, direction)``: Mehrotra's predictor, then the corrector on the same
-    factor (``LinAlgError`` where the reduced matrix does not factor)."""
-    cones = program.cones
-    point = _Iterate(program, p.s, p.z, shift)
-    squares = [cone.product(sc.lam, sc.lam) for cone, sc in zip(cones, point.scalings)]
-    refinements = REFINEMENTS if gap <= REFINE_GAP * max(abs(p.a), options.gap_floor) else 0
-    _, _, _, ds, dz = point.direction(*residuals, squares, refinements)
-    step = largest_step(cones, p.s, p.z, ds, dz)
-    predicted = float(sum(np.sum((sb + step * dsb) * (zb + step * dzb))
-                          for sb, zb, dsb, dzb in zip(p.s, p.z, ds, dz)))
-    target = (predicted / gap) ** 3 * gap / program.degree
-    r_comp = [square + cone.product(sc.times_w_inverse(dsb), sc.times_w(dzb))
-              - target * cone.identity(len(square))
-              for cone, sc, square, dsb, dzb in zip(cones, point.scalings, squares, ds, dz)]
-    direction = point.direction(*residuals, r_comp, refinements)
-    return options.step_fraction * largest_step(cones, p.s, p.z, *direction[3:]), direction

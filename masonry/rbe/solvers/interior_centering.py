@@ -22,8 +22,8 @@ leaves ::
 ``A D A^T`` is the Newton method's matrix (one 3 x 3 block ``D_v`` per vertex, the same
 :class:`~.cholesky.BlockCholesky` symbolic analysis, which a stage sequence holds);
 ``B E B^T`` adds a 3 x 3 block to the force rows of each free block's diagonal block, so
-the pattern is the same. Mehrotra's predictor-corrector as :mod:`.interior_adhesion`, from
-a start that meets the equilibrium rows (:func:`_cold`). The multipliers of the supports'
+the pattern is the same. Mehrotra's predictor-corrector (:mod:`.predictor_corrector`,
+shared with :mod:`.interior_adhesion`) from a start that meets the equilibrium rows (:func:`_cold`). The multipliers of the supports'
 cones, and of Coulomb's cone (``G_1`` invertible) where a vertex's multiplier outweighs
 its slack (``W^2`` small), come from their dual rows and their slacks from the
 complementarity; the others' slacks from the cone rows and multipliers through
@@ -49,16 +49,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from masonry.rbe.solvers.base import OPTIMAL, OPTIMAL_INACCURATE, SOLVER_ERROR, USER_LIMIT
+from masonry.rbe.solvers.base import SOLVER_ERROR
 from masonry.rbe.solvers.cones import Lorentz, Orthant
-from masonry.rbe.solvers.interior import (
-    VertexCone,
-    largest_step,
-    scaling_of,
-    vertex_cones,
-    vertex_inverse,
-)
+from masonry.rbe.solvers.interior import VertexCone, vertex_cones, vertex_inverse
 from masonry.rbe.solvers.newton import NewtonSystem
+from masonry.rbe.solvers.predictor_corrector import ConeIterate, inside_start, iterate
 
 log = logging.getLogger(__name__)
 
@@ -89,10 +84,15 @@ class CenteringOptions:
         Fraction of the largest step to the boundary of the cones that is taken (at
         0.99 the iterates of preset 1's upper brick stages lost their centring near the
         optimum and stalled, the pure centring step itself at 0.02).
-    regularization : float
-        Shift of the reduced matrix relative to its mean diagonal.
-    min_step : float
-        Stop when a step falls below this.
+    regularization, min_step : float
+        The reduced matrix's shift relative to its mean diagonal; the step below which
+        the method stops.
+    refinements, refine_gap : int, float
+        Passes of iterative refinement of a direction (CVXOPT's) once the gap is below
+        ``refine_gap`` times the objective (or ``gap_floor``): near the optimum the
+        scalings span many decades, and a direction that leaves a row unsolved by more
+        than the row's tolerance stalls the method (one pass left preset 1's free web
+        2e-5 of the reference weight from the optimum, three 2e-6).
     """
 
     tol: float = 1e-8
@@ -104,6 +104,8 @@ class CenteringOptions:
     step_fraction: float = 0.95
     regularization: float = 1e-10
     min_step: float = 1e-6
+    refinements: int = 3
+    refine_gap: float = 1e-2
 
 
 @dataclass
@@ -141,10 +143,13 @@ SUPPORT = Lorentz(4)
 
 
 class _Program:
-    """The program (module docstring) on ``ns``."""
+    """The program (module docstring) on ``ns``, as :func:`.predictor_corrector.iterate`
+    takes it; ``diagonal_shift`` the reduced matrix's."""
 
-    def __init__(self, ns: NewtonSystem):
+    def __init__(self, ns: NewtonSystem, options: CenteringOptions):
         self.ns = ns
+        self.diagonal_shift = options.regularization * ns.diagonal_scale
+        self.gap_floor = options.gap_floor
         self.friction = vertex_cones(ns.components, ns.cone, ns.mu)[0]
         self.vertex = [self.friction] + ([CUTOFF] if ns.floor is not None else [])
         self.cones = [vc.cone for vc in self.vertex] + [SUPPORT]
@@ -174,6 +179,23 @@ class _Program:
         r_cones = [sb - exact for sb, exact in zip(p.s, self.slacks(p.x, p.w))]
         return r_x, r_w, r_primal, r_cones
 
+    def measures(self, p: Point, residuals) -> tuple:
+        """``(primal, dual, gap)`` of ``p`` (:class:`CenteringOptions`)."""
+        r_x, r_w, r_primal, r_cones = residuals
+        b_inf = max(float(np.abs(self.ns.b).max()), 1.0)
+        primal = max(float(np.abs(r_primal).max()),
+                     max(float(np.abs(rc).max()) for rc in r_cones)) / b_inf
+        dual = max(float(np.abs(r_x).max()), float(np.abs(r_w).max())) \
+            / max(1.0, float(np.abs(p.y).max()))
+        return primal, dual, float(sum(np.sum(sb * zb) for sb, zb in zip(p.s, p.z)))
+
+    @staticmethod
+    def objective(p: Point) -> float:
+        return float(p.w[:, 0].sum())
+
+    def iterate_at(self, s, z) -> "_Iterate":
+        return _Iterate(self, s, z, self.diagonal_shift)
+
     def slacks(self, x, w) -> list:
         """The cone rows' slacks of ``(x, w)``: ``h - G (x, w)``."""
         out = [-(x @ self.friction.G.T)]
@@ -182,16 +204,14 @@ class _Program:
         return out + [w.copy()]
 
 
-class _Iterate:
-    """The reduced system at one point (module docstring): factored once, solved for the
+class _Iterate(ConeIterate):
+    """``A D A^T + B E B^T`` at one point (module docstring), factored once for the
     predictor and the corrector."""
 
     def __init__(self, program: _Program, s, z, shift):
+        super().__init__(program.cones, s, z)
+        ns, w_inverse = program.ns, self.w_inverse
         self.program = program
-        ns = program.ns
-        self.scalings, w_inverse = zip(*(scaling_of(cone, sb, zb) for cone, sb, zb in
-                                         zip(program.cones, s, z)))
-        self.w2_inverse = [w * w if w.ndim == 2 else w @ w for w in w_inverse]
         if program.square is not None and len(program.vertex) == 1:
             self.D = program.square @ self.scalings[0].D @ program.square.T  # G^-1 W^2 G^-T
         else:
@@ -205,23 +225,6 @@ class _Iterate:
         blocks[diagonal, :3, :3] += self.E[:, 1:, 1:]
         blocks[diagonal[program.untouched], 3:, 3:] += np.eye(3)
         self.factor = ns.symbolic.factor(blocks)
-
-    def _w2i(self, b, v):
-        """``W_b^-2 v`` per vertex or block."""
-        w = self.w2_inverse[b]
-        return w * v if w.ndim == 2 else np.einsum("vij,vj->vi", w, v)
-
-    def direction(self, r_x, r_w, r_primal, r_cones, r_comp, refinements=0):
-        """``(dx, dw, dy, ds, dz)`` for the residuals of :meth:`_Program.residuals` and
-        the scaled complementarity ``lam o (W^-1 ds + W dz) = -r_comp`` (per cone), with
-        ``refinements`` passes of iterative refinement on the unreduced rows."""
-        q_c = [-cone.divide(sc.lam, rc)
-               for cone, sc, rc in zip(self.program.cones, self.scalings, r_comp)]
-        target = (r_x, r_w, r_primal, r_cones, q_c)
-        d = self._solve(*target)
-        for _ in range(refinements):
-            d = tuple(_add(u, v) for u, v in zip(d, self._solve(*self._left(d, target))))
-        return d
 
     def _left(self, d, target) -> tuple:
         """What ``d`` leaves of the rows it solves: the right-hand side of its
@@ -246,7 +249,7 @@ class _Iterate:
         """The direction for the rows' residuals and ``W^-1 ds + W dz = q_c``."""
         program, ns = self.program, self.program.ns
         wq = [sc.times_w_inverse(q) for sc, q in zip(self.scalings, q_c)]
-        pulled = [wq[b] + self._w2i(b, r_cones[b]) for b in range(len(program.cones))]
+        pulled = [wq[b] + self.w2i(b, r_cones[b]) for b in range(len(program.cones))]
         qx = -r_x
         for vc, pb in zip(program.vertex, pulled):
             qx = qx - pb @ vc.G
@@ -258,7 +261,7 @@ class _Iterate:
         ds, dz = [], []
         for b, vc in enumerate(program.vertex):
             ds.append(-r_cones[b] - dx @ vc.G.T)     # from the cone rows: keeps them exact
-            dz.append(wq[b] + self._w2i(b, r_cones[b] + dx @ vc.G.T))
+            dz.append(wq[b] + self.w2i(b, r_cones[b] + dx @ vc.G.T))
         if program.square is not None:  # Coulomb's cone: its dz from the dual rows
             rest = (ns.AT @ dy).reshape(qx.shape) - r_x
             for vc, dzb in zip(program.vertex[1:], dz[1:]):
@@ -277,22 +280,7 @@ class _Iterate:
         return dx, ds[-1] + r_cones[-1], dy, ds, dz
 
 
-REFINEMENTS = 3
-REFINE_GAP = 1e-2
-"""Passes of iterative refinement of a direction (CVXOPT's) once the gap is below this
-times the objective (or :attr:`CenteringOptions.gap_floor`): near the optimum the
-scalings span many decades, and a direction that leaves a row unsolved by more than the
-row's tolerance stalls the method (one pass left preset 1's free web 2e-5 of the
-reference weight from the optimum, three 2e-6)."""
-
-
-def _add(u, v):
-    if isinstance(u, list):
-        return [a + b for a, b in zip(u, v)]
-    return u + v
-
-
-def _cold(program: _Program, shift) -> Point:
+def _cold(program: _Program) -> Point:
     """A start that meets the equilibrium rows and nearly every cone row: the
     least-squares forces of the unit scaling (``A x + B u = b``), each support's
     ``tau_j`` :data:`START_MARGIN` above ``||u_j||``, a vertex outside its cones shifted
@@ -301,7 +289,7 @@ def _cold(program: _Program, shift) -> Point:
     cones, ns = program.cones, program.ns
     units = [cone.identity(len(e)) for cone, e in
              zip(cones, [np.zeros(program.n)] * (len(cones) - 1) + [np.zeros(program.blocks)])]
-    first = _Iterate(program, units, units, shift)
+    first = program.iterate_at(units, units)
     zero = [np.zeros_like(u) for u in units]
     x, w, _, _, _ = first.direction(np.zeros((program.n, 3)), np.zeros_like(program.cost),
                                     -ns.b, zero, zero)
@@ -310,14 +298,7 @@ def _cold(program: _Program, shift) -> Point:
     rows = np.concatenate([x, w[:, 1:]])
     margin = START_MARGIN * max(float(np.sqrt(np.mean(np.sum(rows * rows, axis=1)))), 1e-3)
     w[:, 0] = np.linalg.norm(w[:, 1:], axis=1) + margin
-    s = program.slacks(x, w)
-    s = [sb + np.maximum(0.0, margin - cone.min_eigenvalue(sb))[:, None]
-         * cone.identity(len(sb)) for cone, sb in zip(cones, s)]
-    least = min(float(cone.min_eigenvalue(zb).min()) for cone, zb in zip(cones, z))
-    z = [zb + max(0.0, -1.5 * least) * cone.identity(len(zb)) for cone, zb in zip(cones, z)]
-    product = sum(float(np.sum(sb * zb)) for sb, zb in zip(s, z))
-    trace = sum(cone.trace(sb) for cone, sb in zip(cones, s))
-    z = [zb + (0.5 * product / trace) * cone.identity(len(zb)) for cone, zb in zip(cones, z)]
+    s, z = inside_start(cones, program.slacks(x, w), z, margin)
     return Point(x, w, y, s, z)
 
 
@@ -329,81 +310,13 @@ def solve(ns: NewtonSystem, options: CenteringOptions = CenteringOptions()) -> S
     """The centering force's program (module docstring) on the friction-net system
     ``ns`` (its friction model, ``mu``, cut-off floor and ``b``)."""
     begin = time.perf_counter()
-    program = _Program(ns)
-    shift = options.regularization * ns.diagonal_scale
+    program = _Program(ns, options)
     try:
-        p = _cold(program, shift)
+        p = _cold(program)
     except np.linalg.LinAlgError as error:
         log.warning("centering force: reduced matrix not positive definite: %s", error)
         return Solution(SOLVER_ERROR, None, None, 0, time.perf_counter() - begin)
-    status, iterations, best = USER_LIMIT, 0, None
-    for iterations in range(options.max_iter + 1):
-        residuals = program.residuals(p)
-        measures = _measures(program, p, residuals)
-        objective = float(p.w[:, 0].sum())
-        if _within(measures, (options.tol, options.dual_tol, options.gap_tol,
-                              options.gap_floor), objective):
-            status = OPTIMAL
-            break
-        if _within(measures, options.reduced, objective):
-            best = p
-        if iterations == options.max_iter:
-            break
-        try:
-            step, direction = _step(program, p, residuals, shift, options)
-        except np.linalg.LinAlgError as error:
-            log.debug("centering force: reduced matrix not positive definite: %s", error)
-            step = 0.0
-        if step < options.min_step:
-            log.debug("centering force: stopped at iteration %d (step %.1e; primal %.1e, "
-                      "dual %.1e, gap %.1e)", iterations, step, *measures)
-            if best is not None:  # the last point within the reduced tolerances
-                status, p = OPTIMAL_INACCURATE, best
-            break
-        p = Point(*(old + step * d for old, d in zip((p.x, p.w, p.y), direction[:3])),
-                  [sb + step * d for sb, d in zip(p.s, direction[3])],
-                  [zb + step * d for zb, d in zip(p.z, direction[4])])
-        log.debug("centering force %d: total %.6e, primal %.1e, dual %.1e, gap %.1e, "
-                  "step %.3f", iterations, objective, *measures, step)
-    if status == USER_LIMIT and best is not None:
-        status, p = OPTIMAL_INACCURATE, best
+    status, p, iterations = iterate(
+        program, p, options,
+        (options.tol, options.dual_tol, options.gap_tol, options.gap_floor), "centering force")
     return Solution(status, p.x, p.w[:, 1:], iterations, time.perf_counter() - begin)
-
-
-def _measures(program, p: Point, residuals) -> tuple:
-    """``(primal, dual, gap)`` of ``p`` (:class:`CenteringOptions`)."""
-    r_x, r_w, r_primal, r_cones = residuals
-    b_inf = max(float(np.abs(program.ns.b).max()), 1.0)
-    primal = max(float(np.abs(r_primal).max()),
-                 max(float(np.abs(rc).max()) for rc in r_cones)) / b_inf
-    dual = max(float(np.abs(r_x).max()), float(np.abs(r_w).max())) \
-        / max(1.0, float(np.abs(p.y).max()))
-    return primal, dual, float(sum(np.sum(sb * zb) for sb, zb in zip(p.s, p.z)))
-
-
-def _within(measures, tolerances, objective) -> bool:
-    primal, dual, gap = measures
-    tol, dual_tol, gap_tol, gap_floor = tolerances
-    return primal <= tol and dual <= dual_tol \
-        and gap <= max(gap_tol * abs(objective), gap_floor)
-
-
-def _step(program, p: Point, residuals, shift, options) -> tuple:
-    """``(step, direction)``: Mehrotra's predictor, then the corrector on the same
-    factor (``LinAlgError`` where the reduced matrix does not factor)."""
-    cones = program.cones
-    point = _Iterate(program, p.s, p.z, shift)
-    gap = float(sum(np.sum(sb * zb) for sb, zb in zip(p.s, p.z)))
-    squares = [cone.product(sc.lam, sc.lam) for cone, sc in zip(cones, point.scalings)]
-    objective = float(p.w[:, 0].sum())
-    refinements = REFINEMENTS if gap <= REFINE_GAP * max(objective, options.gap_floor) else 0
-    _, _, _, ds, dz = point.direction(*residuals, squares, refinements)
-    step = largest_step(cones, p.s, p.z, ds, dz)
-    predicted = float(sum(np.sum((sb + step * dsb) * (zb + step * dzb))
-                          for sb, zb, dsb, dzb in zip(p.s, p.z, ds, dz)))
-    target = (predicted / gap) ** 3 * gap / program.degree
-    r_comp = [square + cone.product(sc.times_w_inverse(dsb), sc.times_w(dzb))
-              - target * cone.identity(len(square))
-              for cone, sc, square, dsb, dzb in zip(cones, point.scalings, squares, ds, dz)]
-    direction = point.direction(*residuals, r_comp, refinements)
-    return options.step_fraction * largest_step(cones, p.s, p.z, *direction[3:]), direction
