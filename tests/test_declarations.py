@@ -84,8 +84,10 @@ def _toml(value) -> str:
 def test_every_declared_input_is_a_study_key_that_gives_its_value(tmp_path, part, name):
     value = _other_value(part, name)
     base = ('boundary = "free"\nlateral = 0\n' if name == "friction_law" else "")
-    if name in FILE_OUTPUTS:  # chosen once for every variant
-        text = f"[base]\n{base}[grid]\nn = [6, 8]\n[outputs]\n{name} = {_toml(value)}\n"
+    if name in FILE_OUTPUTS:  # chosen once for every variant (a 3MF of the printable body)
+        beside = "printable = true\n" if name == "print_size" else ""
+        text = (f"[base]\n{base}[grid]\nn = [6, 8]\n[outputs]\n{beside}"
+                f"{name} = {_toml(value)}\n")
     else:
         text = f"[base]\n{base}{option_of(name)} = {_toml(value)}\n[grid]\nn = [6, 8]\n"
     path = tmp_path / "study.toml"
@@ -97,6 +99,18 @@ def test_every_declared_input_is_a_study_key_that_gives_its_value(tmp_path, part
         path.write_text(f"[base]\n{option_of(name)} = {_toml(value)}\n")
         with pytest.raises(Exception, match=r"\[outputs\] table chooses it"):
             load_study(path)
+
+
+def test_a_study_refuses_a_print_size_without_the_printable_body(tmp_path, capsys):
+    """A study writes no printable body unless asked, so a print size alone would write
+    no 3MF: refused in one line naming the file and key, exit 2, as ``masonry run``
+    refuses ``--print-size`` beside ``--no-printable``."""
+    path = tmp_path / "study.toml"
+    path.write_text("[grid]\nn = [6, 8]\n[outputs]\nprint_size = 100\n")
+    assert main(["sweep", str(path), "--out", str(tmp_path / "o")]) == 2
+    line = capsys.readouterr().err.strip()
+    assert line.count("\n") == 0 and "outputs.print_size = 100" in line
+    assert "printable = true" in line and not (tmp_path / "o").exists()
 
 
 def test_the_record_of_written_outputs_is_what_the_folder_holds(tmp_path):

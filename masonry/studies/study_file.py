@@ -128,12 +128,16 @@ def load_study(path, draws=True):
               "grid": _fields(grid, "grid", where, lists=True),
               "sample": _fields(sample, "sample", where), "mortar": mortar}
     _check_laying(tables, stages, where)
+    chosen = {**Study.outputs_default(), **_outputs_table(outputs, refuse)}
+    if chosen.get("print_size") is not None and not chosen.get("printable", True):
+        refuse("outputs.print_size", chosen["print_size"],
+               "printable = true beside it in [outputs] (dome.3mf is the printable body "
+               "at that size; a study writes none unless asked)")
     study = Study(
         base={**(PRESETS[str(preset)] if preset is not None else {}), **tables["base"],
               **mortar},
         grid=tables["grid"], sample=tables["sample"], count=count, seed=seed,
-        outputs={**Study.outputs_default(), **_outputs_table(outputs, refuse)},
-        constraints=constraints, **stages)
+        outputs=chosen, constraints=constraints, **stages)
     study = _checked_constraints(study, where)
     _check_variants(study, where, None if draws else _search_probes(study), mortar)
     return study
