@@ -54,7 +54,12 @@ from masonry.rbe.solvers.base import SOLVER_ERROR
 from masonry.rbe.solvers.cones import Orthant
 from masonry.rbe.solvers.interior import VertexCone, vertex_cones, vertex_inverse
 from masonry.rbe.solvers.newton import NewtonSystem
-from masonry.rbe.solvers.predictor_corrector import ConeIterate, inside_start, iterate
+from masonry.rbe.solvers.predictor_corrector import (
+    START_MARGIN,
+    ConeIterate,
+    inside_start,
+    iterate,
+)
 
 log = logging.getLogger(__name__)
 
@@ -335,10 +340,6 @@ def _cold(program: _Program) -> Point:
     s, z = inside_start(cones, program.slacks(x, a), z, margin)
     return Point(x, a, y, s, z)
 
-
-START_MARGIN = 0.1
-"""The starting slacks' least eigenvalue, relative to the root mean square vertex
-force."""
 
 START_QUANTILE = 0.9
 """The share of the vertices the starting ``a`` puts inside their cones; the few that

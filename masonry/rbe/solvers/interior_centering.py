@@ -53,7 +53,12 @@ from masonry.rbe.solvers.base import SOLVER_ERROR
 from masonry.rbe.solvers.cones import Lorentz, Orthant
 from masonry.rbe.solvers.interior import VertexCone, vertex_cones, vertex_inverse
 from masonry.rbe.solvers.newton import NewtonSystem
-from masonry.rbe.solvers.predictor_corrector import ConeIterate, inside_start, iterate
+from masonry.rbe.solvers.predictor_corrector import (
+    START_MARGIN,
+    ConeIterate,
+    inside_start,
+    iterate,
+)
 
 log = logging.getLogger(__name__)
 
@@ -257,13 +262,14 @@ class _Iterate(ConeIterate):
         rhs = -r_primal - ns.A @ np.einsum("vij,vj->vi", self.D, qx).ravel()
         rhs.reshape(-1, 6)[:, :3] -= np.einsum("fij,fj->fi", self.E[:, 1:], qw)
         dy = self.factor.solve(rhs)
-        dx = np.einsum("vij,vj->vi", self.D, qx + (ns.AT @ dy).reshape(qx.shape))
+        pushed = (ns.AT @ dy).reshape(qx.shape)
+        dx = np.einsum("vij,vj->vi", self.D, qx + pushed)
         ds, dz = [], []
         for b, vc in enumerate(program.vertex):
             ds.append(-r_cones[b] - dx @ vc.G.T)     # from the cone rows: keeps them exact
             dz.append(wq[b] + self.w2i(b, r_cones[b] + dx @ vc.G.T))
         if program.square is not None:  # Coulomb's cone: its dz from the dual rows
-            rest = (ns.AT @ dy).reshape(qx.shape) - r_x
+            rest = pushed - r_x
             for vc, dzb in zip(program.vertex[1:], dz[1:]):
                 rest = rest - dzb @ vc.G
             scaling, keep = self.scalings[0], self.slack[:, None]
@@ -287,8 +293,8 @@ def _cold(program: _Program) -> Point:
     inside; the least-squares multipliers of the objective, shifted inside and balanced
     with the slacks (:func:`~.cones.centred_start`'s rule, the slacks kept)."""
     cones, ns = program.cones, program.ns
-    units = [cone.identity(len(e)) for cone, e in
-             zip(cones, [np.zeros(program.n)] * (len(cones) - 1) + [np.zeros(program.blocks)])]
+    units = [cone.identity(program.n) for cone in cones[:-1]] + [
+        SUPPORT.identity(program.blocks)]
     first = program.iterate_at(units, units)
     zero = [np.zeros_like(u) for u in units]
     x, w, _, _, _ = first.direction(np.zeros((program.n, 3)), np.zeros_like(program.cost),
@@ -301,9 +307,6 @@ def _cold(program: _Program) -> Point:
     s, z = inside_start(cones, program.slacks(x, w), z, margin)
     return Point(x, w, y, s, z)
 
-
-START_MARGIN = 0.1
-"""The starting slacks' least eigenvalue, relative to the root mean square force."""
 
 
 def solve(ns: NewtonSystem, options: CenteringOptions = CenteringOptions()) -> Solution:

@@ -51,7 +51,8 @@ def iterate(program, p, options, tolerances, name) -> tuple:
         refinements = options.refinements if measures[2] <= options.refine_gap * max(
             abs(objective), program.gap_floor) else 0
         try:
-            step, direction = _step(program, p, residuals, refinements, options.step_fraction)
+            step, direction = _step(program, p, residuals, measures[2], refinements,
+                                    options.step_fraction)
         except np.linalg.LinAlgError as error:
             log.debug("%s: reduced matrix not positive definite: %s", name, error)
             step = 0.0
@@ -85,12 +86,12 @@ def within(measures, tolerances, objective) -> bool:
                                                                 gap_floor)
 
 
-def _step(program, p, residuals, refinements, step_fraction) -> tuple:
-    """``(step, direction)``: Mehrotra's predictor, then the corrector on the same
-    factor (``LinAlgError`` where the reduced matrix does not factor)."""
+def _step(program, p, residuals, gap, refinements, step_fraction) -> tuple:
+    """``(step, direction)`` from ``p`` (whose gap ``s^T z`` is ``gap``): Mehrotra's
+    predictor, then the corrector on the same factor (``LinAlgError`` where the reduced
+    matrix does not factor)."""
     cones = program.cones
     point = program.iterate_at(p.s, p.z)
-    gap = float(sum(np.sum(sb * zb) for sb, zb in zip(p.s, p.z)))
     squares = [cone.product(sc.lam, sc.lam) for cone, sc in zip(cones, point.scalings)]
     ds, dz = point.direction(*residuals, squares, refinements=refinements)[-2:]
     step = largest_step(cones, p.s, p.z, ds, dz)
@@ -102,6 +103,11 @@ def _step(program, p, residuals, refinements, step_fraction) -> tuple:
               for cone, sc, square, dsb, dzb in zip(cones, point.scalings, squares, ds, dz)]
     direction = point.direction(*residuals, r_comp, refinements=refinements)
     return step_fraction * largest_step(cones, p.s, p.z, *direction[-2:]), direction
+
+
+START_MARGIN = 0.1
+"""A start's slacks' least eigenvalue, relative to the root mean square force of the
+least-squares point it starts from (:func:`inside_start`)."""
 
 
 def inside_start(cones, s, z, margin) -> tuple:
@@ -149,12 +155,6 @@ class ConeIterate:
         for _ in range(refinements):
             d = tuple(_add(u, v) for u, v in zip(d, self._solve(*self._left(d, target))))
         return d
-
-    def _solve(self, *target):
-        raise NotImplementedError
-
-    def _left(self, d, target):
-        raise NotImplementedError
 
 
 def _add(u, v):
