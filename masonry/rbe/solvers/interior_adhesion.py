@@ -50,16 +50,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from masonry.rbe.solvers import predictor_corrector
 from masonry.rbe.solvers.base import SOLVER_ERROR
 from masonry.rbe.solvers.cones import Orthant
 from masonry.rbe.solvers.interior import VertexCone, vertex_cones, vertex_inverse
 from masonry.rbe.solvers.newton import NewtonSystem
-from masonry.rbe.solvers.predictor_corrector import (
-    START_MARGIN,
-    ConeIterate,
-    inside_start,
-    iterate,
-)
 
 log = logging.getLogger(__name__)
 
@@ -202,7 +197,7 @@ class _Program:
         return x
 
 
-class _Iterate(ConeIterate):
+class _Iterate(predictor_corrector.ConeIterate):
     """The reduced system at one point (module docstring): factored once, solved for the
     predictor and the corrector."""
 
@@ -333,11 +328,12 @@ def _cold(program: _Program) -> Point:
     _, _, y, _, z = first.direction(np.zeros((program.n, 3)), 1.0,
                                     np.zeros_like(program.ns.b), zero, zero)
     force = program.physical(Point(x, a, y, [], []))
-    margin = START_MARGIN * float(np.sqrt(np.mean(np.sum(force * force, axis=1))))
+    rms = float(np.sqrt(np.mean(np.sum(force * force, axis=1))))
+    margin = predictor_corrector.START_MARGIN * rms
     a = _least_inside(program, force, margin)
     x = force.copy()
     x[:, 0] += a * program.shift                        # x~ of the physical forces
-    s, z = inside_start(cones, program.slacks(x, a), z, margin)
+    s, z = predictor_corrector.inside_start(cones, program.slacks(x, a), z, margin)
     return Point(x, a, y, s, z)
 
 
@@ -379,7 +375,7 @@ def solve(ns: NewtonSystem, held, ratio,
     except np.linalg.LinAlgError as error:
         log.warning("least adhesion: reduced matrix not positive definite: %s", error)
         return Solution(SOLVER_ERROR, None, None, 0, time.perf_counter() - begin)
-    status, p, iterations = iterate(
+    status, p, iterations = predictor_corrector.iterate(
         program, p, options, (options.tol, options.dual_tol, options.gap_tol,
                               options.gap_tol * options.gap_floor), "least adhesion")
     return Solution(status, p, program.physical(p), iterations, time.perf_counter() - begin)

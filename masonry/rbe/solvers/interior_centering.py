@@ -23,10 +23,10 @@ leaves ::
 :class:`~.cholesky.BlockCholesky` symbolic analysis, which a stage sequence holds);
 ``B E B^T`` adds a 3 x 3 block to the force rows of each free block's diagonal block, so
 the pattern is the same. Mehrotra's predictor-corrector (:mod:`.predictor_corrector`,
-shared with :mod:`.interior_adhesion`) from a start that meets the equilibrium rows (:func:`_cold`). The multipliers of the supports'
-cones, and of Coulomb's cone (``G_1`` invertible) where a vertex's multiplier outweighs
-its slack (``W^2`` small), come from their dual rows and their slacks from the
-complementarity; the others' slacks from the cone rows and multipliers through
+shared with :mod:`.interior_adhesion`) from a start that meets the equilibrium rows
+(:func:`_cold`). The multipliers of the supports' cones, and of Coulomb's cone (``G_1``
+invertible) where a vertex's multiplier outweighs its slack (``W^2`` small), come from
+their dual rows and their slacks from the complementarity; the others' slacks from the cone rows and multipliers through
 ``W^-2``: ``W^-2 (W^2 v)`` of a cone near its apex keeps no digit of ``v`` (the dual rows
 were lost in the last iterations), ``W^2 (W^-2 v)`` likewise the other way (the cone
 rows were).
@@ -49,16 +49,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from masonry.rbe.solvers import predictor_corrector
 from masonry.rbe.solvers.base import SOLVER_ERROR
 from masonry.rbe.solvers.cones import Lorentz, Orthant
 from masonry.rbe.solvers.interior import VertexCone, vertex_cones, vertex_inverse
 from masonry.rbe.solvers.newton import NewtonSystem
-from masonry.rbe.solvers.predictor_corrector import (
-    START_MARGIN,
-    ConeIterate,
-    inside_start,
-    iterate,
-)
 
 log = logging.getLogger(__name__)
 
@@ -209,7 +204,7 @@ class _Program:
         return out + [w.copy()]
 
 
-class _Iterate(ConeIterate):
+class _Iterate(predictor_corrector.ConeIterate):
     """``A D A^T + B E B^T`` at one point (module docstring), factored once for the
     predictor and the corrector."""
 
@@ -302,9 +297,10 @@ def _cold(program: _Program) -> Point:
     _, _, y, _, z = first.direction(np.zeros((program.n, 3)), program.cost,
                                     np.zeros_like(ns.b), zero, zero)
     rows = np.concatenate([x, w[:, 1:]])
-    margin = START_MARGIN * max(float(np.sqrt(np.mean(np.sum(rows * rows, axis=1)))), 1e-3)
+    rms = float(np.sqrt(np.mean(np.sum(rows * rows, axis=1))))
+    margin = predictor_corrector.START_MARGIN * max(rms, 1e-3)
     w[:, 0] = np.linalg.norm(w[:, 1:], axis=1) + margin
-    s, z = inside_start(cones, program.slacks(x, w), z, margin)
+    s, z = predictor_corrector.inside_start(cones, program.slacks(x, w), z, margin)
     return Point(x, w, y, s, z)
 
 
@@ -319,7 +315,7 @@ def solve(ns: NewtonSystem, options: CenteringOptions = CenteringOptions()) -> S
     except np.linalg.LinAlgError as error:
         log.warning("centering force: reduced matrix not positive definite: %s", error)
         return Solution(SOLVER_ERROR, None, None, 0, time.perf_counter() - begin)
-    status, p, iterations = iterate(
+    status, p, iterations = predictor_corrector.iterate(
         program, p, options,
         (options.tol, options.dual_tol, options.gap_tol, options.gap_floor), "centering force")
     return Solution(status, p.x, p.w[:, 1:], iterations, time.perf_counter() - begin)
