@@ -26,10 +26,10 @@ the pattern is the same. Mehrotra's predictor-corrector (:mod:`.predictor_correc
 shared with :mod:`.interior_adhesion`) from a start that meets the equilibrium rows
 (:func:`_cold`). The multipliers of the supports' cones, and of Coulomb's cone (``G_1``
 invertible) where a vertex's multiplier outweighs its slack (``W^2`` small), come from
-their dual rows and their slacks from the complementarity; the others' slacks from the cone rows and multipliers through
-``W^-2``: ``W^-2 (W^2 v)`` of a cone near its apex keeps no digit of ``v`` (the dual rows
-were lost in the last iterations), ``W^2 (W^-2 v)`` likewise the other way (the cone
-rows were).
+their dual rows and their slacks from the complementarity; the others' slacks from the
+cone rows and multipliers through ``W^-2``: ``W^-2 (W^2 v)`` of a cone near its apex
+keeps no digit of ``v`` (the dual rows were lost in the last iterations), ``W^2 (W^-2
+v)`` likewise the other way (the cone rows were).
 
 Why it exists: Clarabel factors the whole KKT system (a row per vertex force, cone row
 and support component) at every one of its iterations; this factors the six rows per
