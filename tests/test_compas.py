@@ -8,6 +8,8 @@ import numpy as np
 import pytest
 
 import masonry
+from masonry.export.compas_json import assembly_json
+from masonry.interfaces import Interfaces
 from masonry.scenes.imported import read_blocks
 from masonry.scenes.mesh_files import AssemblyError
 from masonry_cli.main import main
@@ -203,3 +205,64 @@ def test_round_trip_compas_assembly_loads_it(dome_run):
     for interface in interfaces:
         assert len(interface.forces) == len(interface.points)
         assert np.isclose(np.linalg.norm(interface.frame.normal), 1.0, atol=1e-9)
+
+
+def _turned(faces: Interfaces, x):
+    """The same joints described from their other block: pair, normal and polygon
+    turned, the axes swapped (still right-handed), and the friction the force on the
+    first block (f1, f2 become -f2, -f1)."""
+    order = np.concatenate([np.arange(a, b)[::-1] for a, b in
+                            zip(faces.offsets[:-1], faces.offsets[1:])])
+    turned = Interfaces(pair=faces.pair[:, ::-1], kind=faces.kind,
+                        vertices=faces.vertices[order], offsets=faces.offsets,
+                        area=faces.area, centre=faces.centre, normal=-faces.normal,
+                        t1=faces.t2, t2=faces.t1)
+    return turned, x[order][:, [0, 1, 3, 2]] * [1, 1, -1, -1]
+
+
+def test_joints_stored_from_either_block_hold_the_same_forces():
+    """Every joint of a wall as two halves, the second stored from its other block: the
+    file lists both under one edge, and their force on the edge's second block is the
+    joint's whole force on that block, each polygon counter-clockwise about its frame's
+    normal."""
+    assembly = masonry.read(SAMPLES / "compas_assembly" / "wall_assembly.json")
+    result = assembly.solve()
+    faces, x = assembly.model.interfaces, result.x.reshape(-1, 4)
+    turned, x_turned = _turned(faces, x)
+    both = Interfaces(**{name: np.concatenate([getattr(faces, name), getattr(turned, name)])
+                         for name in ("pair", "kind", "vertices", "area", "centre", "normal",
+                                      "t1", "t2")},
+                      offsets=np.concatenate([faces.offsets,
+                                              faces.offsets[1:] + faces.offsets[-1]]))
+    halves = np.concatenate([x, x_turned]) / 2
+    document = json.loads(assembly_json(assembly.model.blocks, both, halves.reshape(-1),
+                                        result.to_dict()))
+    # each joint's force on its second block, from the solution's own layout
+    push = (x[:, :1] - x[:, 1:2]) * np.repeat(faces.normal, faces.vertex_count, axis=0) \
+        + x[:, 2:3] * np.repeat(faces.t1, faces.vertex_count, axis=0) \
+        + x[:, 3:4] * np.repeat(faces.t2, faces.vertex_count, axis=0)
+    on_second = np.add.reduceat(push, faces.offsets[:-1])
+    expected = {(int(u), int(v)): on_second[k] for k, (u, v) in enumerate(faces.pair)}
+    edges = document["data"]["graph"]["data"]["edge"]
+    seen = 0
+    for u, neighbours in edges.items():
+        for v, attributes in neighbours.items():
+            assert len(attributes["interfaces"]) == 2
+            total = np.zeros(3)
+            for interface in attributes["interfaces"]:
+                data = interface["data"]
+                frame = data["frame"]["data"]
+                xaxis, yaxis = np.array(frame["xaxis"]), np.array(frame["yaxis"])
+                normal = np.cross(xaxis, yaxis)
+                polygon = np.array([p["data"] for p in data["points"]])
+                area = 0.5 * np.cross(polygon - polygon[0], np.roll(polygon, -1, axis=0)
+                                      - polygon[0]).sum(axis=0)
+                assert np.isclose(area @ normal, data["size"], rtol=1e-9)
+                for force in data["forces"]:
+                    total += (force["c_np"] - force["c_nn"]) * normal \
+                        + force["c_u"] * xaxis + force["c_v"] * yaxis
+            key = (int(u), int(v))
+            want = expected[key] if key in expected else -expected[key[::-1]]
+            assert np.allclose(total, want, rtol=1e-9, atol=1e-9 * np.abs(x).max())
+            seen += 1
+    assert seen == len(faces)

@@ -18,8 +18,11 @@ file's ``is_support``). The layout is the one compas_assembly 0.7 writes:
 - ``data.attributes.masonry``: the verdict and the settings it holds for.
 """
 
+import gc
 import json
-import uuid
+import os
+from contextlib import contextmanager
+from itertools import pairwise
 
 import numpy as np
 
@@ -46,16 +49,14 @@ def assembly_json(blocks, interfaces, x, record: dict, name: str = "masonry") ->
     name : str
         The assembly's name (the run's structure id).
     """
-    nodes = {str(b): _node(blocks, b) for b in range(blocks.n_blocks)}
-    edges = {str(b): {} for b in range(blocks.n_blocks)}
-    forces = None if x is None else np.asarray(x, dtype=float).reshape(-1, 4)
-    for k in range(len(interfaces)):
-        u, v = (int(i) for i in interfaces.pair[k])
-        flip = str(u) in edges[str(v)]  # the pair is stored the other way round already
-        if flip:
-            u, v = v, u
-        edge = edges[str(u)].setdefault(str(v), {"interfaces": []})
-        edge["interfaces"].append(_interface(interfaces, k, forces, flip))
+    n_objects = 2 + blocks.n_blocks + 3 * len(interfaces) + len(interfaces.vertices)
+    guid = iter(_guids(n_objects)).__next__
+    with _no_collection():
+        nodes = _nodes(blocks, guid)
+        edges = {str(b): {} for b in range(blocks.n_blocks)}
+        for u, v, interface in _interfaces(interfaces, x, guid):
+            edges[str(u)].setdefault(str(v), {"interfaces": []})["interfaces"].append(
+                interface)
     verdict = {key: _plain(record.get(key)) for key in VERDICT_KEYS}
     graph = {"attributes": {}, "default_node_attributes": {
                  "x": 0.0, "y": 0.0, "z": 0.0, "block": None, "is_support": False,
@@ -63,12 +64,38 @@ def assembly_json(blocks, interfaces, x, record: dict, name: str = "masonry") ->
              "default_edge_attributes": {"interfaces": None},
              "node": nodes, "edge": edges, "max_node": blocks.n_blocks - 1}
     data = {"attributes": {"name": name, "masonry": {**verdict, "units": "N, m"}},
-            "graph": _object("compas.datastructures/Graph", graph)}
-    return json.dumps(_object(ASSEMBLY_DTYPE, data), allow_nan=False)
+            "graph": _object("compas.datastructures/Graph", graph, guid())}
+    return json.dumps(_object(ASSEMBLY_DTYPE, data, guid()), allow_nan=False,
+                      check_circular=False)  # a tree built here: no cycle to look for
 
 
-def _object(dtype: str, data, name=None) -> dict:
-    obj = {"dtype": dtype, "data": data, "guid": str(uuid.uuid4())}
+@contextmanager
+def _no_collection():
+    """Python's cyclic garbage collector paused: the document is a tree of a few hundred
+    thousand small dicts and lists, none in a cycle, and the collector's passes over
+    them took half of building it."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def _guids(n: int) -> list:
+    """``n`` random (version 4) UUIDs as compas writes them, made in one draw: one
+    ``uuid.uuid4()`` per object took a third of a large assembly's export."""
+    raw = np.frombuffer(os.urandom(16 * n), np.uint8).reshape(n, 16).copy()
+    raw[:, 6] = raw[:, 6] & 0x0F | 0x40  # version 4
+    raw[:, 8] = raw[:, 8] & 0x3F | 0x80  # RFC 4122 variant
+    h = raw.tobytes().hex()
+    return [f"{h[i:i + 8]}-{h[i + 8:i + 12]}-{h[i + 12:i + 16]}-{h[i + 16:i + 20]}-"
+            f"{h[i + 20:i + 32]}" for i in range(0, 32 * n, 32)]
+
+
+def _object(dtype: str, data, guid: str, name=None) -> dict:
+    obj = {"dtype": dtype, "data": data, "guid": guid}
     if name is not None:
         obj["name"] = name
     return obj
@@ -83,49 +110,68 @@ def _plain(value):
     return value
 
 
-def _mesh_data(points, faces) -> dict:
-    """A compas ``Mesh``'s data of ``points`` ((n, 3) float) and ``faces`` (lists of
+def _mesh_data(points: list, faces: list) -> dict:
+    """A compas ``Mesh``'s data of ``points`` ([x, y, z] lists) and ``faces`` (lists of
     indices into them)."""
     return {"attributes": {}, "default_vertex_attributes": {"x": 0.0, "y": 0.0, "z": 0.0},
             "default_edge_attributes": {}, "default_face_attributes": {},
-            "vertex": {str(i): dict(zip("xyz", map(float, p))) for i, p in enumerate(points)},
-            "face": {str(f): [int(i) for i in face] for f, face in enumerate(faces)},
+            "vertex": {str(i): {"x": x, "y": y, "z": z} for i, (x, y, z) in enumerate(points)},
+            "face": {str(f): face for f, face in enumerate(faces)},
             "facedata": {str(f): {} for f in range(len(faces))}, "edgedata": {},
             "max_vertex": len(points) - 1, "max_face": len(faces) - 1}
 
 
-def _node(blocks, b: int) -> dict:
-    first = blocks.vertex_offsets[b]
-    faces = [blocks.face_vertices[blocks.face_offsets[f]:blocks.face_offsets[f + 1]] - first
-             for f in blocks.block_faces(b)]
-    data = _mesh_data(blocks.block_vertices(b), faces)
-    data["attributes"] = {"node": None}
-    x, y, z = (float(c) for c in blocks.block_centroid[b])
-    return {"block": _object("compas_assembly.datastructures/Block", data,
-                             name=str(blocks.block_name[b])),
-            "x": x, "y": y, "z": z, "is_support": bool(blocks.block_is_support[b])}
+def _nodes(blocks, guid) -> dict:
+    """The graph's nodes: every block as a compas_assembly ``Block``."""
+    vertices = blocks.vertices.tolist()
+    first = blocks.vertex_offsets
+    local = blocks.face_vertices - np.repeat(first[blocks.face_block],
+                                             np.diff(blocks.face_offsets))
+    face_lists = [local[a:b].tolist() for a, b in pairwise(blocks.face_offsets.tolist())]
+    face_first = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks + 1)).tolist()
+    centroids = blocks.block_centroid.tolist()
+    nodes = {}
+    for b, (name, is_support) in enumerate(zip(blocks.block_name.tolist(),
+                                                blocks.block_is_support.tolist())):
+        data = _mesh_data(vertices[first[b]:first[b + 1]],
+                          face_lists[face_first[b]:face_first[b + 1]])
+        data["attributes"] = {"node": None}
+        x, y, z = centroids[b]
+        nodes[str(b)] = {"block": _object("compas_assembly.datastructures/Block", data,
+                                          guid(), name=str(name)),
+                         "x": x, "y": y, "z": z, "is_support": bool(is_support)}
+    return nodes
 
 
-def _interface(interfaces, k: int, forces, flip: bool) -> dict:
-    """Interface ``k``; ``flip``: seen from its other block (normal reversed: x = t2,
-    y = t1, and the friction of the force on the first block, -f2 and -f1)."""
-    polygon = interfaces.polygon(k)
-    xaxis, yaxis = interfaces.t1[k], interfaces.t2[k]
-    if flip:
-        xaxis, yaxis, polygon = yaxis, xaxis, polygon[::-1]
-    frame = {"point": interfaces.centre[k].tolist(), "xaxis": xaxis.tolist(),
-             "yaxis": yaxis.tolist()}
-    point_forces = None
-    if forces is not None:
-        rows = forces[interfaces.offsets[k]:interfaces.offsets[k + 1]]
-        if flip:
-            rows = np.stack([rows[:, 0], rows[:, 1], -rows[:, 3], -rows[:, 2]], axis=1)[::-1]
-        point_forces = [dict(zip(("c_np", "c_nn", "c_u", "c_v"), map(float, row)))
-                        for row in rows]
-    data = {"points": [_object("compas.geometry/Point", p.tolist()) for p in polygon],
-            "size": float(interfaces.area[k]),
-            "frame": _object("compas.geometry/Frame", frame),
-            "forces": point_forces,
-            "mesh": _object("compas.datastructures/Mesh",
-                            _mesh_data(polygon, [list(range(len(polygon)))]))}
-    return _object("compas_assembly.datastructures/Interface", data)
+def _interfaces(interfaces, x, guid):
+    """``(u, v, interface)`` of every interface, seen from the block that first meets
+    the pair: an interface stored the other way round is flipped (normal reversed:
+    x = t2, y = t1, its polygon reversed, and the friction of the force on the first
+    block, -f2 and -f1)."""
+    pair = interfaces.pair
+    _, first, which = np.unique(pair.min(axis=1) * (pair.max() + 1) + pair.max(axis=1),
+                                return_index=True, return_inverse=True)
+    flip = pair[first[which.reshape(-1)], 0] != pair[:, 0]
+    axes = np.where(flip[:, None, None], np.stack([interfaces.t2, interfaces.t1], axis=1),
+                    np.stack([interfaces.t1, interfaces.t2], axis=1)).tolist()
+    points = interfaces.vertices.tolist()
+    rows = [None] * len(points)
+    if x is not None:
+        forces = np.asarray(x, dtype=float).reshape(-1, 4).copy()
+        turned = flip[interfaces.vertex_interface]
+        forces[turned, 2:] = -forces[turned][:, [3, 2]]
+        rows = [{"c_np": a, "c_nn": b, "c_u": c, "c_v": d} for a, b, c, d in forces.tolist()]
+    for k, (a, b) in enumerate(pairwise(interfaces.offsets.tolist())):
+        polygon, point_forces = points[a:b], rows[a:b]
+        if flip[k]:
+            polygon, point_forces = polygon[::-1], point_forces[::-1]
+        frame = {"point": interfaces.centre[k].tolist(), "xaxis": axes[k][0],
+                 "yaxis": axes[k][1]}
+        data = {"points": [_object("compas.geometry/Point", p, guid()) for p in polygon],
+                "size": float(interfaces.area[k]),
+                "frame": _object("compas.geometry/Frame", frame, guid()),
+                "forces": None if x is None else point_forces,
+                "mesh": _object("compas.datastructures/Mesh",
+                                _mesh_data(polygon, [list(range(len(polygon)))]), guid())}
+        u, v = pair[k, ::-1] if flip[k] else pair[k]
+        yield int(u), int(v), _object("compas_assembly.datastructures/Interface", data, guid())
