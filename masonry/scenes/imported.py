@@ -499,11 +499,17 @@ def _convex_blocks(soup: TriangleSoup, path: Path, tol: Tolerances) -> Blocks:
     problem = _surface_problem(soup) or _volume_problem(volume, soup, vstart, tol)
     if problem is not None:
         raise AssemblyError(f"{path}: block {soup.block_name[problem[0]]!r} {problem[1]}")
+    order = np.argsort(soup.triangle_block, kind="stable")
+    tstart = np.searchsorted(soup.triangle_block[order], np.arange(len(soup.block_name) + 1))
+    own = _own_faces(soup, vstart, tol.contact)
     hulls = []
     for b in range(len(soup.block_name)):
         points = soup.vertices[vstart[b]:vstart[b + 1]]
-        hull, why = _convex_hull(points, volume[b],
-                                 soup.triangles[soup.triangle_block == b] - vstart[b])
+        if own[b] is not None:
+            hulls.append((points, own[b], volume[b]))
+            continue
+        triangles = soup.triangles[order[tstart[b]:tstart[b + 1]]] - vstart[b]
+        hull, why = _convex_hull(points, volume[b], triangles)
         if why is not None:
             raise AssemblyError(f"{path}: block {soup.block_name[b]!r} {why}")
         hulls.append((points, hull_faces(points, hull, tol.contact), hull.volume))
@@ -521,6 +527,56 @@ def _convex_blocks(soup: TriangleSoup, path: Path, tol: Tolerances) -> Blocks:
                             "merged into planar polygons (nearly coplanar facets: a curved "
                             "surface?)")
     return blocks
+
+
+OWN_FACES_MAX = 62
+"""Most vertices of a block whose faces :func:`_own_faces` finds (a face's vertices are
+the bits of one 64-bit integer); larger blocks go to qhull."""
+
+
+def _own_faces(soup: TriangleSoup, vstart, distance) -> list:
+    """Per block, the planar faces of its hull as :func:`~masonry.blocks.hull_faces`
+    gives them, where its own triangles bound it: every vertex within ``distance``
+    (metres) of the inside of every triangle's plane (the block is convex), no triangle
+    thinner than ``distance``, at most :data:`OWN_FACES_MAX` vertices. None for the other
+    blocks, for qhull to decide: this check runs on all blocks at once, where qhull, one
+    block at a time, took most of the time to read a wall of small blocks."""
+    count = np.diff(vstart)
+    corners = soup.vertices[soup.triangles]
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    twice_area = np.linalg.norm(cross, axis=1)
+    longest = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
+    thin = twice_area <= distance * longest
+    candidate = (count <= OWN_FACES_MAX) & (np.bincount(
+        soup.triangle_block, thin, minlength=len(count)) == 0)
+    tri = np.flatnonzero(candidate[soup.triangle_block])
+    block = soup.triangle_block[tri]
+    normal = cross[tri] / twice_area[tri, None]
+    # every (triangle, vertex of its block) pair: the vertex's height over the plane
+    size = count[block]
+    first = np.cumsum(size) - size
+    pair = np.repeat(np.arange(len(tri)), size)
+    local = np.arange(len(pair)) - first[pair]
+    height = np.einsum("ij,ij->i", normal[pair],
+                       soup.vertices[vstart[block[pair]] + local] - corners[tri[pair], 0])
+    outside = np.full(len(count), np.inf)
+    outside[candidate] = -np.inf
+    np.maximum.at(outside, block[pair], height)
+    convex = outside <= distance
+    # a face: the triangles on which the same vertices lie (a bit mask), once per block
+    key = np.bitwise_or.reduceat(np.where(np.abs(height) <= distance,
+                                          np.left_shift(1, local), 0), first)
+    keep = convex[block]
+    order = np.flatnonzero(keep)[np.lexsort((key[keep], block[keep]))]
+    new = np.ones(len(order), bool)
+    new[1:] = (key[order[1:]] != key[order[:-1]]) | (block[order[1:]] != block[order[:-1]])
+    face = order[new]
+    entry_face, entry_point = np.nonzero((key[face, None] >> np.arange(OWN_FACES_MAX)) & 1)
+    fstart = np.searchsorted(block[face], np.arange(len(count) + 1))
+    estart = np.searchsorted(entry_face, fstart)
+    return [(entry_face[estart[b]:estart[b + 1]] - fstart[b],
+             entry_point[estart[b]:estart[b + 1]], normal[face[fstart[b]:fstart[b + 1]]])
+            if convex[b] else None for b in range(len(count))]
 
 
 def _vertex_ranges(soup: TriangleSoup) -> np.ndarray:

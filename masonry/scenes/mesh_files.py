@@ -107,7 +107,8 @@ def _read_obj(data: bytes) -> TriangleSoup:
     fast but keeps no object or group names, and refuses a file with fewer normals than
     vertices (Rhino's style: ``fixtures/assembly/arch_rhino.obj``).
     """
-    vertices, faces, face_object, face_group = [], [], [], []
+    vertices, corners = [], []
+    faces = []  # per face: its line, the vertices before it, its size, object and group
     objects, groups = [], {}
     current_object = current_group = -1
     for number, line in enumerate(data.decode("utf-8", errors="replace").splitlines(), 1):
@@ -122,15 +123,9 @@ def _read_obj(data: bytes) -> TriangleSoup:
         elif tag == "f":
             if len(parts) < 4:
                 raise AssemblyError(f"line {number}: a face needs three vertices")
-            count = len(vertices)
-            ids = [int(p.split("/", 1)[0]) for p in parts[1:]]
-            ids = [i - 1 if i > 0 else count + i for i in ids]
-            if min(ids) < 0 or max(ids) >= count:
-                raise AssemblyError(f"line {number}: the face refers to a vertex that is not "
-                                    f"defined before it (the file has {count} by then)")
-            faces.append(ids)
-            face_object.append(current_object)
-            face_group.append(current_group)
+            corners += parts[1:]
+            faces.append((number, len(vertices), len(parts) - 1, current_object,
+                          current_group))
         elif tag == "o":
             objects.append(" ".join(parts[1:]))
             current_object = len(objects) - 1
@@ -140,30 +135,48 @@ def _read_obj(data: bytes) -> TriangleSoup:
     vertices = np.array(vertices, dtype=float)
     if not faces:
         return TriangleSoup([], vertices)
-    return _obj_blocks(vertices, faces, np.array(face_object), np.array(face_group),
-                       objects, list(groups))
+    face_line, before, size, face_object, face_group = np.array(faces).T
+    return _obj_blocks(vertices, _obj_indices(corners, face_line, before, size), size,
+                       face_object, face_group, objects, list(groups))
 
 
-def _obj_blocks(vertices, faces, face_object, face_group, objects, groups) -> TriangleSoup:
+def _obj_indices(corners, face_line, before, size):
+    """(C,) int: the vertex of every face corner (``i``, ``i/t``, ``i/t/n``, ``i//n``;
+    negative: relative to the ``before`` vertices the file defined before the face;
+    ``size`` corners per face), 0-based. An index out of range raises naming its face's
+    line (``face_line``)."""
+    if any("/" in corner for corner in corners):
+        corners = [corner.split("/", 1)[0] for corner in corners]
+    ids = np.array(corners).astype(np.int64)  # ValueError: not an integer
+    count = np.repeat(before, size)
+    ids = np.where(ids > 0, ids - 1, count + ids)
+    bad = (ids < 0) | (ids >= count)
+    if bad.any():
+        face = np.repeat(np.arange(len(size)), size)[np.argmax(bad)]
+        raise AssemblyError(f"line {face_line[face]}: the face refers to a vertex that is not "
+                            f"defined before it (the file has {before[face]} by then)")
+    return ids
+
+
+def _obj_blocks(vertices, flat, counts, face_object, face_group, objects,
+                groups) -> TriangleSoup:
     """The soup of an OBJ's polygons: one block per object, else per group, else one soup
     to split into bodies.
 
     Parameters
     ----------
     vertices : (V, 3) float
-    faces : list of lists of int
-        Each polygon's vertex indices.
+    flat, counts : (C,) int, (F,) int
+        The polygons' vertex indices, polygon after polygon, and each polygon's count.
     face_object, face_group : (F,) int
         Index into ``objects`` and ``groups`` of every polygon, -1 before the first.
     objects, groups : list of str
         Names in order of appearance (objects may repeat, groups do not).
     """
-    counts = np.array([len(f) for f in faces])
-    flat = np.fromiter((i for f in faces for i in f), dtype=np.int64, count=int(counts.sum()))
     triangles, face = fan(flat, counts)
-    if len(set(face_object)) >= 2:
+    if len(np.unique(face_object)) >= 2:
         names, key = objects, face_object
-    elif len(set(face_group)) >= 2:
+    elif len(np.unique(face_group)) >= 2:
         names, key = groups, face_group
     else:
         named = (objects[face_object[0]] if face_object[0] >= 0
