@@ -117,15 +117,19 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, is_copy=None) -> b
     corner_start = blocks.face_offsets[face_start].tolist()
     corners = vertices[blocks.face_vertices].tolist()  # every face's corners, in order
     sizes = np.diff(blocks.face_offsets).tolist()
-    for i in range(blocks.n_blocks):
+    layers = [copies_layer if copy else layer[code] if is_free else support_layer
+              for copy, code, is_free in zip(is_copy.tolist(), blocks.block_class.tolist(),
+                                             free.tolist())]
+    texts = {key: list(map(str, np.asarray(values).tolist()))
+             for key, values in user_text.items()}
+    attributes = rhino3dm.ObjectAttributes()  # AddMesh copies it: one for every block
+    for i, name in enumerate(blocks.block_name.tolist()):
         mesh = _unwelded_mesh(rhino3dm, corners[corner_start[i]:corner_start[i + 1]],
                               sizes[face_start[i]:face_start[i + 1]])
-        attributes = rhino3dm.ObjectAttributes()
-        attributes.Name = str(blocks.block_name[i])
-        attributes.LayerIndex = (copies_layer if is_copy[i] else layer[blocks.block_class[i]]
-                                 if free[i] else support_layer)
-        for key, values in user_text.items():
-            attributes.SetUserString(key, str(values[i]))
+        attributes.Name = str(name)
+        attributes.LayerIndex = layers[i]
+        for key, values in texts.items():
+            attributes.SetUserString(key, values[i])
         model.Objects.AddMesh(mesh, attributes)
 
     # rhino3dm writes to paths only
