@@ -26,9 +26,16 @@ BYTES_PER_BRICK = 200e3
 preset 1's full dome with ``--p 21`` (docs/bench.md, "In brief"; balanced takes less than half)."""
 
 UNITS_PER_BRICK = 2.7
-"""Intrados area of a dome section per brick, in square units, for the size estimate
-made before building (:func:`masonry.scenes.check_size`): 2.0 to 3.3 on the presets
-and their extremes (pattern and fill-in bricks are smaller than regular ones)."""
+"""Intrados area of a dome section per brick, in square units, for the first size
+estimate made before building (:func:`masonry.scenes.polygonal.intrados_bricks`): 2.0
+to 3.7 on the presets and their extremes (pattern and fill-in bricks are smaller than
+regular ones, and the share of them falls as p grows)."""
+
+COUNTED_BRICKS = 100_000
+"""A polygonal dome's web that :data:`UNITS_PER_BRICK` puts at no more bricks than this
+is counted from its plan before it is built (:func:`masonry.scenes.polygonal.web_bricks`):
+exactly, in about 0.5 s for the 12,153 bricks of a web of preset 1 at ``p = 48``
+(docs/bench.md, "The size check"); a larger web keeps the first estimate."""
 
 REVOLUTION_UNITS_PER_BRICK = 4.17
 BRICKS_PER_COURSE_AND_NODE = 1.53

@@ -23,8 +23,8 @@ from masonry.errors import ParameterError
 from masonry.parameters import declare
 from masonry.scenes.base import Scene, SceneKind, Symmetry, ThrustSection, hexahedra_frames
 from masonry.scenes.bricks import blocks_from_layout, posed_corners
-from masonry.tolerances import (STRETCH_USUAL_RANGE, UNITS_PER_BRICK, UNITS_PER_PLAIN_BRICK,
-                                Tolerances)
+from masonry.tolerances import (COUNTED_BRICKS, STRETCH_USUAL_RANGE, UNITS_PER_BRICK,
+                                UNITS_PER_PLAIN_BRICK, Tolerances)
 
 log = logging.getLogger(__name__)
 
@@ -76,13 +76,29 @@ def build_web(geometry: PolygonalDome) -> Scene:
     for its bricks: consecutive courses would meet in wedges wider than the interface
     detector's ``max_gap_angle`` closes, and the courses would not bear on each other.
     """
-    dims = Dimensions.of(geometry)
-    levels = level_table(geometry, dims)
-    _check_levels(geometry, levels)
+    dims, levels, pattern, layout = web_plan(geometry)
     low, high = STRETCH_USUAL_RANGE
     if not low <= geometry.stretch <= high:
         log.warning("stretch=%g is outside %g..%g: the dome is unusually flat or tall",
                     geometry.stretch, low, high)
+    tan = np.tan(np.pi / geometry.n)
+    u = geometry.unit
+    # ground slab: one mitered slab under course 1, as deep as a pattern brick
+    ground = posed_corners(np.array([[dims.a, -u]]), np.zeros(1), np.array([4 * u]),
+                           np.array([u]), np.zeros(1), np.zeros(1),
+                           np.array([tan]), np.array([tan]))[0]
+    blocks = blocks_from_layout(layout, levels, u, tan, ground)
+    return Scene(Section, geometry, blocks, levels, pattern, layout, dims,
+                 *hexahedra_frames(blocks))
+
+
+def web_plan(geometry: PolygonalDome) -> tuple:
+    """``(dims, levels, pattern, layout)``: one web in plan, its courses' levels, its
+    herringbone and every course's bricks (docs/model.md 4.2 to 4.4), before any brick is
+    posed. Raises :class:`~masonry.errors.ParameterError` as :func:`build_web` says."""
+    dims = Dimensions.of(geometry)
+    levels = level_table(geometry, dims)
+    _check_levels(geometry, levels)
     half_width = levels.y[1:] / geometry.unit
     pattern = (build_pattern(half_width, geometry.p, geometry.r)
                if geometry.pattern == "herringbone" else Pattern.none())
@@ -94,15 +110,7 @@ def build_web(geometry: PolygonalDome) -> Scene:
             f"raise p, or --pattern none for the courses without a pattern",
             related=("p", "r", "stretch", "unit"))
     layout = fill_courses(half_width, pattern, geometry.min_fill, miter=True)
-    tan = np.tan(np.pi / geometry.n)
-    u = geometry.unit
-    # ground slab: one mitered slab under course 1, as deep as a pattern brick
-    ground = posed_corners(np.array([[dims.a, -u]]), np.zeros(1), np.array([4 * u]),
-                           np.array([u]), np.zeros(1), np.zeros(1),
-                           np.array([tan]), np.array([tan]))[0]
-    blocks = blocks_from_layout(layout, levels, u, tan, ground)
-    return Scene(Section, geometry, blocks, levels, pattern, layout, dims,
-                 *hexahedra_frames(blocks))
+    return dims, levels, pattern, layout
 
 
 def _check_levels(geometry, levels):
@@ -126,7 +134,21 @@ def _check_levels(geometry, levels):
 
 
 def web_bricks(geometry: PolygonalDome) -> float:
-    """The number of blocks of one web, from its dimensions alone: its intrados area (the
+    """The number of blocks of one web with its ground slab, before it is built: counted
+    from its plan (:func:`web_plan`) where :func:`intrados_bricks` puts it at no more than
+    :data:`~masonry.tolerances.COUNTED_BRICKS` bricks; else, or where the plan is
+    refused, that estimate."""
+    rough = intrados_bricks(geometry)
+    if not rough <= COUNTED_BRICKS:
+        return rough
+    try:
+        return float(len(web_plan(geometry)[3].course) + 1)
+    except ParameterError:  # refused again, with its reason, when it is built
+        return rough
+
+
+def intrados_bricks(geometry: PolygonalDome) -> float:
+    """The number of blocks of one web from its dimensions alone: its intrados area (the
     web's width integrated along the quarter ellipse) over
     :data:`~masonry.tolerances.UNITS_PER_BRICK` (a plain dome's:
     :data:`~masonry.tolerances.UNITS_PER_PLAIN_BRICK`), within a factor 1.4."""
