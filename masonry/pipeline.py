@@ -352,7 +352,7 @@ def run(params: Params, out_root="exports", *, analyse=True, force=False, scene=
     if result is not None and params.load is not None:
         with timer.stage("collapse"):
             collapse = collapse_of(model, params, result)
-    record.update(results_record(result, collapse, centering, scene.blocks.block_name,
+    record.update(results_record(result, collapse, centering, model.blocks.block_name,
                                  adhesion))
     made = RunOutputs(params, scene, model, result, collapse=collapse, centering=centering,
                       adhesion=adhesion, title=job.structure_id)

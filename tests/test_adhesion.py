@@ -229,3 +229,33 @@ def test_the_arch_needs_more_where_its_springings_hold_less(tmp_path):
     assert "_sj0.5" in folder.name
     text = (folder / "00_parameters.txt").read_text()
     assert "at bed joints; head joints x1, joints with a support x0.5" in text
+
+
+def test_a_cyclic_sections_joints_with_its_neighbours_are_named_in_run_json(tmp_path,
+                                                                            monkeypatch):
+    """On a cyclic section the least adhesion's joints are the model's, whose blocks past
+    the section's are its neighbours' images (``w1_...``): run.json names both blocks of
+    a joint with an image as the model does. Preset 1's section at p 30 (mu 0.7) needs
+    such a joint most; here a small section's program is run, then the joint's share
+    given to one image joint."""
+    from masonry import pipeline
+
+    solved = pipeline.adhesion_of
+
+    def image_joint_needs_most(model, params, rbe=None):
+        result = solved(model, params, rbe)
+        k = int(np.flatnonzero(model.interfaces.pair.max(axis=1) >= n_section)[0])
+        need = np.zeros(len(model.interfaces))
+        need[k] = 1.0
+        return dataclasses.replace(result, a_kPa=1.0, interface_kPa=need)
+
+    n_section = masonry.build(1, p=4).scene.blocks.n_blocks
+    monkeypatch.setattr(pipeline, "adhesion_of", image_joint_needs_most)
+    assert main(["run", "--p", "4", "--mu", "0.1", "--no-plots", "--no-printable",
+                 "--no-html", "--out", str(tmp_path), "-q"]) == 0
+    record = json.loads(next(tmp_path.glob("*/run.json")).read_text())
+    model = masonry.build(1, p=4).model
+    [joint] = record["adhesion"]["joints"]
+    pair = model.interfaces.pair[joint["interface"]]
+    assert joint["blocks"] == [str(model.blocks.block_name[b]) for b in pair]
+    assert any(name.startswith("w1_") for name in joint["blocks"])
