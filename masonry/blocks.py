@@ -391,6 +391,12 @@ class Blocks:
         return dataclasses.replace(self, vertices=vertices)
 
 
+MASK_BITS = 62
+"""Most points whose subsets are kept as the bits of one int64 (a face's points in
+:func:`hull_faces` and :func:`masonry.scenes.imported._own_faces`); more take a byte
+string there, and qhull here."""
+
+
 def hull_faces(points, hull, distance):
     """Planar faces of a convex hull: ``(face_of_entry, point_of_entry, normal)``.
 
@@ -403,7 +409,7 @@ def hull_faces(points, hull, distance):
     # only the hull's vertices: a point inside a face (a T-junction) is no corner
     corner = hull.vertices
     on = np.abs(normal @ points[corner].T + offset[:, None]) <= distance  # (T, n)
-    if on.shape[1] <= 62:
+    if on.shape[1] <= MASK_BITS:
         key = on @ (np.int64(1) << np.arange(on.shape[1], dtype=np.int64))
     else:
         key = np.packbits(on, axis=1).view(f"V{(on.shape[1] + 7) // 8}").reshape(-1)

@@ -34,8 +34,8 @@ regular ones, and the share of them falls as p grows)."""
 COUNTED_BRICKS = 100_000
 """A polygonal dome's web that :data:`UNITS_PER_BRICK` puts at no more bricks than this
 is counted from its plan before it is built (:func:`masonry.scenes.polygonal.web_bricks`):
-exactly, in about 0.5 s for the 12,153 bricks of a web of preset 1 at ``p = 48``
-(docs/bench.md, "The size check"); a larger web keeps the first estimate."""
+exactly, at a cost that grows with the web (docs/bench.md, "The size check"); a larger
+web keeps the first estimate."""
 
 REVOLUTION_UNITS_PER_BRICK = 4.17
 BRICKS_PER_COURSE_AND_NODE = 1.53

@@ -210,6 +210,9 @@ def bad_files(tmp_path, fixtures_dir):
                   ["cut.obj", "'voussoir_08'", "not closed", "truncated"]))
     cases.append((make("bad_index.obj", b"v 0 0 0\nv 1 0 0\nf 1 2 3\n"),
                   ["bad_index.obj", "line 3", "vertex"]))
+    cases.append((make("huge_index.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                         b"f 1 2 3\nf 99999999999999999999 2 3\n"),
+                  ["huge_index.obj", "line 5", "vertex"]))
     cases.append((make("words.obj", b"v 0 zero 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"),
                   ["words.obj", "not a readable OBJ"]))
     # a word where a coordinate belongs: refused, not read up to the word
@@ -334,3 +337,76 @@ def test_reader_bench_rows_and_command(wall, tmp_path, capsys):
     assert "| wall.obj | meshio |" in (tmp_path / "bench_readers" / "readers.md").read_text()
     assert main(["bench", "--readers", str(obj), "--collapse", "--out", str(tmp_path)]) == 2
     assert "one bench at a time" in capsys.readouterr().err
+
+
+def _faces(blocks) -> list:
+    """Every block's faces as sets of corner coordinates (to 1e-12 m), in no order."""
+    faces = [[] for _ in range(blocks.n_blocks)]
+    for f in range(blocks.n_faces):
+        ring = blocks.vertices[blocks.face_vertices[blocks.face_offsets[f]:
+                                                    blocks.face_offsets[f + 1]]]
+        faces[blocks.face_block[f]].append(tuple(sorted(map(tuple, np.round(ring, 12)))))
+    return [sorted(block) for block in faces]
+
+
+@pytest.mark.parametrize("name", ["assembly/arch_rhino.obj",
+                                  "compas/compas_cra/type-c.json",
+                                  "compas/compas_cra/type-d.json",
+                                  "compas/compas_assembly/wall_assembly.json"])
+def test_blocks_bounded_by_their_own_triangles_are_qhulls(name, monkeypatch, fixtures_dir):
+    """The faces found from a block's own triangles, for all blocks at once, are those of
+    its convex hull by qhull (every block through qhull when no block is small enough for
+    the one pass), with the same volumes."""
+    from masonry.scenes import imported
+
+    own = read_blocks([fixtures_dir / name])
+    monkeypatch.setattr(imported, "MASK_BITS", 0)
+    hulls = read_blocks([fixtures_dir / name])
+    assert list(own.block_name) == list(hulls.block_name)
+    assert _faces(own) == _faces(hulls)
+    assert np.allclose(own.block_volume, hulls.block_volume, rtol=1e-12)
+
+
+def test_a_block_dented_less_than_the_contact_tolerance_is_refused_as_not_convex(tmp_path):
+    """A 1 cm cube with one face pushed in 0.5 mm, in a scene 1 km across: the dent is
+    within the scene's contact tolerance but 1.7 % of the cube's volume, beyond qhull's
+    convexity tolerance, and the message says so."""
+    far = trimesh.creation.box([10.0, 10.0, 10.0])
+    far.apply_translation([1000.0, 0.0, 0.0])
+    dent = trimesh.creation.box([0.01, 0.01, 0.01])
+    top = np.isclose(dent.vertices[:, 2], 0.005)
+    centre = len(dent.vertices)
+    vertices = np.vstack([dent.vertices, [0.0, 0.0, 0.0045]])
+    faces = [f for f in dent.faces.tolist() if not all(top[f])]
+    ring = np.flatnonzero(top)[np.argsort(np.arctan2(*dent.vertices[top][:, 1::-1].T))]
+    faces += [[ring[k], ring[(k + 1) % 4], centre] for k in range(4)]
+    dented = trimesh.Trimesh(vertices, faces, process=False)
+    dented.fix_normals()
+    path = tmp_path / "dented.obj"
+    lines = []
+    for name, mesh, start in (("far", far, 1), ("dented", dented, 9)):
+        lines += [f"o {name}"] + [f"v {x!r} {y!r} {z!r}" for x, y, z in mesh.vertices.tolist()]
+        lines += [f"f {a + start} {b + start} {c + start}" for a, b, c in mesh.faces.tolist()]
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(AssemblyError, match="'dented' is not convex"):
+        read_blocks([path])
+
+
+def test_obj_face_forms_and_relative_indices_read_as_plain_ones(tmp_path):
+    """``i``, ``i/t``, ``i//n``, ``i/t/n`` and negative (relative) indices name the same
+    corners: a cube written each way reads as the same block."""
+    cube = trimesh.creation.box([1.0, 2.0, 3.0])
+    head = [f"v {x!r} {y!r} {z!r}" for x, y, z in cube.vertices.tolist()] + ["vt 0 0",
+                                                                            "vn 0 0 1"]
+    forms = {"plain": "{i}", "texture": "{i}/1", "normal": "{i}//1", "both": "{i}/1/1",
+             "relative": "{r}"}
+    read = {}
+    for name, form in forms.items():
+        faces = [" ".join(["f"] + [form.format(i=i + 1, r=i - len(cube.vertices))
+                                   for i in face]) for face in cube.faces.tolist()]
+        path = tmp_path / f"{name}.obj"
+        path.write_text("\n".join(["o cube"] + head + faces) + "\n")
+        read[name] = read_blocks([path])
+    for name, blocks in read.items():
+        assert _faces(blocks) == _faces(read["plain"]), name
+        assert blocks.block_volume[0] == pytest.approx(6.0, rel=1e-12)

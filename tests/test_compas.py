@@ -2,6 +2,8 @@
 refused, and assembly.json loaded by the real compas_assembly and by masonry."""
 
 import json
+import re
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -242,13 +244,15 @@ def test_joints_stored_from_either_block_hold_the_same_forces():
         + x[:, 2:3] * np.repeat(faces.t1, faces.vertex_count, axis=0) \
         + x[:, 3:4] * np.repeat(faces.t2, faces.vertex_count, axis=0)
     on_second = np.add.reduceat(push, faces.offsets[:-1])
-    expected = {(int(u), int(v)): on_second[k] for k, (u, v) in enumerate(faces.pair)}
+    turning = np.add.reduceat(np.cross(faces.vertices, push), faces.offsets[:-1])
+    expected = {(int(u), int(v)): (on_second[k], turning[k])
+                for k, (u, v) in enumerate(faces.pair)}
     edges = document["data"]["graph"]["data"]["edge"]
     seen = 0
     for u, neighbours in edges.items():
         for v, attributes in neighbours.items():
             assert len(attributes["interfaces"]) == 2
-            total = np.zeros(3)
+            total, moment = np.zeros(3), np.zeros(3)
             for interface in attributes["interfaces"]:
                 data = interface["data"]
                 frame = data["frame"]["data"]
@@ -258,11 +262,21 @@ def test_joints_stored_from_either_block_hold_the_same_forces():
                 area = 0.5 * np.cross(polygon - polygon[0], np.roll(polygon, -1, axis=0)
                                       - polygon[0]).sum(axis=0)
                 assert np.isclose(area @ normal, data["size"], rtol=1e-9)
-                for force in data["forces"]:
-                    total += (force["c_np"] - force["c_nn"]) * normal \
+                for point, force in zip(polygon, data["forces"]):
+                    vector = (force["c_np"] - force["c_nn"]) * normal \
                         + force["c_u"] * xaxis + force["c_v"] * yaxis
+                    total += vector
+                    moment += np.cross(point, vector)
             key = (int(u), int(v))
-            want = expected[key] if key in expected else -expected[key[::-1]]
-            assert np.allclose(total, want, rtol=1e-9, atol=1e-9 * np.abs(x).max())
+            sign = 1.0 if key in expected else -1.0
+            want, want_moment = expected[key] if key in expected else expected[key[::-1]]
+            scale = np.abs(x).max()
+            assert np.allclose(total, sign * want, rtol=1e-9, atol=1e-9 * scale)
+            assert np.allclose(moment, sign * want_moment, rtol=1e-9,
+                               atol=1e-9 * scale * np.abs(faces.vertices).max())
             seen += 1
     assert seen == len(faces)
+    guids = re.findall(r'"guid": "([^"]*)"', json.dumps(document))
+    assert len(set(guids)) == len(guids) > 2 * len(faces)
+    assert all(uuid.UUID(g).version == 4 and uuid.UUID(g).variant == uuid.RFC_4122
+               and str(uuid.UUID(g)) == g for g in guids)

@@ -112,7 +112,7 @@ def test_a_huge_dome_is_refused_before_anything_is_laid_out(scene, monkeypatch, 
     ("dome", dict(n=6, r=0, p=3, cut=0.5)), ("dome", dict(preset="3", p=4))])
 def test_a_polygonal_domes_size_check_counts_the_blocks_it_builds(scene, inputs):
     """Counted from the web's plan: exact where the intrados estimate was 26 % (preset 1
-    at p 30, 41,072 bricks in the whole dome) and 33 % (preset 3 at p 48) too high."""
+    at p 30: 41,072 bricks and 8 slabs) and 33 % (preset 3 at p 48) too high."""
     inputs = dict(inputs)
     preset = inputs.pop("preset", None)
     params = (from_preset(preset, scene=scene, **inputs) if preset

@@ -40,8 +40,8 @@ from pathlib import Path
 
 import numpy as np
 
-from masonry.blocks import (BLOCK, BLOCK_CLASSES, Blocks, blocks_from_hulls, concatenate,
-                            hull_faces)
+from masonry.blocks import (BLOCK, BLOCK_CLASSES, MASK_BITS, Blocks, blocks_from_hulls,
+                            concatenate, hull_faces)
 from masonry.meshing import merge_vertices
 from masonry.parameters import declare
 from masonry.scenes.base import Scene, SceneKind
@@ -501,7 +501,7 @@ def _convex_blocks(soup: TriangleSoup, path: Path, tol: Tolerances) -> Blocks:
         raise AssemblyError(f"{path}: block {soup.block_name[problem[0]]!r} {problem[1]}")
     order = np.argsort(soup.triangle_block, kind="stable")
     tstart = np.searchsorted(soup.triangle_block[order], np.arange(len(soup.block_name) + 1))
-    own = _own_faces(soup, vstart, tol.contact)
+    own = _own_faces(soup, vstart, volume, tol.contact)
     hulls = []
     for b in range(len(soup.block_name)):
         points = soup.vertices[vstart[b]:vstart[b + 1]]
@@ -529,25 +529,25 @@ def _convex_blocks(soup: TriangleSoup, path: Path, tol: Tolerances) -> Blocks:
     return blocks
 
 
-OWN_FACES_MAX = 62
-"""Most vertices of a block whose faces :func:`_own_faces` finds (a face's vertices are
-the bits of one 64-bit integer); larger blocks go to qhull."""
-
-
-def _own_faces(soup: TriangleSoup, vstart, distance) -> list:
-    """Per block, the planar faces of its hull as :func:`~masonry.blocks.hull_faces`
-    gives them, where its own triangles bound it: every vertex within ``distance``
-    (metres) of the inside of every triangle's plane (the block is convex), no triangle
-    thinner than ``distance``, at most :data:`OWN_FACES_MAX` vertices. None for the other
-    blocks, for qhull to decide: this check runs on all blocks at once, where qhull, one
-    block at a time, took most of the time to read a wall of small blocks."""
+def _own_faces(soup: TriangleSoup, vstart, volume, distance) -> list:
+    """Per block, the planar faces of its hull in :func:`~masonry.blocks.hull_faces`'s
+    form, where its own triangles bound it: every vertex within ``distance`` (metres) of
+    the inside of every triangle's plane, and so little outside that the hull's volume
+    exceeds the block's ``volume`` by at most :data:`~masonry.tolerances.CONVEXITY_REL`
+    (qhull's test), no triangle thinner than ``distance``, at most
+    :data:`~masonry.blocks.MASK_BITS` vertices. None for the other blocks, for qhull to
+    decide. One pass over all blocks, where qhull takes one block at a time. A vertex
+    inside a face or an edge (a T-junction) is kept in the faces' vertex sets, which
+    qhull's corners leave out (:func:`~masonry.blocks.blocks_from_hulls` drops it from
+    both), so such a block's faces can come in another order than qhull's."""
     count = np.diff(vstart)
     corners = soup.vertices[soup.triangles]
     cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
     twice_area = np.linalg.norm(cross, axis=1)
     longest = np.linalg.norm(corners - np.roll(corners, 1, axis=1), axis=2).max(axis=1)
     thin = twice_area <= distance * longest
-    candidate = (count <= OWN_FACES_MAX) & (np.bincount(
+    surface = np.bincount(soup.triangle_block, twice_area / 2, minlength=len(count))
+    candidate = (count <= MASK_BITS) & (np.bincount(
         soup.triangle_block, thin, minlength=len(count)) == 0)
     tri = np.flatnonzero(candidate[soup.triangle_block])
     block = soup.triangle_block[tri]
@@ -562,7 +562,9 @@ def _own_faces(soup: TriangleSoup, vstart, distance) -> list:
     outside = np.full(len(count), np.inf)
     outside[candidate] = -np.inf
     np.maximum.at(outside, block[pair], height)
-    convex = outside <= distance
+    # the hull lies within ``outside`` of every face's plane: to first order it adds at
+    # most surface x outside to the block
+    convex = (outside <= distance) & (outside * surface <= CONVEXITY_REL * volume)
     # a face: the triangles on which the same vertices lie (a bit mask), once per block
     key = np.bitwise_or.reduceat(np.where(np.abs(height) <= distance,
                                           np.left_shift(1, local), 0), first)
@@ -571,7 +573,7 @@ def _own_faces(soup: TriangleSoup, vstart, distance) -> list:
     new = np.ones(len(order), bool)
     new[1:] = (key[order[1:]] != key[order[:-1]]) | (block[order[1:]] != block[order[:-1]])
     face = order[new]
-    entry_face, entry_point = np.nonzero((key[face, None] >> np.arange(OWN_FACES_MAX)) & 1)
+    entry_face, entry_point = np.nonzero((key[face, None] >> np.arange(MASK_BITS)) & 1)
     fstart = np.searchsorted(block[face], np.arange(len(count) + 1))
     estart = np.searchsorted(entry_face, fstart)
     return [(entry_face[estart[b]:estart[b + 1]] - fstart[b],

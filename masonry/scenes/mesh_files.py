@@ -34,6 +34,10 @@ from masonry.scenes.compas_json import read_compas_json
 from masonry.scenes.soup import AssemblyError, TriangleSoup, fan
 from masonry.tolerances import MAX_COORDINATE_M
 
+MAX_INDEX = 2**62
+"""An OBJ index beyond this (either sign) is read as this: out of range all the same,
+and within numpy's integers."""
+
 FORMATS = (".obj", ".stl", ".ply", ".json")
 """File suffixes :func:`read_mesh` reads (case-insensitive)."""
 
@@ -147,7 +151,11 @@ def _obj_indices(corners, face_line, before, size):
     line (``face_line``)."""
     if any("/" in corner for corner in corners):
         corners = [corner.split("/", 1)[0] for corner in corners]
-    ids = np.array(corners).astype(np.int64)  # ValueError: not an integer
+    ids = list(map(int, corners))  # ValueError: not an integer
+    try:
+        ids = np.array(ids, dtype=np.int64)
+    except OverflowError:  # far beyond any file's vertices: out of range below
+        ids = np.array([max(-MAX_INDEX, min(MAX_INDEX, i)) for i in ids], dtype=np.int64)
     count = np.repeat(before, size)
     ids = np.where(ids > 0, ids - 1, count + ids)
     bad = (ids < 0) | (ids >= count)
