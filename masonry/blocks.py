@@ -335,6 +335,12 @@ class Blocks:
         start, stop = self.face_offsets[face], self.face_offsets[face + 1]
         return self.vertices[self.face_vertices[start:stop]]
 
+    @property
+    def block_face_offsets(self) -> np.ndarray:
+        """(B + 1,) int: block ``i`` owns faces ``block_face_offsets[i]`` to
+        ``block_face_offsets[i + 1]`` (faces are stored block after block)."""
+        return np.searchsorted(self.face_block, np.arange(self.n_blocks + 1))
+
     def block_faces(self, block: int) -> np.ndarray:
         """Face indices of one block (faces are stored block after block)."""
         return np.flatnonzero(self.face_block == block)

@@ -128,7 +128,7 @@ def _nodes(blocks, guid) -> dict:
     local = blocks.face_vertices - np.repeat(first[blocks.face_block],
                                              np.diff(blocks.face_offsets))
     face_lists = [local[a:b].tolist() for a, b in pairwise(blocks.face_offsets.tolist())]
-    face_first = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks + 1)).tolist()
+    face_first = blocks.block_face_offsets.tolist()
     centroids = blocks.block_centroid.tolist()
     nodes = {}
     for b, (name, is_support) in enumerate(zip(blocks.block_name.tolist(),

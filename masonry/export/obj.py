@@ -38,7 +38,7 @@ def blocks_obj(blocks: Blocks, vertices=None, groups=None) -> bytes:
     vertices = blocks.vertices if vertices is None else vertices
     # block i's lines: its "o" line, its vertices, its faces; every line's row in the
     # file follows from the counts of the blocks before it
-    first_face = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks))
+    first_face = blocks.block_face_offsets[:-1]
     block_row = np.arange(blocks.n_blocks) + blocks.vertex_offsets[:-1] + first_face
     vertex_block = np.repeat(np.arange(blocks.n_blocks), np.diff(blocks.vertex_offsets))
     vertex_row = np.arange(len(vertex_block)) + vertex_block + 1 + first_face[vertex_block]

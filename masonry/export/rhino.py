@@ -113,7 +113,7 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, is_copy=None) -> b
     if is_copy.any():
         copies_layer = model.Layers.AddLayer(COPIES_LAYER, _COPIES_COLOUR)
 
-    face_start = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks + 1))
+    face_start = blocks.block_face_offsets
     corner_start = blocks.face_offsets[face_start].tolist()
     corners = vertices[blocks.face_vertices].tolist()  # every face's corners, in order
     sizes = np.diff(blocks.face_offsets).tolist()

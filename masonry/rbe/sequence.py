@@ -177,17 +177,16 @@ class StageSequence:
             :data:`CERTIFICATE`.
         """
         start = time.perf_counter()
-        keep = kept_blocks(self.model, is_present)
-        interfaces = keep[self.model.interfaces.pair].all(axis=1)
-        rows = keep[self.whole.free_block]
+        rows, interfaces = self._selection(is_present)
         cone = friction_model(accuracy, cone)
-        system = self._part(rows, interfaces, mu=mu, density=density, cone=cone,
-                            cohesion=cohesion, tensile=tensile)
+        material = {"mu": mu, "density": density, "cone": cone, "cohesion": cohesion,
+                    "tensile": tensile}
+        system = self._part(rows, interfaces, **material)
         certificate = None
         if local is not None and friction == "auto" and solver is None:
-            certificate = self._certificate(system, rows, interfaces,
-                                            kept_blocks(self.model, local) & keep, accuracy,
-                                            cohesion, tensile)
+            local_rows, small = self._local_part(local, rows, interfaces, material)
+            if small is not None:
+                certificate = self._certificate(small, int(local_rows.sum()), accuracy)
         starts = {method: self._start(method, rows) for method in FRICTION_METHODS
                   if self._known[method][rows].any()}
         problem = RBEProblem.of_system(system, symbolic=self._symbolic(
@@ -273,17 +272,14 @@ class StageSequence:
         one its RBE solve used); both by :func:`masonry.rbe.centering.solve_centering`.
         ``weight_N`` is the part's; ``block`` the scene's blocks; the mortar as
         :meth:`solve` takes it."""
-        keep = kept_blocks(self.model, is_present)
-        interfaces = keep[self.model.interfaces.pair].all(axis=1)
-        rows = keep[self.whole.free_block]
-        local_rows = kept_blocks(self.model, local)[self.whole.free_block] & rows
-        material = dict(mu=mu, density=density, cone=friction_model(accuracy, cone),
-                        cohesion=cohesion, tensile=tensile)
+        rows, interfaces = self._selection(is_present)
+        material = {"mu": mu, "density": density, "cone": friction_model(accuracy, cone),
+                    "cohesion": cohesion, "tensile": tensile}
         system = self._part(rows, interfaces, **material)
+        local_rows, small = self._local_part(local, rows, interfaces, material)
         result = None
-        if local_rows.any():
-            result = self._local_centering(system, rows, local_rows, interfaces, material,
-                                           accuracy)
+        if small is not None:
+            result = self._local_centering(system, small, rows, local_rows, accuracy)
         if result is None:
             result = solve_centering(system,
                                      symbolic=self._symbolic(rows, self._within_of(rows)))
@@ -292,12 +288,11 @@ class StageSequence:
         return dataclasses.replace(result, weight_N=system.total_weight,
                                    block=source[result.block])
 
-    def _local_centering(self, system, rows, local_rows, interfaces, material,
+    def _local_centering(self, system, small, rows, local_rows,
                          accuracy) -> CenteringResult | None:
-        """The centering force of the ``local_rows`` alone, the rest of the part held
-        fixed, where the whole part ``system`` carries it (Newton, from the last
-        stage's point, within the acceptance tolerance); else None."""
-        small = self._part(local_rows, interfaces & self._touching(local_rows), **material)
+        """The centering force of the ``local_rows`` alone (their system ``small``, the
+        rest of the part held fixed), where the whole part ``system`` carries it (Newton,
+        from the last stage's point, within the acceptance tolerance); else None."""
         reduced = solve_centering(small)
         if reduced.total_N is None:
             return None
@@ -336,9 +331,7 @@ class StageSequence:
         columns of the whole model's matrices, one conic program per part (the part's
         model is the one :func:`~masonry.rbe.boundary.restrict` gives, so is its ``a*``).
         ``interface_pair`` indexes the whole model's blocks."""
-        keep = kept_blocks(self.model, is_present)
-        interfaces = keep[self.model.interfaces.pair].all(axis=1)
-        rows = keep[self.whole.free_block]
+        rows, interfaces = self._selection(is_present)
         system = part_system(self.whole, rows, interfaces).with_material(
             mu=mu, density=density, cone=cone)
         return solve_adhesion(system, self.model.interfaces.subset(interfaces), ratio=ratio,
@@ -346,23 +339,29 @@ class StageSequence:
                               solver=solver,
                               symbolic=self._symbolic(rows, self._within_of(rows)))
 
-    def _touching(self, rows) -> np.ndarray:
-        """(K,) bool: the interfaces with a side on the free blocks ``rows``."""
-        side = self.whole.side_row
-        return ((side >= 0) & rows[np.maximum(side, 0)]).any(axis=1)
+    def _selection(self, is_present) -> tuple:
+        """``(rows, interfaces)``: the free blocks ((F,) bool) and the interfaces ((K,)
+        bool) of the part whose scene blocks ``is_present``."""
+        keep = kept_blocks(self.model, is_present)
+        return keep[self.whole.free_block], keep[self.model.interfaces.pair].all(axis=1)
 
-    def _certificate(self, system, rows, interfaces, local, accuracy, cohesion,
-                     tensile) -> dict | None:
-        """Friction-net of the ``local`` blocks ((B,) bool) alone, the rest of the part
-        held fixed, under the part's law (``cohesion``, ``tensile`` as :meth:`solve`
-        takes them), by Clarabel: its record when it certifies infeasibility (the part
-        cannot stand), else None."""
-        local_rows = local[self.whole.free_block] & rows
+    def _local_part(self, local, rows, interfaces, material) -> tuple:
+        """``(local_rows, small)``: the part's free blocks among the ``local`` scene
+        blocks and their system alone, the rest of the part (``rows``, ``interfaces``)
+        held fixed, under the part's ``material`` (:meth:`_part`'s keywords); ``small``
+        None where none of them is free."""
+        local_rows = kept_blocks(self.model, local)[self.whole.free_block] & rows
         if not local_rows.any():
-            return None
-        small = self._part(local_rows, interfaces & self._touching(local_rows),
-                           mu=system.mu, density=system.density, cone=system.cone,
-                           cohesion=cohesion, tensile=tensile)
+            return local_rows, None
+        touching = ((self.whole.side_row >= 0)
+                    & local_rows[np.maximum(self.whole.side_row, 0)]).any(axis=1)
+        return local_rows, self._part(local_rows, interfaces & touching, **material)
+
+    def _certificate(self, small, blocks, accuracy) -> dict | None:
+        """Friction-net of the local blocks alone (their system ``small``, the rest of
+        the part held fixed, under the part's law; ``blocks`` of them, for the record),
+        by Clarabel: its record when it certifies infeasibility (the part cannot stand),
+        else None."""
         clarabel = BACKENDS["clarabel"]
         outcome = clarabel.solve_rbe(small, "net",
                                      ACCURACY[accuracy].options.get(clarabel.settings, {}),
@@ -370,6 +369,6 @@ class StageSequence:
         record = {"friction": "net", "solver": CERTIFICATE, "status": outcome.status,
                   "iterations": outcome.iterations,
                   "setup_s": round(outcome.setup_time, 4),
-                  "solve_s": round(outcome.solve_time, 4), "blocks": int(local_rows.sum())}
+                  "solve_s": round(outcome.solve_time, 4), "blocks": blocks}
         log.debug("local certificate on %d blocks: %s", record["blocks"], outcome.status)
         return record if outcome.status == INFEASIBLE else None

@@ -231,5 +231,5 @@ class Scene:
 def hexahedra_frames(blocks: Blocks):
     """``(up, inward)`` of hexahedral bricks: the normals of their top face (face 5) and of
     their inner face (face 0), see :data:`masonry.blocks.HEX_FACES`."""
-    first = np.searchsorted(blocks.face_block, np.arange(blocks.n_blocks))
+    first = blocks.block_face_offsets[:-1]
     return blocks.face_normal[first + 5], blocks.face_normal[first]
