@@ -74,6 +74,12 @@ def register(subparsers):
                              "brick by brick (masonry stages --dome --by brick --course "
                              "K): each stage's least adhesion against its RBE solve, both "
                              "in one sequence; writes DIR/bench_adhesion/adhesion.md")
+    parser.add_argument("--scale", action="store_true",
+                        help="instead: whole masonry run processes (no plots, no printable "
+                             "body) of a running-bond wall at about 1,000 to 100,000 bricks "
+                             "and of preset 1's full dome at p 4 to 26, each fresh: time, "
+                             "Newton steps, peak memory and their fitted exponents; writes "
+                             "DIR/bench_scale/scale.md")
     parser.add_argument("--out", default="exports", metavar="DIR",
                         help="output root: writes DIR/bench/bench.csv, bench.md and "
                              "frontier.png (default exports)")
@@ -94,7 +100,7 @@ def handle(args, report):
     chosen = [option for option, on in (
         ("collapse", args.collapse), ("friction_models", args.friction_models is not None),
         ("readers", bool(args.readers)), ("outputs", args.outputs), ("stages", args.stages),
-        ("adhesion_course", args.adhesion_course is not None)) if on]
+        ("adhesion_course", args.adhesion_course is not None), ("scale", args.scale)) if on]
     if len(chosen) > 1:
         raise ParameterError(chosen[1], getattr(args, chosen[1]), f"one bench at a time: "
                              f"not with --{chosen[0].replace('_', '-')}")
@@ -113,6 +119,8 @@ def handle(args, report):
         return _stages(args, report)
     if args.adhesion_course is not None:
         return _adhesion(args, report)
+    if args.scale:
+        return _scale(args, report)
     from masonry_benchmarks.bench import (bench, frontier_png, ratios_markdown, table_csv,
                                        table_markdown)
 
@@ -204,6 +212,13 @@ def _adhesion(args, report):
                           progress=None if args.quiet else _progress)
     markdown = adhesion_markdown(rows)
     return _published(args, report, "adhesion", markdown)
+
+
+def _scale(args, report):
+    from masonry_benchmarks.scale_bench import scale_bench, scale_markdown, scale_structures
+
+    rows = scale_bench(scale_structures(), progress=None if args.quiet else _progress)
+    return _published(args, report, "scale", scale_markdown(rows))
 
 
 def _readers(args, report):

@@ -136,7 +136,8 @@ def add_model_options(parser):
     g.add_argument("--max-bricks", dest="max_bricks", type=int, default=MAX_BRICKS,
                    metavar="N", help=f"refuse a model estimated above N blocks before "
                                      f"building it (default {MAX_BRICKS}, about "
-                                     f"{MAX_BRICKS * BYTES_PER_BRICK / 1e9:.0f} GB to solve)")
+                                     f"{MAX_BRICKS * BYTES_PER_BRICK['balanced'] / 2**30:.0f} "
+                                     f"GiB to solve one that stands)")
     add_scene_options(parser)
 
 

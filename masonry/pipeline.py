@@ -591,14 +591,16 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
     The forces (what a user waits for) are made here first; where processes fork (Linux)
     and the process has two cores, this process and a forked copy then share the others,
     each taking the next exporter not yet taken (:class:`masonry.forking.Shared`; the
-    registry lists the long ones first), and this process writes every file. The
-    exporters made here count their time towards their stage, and the time this process
-    waited for the other's share counts as ``other_process``.
+    registry lists the long ones first), each writing the files it made into the
+    folder and handing back their names and its record. The exporters made here count
+    their time towards their stage, and the time this process waited for the other's
+    share counts as ``other_process``.
 
     Parameters
     ----------
     folder : RunFolder
-        Anything with ``write(relative, data)``.
+        Anything with ``write(relative, data)`` that writes to disk (a forked process
+        writes its share through its copy of it).
     made : masonry.export.RunOutputs
         What the run made; each exporter's ``wanted(made)`` decides whether it writes.
     record : dict
@@ -609,28 +611,35 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
     wanted = [exporter for exporter in EXPORTERS if exporter.wanted(made)]
     written = {}
 
-    def write(exporter, export):
+    def written_by(exporter):
+        """Make ``exporter``'s files and write them (in either process: the folder is a
+        path, and a large file does not travel back through a pipe); its files' names
+        and its record."""
+        export = exporter.make(made)
         for relative, data in export.files.items():
             folder.write(relative, data)
-        written[exporter.name] = tuple(export.files)
-        if export.record is not None:
-            _merge(record, exporter.key, export.record)
+        return tuple(export.files), export.record
+
+    def note(exporter, done):
+        written[exporter.name], part = done
+        if part is not None:
+            _merge(record, exporter.key, part)
 
     first = [exporter for exporter in wanted if exporter.stage == "forces"]
     for exporter in first:
         with timer.stage(exporter.stage):
-            write(exporter, exporter.make(made))
+            note(exporter, written_by(exporter))
     rest = [exporter for exporter in wanted if exporter not in first]
     for name in dict.fromkeys(name for exporter in rest for name in exporter.imports):
         importlib.import_module(name)  # once, before the processes part
-    with forking.Shared(lambda index: rest[index].make(made), len(rest)) as shared:
+    with forking.Shared(lambda index: written_by(rest[index]), len(rest)) as shared:
         while (index := shared.take()) is not None:
             with timer.stage(rest[index].stage):
-                write(rest[index], rest[index].make(made))
+                note(rest[index], written_by(rest[index]))
         if shared.forked_off:
             with timer.stage("other_process"):
-                for index, export in sorted(shared.theirs().items()):
-                    write(rest[index], export)
+                for index, done in sorted(shared.theirs().items()):
+                    note(rest[index], done)
     return written
 
 

@@ -18,12 +18,21 @@ G = 9.81
 """Gravitational acceleration, m/s^2 (docs/model.md 2)."""
 
 MAX_BRICKS = 50_000
-"""Largest model built without being asked (``--max-bricks``): solving takes about
-:data:`BYTES_PER_BRICK` each, so the default stays within 10 GB."""
+"""Largest model built without being asked (``--max-bricks``): a run of that many bricks
+that stands takes about 3 GiB at the balanced preset (:data:`BYTES_PER_BRICK`)."""
 
-BYTES_PER_BRICK = 200e3
-"""Peak memory of a run per brick, accurate preset: 4.2 GiB for the 21,648 bricks of
-preset 1's full dome with ``--p 21`` (docs/bench.md, "In brief"; balanced takes less than half)."""
+BYTES_PER_BRICK = {"fast": 64e3, "balanced": 64e3, "accurate": 106e3}
+"""Peak memory of a run (``masonry run`` without plots, ``masonry bench --scale``) of a
+structure that stands, per brick by accuracy preset, beyond :data:`RUN_BYTES`. Fitted to
+preset 1's full dome (1,664 to 31,712 bricks) and a running-bond wall (1,025 to 100,250
+bricks) at the balanced preset (fast takes the same), within 22 % of every row; the
+accurate preset from preset 1's full dome at 13,680 bricks (docs/bench.md, "How time
+and memory grow"). One that cannot stand takes more: 8.2 GiB, 215 kB a brick, for
+preset 1's 41,072-brick dome when Clarabel decided it (docs/scale.md)."""
+
+RUN_BYTES = 100e6
+"""Peak memory of a run besides its bricks': Python, numpy, scipy and the solvers
+(0.16 GiB at 1,025 bricks)."""
 
 UNITS_PER_BRICK = 2.7
 """Intrados area of a dome section per brick, in square units, for the first size

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import masonry
+from masonry.export import compas_json
 from masonry.export.compas_json import assembly_json
 from masonry.interfaces import Interfaces
 from masonry.scenes.imported import read_blocks
@@ -222,11 +223,13 @@ def _turned(faces: Interfaces, x):
     return turned, x[order][:, [0, 1, 3, 2]] * [1, 1, -1, -1]
 
 
-def test_joints_stored_from_either_block_hold_the_same_forces():
+@pytest.mark.parametrize("chunk", [1, 3, compas_json.CHUNK])
+def test_joints_stored_from_either_block_hold_the_same_forces(monkeypatch, tmp_path, chunk):
     """Every joint of a wall as two halves, the second stored from its other block: the
     file lists both under one edge, and their force on the edge's second block is the
     joint's whole force on that block, each polygon counter-clockwise about its frame's
-    normal."""
+    normal; whether the file is made one block at a time, a few, or all at once."""
+    monkeypatch.setattr(compas_json, "CHUNK", chunk)
     assembly = masonry.read(SAMPLES / "compas_assembly" / "wall_assembly.json")
     result = assembly.solve()
     faces, x = assembly.model.interfaces, result.x.reshape(-1, 4)
@@ -276,6 +279,14 @@ def test_joints_stored_from_either_block_hold_the_same_forces():
                                atol=1e-9 * scale * np.abs(faces.vertices).max())
             seen += 1
     assert seen == len(faces)
+    nodes = document["data"]["graph"]["data"]["node"]
+    assert list(nodes) == [str(b) for b in range(assembly.model.blocks.n_blocks)]
+    assert [n["block"]["name"] for n in nodes.values()] == list(assembly.model.blocks.block_name)
+    (tmp_path / "both.json").write_text(json.dumps(document))
+    blocks, back = assembly.model.blocks, masonry.read(tmp_path / "both.json").model.blocks
+    assert np.allclose(back.block_volume, blocks.block_volume, rtol=1e-12)
+    assert np.allclose(back.block_centroid, blocks.block_centroid, rtol=0,
+                       atol=1e-12 * np.abs(blocks.vertices).max())
     guids = re.findall(r'"guid": "([^"]*)"', json.dumps(document))
     assert len(set(guids)) == len(guids) > 2 * len(faces)
     assert all(uuid.UUID(g).version == 4 and uuid.UUID(g).variant == uuid.RFC_4122

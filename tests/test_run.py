@@ -68,17 +68,26 @@ def wall_outputs(plots, printable):
 
 
 class RecordingFolder:
-    """Stands in for a RunFolder: keeps what is written."""
+    """Stands in for a RunFolder: writes into ``root`` (a forked process's files land
+    there too) and refuses a file written twice, by either process."""
 
-    def __init__(self):
-        self.files = {}
+    def __init__(self, root):
+        self.root = Path(root)
 
     def write(self, relative, data):
-        assert relative not in self.files, f"{relative} written twice"
-        self.files[relative] = data
+        path = self.root / relative
+        assert not path.exists(), f"{relative} written twice"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(data.encode() if isinstance(data, str) else data)
+
+    @property
+    def files(self) -> dict:
+        """What was written: path inside the folder -> bytes."""
+        return {path.relative_to(self.root).as_posix(): path.read_bytes()
+                for path in self.root.rglob("*") if path.is_file()}
 
 
-def test_the_run_writes_what_the_registry_makes(wall_run):
+def test_the_run_writes_what_the_registry_makes(wall_run, tmp_path):
     """The expected files come from the registry's exporters themselves: each one the
     run wants writes exactly its files, the others none, and the CLI's run folder holds
     the same files (byte for byte where no time is recorded in them)."""
@@ -90,7 +99,7 @@ def test_the_run_writes_what_the_registry_makes(wall_run):
     expected = {}
     for exporter in wanted:
         expected.update(exporter.make(made).files)
-    recorder, record = RecordingFolder(), {}
+    recorder, record = RecordingFolder(tmp_path), {}
     write_exports(recorder, made, record, Timer())
     assert recorder.files.keys() == expected.keys()
     for name, data in expected.items():
@@ -102,21 +111,23 @@ def test_the_run_writes_what_the_registry_makes(wall_run):
 
 @pytest.mark.parametrize("fork", [True, False])
 def test_exporters_shared_with_a_forked_process_equal_the_ones_made_here(
-        monkeypatch, fork):
+        monkeypatch, tmp_path, fork):
     """The exporters after the forces are shared between this process and a forked one
     where the platform forks (and all made here where it does not): the files are the
-    same bytes, each written once, and the time waited for the other process is a stage
-    of its own."""
+    same bytes, each written once (by the process that made it), the names of all of
+    them returned, and the time waited for the other process is a stage of its own."""
     monkeypatch.setattr("masonry.forking.can_fork", lambda: fork)
     monkeypatch.setattr("masonry.forking.cores", lambda: 2)
     made = wall_outputs(plots=True, printable=False)
     plots = [e for e in EXPORTERS if e.stage == "plots" and e.wanted(made)]
     expected = {name: data for e in plots for name, data in e.make(made).files.items()}
     assert "RBE/01_angle/normal.png" in expected and "01_angle/3_structure.png" in expected
-    recorder, timer = RecordingFolder(), Timer()
-    write_exports(recorder, made, {}, timer)
-    assert expected and all(recorder.files[name] == data for name, data in expected.items())
-    assert "bricks.3dm" in recorder.files
+    recorder, timer = RecordingFolder(tmp_path), Timer()
+    written = write_exports(recorder, made, {}, timer)
+    files = recorder.files
+    assert expected and all(files[name] == data for name, data in expected.items())
+    assert "bricks.3dm" in files
+    assert sorted(name for names in written.values() for name in names) == sorted(files)
     assert ("other_process" in timer.seconds) == fork
 
 
@@ -270,4 +281,20 @@ def test_the_output_bench_times_every_exporter_a_run_writes(tmp_path, capsys):
     assert plots and plots[0]["files"] >= 2 and plots[0]["bricks"] == 16
     assert outputs_markdown(rows).splitlines()[-1].startswith("| arch | | all | |")
     assert main(["bench", "--outputs", "--collapse", "--out", str(tmp_path)]) == 2
+    assert "one bench at a time" in capsys.readouterr().err
+
+
+def test_the_scale_bench_measures_a_fresh_run_and_fits_power_laws(tmp_path, capsys):
+    from masonry_benchmarks.scale_bench import exponent, scale_bench, scale_markdown
+
+    power = [{"bricks": b, "x": 3.0 * b**1.5} for b in (1000, 5000, 20000, 80000)]
+    assert exponent(power, "x") == pytest.approx(1.5, abs=1e-12)
+    assert exponent(power[:2], "x") is None  # one row of at least 5,000 bricks
+    # the wall preset: 10 courses of 8 and of 9 bricks (fixtures/README.md), standing
+    [row] = scale_bench({"wall": ("wall", "wall", {})})
+    assert row["bricks"] == 85 and row["verdict"] == "feasible"
+    assert 0 < row["solve_s"] < row["wall_s"] and row["cpu_s"] > 0
+    assert row["newton_steps"] >= 1 and 0.05 < row["peak_gib"] < 2.0
+    assert "| wall | 85 | feasible |" in scale_markdown([row])
+    assert main(["bench", "--scale", "--stages", "--out", str(tmp_path)]) == 2
     assert "one bench at a time" in capsys.readouterr().err

@@ -34,6 +34,12 @@ VERDICT_KEYS = ("verdict", "feasible", "friction", "mu", "friction_model", "weig
 """The RBE result's entries copied into ``data.attributes.masonry``."""
 
 
+CHUNK = 2000
+"""Blocks (the graph's nodes, or the edges that start at them) made into JSON text at a
+time: the document is never whole as Python objects, which at 100,000 blocks would take
+gigabytes and fresh memory for each (docs/bench.md, "How time and memory grow")."""
+
+
 def assembly_json(blocks, interfaces, x, record: dict, name: str = "masonry") -> str:
     """The ``Assembly`` JSON of analysed blocks (strict JSON: no NaN).
 
@@ -52,27 +58,42 @@ def assembly_json(blocks, interfaces, x, record: dict, name: str = "masonry") ->
     n_objects = 2 + blocks.n_blocks + 3 * len(interfaces) + len(interfaces.vertices)
     guid = iter(_guids(n_objects)).__next__
     with _no_collection():
-        nodes = _nodes(blocks, guid)
-        edges = {str(b): {} for b in range(blocks.n_blocks)}
-        for u, v, interface in _interfaces(interfaces, x, guid):
-            edges[str(u)].setdefault(str(v), {"interfaces": []})["interfaces"].append(
-                interface)
+        nodes = _members(_nodes(blocks, guid, first) for first in range(0, blocks.n_blocks,
+                                                                         CHUNK))
+        edges = _members(_Edges(interfaces, x, blocks.n_blocks).chunks(guid))
     verdict = {key: _plain(record.get(key)) for key in VERDICT_KEYS}
-    graph = {"attributes": {}, "default_node_attributes": {
-                 "x": 0.0, "y": 0.0, "z": 0.0, "block": None, "is_support": False,
-                 "section": None, "mesh_size": None, "displacement": [0.0] * 6},
-             "default_edge_attributes": {"interfaces": None},
-             "node": nodes, "edge": edges, "max_node": blocks.n_blocks - 1}
-    data = {"attributes": {"name": name, "masonry": {**verdict, "units": "N, m"}},
-            "graph": _object("compas.datastructures/Graph", graph, guid())}
-    return json.dumps(_object(ASSEMBLY_DTYPE, data, guid()), allow_nan=False,
-                      check_circular=False)  # a tree built here: no cycle to look for
+    defaults = {"x": 0.0, "y": 0.0, "z": 0.0, "block": None, "is_support": False,
+                "section": None, "mesh_size": None, "displacement": [0.0] * 6}
+    attributes = {"name": name, "masonry": {**verdict, "units": "N, m"}}
+    graph_guid, guid = guid(), guid()
+    # the text in pieces, joined once: the document may be hundreds of megabytes
+    head = (f'{{"dtype": "{ASSEMBLY_DTYPE}", "data": {{"attributes": {_dumps(attributes)}, '
+            f'"graph": {{"dtype": "compas.datastructures/Graph", "data": {{"attributes": {{}}, '
+            f'"default_node_attributes": {_dumps(defaults)}, '
+            f'"default_edge_attributes": {{"interfaces": null}}, "node": ')
+    tail = (f', "max_node": {blocks.n_blocks - 1}}}, "guid": "{graph_guid}"}}}}, '
+            f'"guid": "{guid}"}}')
+    return "".join([head, *nodes, ', "edge": ', *edges, tail])
+
+
+def _dumps(value) -> str:
+    """Strict JSON of a tree built here (no cycle to look for)."""
+    return json.dumps(value, allow_nan=False, check_circular=False)
+
+
+def _members(chunks) -> list:
+    """One JSON object of the members of ``chunks`` (dicts, in order), as pieces of
+    text."""
+    texts = [_dumps(chunk)[1:-1] for chunk in chunks if chunk]
+    pieces = [", "] * (2 * len(texts) - 1) if texts else []
+    pieces[::2] = texts
+    return ["{", *pieces, "}"]
 
 
 @contextmanager
 def _no_collection():
-    """Python's cyclic garbage collector paused: the document is a tree of a few hundred
-    thousand small dicts and lists, none in a cycle, for the collector to pass over
+    """Python's cyclic garbage collector paused: each chunk of the document is a tree of
+    thousands of small dicts and lists, none in a cycle, for the collector to pass over
     again and again while it grows (docs/bench.md, "A 5,025-block wall")."""
     enabled = gc.isenabled()
     gc.disable()
@@ -121,57 +142,95 @@ def _mesh_data(points: list, faces: list) -> dict:
             "max_vertex": len(points) - 1, "max_face": len(faces) - 1}
 
 
-def _nodes(blocks, guid) -> dict:
-    """The graph's nodes: every block as a compas_assembly ``Block``."""
-    vertices = blocks.vertices.tolist()
-    first = blocks.vertex_offsets
-    local = blocks.face_vertices - np.repeat(first[blocks.face_block],
-                                             np.diff(blocks.face_offsets))
-    face_lists = [local[a:b].tolist() for a, b in pairwise(blocks.face_offsets.tolist())]
-    face_first = blocks.block_face_offsets.tolist()
-    centroids = blocks.block_centroid.tolist()
+def _nodes(blocks, guid, first) -> dict:
+    """The graph's nodes of :data:`CHUNK` blocks from block ``first``: each a
+    compas_assembly ``Block``."""
+    stop = min(first + CHUNK, blocks.n_blocks)
+    corners, face_of = blocks.vertex_offsets, blocks.block_face_offsets
+    faces = slice(face_of[first], face_of[stop])
+    counts = np.diff(blocks.face_offsets[faces.start:faces.stop + 1])
+    corner = blocks.face_vertices[blocks.face_offsets[faces.start]:
+                                  blocks.face_offsets[faces.stop]]
+    # every face's corners numbered within its block
+    local = (corner - np.repeat(corners[blocks.face_block[faces]], counts)).tolist()
+    face_lists = [local[a:b] for a, b in pairwise(np.concatenate([[0], np.cumsum(counts)])
+                                                  .tolist())]
+    block_faces = (face_of[first:stop + 1] - face_of[first]).tolist()
+    vertices = blocks.vertices[corners[first]:corners[stop]].tolist()
+    vertex_first = (corners[first:stop + 1] - corners[first]).tolist()
+    centroids = blocks.block_centroid[first:stop].tolist()
     nodes = {}
-    for b, (name, is_support) in enumerate(zip(blocks.block_name.tolist(),
-                                                blocks.block_is_support.tolist())):
-        data = _mesh_data(vertices[first[b]:first[b + 1]],
-                          face_lists[face_first[b]:face_first[b + 1]])
+    for i, (name, is_support) in enumerate(zip(blocks.block_name[first:stop].tolist(),
+                                                blocks.block_is_support[first:stop].tolist())):
+        data = _mesh_data(vertices[vertex_first[i]:vertex_first[i + 1]],
+                          face_lists[block_faces[i]:block_faces[i + 1]])
         data["attributes"] = {"node": None}
-        x, y, z = centroids[b]
-        nodes[str(b)] = {"block": _object("compas_assembly.datastructures/Block", data,
-                                          guid(), name=str(name)),
-                         "x": x, "y": y, "z": z, "is_support": bool(is_support)}
+        x, y, z = centroids[i]
+        nodes[str(first + i)] = {"block": _object("compas_assembly.datastructures/Block",
+                                                  data, guid(), name=str(name)),
+                                 "x": x, "y": y, "z": z, "is_support": bool(is_support)}
     return nodes
 
 
-def _interfaces(interfaces, x, guid):
-    """``(u, v, interface)`` of every interface, seen from the block that first meets
-    the pair: an interface stored the other way round is flipped (normal reversed:
-    x = t2, y = t1, its polygon reversed, and the friction of the force on the first
-    block, -f2 and -f1)."""
-    pair = interfaces.pair
-    _, first, which = np.unique(pair.min(axis=1) * (pair.max(initial=0) + 1) + pair.max(axis=1),
-                                return_index=True, return_inverse=True)
-    flip = pair[first[which.reshape(-1)], 0] != pair[:, 0]
-    axes = np.where(flip[:, None, None], np.stack([interfaces.t2, interfaces.t1], axis=1),
-                    np.stack([interfaces.t1, interfaces.t2], axis=1)).tolist()
-    points = interfaces.vertices.tolist()
-    rows = [None] * len(points)
-    if x is not None:
-        forces = np.asarray(x, dtype=float).reshape(-1, 4).copy()
-        turned = flip[interfaces.vertex_interface]
-        forces[turned, 2:] = -forces[turned][:, [3, 2]]
-        rows = [{"c_np": a, "c_nn": b, "c_u": c, "c_v": d} for a, b, c, d in forces.tolist()]
-    for k, (a, b) in enumerate(pairwise(interfaces.offsets.tolist())):
-        polygon, point_forces = points[a:b], rows[a:b]
-        if flip[k]:
-            polygon, point_forces = polygon[::-1], point_forces[::-1]
-        frame = {"point": interfaces.centre[k].tolist(), "xaxis": axes[k][0],
-                 "yaxis": axes[k][1]}
-        data = {"points": [_object("compas.geometry/Point", p, guid()) for p in polygon],
-                "size": float(interfaces.area[k]),
-                "frame": _object("compas.geometry/Frame", frame, guid()),
-                "forces": None if x is None else point_forces,
-                "mesh": _object("compas.datastructures/Mesh",
-                                _mesh_data(polygon, [list(range(len(polygon)))]), guid())}
-        u, v = pair[k, ::-1] if flip[k] else pair[k]
-        yield int(u), int(v), _object("compas_assembly.datastructures/Interface", data, guid())
+class _Edges:
+    """The graph's edges: every interface seen from the block that first meets the pair
+    (``u``), under ``edge[u][v].interfaces`` in the order of the interfaces. An interface
+    stored the other way round is flipped (normal reversed: x = t2, y = t1, its polygon
+    reversed, and the friction of the force on the first block, -f2 and -f1)."""
+
+    def __init__(self, interfaces, x, n_blocks):
+        self.interfaces, self.n_blocks = interfaces, n_blocks
+        pair = interfaces.pair
+        key = pair.min(axis=1) * (pair.max(initial=0) + 1) + pair.max(axis=1)
+        _, first, which = np.unique(key, return_index=True, return_inverse=True)
+        self.flip = pair[first[which.reshape(-1)], 0] != pair[:, 0]
+        self.ends = np.where(self.flip[:, None], pair[:, ::-1], pair)
+        self.order = np.argsort(self.ends[:, 0], kind="stable")  # by u, then as stored
+        self.forces = None
+        if x is not None:
+            self.forces = np.asarray(x, dtype=float).reshape(-1, 4).copy()
+            turned = self.flip[interfaces.vertex_interface]
+            self.forces[turned, 2:] = -self.forces[turned][:, [3, 2]]
+
+    def chunks(self, guid):
+        """``{u: {v: {"interfaces": [...]}}}`` of :data:`CHUNK` blocks ``u`` at a time,
+        every block ``u`` in order (an empty dict where no interface starts)."""
+        starts = self.ends[self.order, 0]
+        for low in range(0, self.n_blocks, CHUNK):
+            high = min(low + CHUNK, self.n_blocks)
+            ks = self.order[np.searchsorted(starts, low):np.searchsorted(starts, high)]
+            edges = {str(b): {} for b in range(low, high)}
+            for (u, v), interface in zip(self.ends[ks].tolist(), self._interfaces(ks, guid)):
+                edges[str(u)].setdefault(str(v), {"interfaces": []})["interfaces"].append(
+                    interface)
+            yield edges
+
+    def _interfaces(self, ks, guid):
+        """The compas_assembly ``Interface`` of every interface ``ks``, in turn."""
+        interfaces, flip = self.interfaces, self.flip[ks].tolist()
+        offsets = interfaces.offsets
+        counts = offsets[ks + 1] - offsets[ks]
+        bounds = np.concatenate([[0], np.cumsum(counts)])
+        rows = np.repeat(offsets[ks] - bounds[:-1], counts) + np.arange(bounds[-1])
+        bounds = bounds.tolist()
+        points = interfaces.vertices[rows].tolist()
+        point_forces = [None] * len(rows)
+        if self.forces is not None:
+            point_forces = [{"c_np": a, "c_nn": b, "c_u": c, "c_v": d}
+                            for a, b, c, d in self.forces[rows].tolist()]
+        axes = np.where(self.flip[ks, None, None],
+                        np.stack([interfaces.t2[ks], interfaces.t1[ks]], axis=1),
+                        np.stack([interfaces.t1[ks], interfaces.t2[ks]], axis=1)).tolist()
+        centres, areas = interfaces.centre[ks].tolist(), interfaces.area[ks].tolist()
+        for i, (a, b) in enumerate(pairwise(bounds)):
+            polygon, vertex_forces = points[a:b], point_forces[a:b]
+            if flip[i]:
+                polygon, vertex_forces = polygon[::-1], vertex_forces[::-1]
+            frame = {"point": centres[i], "xaxis": axes[i][0], "yaxis": axes[i][1]}
+            data = {"points": [_object("compas.geometry/Point", p, guid()) for p in polygon],
+                    "size": areas[i],
+                    "frame": _object("compas.geometry/Frame", frame, guid()),
+                    "forces": None if self.forces is None else vertex_forces,
+                    "mesh": _object("compas.datastructures/Mesh",
+                                    _mesh_data(polygon, [list(range(len(polygon)))]), guid())}
+            yield _object("compas_assembly.datastructures/Interface", data, guid())

@@ -25,12 +25,12 @@ from masonry.scenes.imported import Assembly
 from masonry.scenes.polygonal import Dome, Section
 from masonry.scenes.revolution import Revolution, Sector
 from masonry.scenes.wall import Wall
-from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS
+from masonry.tolerances import BYTES_PER_BRICK, MAX_BRICKS, RUN_BYTES
 
 KINDS = {kind.name: kind for kind in (Section, Wall, Dome, Assembly, Arch, Revolution, Sector)}
 """Scene name -> its :class:`~masonry.scenes.base.SceneKind`."""
 
-__all__ = ["KINDS", "Scene", "SceneKind", "build", "check_size", "kind_of"]
+__all__ = ["KINDS", "Scene", "SceneKind", "build", "check_size", "kind_of", "memory_estimate"]
 
 
 def kind_of(name: str) -> type:
@@ -59,13 +59,20 @@ def check_size(params, max_bricks=MAX_BRICKS) -> float:
     """
     bricks = params.kind.estimate_blocks(params.geometry)
     if not bricks <= max_bricks:
-        memory = bricks * BYTES_PER_BRICK / 2**30
+        memory = memory_estimate(params, bricks) / 2**30
         raise ParameterError(
             "max_bricks", max_bricks,
             f"a model of at most {max_bricks:,} blocks: this one would have about "
-            f"{_about(bricks)} (about {memory:.2g} GiB of memory to solve); raise "
+            f"{_about(bricks)} (about {memory:.2g} GiB of memory to solve, if it stands); raise "
             f"--max-bricks to build it anyway")
     return bricks
+
+
+def memory_estimate(params, bricks: float) -> float:
+    """The peak memory, bytes, of a run of ``params`` (``masonry run`` without plots) with
+    ``bricks`` bricks, if it stands: :data:`~masonry.tolerances.RUN_BYTES` and
+    :data:`~masonry.tolerances.BYTES_PER_BRICK` of its accuracy preset for each brick."""
+    return RUN_BYTES + bricks * BYTES_PER_BRICK[params.analysis.accuracy]
 
 
 def _about(value: float) -> str:

@@ -1,0 +1,156 @@
+"""How time and memory grow with the bricks (``masonry bench --scale``): whole ``masonry
+run`` processes of one structure at growing sizes, each in a fresh process (its own
+start-up, its own peak memory), without plots or the printable body (the command line's
+``--no-plots --no-printable``: what the run solves and writes), and the exponent of a
+power law fitted to each column.
+
+A row's peak memory is the largest resident set of the run's processes (the kernel's
+``ru_maxrss`` of the process and the ones it forked); its times come from the run's own
+``run.json`` (``timings_s``: the stages of the process that reports, and the time it
+waited for the other's exports) and from the kernel (wall and CPU of the whole process).
+"""
+
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from masonry.params import from_preset
+from masonry.scenes import memory_estimate
+
+SCALE_COLUMNS = ("structure", "bricks", "verdict", "wall_s", "cpu_s", "solve_s",
+                 "newton_steps", "newton_setup_s", "exports_s", "peak_gib", "estimate_gib")
+"""Columns of a scale row: ``solve_s`` the RBE solve (``timings_s.solve``),
+``newton_steps`` and ``newton_setup_s`` its Newton attempts' iterations and symbolic
+set-up summed, ``exports_s`` the files after the forces (``timings_s``: ``exports``,
+``html`` and the wait for the other process), ``estimate_gib`` what ``--max-bricks``'s
+message says the run needs (:func:`masonry.scenes.memory_estimate`)."""
+
+WALLS = (50, 112, 224, 354, 500)
+"""The walls' courses: ``0.4 courses`` bricks in each (``--wall-length 1.6 courses``),
+about 1,000, 5,000, 20,000, 50,000 and 100,000 bricks of one shape."""
+
+DOMES = (4, 10, 16, 21, 26)
+"""Preset 1's full dome at these ``p``: 1,664 to 31,712 bricks, every one standing
+(docs/scale.md: from p 27 its profile does not)."""
+
+FIT_FROM = 5000
+"""The exponents are fitted to the rows of at least this many bricks: below, the
+start-up (imports, about a second) hides how the work grows."""
+
+
+def scale_structures(walls=WALLS, domes=DOMES) -> dict:
+    """``{name: (family, preset, inputs)}`` of the default rows: the inputs as
+    :func:`~masonry.params.from_preset` takes them, the command line's options by their
+    names."""
+    out = {}
+    for courses in walls:
+        length = round(1.6 * courses)
+        out[f"wall {length} x {courses}"] = ("wall", "wall", {"wall_length": float(length),
+                                                              "wall_courses": courses})
+    for p in domes:
+        out[f"preset 1 full dome, p {p}"] = ("preset 1 full dome", "1",
+                                             {"scene": "dome", "p": p})
+    return out
+
+
+def scale_bench(structures: dict, progress=None) -> list:
+    """One ``masonry run`` per structure, each in a fresh process, into a temporary
+    folder (removed after).
+
+    Parameters
+    ----------
+    structures : dict str -> (str, str, dict)
+        Name -> (its family, its preset, its inputs): :func:`scale_structures`.
+    progress : callable(str), optional
+        Called with a line per row.
+
+    Returns
+    -------
+    list of dict
+        Keys :data:`SCALE_COLUMNS` and ``family``.
+    """
+    rows = []
+    for name, (family, preset, inputs) in structures.items():
+        options = [f"--{key.replace('_', '-')}={value}" for key, value in inputs.items()]
+        with tempfile.TemporaryDirectory(prefix="masonry-scale-") as out:
+            wall, cpu, peak = _run([f"--preset={preset}", *options, "--no-plots",
+                                    "--no-printable", "--quiet", "--max-bricks=10000000",
+                                    f"--out={out}"])
+            record = json.loads(next(Path(out).glob("*/run.json")).read_text())
+        row = _from_record(record)
+        row["estimate_gib"] = memory_estimate(from_preset(preset, **inputs),
+                                              row["bricks"]) / 2**30
+        rows.append({"structure": name, "family": family, "wall_s": wall, "cpu_s": cpu,
+                     "peak_gib": peak, **row})
+        if progress is not None:
+            progress(f"{name}: {rows[-1]['bricks']:,} bricks, {wall:.1f} s, "
+                     f"{peak:.2f} GiB")
+    return rows
+
+
+def _run(arguments) -> tuple:
+    """``masonry run arguments`` in a fresh process: (wall s, CPU s, peak GiB)."""
+    command = [sys.executable, "-c",
+               "import sys; from masonry_cli.main import main; sys.exit(main())", "run",
+               *arguments]
+    start = time.perf_counter()
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL)
+    _, status, usage = os.wait4(process.pid, 0)
+    wall = time.perf_counter() - start
+    process.returncode = os.waitstatus_to_exitcode(status)
+    if process.returncode != 0:
+        raise RuntimeError(f"masonry run {' '.join(arguments)} ended with "
+                           f"{process.returncode}")
+    # ru_maxrss is in kilobytes on Linux
+    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024**2
+
+
+def _from_record(record: dict) -> dict:
+    """A row's columns read from the run's ``run.json``."""
+    timings = record["timings_s"]
+    newton = [a for a in record["rbe"].get("attempts", []) if a.get("solver") == "newton"]
+    bricks = record["counts"]["bricks"]
+    return {"bricks": bricks, "verdict": record["rbe"]["verdict"],
+            "solve_s": timings.get("solve"),
+            "newton_steps": sum(a["iterations"] for a in newton),
+            "newton_setup_s": sum(a.get("setup_s", 0.0) for a in newton),
+            "exports_s": sum(timings.get(k, 0.0) for k in ("exports", "html",
+                                                           "other_process"))}
+
+
+def exponent(rows, column, smallest=FIT_FROM) -> float | None:
+    """The exponent ``k`` of ``column = c bricks^k`` fitted (least squares in logs) to
+    the ``rows`` of at least ``smallest`` bricks with a positive value; None with fewer
+    than two."""
+    points = [(row["bricks"], row[column]) for row in rows
+              if row["bricks"] >= smallest and (row.get(column) or 0) > 0]
+    if len(points) < 2:
+        return None
+    x, y = np.log(np.array(points, dtype=float)).T
+    return float(np.polyfit(x, y, 1)[0])
+
+
+def scale_markdown(rows) -> str:
+    """The rows as a table, then each family's fitted exponents."""
+    from masonry_benchmarks.markdown import markdown_table
+
+    table = markdown_table(rows, SCALE_COLUMNS, formats={
+        "bricks": "{:,}", "wall_s": "{:.1f}", "cpu_s": "{:.1f}", "solve_s": "{:.2f}",
+        "newton_setup_s": "{:.2f}", "exports_s": "{:.2f}", "peak_gib": "{:.2f}",
+        "estimate_gib": "{:.2f}"})
+    fitted = ("wall_s", "cpu_s", "solve_s", "newton_steps", "exports_s", "peak_gib")
+    lines = ["| family | " + " | ".join(fitted) + " |", "|---|" + "---|" * len(fitted)]
+    for family in dict.fromkeys(row["family"] for row in rows):
+        of = [row for row in rows if row["family"] == family]
+        values = [exponent(of, column) for column in fitted]
+        lines.append(f"| {family} | " + " | ".join(
+            "" if v is None or not math.isfinite(v) else f"{v:.2f}" for v in values) + " |")
+    return (table + f"\nexponents k of a fit c bricks^k to the rows of at least "
+            f"{FIT_FROM:,} bricks:\n\n" + "\n".join(lines) + "\n")
