@@ -80,13 +80,17 @@ def scale_bench(structures: dict, progress=None) -> list:
     for name, (family, preset, inputs) in structures.items():
         options = [f"--{key.replace('_', '-')}={value}" for key, value in inputs.items()]
         with tempfile.TemporaryDirectory(prefix="masonry-scale-") as out:
-            wall, cpu, peak = _run([f"--preset={preset}", *options, "--no-plots",
-                                    "--no-printable", "--quiet", "--max-bricks=10000000",
-                                    f"--out={out}"])
-            record = json.loads(next(Path(out).glob("*/run.json")).read_text())
+            arguments = [f"--preset={preset}", *options, "--no-plots", "--no-printable",
+                         "--quiet", "--max-bricks=10000000", f"--out={out}"]
+            wall, cpu, peak, code = _run(arguments)
+            written = list(Path(out).glob("*/run.json"))
+            if not written:  # a run that gives no verdict still writes its run.json
+                raise RuntimeError(f"masonry run {' '.join(arguments)} ended with {code} "
+                                   f"and wrote no run.json")
+            record = json.loads(written[0].read_text())
         row = _from_record(record)
-        row["estimate_gib"] = memory_estimate(from_preset(preset, **inputs),
-                                              row["bricks"]) / 2**30
+        accuracy = from_preset(preset, **inputs).analysis.accuracy
+        row["estimate_gib"] = memory_estimate(row["bricks"], accuracy) / 2**30
         rows.append({"structure": name, "family": family, "wall_s": wall, "cpu_s": cpu,
                      "peak_gib": peak, **row})
         if progress is not None:
@@ -96,7 +100,9 @@ def scale_bench(structures: dict, progress=None) -> list:
 
 
 def _run(arguments) -> tuple:
-    """``masonry run arguments`` in a fresh process: (wall s, CPU s, peak GiB)."""
+    """``masonry run arguments`` in a fresh process: (wall s, CPU s, peak GiB, exit
+    code). The peak is the largest process's (Linux's ``ru_maxrss``, in kilobytes): a
+    forked process shares most of its pages with the one that forked it."""
     command = [sys.executable, "-c",
                "import sys; from masonry_cli.main import main; sys.exit(main())", "run",
                *arguments]
@@ -105,11 +111,8 @@ def _run(arguments) -> tuple:
     _, status, usage = os.wait4(process.pid, 0)
     wall = time.perf_counter() - start
     process.returncode = os.waitstatus_to_exitcode(status)
-    if process.returncode != 0:
-        raise RuntimeError(f"masonry run {' '.join(arguments)} ended with "
-                           f"{process.returncode}")
-    # ru_maxrss is in kilobytes on Linux
-    return wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024**2
+    return (wall, usage.ru_utime + usage.ru_stime, usage.ru_maxrss / 1024**2,
+            process.returncode)
 
 
 def _from_record(record: dict) -> dict:

@@ -11,9 +11,8 @@ from masonry.params import (PRESETS, Params, applies, from_preset, load, names, 
                             section_default, validate)
 from masonry.rbe.collapse_result import VERDICTS
 from masonry.rbe.settings import Analysis
-from masonry.scenes import KINDS, kind_of
-from masonry.tolerances import (BYTES_PER_BRICK, INTERPENETRATION_REL, MAX_BRICKS,
-                                OVERLAP_TOLERANCE_RANGE)
+from masonry.scenes import KINDS, kind_of, memory_estimate
+from masonry.tolerances import INTERPENETRATION_REL, MAX_BRICKS, OVERLAP_TOLERANCE_RANGE
 
 MATERIAL_OPTIONS = ("mu", "friction_cone", "density", "cohesion_kpa", "tensile_kpa",
                     "head_joint_ratio", "support_joint_ratio", "adhesion_tension_ratio")
@@ -133,11 +132,11 @@ def add_model_options(parser):
     g.add_argument("--fast", action="store_true", default=None,
                    help="the fast accuracy preset and quick figures (one view, lower "
                         "resolution)")
+    memory = memory_estimate(MAX_BRICKS, Analysis().accuracy) / 2**30
     g.add_argument("--max-bricks", dest="max_bricks", type=int, default=MAX_BRICKS,
                    metavar="N", help=f"refuse a model estimated above N blocks before "
                                      f"building it (default {MAX_BRICKS}, about "
-                                     f"{MAX_BRICKS * BYTES_PER_BRICK['balanced'] / 2**30:.0f} "
-                                     f"GiB to solve one that stands)")
+                                     f"{memory:.0f} GiB to solve one that stands)")
     add_scene_options(parser)
 
 

@@ -592,9 +592,10 @@ def write_exports(folder: RunFolder, made: RunOutputs, record: dict, timer: Time
     and the process has two cores, this process and a forked copy then share the others,
     each taking the next exporter not yet taken (:class:`masonry.forking.Shared`; the
     registry lists the long ones first), each writing the files it made into the
-    folder and handing back their names and its record. The exporters made here count
-    their time towards their stage, and the time this process waited for the other's
-    share counts as ``other_process``.
+    folder and handing back their names and its record (when the forked process fails,
+    this one makes and writes its share again, over what it wrote). The exporters made
+    here count their time towards their stage, and the time this process waited for the
+    other's share counts as ``other_process``.
 
     Parameters
     ----------

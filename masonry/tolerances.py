@@ -22,13 +22,15 @@ MAX_BRICKS = 50_000
 that stands takes about 3 GiB at the balanced preset (:data:`BYTES_PER_BRICK`)."""
 
 BYTES_PER_BRICK = {"fast": 64e3, "balanced": 64e3, "accurate": 106e3}
-"""Peak memory of a run (``masonry run`` without plots, ``masonry bench --scale``) of a
-structure that stands, per brick by accuracy preset, beyond :data:`RUN_BYTES`. Fitted to
-preset 1's full dome (1,664 to 31,712 bricks) and a running-bond wall (1,025 to 100,250
-bricks) at the balanced preset (fast takes the same), within 22 % of every row; the
-accurate preset from preset 1's full dome at 13,680 bricks (docs/bench.md, "How time
-and memory grow"). One that cannot stand takes more: 8.2 GiB, 215 kB a brick, for
-preset 1's 41,072-brick dome when Clarabel decided it (docs/scale.md)."""
+"""Peak memory of a run (``masonry run`` without plots, ``masonry bench --scale``: its
+largest process) of a structure that stands, per brick by accuracy preset (every one of
+:data:`masonry.rbe.accuracy.ACCURACY`), beyond :data:`RUN_BYTES`. Fitted to preset 1's
+full dome (1,664 to 31,712 bricks) and a running-bond wall (1,025 to 100,250 bricks) at
+the balanced preset, within 22 % of every row; the fast and accurate presets measured
+on preset 1's full dome at 13,680 bricks (0.81 and 1.45 GiB, balanced 0.81 GiB;
+docs/bench.md, "How time and memory grow"). One that cannot stand takes more: 8.2 GiB,
+214 kB a brick, for preset 1's 41,072-brick dome when Clarabel decided it
+(docs/scale.md)."""
 
 RUN_BYTES = 100e6
 """Peak memory of a run besides its bricks': Python, numpy, scipy and the solvers

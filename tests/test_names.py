@@ -12,7 +12,9 @@ import masonry
 from masonry.errors import ParameterError
 from masonry.params import Params, from_preset, validate
 from masonry.rbe.loads import point_loads
+from masonry.rbe.accuracy import ACCURACY
 from masonry.scenes import build, check_size, memory_estimate
+from masonry.tolerances import BYTES_PER_BRICK
 from masonry_cli.main import main
 
 SMALL = {
@@ -150,7 +152,12 @@ def test_the_size_checks_estimates_are_within_a_quarter_of_the_measured(row):
         assert blocks == row["bricks"] + 8
     else:
         assert 0 <= blocks / row["bricks"] - 1 < 0.03
-    assert abs(memory_estimate(params, row["bricks"]) / 2**30 / row["peak_gib"] - 1) < 0.25
+    estimate = memory_estimate(row["bricks"], params.analysis.accuracy) / 2**30
+    assert abs(estimate / row["peak_gib"] - 1) < 0.25
+
+
+def test_the_memory_estimate_knows_every_accuracy_preset():
+    assert BYTES_PER_BRICK.keys() == ACCURACY.keys()
 
 
 def test_a_refused_model_names_its_memory_if_it_stands(capsys, tmp_path):

@@ -2,6 +2,8 @@
 
 import csv
 import json
+import os
+import time
 from pathlib import Path
 
 import meshio
@@ -76,9 +78,12 @@ class RecordingFolder:
 
     def write(self, relative, data):
         path = self.root / relative
-        assert not path.exists(), f"{relative} written twice"
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_bytes(data.encode() if isinstance(data, str) else data)
+        try:
+            with open(path, "xb") as file:
+                file.write(data.encode() if isinstance(data, str) else data)
+        except FileExistsError:
+            raise AssertionError(f"{relative} written twice") from None
 
     @property
     def files(self) -> dict:
@@ -129,6 +134,39 @@ def test_exporters_shared_with_a_forked_process_equal_the_ones_made_here(
     assert "bricks.3dm" in files
     assert sorted(name for names in written.values() for name in names) == sorted(files)
     assert ("other_process" in timer.seconds) == fork
+
+
+def test_a_forked_process_that_dies_after_writing_has_its_share_made_here(
+        monkeypatch, tmp_path, caplog):
+    """The forked process writes a file of its share and dies before it reports: this
+    process makes and writes that share again (over the file), and the run's files are
+    whole and all named."""
+    monkeypatch.setattr("masonry.forking.can_fork", lambda: True)
+    monkeypatch.setattr("masonry.forking.cores", lambda: 2)
+    made = wall_outputs(plots=False, printable=False)
+    wanted = [e for e in EXPORTERS if e.wanted(made)]
+    expected = {name: data for e in wanted for name, data in e.make(made).files.items()}
+    here, waited = os.getpid(), []
+
+    class DiesThere:
+        def write(self, relative, data):
+            if os.getpid() == here and not waited:  # the other process takes its share
+                time.sleep(0.5)
+                waited.append(relative)
+            path = tmp_path / relative
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data.encode() if isinstance(data, str) else data)
+            if os.getpid() != here:
+                os._exit(1)
+
+    written = write_exports(DiesThere(), made, {}, Timer())
+    assert "the second process failed" in caplog.text
+    assert sorted(n for names in written.values() for n in names) == sorted(expected)
+    for name, data in expected.items():
+        assert (tmp_path / name).is_file(), name
+        if name.endswith((".csv", ".obj", ".vtu")):
+            data = data.encode() if isinstance(data, str) else data
+            assert (tmp_path / name).read_bytes() == data, name
 
 
 def test_an_exporter_failing_fails_the_run_and_keeps_the_earlier_folder(wall_run, monkeypatch, capsys):

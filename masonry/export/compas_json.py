@@ -65,14 +65,14 @@ def assembly_json(blocks, interfaces, x, record: dict, name: str = "masonry") ->
     defaults = {"x": 0.0, "y": 0.0, "z": 0.0, "block": None, "is_support": False,
                 "section": None, "mesh_size": None, "displacement": [0.0] * 6}
     attributes = {"name": name, "masonry": {**verdict, "units": "N, m"}}
-    graph_guid, guid = guid(), guid()
+    graph_guid, assembly_guid = guid(), guid()
     # the text in pieces, joined once: the document may be hundreds of megabytes
     head = (f'{{"dtype": "{ASSEMBLY_DTYPE}", "data": {{"attributes": {_dumps(attributes)}, '
             f'"graph": {{"dtype": "compas.datastructures/Graph", "data": {{"attributes": {{}}, '
             f'"default_node_attributes": {_dumps(defaults)}, '
             f'"default_edge_attributes": {{"interfaces": null}}, "node": ')
     tail = (f', "max_node": {blocks.n_blocks - 1}}}, "guid": "{graph_guid}"}}}}, '
-            f'"guid": "{guid}"}}')
+            f'"guid": "{assembly_guid}"}}')
     return "".join([head, *nodes, ', "edge": ', *edges, tail])
 
 

@@ -59,7 +59,7 @@ def check_size(params, max_bricks=MAX_BRICKS) -> float:
     """
     bricks = params.kind.estimate_blocks(params.geometry)
     if not bricks <= max_bricks:
-        memory = memory_estimate(params, bricks) / 2**30
+        memory = memory_estimate(bricks, params.analysis.accuracy) / 2**30
         raise ParameterError(
             "max_bricks", max_bricks,
             f"a model of at most {max_bricks:,} blocks: this one would have about "
@@ -68,11 +68,11 @@ def check_size(params, max_bricks=MAX_BRICKS) -> float:
     return bricks
 
 
-def memory_estimate(params, bricks: float) -> float:
-    """The peak memory, bytes, of a run of ``params`` (``masonry run`` without plots) with
-    ``bricks`` bricks, if it stands: :data:`~masonry.tolerances.RUN_BYTES` and
-    :data:`~masonry.tolerances.BYTES_PER_BRICK` of its accuracy preset for each brick."""
-    return RUN_BYTES + bricks * BYTES_PER_BRICK[params.analysis.accuracy]
+def memory_estimate(bricks: float, accuracy: str) -> float:
+    """The peak memory, bytes, of a run (``masonry run`` without plots) of ``bricks``
+    bricks that stands, at the ``accuracy`` preset: :data:`~masonry.tolerances.RUN_BYTES`
+    and :data:`~masonry.tolerances.BYTES_PER_BRICK` of the preset for each brick."""
+    return RUN_BYTES + bricks * BYTES_PER_BRICK[accuracy]
 
 
 def _about(value: float) -> str:
