@@ -21,7 +21,6 @@ from pathlib import Path
 
 import numpy as np
 
-from masonry.params import from_preset
 from masonry.scenes import memory_estimate
 
 SCALE_COLUMNS = ("structure", "bricks", "verdict", "wall_s", "cpu_s", "solve_s",
@@ -88,11 +87,8 @@ def scale_bench(structures: dict, progress=None) -> list:
                 raise RuntimeError(f"masonry run {' '.join(arguments)} ended with {code} "
                                    f"and wrote no run.json")
             record = json.loads(written[0].read_text())
-        row = _from_record(record)
-        accuracy = from_preset(preset, **inputs).analysis.accuracy
-        row["estimate_gib"] = memory_estimate(row["bricks"], accuracy) / 2**30
         rows.append({"structure": name, "family": family, "wall_s": wall, "cpu_s": cpu,
-                     "peak_gib": peak, **row})
+                     "peak_gib": peak, **_from_record(record)})
         if progress is not None:
             progress(f"{name}: {rows[-1]['bricks']:,} bricks, {wall:.1f} s, "
                      f"{peak:.2f} GiB")
@@ -120,12 +116,14 @@ def _from_record(record: dict) -> dict:
     timings = record["timings_s"]
     newton = [a for a in record["rbe"].get("attempts", []) if a.get("solver") == "newton"]
     bricks = record["counts"]["bricks"]
+    estimate = memory_estimate(bricks, record["params"]["accuracy"])
     return {"bricks": bricks, "verdict": record["rbe"]["verdict"],
             "solve_s": timings.get("solve"),
             "newton_steps": sum(a["iterations"] for a in newton),
             "newton_setup_s": sum(a.get("setup_s", 0.0) for a in newton),
             "exports_s": sum(timings.get(k, 0.0) for k in ("exports", "html",
-                                                           "other_process"))}
+                                                           "other_process")),
+            "estimate_gib": estimate / 2**30}
 
 
 def exponent(rows, column, smallest=FIT_FROM) -> float | None:

@@ -335,7 +335,7 @@ class Blocks:
         start, stop = self.face_offsets[face], self.face_offsets[face + 1]
         return self.vertices[self.face_vertices[start:stop]]
 
-    @property
+    @cached_property
     def block_face_offsets(self) -> np.ndarray:
         """(B + 1,) int: block ``i`` owns faces ``block_face_offsets[i]`` to
         ``block_face_offsets[i + 1]`` (faces are stored block after block)."""
