@@ -3,6 +3,8 @@ an independent 2D linear program on the arch's voussoirs."""
 
 import csv
 import dataclasses
+import functools
+import itertools
 import json
 import shlex
 
@@ -16,7 +18,7 @@ from masonry import forking
 from masonry.blocks import Blocks
 from masonry.pipeline import build_model
 from masonry.params import ParameterError, Params, from_preset, validate
-from masonry.rbe.azimuth_refine import floor_between
+from masonry.rbe.azimuth_refine import MAX_SOLVES, floor_between, refine_least
 from masonry.rbe.boundary import Model
 from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
                                   collapse_load, fixed_capacity_factor)
@@ -395,6 +397,51 @@ def test_the_floor_between_two_azimuths_bounds_every_mechanism_between_them():
     assert floor_between(20.0, ends[0], 35.0, ends[1]) == pytest.approx(ends[0], rel=1e-12)
     # an end where no factor bounds the load leaves the other's branch
     assert floor_between(0.0, 2.0, 15.0, np.inf) == pytest.approx(2.0, rel=1e-12)
+
+
+def _support(azimuth, points=None, centre=None, radius=None):
+    """``1 / h(azimuth)`` of a convex set of the plane: the polygon of ``points``, or the
+    disc of ``radius`` about ``centre``."""
+    u = np.array([np.cos(np.radians(azimuth)), np.sin(np.radians(azimuth))])
+    h = float(np.max(points @ u)) if points is not None else radius + float(centre @ u)
+    return 1.0 / h
+
+
+@pytest.mark.parametrize("corner_deg", [7.0, 19.0, 22.5, 37.3])
+def test_the_refinement_cuts_a_polygon_at_its_farthest_vertex(corner_deg):
+    """The set of a program's mechanisms is a polygon: the least factor is ``1 / |v|``
+    at the farthest vertex ``v``'s azimuth. Sampled every 15 degrees, the corners find it
+    to 1e-9 in at most two solves wherever the vertex lies (on a sample: none)."""
+    angles = np.radians([corner_deg - 40.0, corner_deg, corner_deg + 50.0, 200.0])
+    radii = np.array([2.0, 2.5, 2.1, 1.0])
+    points = radii[:, None] * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    samples = [(a, _support(a, points)) for a in np.arange(0.0, 360.0, 15.0)]
+    new = refine_least(samples, lambda a: _support(a, points))
+    least = min(f for _, f in samples + new)
+    assert least == pytest.approx(1.0 / 2.5, rel=1e-9)
+    assert len(new) <= 2 and (corner_deg % 15.0 != 0.0 or not new)
+
+
+def test_the_refinement_certifies_a_smooth_least_on_a_mirror_plane(caplog):
+    """A disc about an off-centre point: a smooth family of mechanisms, the least factor
+    ``1 / (r + |c|)`` at ``c``'s azimuth, here a sample in the set's mirror plane (as on
+    preset 1's dome, where Brent's method spent every solve converging on the sample and
+    stopped uncertified). The search closes every bracket's floor to its tolerance
+    (1e-7) within its solves, the mirror image's bracket left to the symmetry."""
+    centre = np.array([np.cos(np.radians(30.0)), np.sin(np.radians(30.0))])
+    samples = [(a, _support(a, centre=centre, radius=2.0)) for a in np.arange(0.0, 360.0,
+                                                                                 15.0)]
+    orbit = functools.partial(symmetric_key, mirrors=(30.0,))
+    with caplog.at_level("WARNING"):
+        new = refine_least(samples, lambda a: _support(a, centre=centre, radius=2.0),
+                           key=orbit)
+    assert 0 < len(new) < MAX_SOLVES and "stopped" not in caplog.text
+    assert all(f >= 1.0 / 3.0 * (1.0 - 1e-12) for _, f in new)
+    assert all(15.0 < a < 30.0 for a, _ in new)  # one side of the mirror
+    # every floor between the solved azimuths there within 1e-7 of the least, 1 / 3
+    solved = sorted([(15.0, samples[1][1]), (30.0, samples[2][1]), *new])
+    floors = [floor_between(a, f, b, g) for (a, f), (b, g) in itertools.pairwise(solved)]
+    assert min(floors) >= (1.0 - 1e-7) / 3.0
 
 
 def test_run_reports_the_refined_least_of_an_azimuth_search(tmp_path, capsys):

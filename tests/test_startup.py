@@ -18,15 +18,16 @@ HEAVY = ("scipy", "matplotlib", "cvxpy", "meshio", "rhino3dm", "dask", "pandas",
 """Libraries a command loads only when it does the work that needs them."""
 
 
-def loaded_by(argv) -> tuple:
-    """``(exit code, the HEAVY libraries loaded)`` of ``masonry ARGV`` in a fresh process."""
+def loaded_by(argv, modules=HEAVY) -> tuple:
+    """``(exit code, the ``modules`` loaded, whether numpy was)`` of ``masonry ARGV`` in a
+    fresh process."""
     script = ("import json, sys\n"
               "from masonry_cli.main import main\n"
               "try:\n"
               f"    code = main({argv!r})\n"
               "except SystemExit as exit:\n"
               "    code = exit.code\n"
-              f"heavy = sorted(m for m in {HEAVY!r} if m in sys.modules)\n"
+              f"heavy = sorted(m for m in {tuple(modules)!r} if m in sys.modules)\n"
               "print(json.dumps([code, heavy, 'numpy' in sys.modules]))\n")
     root = Path(__file__).resolve().parent.parent
     env = {**os.environ, "PYTHONPATH": os.pathsep.join(
@@ -52,6 +53,18 @@ def test_a_refused_option_loads_no_solver_plot_or_exporter(tmp_path, argv):
                                else argv)
     assert code in (0, 2) and not (tmp_path / "o").exists()
     assert heavy == []
+
+
+def test_a_run_that_stands_loads_no_optimizer_plot_or_printing_library(tmp_path):
+    """The self weight of a wall that stands, without figures or printable body: no
+    scipy.optimize (an azimuth's refinement or a dome's levels need it), no plots, no
+    printing geometry, no modelling layer."""
+    unused = ("scipy.optimize", "matplotlib", "plotly", "cvxpy", "osqp", "trimesh",
+              "manifold3d", "meshio", "dask", "compas")
+    code, loaded, _ = loaded_by(["run", "--scene", "wall", "--no-plots", "--no-printable",
+                                 "-q", "--out", str(tmp_path / "o")], unused)
+    assert code == 0 and (tmp_path / "o").is_dir()
+    assert loaded == []
 
 
 def test_the_solver_registry_says_what_each_backend_declares():

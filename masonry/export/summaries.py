@@ -149,7 +149,7 @@ def search_words(record: dict) -> str:
     :meth:`CollapseResult.to_dict` after ``--lateral all``)."""
     refined = record.get("refined") or ()
     return (f"the least of {len(record['azimuths'])} azimuths"
-            + (f" and {len(refined)} more solved between them by Brent's method"
+            + (f" and {len(refined)} more solved between them at the corners of their bounds"
                if refined else ""))
 
 

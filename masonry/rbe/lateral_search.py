@@ -43,8 +43,8 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
                   time_limit=600.0, method=None, cores=None, cohesion=0.0,
                   tensile=0.0, refine=True) -> CollapseResult:
     """The smallest lateral load factor over ``azimuths`` (``--lateral all``) and, with
-    ``refine``, between them: Brent's method on every bracket between two of them (less
-    than 180 degrees apart) where a smaller factor may lie
+    ``refine``, between them: every bracket between two of them (less than 180 degrees
+    apart) where a smaller factor may lie is cut at the corner of its bound
     (:func:`~masonry.rbe.azimuth_refine.refine_least`).
 
     One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: the interior point
