@@ -248,8 +248,9 @@ def add_live_load_options(parser):
                    help="horizontal body force lambda x each block's weight, at AZIMUTH "
                         "degrees from +x toward +y; 'all' searches 24 azimuths and the "
                         "dome's symmetry directions for the worst and refines it "
-                        "between them (where its bound's corners lie, to 1e-7 of lambda; not on a "
-                        "cyclic section: use --scene dome)")
+                        "between them (where its bound's corners lie, to 1e-7 of "
+                        "lambda, 1e-4 when fast; not on a cyclic section: use --scene "
+                        "dome)")
     g.add_argument(f"--{option_of('point_loads')}", dest="point_loads", action="append",
                    metavar="NAME_OR_PATTERN:FX,FY,FZ",
                    help="force in newtons at the centre of the top face of every block "

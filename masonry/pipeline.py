@@ -20,6 +20,7 @@ from masonry.cache import read_cache, write_cache
 from masonry.export import EXPORTERS, RunOutputs, html, rhino, written_outputs
 from masonry.outputs import WRITTEN_OUTPUTS
 from masonry.params import FILE_OUTPUTS, Params, structure_id, validate
+from masonry.rbe.accuracy import ACCURACY
 from masonry.rbe.adhesion import AdhesionResult, least_adhesion, stands_dry
 from masonry.rbe.boundary import Model, analysis_model
 from masonry.rbe.centering import CenteringResult, centering_force
@@ -548,7 +549,8 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
     if isinstance(load, Lateral) and load.azimuth_deg == "all":
         result = worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
                                mirrors=symmetry.mirrors, dead_load_feasible=known, **options,
-                               **analysis.mortar_on(model.interfaces))
+                               **analysis.mortar_on(model.interfaces),
+                               refine_rel=ACCURACY[analysis.accuracy].azimuth_rel)
         return _checked_collapse(model, params, result, 1, known)
     plane = symmetric_plane(load, symmetry.mirrors)
     if (plane is not None and analysis.friction_law == "associated"

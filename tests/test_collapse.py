@@ -16,8 +16,10 @@ from scipy.optimize import linprog
 import masonry
 from masonry import forking
 from masonry.blocks import Blocks
+from masonry import pipeline
 from masonry.pipeline import build_model
 from masonry.params import ParameterError, Params, from_preset, validate
+from masonry.rbe.accuracy import ACCURACY
 from masonry.rbe.azimuth_refine import MAX_SOLVES, floor_between, refine_least
 from masonry.rbe.boundary import Model
 from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
@@ -442,6 +444,40 @@ def test_the_refinement_certifies_a_smooth_least_on_a_mirror_plane(caplog):
     solved = sorted([(15.0, samples[1][1]), (30.0, samples[2][1]), *new])
     floors = [floor_between(a, f, b, g) for (a, f), (b, g) in itertools.pairwise(solved)]
     assert min(floors) >= (1.0 - 1e-7) / 3.0
+
+
+@pytest.mark.parametrize("tol", [1e-7, 1e-4, 1e-3])
+def test_the_refinement_stops_within_its_tolerance(tol):
+    """A looser tolerance (the fast preset's ``azimuth_rel``) takes fewer solves and
+    ends within it of the least, ``1 / (r + |c|)`` for a disc about ``c`` (between the
+    samples, at 20 degrees)."""
+    centre = 1.8 * np.array([np.cos(np.radians(20.0)), np.sin(np.radians(20.0))])
+    samples = [(a, _support(a, centre=centre, radius=2.0)) for a in np.arange(0.0, 360.0,
+                                                                                 15.0)]
+    new = refine_least(samples, lambda a: _support(a, centre=centre, radius=2.0), tol=tol)
+    least = min(f for _, f in samples + new)
+    assert 1.0 / 3.8 <= least <= (1.0 + tol) / 3.8
+    assert len(new) <= {1e-7: MAX_SOLVES, 1e-4: 4, 1e-3: 1}[tol]
+
+
+@pytest.mark.parametrize("accuracy", ["fast", "balanced"])
+def test_a_run_refines_its_azimuth_search_to_its_presets_tolerance(monkeypatch, accuracy):
+    """``--lateral all`` refines to the accuracy preset's ``azimuth_rel``: 1e-4 when
+    fast, 1e-7 otherwise (docs/model.md 6.6)."""
+    asked = {}
+
+    class Asked(Exception):
+        pass
+
+    def search(model, **options):
+        asked.update(options)
+        raise Asked
+
+    params = validate(Params.of(scene="dome", **SMALL_DOME, lateral="all", accuracy=accuracy))
+    monkeypatch.setattr(pipeline, "worst_lateral", search)
+    with pytest.raises(Asked):
+        pipeline.collapse_of(build_model(params)[1], params)
+    assert asked["refine_rel"] == {"fast": 1e-4, "balanced": 1e-7}[accuracy]
 
 
 def test_run_reports_the_refined_least_of_an_azimuth_search(tmp_path, capsys):

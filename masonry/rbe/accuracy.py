@@ -5,7 +5,7 @@ point is accepted. :mod:`masonry.rbe.solve` runs them."""
 from dataclasses import dataclass, field
 
 from masonry.friction import FrictionCone
-from masonry.tolerances import ACCEPT_RESIDUAL
+from masonry.tolerances import ACCEPT_RESIDUAL, AZIMUTH_REFINE_REL
 
 
 @dataclass(frozen=True)
@@ -39,6 +39,11 @@ class AccuracyPreset:
         active set, which leaves residuals near rounding and no interior-point tension
         (Clarabel at 1e-10 left 1e-6 of the weight as tension on a feasible section).
         Kept only if it converges within :data:`masonry.rbe.solve.POLISH_STEPS`.
+    azimuth_rel : float
+        ``--lateral all`` refines its least sample until every bound between the solved
+        azimuths beside it is within this (relative) of the least factor found
+        (:mod:`masonry.rbe.azimuth_refine`; each refinement is a collapse program on the
+        whole model).
     options : dict
         Solver settings by the key a backend takes them under
         (:attr:`~masonry.rbe.solvers.base.Backend.settings`: ``newton``, ``interior``,
@@ -53,6 +58,7 @@ class AccuracyPreset:
     cone: str = "circle"
     load_path: bool = False
     polish: bool = False
+    azimuth_rel: float = AZIMUTH_REFINE_REL
     options: dict = field(default_factory=dict)
 
 
@@ -63,7 +69,7 @@ ACCURACY = {
     # the interior point's last iterations and the acceptance of OSQP's ADMM points.
     "fast": AccuracyPreset(
         "fast", "newton", "interior", residual=1e-4, lp_check=False, load_path=True,
-        polish=False,
+        polish=False, azimuth_rel=1e-4,
         options={"newton": {"tol": 1e-6},
                  "interior": {"tol": 1e-6},
                  "clarabel": {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-6},

@@ -21,7 +21,8 @@ smaller factor or moves the tangent in and lifts the floor (the outer approximat
 sandwich algorithm, G. Rote, Computing 48, 1992). Where ``S`` has a vertex, as an LP's
 set has, the cut's tangent passes through it and the two new corners lie on it: the
 floors become that vertex's factor, exact. The cuts go on until every such floor is
-within :data:`~masonry.tolerances.AZIMUTH_REFINE_REL` of the least found. Brackets away
+within a tolerance of the least found (the accuracy preset's ``azimuth_rel``,
+:data:`~masonry.tolerances.AZIMUTH_REFINE_REL` unless fast). Brackets away
 from the least are not searched: each cut costs a collapse program on the whole model,
 and on a large dome the loose floors of far brackets would ask for hundreds.
 """
@@ -36,11 +37,6 @@ from masonry.tolerances import AZIMUTH_NEAR_LEAST_REL, AZIMUTH_REFINE_REL
 __all__ = ["floor_between", "refine_least", "search_factor"]
 
 log = logging.getLogger(__name__)
-
-XATOL_DEG = float(np.degrees(np.sqrt(2.0 * AZIMUTH_REFINE_REL)))
-"""A bracket whose next cut lies within this of an end (degrees) is settled: the end's
-tangent passes through the corner at that angle from the end's azimuth, so the end's
-factor is within :data:`~masonry.tolerances.AZIMUTH_REFINE_REL` of the floor."""
 
 MAX_SOLVES = 8
 """Collapse programs a refinement solves at the most (each one on the whole model, off
@@ -79,23 +75,27 @@ def search_factor(result) -> float | None:
     return result.load_factor
 
 
-def refine_least(samples, factor_at, key=None) -> list:
+def refine_least(samples, factor_at, key=None, tol=AZIMUTH_REFINE_REL) -> list:
     """Points that refine the least of ``samples`` ((azimuth in degrees, factor) pairs;
     factor None where the solve gave none, ``inf`` where no factor bounds the load) by
     calling ``factor_at(azimuth) -> float or None`` (the same meaning) inside the
     brackets between consecutive solved azimuths, around the circle, where a smaller
     factor than the least found may lie (module docstring). ``key(azimuth)`` names the
     orbit of an azimuth under the structure's symmetries (equal keys, equal factors): of
-    brackets that map onto each other only one is searched. Returns the new
-    ``(azimuth, factor)`` pairs, in the order solved, azimuths in [0, 360)."""
+    brackets that map onto each other only one is searched. The cuts end when every
+    floor is within ``tol`` (relative) of the least found. Returns the new ``(azimuth,
+    factor)`` pairs, in the order solved, azimuths in [0, 360)."""
     known = {float(a) % 360.0: f for a, f in samples if f is not None}
+    # a cut this close to an end (degrees) settles its bracket: the end's tangent passes
+    # through the corner at that angle from it, so its factor is within tol of the floor
+    settled = float(np.degrees(np.sqrt(2.0 * tol)))
     searched, new = set(), []
-    while brackets := _open_brackets(known, key, searched):
+    while brackets := _open_brackets(known, key, searched, tol):
         _, low, high, name = brackets[0]
         searched.add(name)
         cut = _corner(low, known[low], high, known[high % 360.0])[1]
-        if not low + XATOL_DEG < cut < high - XATOL_DEG:
-            continue  # settled: an end's factor is within the tolerance of the floor
+        if not low + settled < cut < high - settled:
+            continue
         if len(new) == MAX_SOLVES:
             log.warning("lateral search: refinement stopped after %d solves; the least "
                         "factor found is kept", len(new))
@@ -111,9 +111,9 @@ def refine_least(samples, factor_at, key=None) -> list:
     return new
 
 
-def _open_brackets(known, key, searched) -> list:
+def _open_brackets(known, key, searched, tol) -> list:
     """``(floor, low, high, name)`` of the brackets between consecutive azimuths of
-    ``known`` whose floor lies below the least factor by more than the tolerance and that
+    ``known`` whose floor lies below the least factor by more than ``tol`` and that
     have an end near the least, not yet ``searched`` (by ``name``: the key of its middle
     and its width), the lowest floor first; ``high`` may pass 360."""
     finite = [f for f in known.values() if np.isfinite(f)]
@@ -131,6 +131,6 @@ def _open_brackets(known, key, searched) -> list:
         if min(ends) > least * (1.0 + AZIMUTH_NEAR_LEAST_REL):
             continue  # not beside the least: its floor is a bound, not searched
         floor = floor_between(low, ends[0], high, ends[1])
-        if name not in searched and floor < least * (1.0 - AZIMUTH_REFINE_REL):
+        if name not in searched and floor < least * (1.0 - tol):
             out.setdefault(name, (floor, low, high, name))
     return sorted(out.values(), key=lambda bracket: bracket[0])
