@@ -550,7 +550,7 @@ def collapse_of(model: Model, params: Params, rbe: RBEResult | None = None) -> C
         result = worst_lateral(model, n_webs=symmetry.webs, period_deg=symmetry.period_deg,
                                mirrors=symmetry.mirrors, dead_load_feasible=known, **options,
                                **analysis.mortar_on(model.interfaces),
-                               refine_rel=ACCURACY[analysis.accuracy].azimuth_rel)
+                               azimuth_rel=ACCURACY[analysis.accuracy].azimuth_rel)
         return _checked_collapse(model, params, result, 1, known)
     plane = symmetric_plane(load, symmetry.mirrors)
     if (plane is not None and analysis.friction_law == "associated"

@@ -360,9 +360,10 @@ neighbours and those of samples tied with it."""
 
 AZIMUTH_REFINE_REL = 1e-7
 """An azimuth search (``--lateral all``) refines its least sample until the least factor
-it found is within this (relative) of the least over every azimuth between its samples
+it found is within this (relative) of the least over every azimuth beside it
 (:mod:`masonry.rbe.azimuth_refine`): below the 1e-6 the collapse program's factor is
-compared to, above its gaps (1e-8)."""
+compared to, above its gaps (1e-8). The balanced and accurate presets' ``azimuth_rel``
+(the fast one's is 1e-4: :mod:`masonry.rbe.accuracy`)."""
 
 CENTERING_REPORTED_REL = 1e-3
 """A block needs a temporary support when the centering force on it (docs/model.md 6.10,

@@ -19,7 +19,6 @@ from masonry.blocks import Blocks
 from masonry import pipeline
 from masonry.pipeline import build_model
 from masonry.params import ParameterError, Params, from_preset, validate
-from masonry.rbe.accuracy import ACCURACY
 from masonry.rbe.azimuth_refine import MAX_SOLVES, floor_between, refine_least
 from masonry.rbe.boundary import Model
 from masonry.rbe.collapse import (UNBOUNDED_NOTE, CollapseLP, CollapseResult,
@@ -446,18 +445,35 @@ def test_the_refinement_certifies_a_smooth_least_on_a_mirror_plane(caplog):
     assert min(floors) >= (1.0 - 1e-7) / 3.0
 
 
-@pytest.mark.parametrize("tol", [1e-7, 1e-4, 1e-3])
-def test_the_refinement_stops_within_its_tolerance(tol):
+@pytest.mark.parametrize("tol, most", [(1e-7, MAX_SOLVES), (1e-4, 4), (1e-3, 1)])
+def test_the_refinement_stops_within_its_tolerance(tol, most):
     """A looser tolerance (the fast preset's ``azimuth_rel``) takes fewer solves and
     ends within it of the least, ``1 / (r + |c|)`` for a disc about ``c`` (between the
     samples, at 20 degrees)."""
     centre = 1.8 * np.array([np.cos(np.radians(20.0)), np.sin(np.radians(20.0))])
     samples = [(a, _support(a, centre=centre, radius=2.0)) for a in np.arange(0.0, 360.0,
                                                                                  15.0)]
-    new = refine_least(samples, lambda a: _support(a, centre=centre, radius=2.0), tol=tol)
+    new = refine_least(samples, lambda a: _support(a, centre=centre, radius=2.0),
+                       azimuth_rel=tol)
     least = min(f for _, f in samples + new)
     assert 1.0 / 3.8 <= least <= (1.0 + tol) / 3.8
-    assert len(new) <= {1e-7: MAX_SOLVES, 1e-4: 4, 1e-3: 1}[tol]
+    assert tol == 1e-7 or len(new) <= most
+
+
+def test_the_refinement_searches_beside_every_sample_near_the_least():
+    """Two samples within 0.1 % of the least sampled, on opposite sides: at 240 and 255
+    degrees (a vertex at 247.5 between them, radius 2) and at 75 (a farther vertex at
+    67.9, radius 2.01: the least factor, 1 / 2.01). The first cut, between 240 and 255,
+    finds 1 / 2 and leaves the sample at 75 more than 0.1 % above it; the brackets beside
+    that sample are searched all the same."""
+    polar = [(247.5, 2.0), (240.0, 1.995), (255.0, 1.995), (67.9, 2.01), (160.0, 1.5),
+             (340.0, 1.5)]
+    points = np.array([[r * np.cos(np.radians(a)), r * np.sin(np.radians(a))]
+                       for a, r in polar])
+    samples = [(a, _support(a, points)) for a in np.arange(0.0, 360.0, 15.0)]
+    new = refine_least(samples, lambda a: _support(a, points))
+    assert new[0][1] == pytest.approx(0.5, rel=1e-12)  # the cut between 240 and 255
+    assert min(f for _, f in new) == pytest.approx(1.0 / 2.01, rel=1e-9)
 
 
 @pytest.mark.parametrize("accuracy", ["fast", "balanced"])
@@ -477,7 +493,7 @@ def test_a_run_refines_its_azimuth_search_to_its_presets_tolerance(monkeypatch, 
     monkeypatch.setattr(pipeline, "worst_lateral", search)
     with pytest.raises(Asked):
         pipeline.collapse_of(build_model(params)[1], params)
-    assert asked["refine_rel"] == {"fast": 1e-4, "balanced": 1e-7}[accuracy]
+    assert asked["azimuth_rel"] == {"fast": 1e-4, "balanced": 1e-7}[accuracy]
 
 
 def test_run_reports_the_refined_least_of_an_azimuth_search(tmp_path, capsys):

@@ -19,8 +19,8 @@ HEAVY = ("scipy", "matplotlib", "cvxpy", "meshio", "rhino3dm", "dask", "pandas",
 
 
 def loaded_by(argv, modules=HEAVY) -> tuple:
-    """``(exit code, the ``modules`` loaded, whether numpy was)`` of ``masonry ARGV`` in a
-    fresh process."""
+    """The exit code of ``masonry ARGV`` in a fresh process, which of ``modules`` it
+    loaded and whether it loaded numpy."""
     script = ("import json, sys\n"
               "from masonry_cli.main import main\n"
               "try:\n"

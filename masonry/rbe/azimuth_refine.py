@@ -15,15 +15,17 @@ seen along ``u(theta)``; its inverse is a floor under the factor there
 (:func:`floor_between`).
 
 Every bracket between two solved azimuths whose floor lies below the least factor found,
-and that has an end at or near the least (:data:`~masonry.tolerances.AZIMUTH_NEAR_LEAST_REL`),
-is cut at its corner's direction, the lowest floor first: the solve there either finds a
-smaller factor or moves the tangent in and lifts the floor (the outer approximation of a
-sandwich algorithm, G. Rote, Computing 48, 1992). Where ``S`` has a vertex, as an LP's
-set has, the cut's tangent passes through it and the two new corners lie on it: the
-floors become that vertex's factor, exact. The cuts go on until every such floor is
-within a tolerance of the least found (the accuracy preset's ``azimuth_rel``,
-:data:`~masonry.tolerances.AZIMUTH_REFINE_REL` unless fast). Brackets away
-from the least are not searched: each cut costs a collapse program on the whole model,
+and that has an end at a sample near the least sampled
+(:data:`~masonry.tolerances.AZIMUTH_NEAR_LEAST_REL`) or at a cut, is cut at its corner's
+direction, the lowest floor first: the solve there either finds a smaller factor or
+moves the tangent in and lifts the floor (the outer approximation of a sandwich
+algorithm, G. Rote, Computing 48, 1992). Where the farthest point of ``S`` is a vertex,
+as an LP's set has, finitely many cuts reach it: once the tangents on either side pass
+through it, the floors there are its factor, exact; where ``S`` is smooth (a family of
+mechanisms) a floor's gap falls with the square of its bracket's width. The cuts go on
+until every such floor is within a tolerance of the least found (the accuracy preset's
+``azimuth_rel``, :data:`~masonry.tolerances.AZIMUTH_REFINE_REL` unless fast). Brackets
+away from the least are not searched: each cut costs a collapse program on the whole model,
 and on a large dome the loose floors of far brackets would ask for hundreds.
 """
 
@@ -53,18 +55,14 @@ def floor_between(azimuth_1, factor_1, azimuth_2, factor_2) -> float:
 
 def _corner(azimuth_1, factor_1, azimuth_2, factor_2) -> tuple:
     """``(floor, azimuth)``: :func:`floor_between` and the azimuth (degrees) of the
-    tangents' corner, where the floor is reached (an end when the corner's direction
-    lies outside the bracket)."""
+    tangents' corner (where the floor is reached when it lies inside the bracket)."""
     width = np.radians(azimuth_2 - azimuth_1)
     h_1, h_2 = 1.0 / factor_1, 1.0 / factor_2
     # h(theta_1 + t) <= h_1 cos t + (h_2 - h_1 cos w) / sin w sin t = R cos(t - psi)
     along = (h_2 - h_1 * np.cos(width)) / np.sin(width)
     psi = np.arctan2(along, h_1)
-    if 0.0 <= psi <= width:
-        top, azimuth = np.hypot(h_1, along), azimuth_1 + np.degrees(psi)
-    else:
-        top, azimuth = max(h_1, h_2), azimuth_1 if h_1 >= h_2 else azimuth_2
-    return (np.inf if top <= 0.0 else 1.0 / top), azimuth
+    top = np.hypot(h_1, along) if 0.0 <= psi <= width else max(h_1, h_2)
+    return (np.inf if top <= 0.0 else 1.0 / top), azimuth_1 + np.degrees(psi)
 
 
 def search_factor(result) -> float | None:
@@ -75,7 +73,7 @@ def search_factor(result) -> float | None:
     return result.load_factor
 
 
-def refine_least(samples, factor_at, key=None, tol=AZIMUTH_REFINE_REL) -> list:
+def refine_least(samples, factor_at, key=None, azimuth_rel=AZIMUTH_REFINE_REL) -> list:
     """Points that refine the least of ``samples`` ((azimuth in degrees, factor) pairs;
     factor None where the solve gave none, ``inf`` where no factor bounds the load) by
     calling ``factor_at(azimuth) -> float or None`` (the same meaning) inside the
@@ -83,54 +81,54 @@ def refine_least(samples, factor_at, key=None, tol=AZIMUTH_REFINE_REL) -> list:
     factor than the least found may lie (module docstring). ``key(azimuth)`` names the
     orbit of an azimuth under the structure's symmetries (equal keys, equal factors): of
     brackets that map onto each other only one is searched. The cuts end when every
-    floor is within ``tol`` (relative) of the least found. Returns the new ``(azimuth,
-    factor)`` pairs, in the order solved, azimuths in [0, 360)."""
+    floor is within ``azimuth_rel`` (relative) of the least found. Returns the new
+    ``(azimuth, factor)`` pairs, in the order solved, azimuths in [0, 360)."""
     known = {float(a) % 360.0: f for a, f in samples if f is not None}
-    # a cut this close to an end (degrees) settles its bracket: the end's tangent passes
-    # through the corner at that angle from it, so its factor is within tol of the floor
-    settled = float(np.degrees(np.sqrt(2.0 * tol)))
+    finite = [f for f in known.values() if np.isfinite(f)]
+    if not finite or min(finite) <= 0.0:
+        return []
+    # the brackets beside the least are those with an end among the samples near the
+    # least sampled or at a cut: a cut's two halves stay searched when it finds a
+    # smaller factor elsewhere
+    near = {a for a, f in known.items() if f <= min(finite) * (1.0 + AZIMUTH_NEAR_LEAST_REL)}
     searched, new = set(), []
-    while brackets := _open_brackets(known, key, searched, tol):
+    while brackets := _open_brackets(known, near, key, searched, azimuth_rel):
         _, low, high, name = brackets[0]
         searched.add(name)
-        cut = _corner(low, known[low], high, known[high % 360.0])[1]
-        if not low + settled < cut < high - settled:
-            continue
         if len(new) == MAX_SOLVES:
             log.warning("lateral search: refinement stopped after %d solves; the least "
                         "factor found is kept", len(new))
             return new
-        factor = factor_at(cut % 360.0)
-        new.append((cut % 360.0, factor))
+        # an open bracket's corner lies inside it: its floor is below both ends' factors
+        cut = _corner(low, known[low], high, known[high % 360.0])[1] % 360.0
+        factor = factor_at(cut)
+        new.append((cut, factor))
         if factor is None or not np.isfinite(factor):
             log.warning("lateral search: no finite factor at %.6g deg; the bracket %.6g to "
-                        "%.6g deg is not searched further", cut % 360.0, low, high % 360.0)
+                        "%.6g deg is not searched further", cut, low, high % 360.0)
             continue
-        known[cut % 360.0] = factor
+        known[cut] = factor
+        near.add(cut)
     log.info("lateral search: %d azimuths refined", len(new))
     return new
 
 
-def _open_brackets(known, key, searched, tol) -> list:
+def _open_brackets(known, near, key, searched, azimuth_rel) -> list:
     """``(floor, low, high, name)`` of the brackets between consecutive azimuths of
-    ``known`` whose floor lies below the least factor by more than ``tol`` and that
-    have an end near the least, not yet ``searched`` (by ``name``: the key of its middle
-    and its width), the lowest floor first; ``high`` may pass 360."""
-    finite = [f for f in known.values() if np.isfinite(f)]
-    if len(known) < 2 or not finite or min(finite) <= 0.0:
+    ``known`` with an end in ``near`` whose floor lies below the least factor by more
+    than ``azimuth_rel``, not yet ``searched`` (by ``name``: the key of its middle and
+    its width), the lowest floor first; ``high`` may pass 360."""
+    least = min(f for f in known.values() if np.isfinite(f))
+    if least <= 0.0:
         return []
-    least = min(finite)
     angles = sorted(known)
     out = {}
     for low, high in zip(angles, angles[1:] + [angles[0] + 360.0]):
-        if not 0.0 < high - low < 180.0:
-            continue
+        if not 0.0 < high - low < 180.0 or not {low, high % 360.0} & near:
+            continue  # not beside the least: its floor is a bound, not searched
         middle = 0.5 * (low + high) % 360.0
         name = (round(middle, 9) if key is None else key(middle), round(high - low, 9))
-        ends = (known[low], known[high % 360.0])
-        if min(ends) > least * (1.0 + AZIMUTH_NEAR_LEAST_REL):
-            continue  # not beside the least: its floor is a bound, not searched
-        floor = floor_between(low, ends[0], high, ends[1])
-        if name not in searched and floor < least * (1.0 - tol):
+        floor = floor_between(low, known[low], high, known[high % 360.0])
+        if name not in searched and floor < least * (1.0 - azimuth_rel):
             out.setdefault(name, (floor, low, high, name))
     return sorted(out.values(), key=lambda bracket: bracket[0])

@@ -42,11 +42,11 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
                   n_webs=None, period_deg=None, mirrors=(), dead_load_feasible=None,
                   time_limit=600.0, method=None, cores=None, cohesion=0.0,
                   tensile=0.0, refine=True,
-                  refine_rel=AZIMUTH_REFINE_REL) -> CollapseResult:
+                  azimuth_rel=AZIMUTH_REFINE_REL) -> CollapseResult:
     """The smallest lateral load factor over ``azimuths`` (``--lateral all``) and, with
     ``refine``, between them: every bracket between two of them (less than 180 degrees
     apart) where a smaller factor may lie is cut at the corner of its bound, until every
-    bound is within ``refine_rel`` of the least
+    bound is within ``azimuth_rel`` of the least
     (:func:`~masonry.rbe.azimuth_refine.refine_least`).
 
     One LP serves every azimuth (:meth:`CollapseLP.solve_lateral`: the interior point
@@ -92,7 +92,8 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
         samples = [(a, search_factor(r)) for a, r in zip(azimuths, results)]
         orbit = functools.partial(symmetric_key, period_deg=period_deg, mirrors=mirrors)
         refine_least(samples, lambda a: search_factor(refined.setdefault(
-            a, cases.solve(a, dead_load_feasible=True))), key=orbit, tol=refine_rel)
+            a, cases.solve(a, dead_load_feasible=True))), key=orbit,
+                     azimuth_rel=azimuth_rel)
     sampled = [r for r in results if r.load_factor is not None]
     found = sampled + [r for r in refined.values() if r.load_factor is not None]
     worst = results[-1]
