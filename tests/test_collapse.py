@@ -455,8 +455,9 @@ def test_the_refinement_stops_within_its_tolerance(tol, most):
                                                                                  15.0)]
     new = refine_least(samples, lambda a: _support(a, centre=centre, radius=2.0),
                        azimuth_rel=tol)
-    least = min(f for _, f in samples + new)
-    assert 1.0 / 3.8 <= least <= (1.0 + tol) / 3.8
+    # the samples alone are off by more than every tolerance: the cuts bring it within
+    assert min(f for _, f in samples) > (1.0 + 1e-3) / 3.8
+    assert min(f for _, f in new) <= (1.0 + tol) / 3.8
     assert most is None or len(new) <= most
 
 
