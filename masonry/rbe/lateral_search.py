@@ -91,9 +91,12 @@ def worst_lateral(model, azimuths=None, *, mu=0.7, density=2000.0, cone="circle"
     if refine and len(results) == len(keys) and results[-1].dead_load_feasible:
         samples = [(a, search_factor(r)) for a, r in zip(azimuths, results)]
         orbit = functools.partial(symmetric_key, period_deg=period_deg, mirrors=mirrors)
-        refine_least(samples, lambda a: search_factor(refined.setdefault(
-            a, cases.solve(a, dead_load_feasible=True))), key=orbit,
-                     azimuth_rel=azimuth_rel)
+
+        def factor_at(azimuth):
+            refined[azimuth] = cases.solve(azimuth, dead_load_feasible=True)
+            return search_factor(refined[azimuth])
+
+        refine_least(samples, factor_at, key=orbit, azimuth_rel=azimuth_rel)
     sampled = [r for r in results if r.load_factor is not None]
     found = sampled + [r for r in refined.values() if r.load_factor is not None]
     worst = results[-1]
