@@ -281,7 +281,7 @@ class RBEProblem:
         """After Newton (``stalled``, its outcome) neither solved nor certified
         friction-net: the load-path LP's verdict (:mod:`~masonry.rbe.solvers.net_feasibility`).
         Its certificate, or its undecided outcome, is returned as is; when it finds
-        friction-net (likely) feasible, Newton resumes from its last dual point with its
+        friction-net feasible, Newton resumes from its last dual point with its
         own stall count (the LP's point is feasible but not the QP's optimum). Returns
         ``(solver name, outcome)``; the LP's record joins ``attempts`` when Newton
         resumes."""
@@ -290,12 +290,10 @@ class RBEProblem:
         decided = net_feasibility.decide(prepared_system(system, "net", workspace),
                                          NewtonOptions(**options).infeasibility_tol,
                                          tol.residual)
-        resume = (net_feasibility.FEASIBLE, net_feasibility.LIKELY_FEASIBLE)
-        if decided.info["verdict"] not in resume or stalled.y is None:
+        if decided.info["verdict"] != net_feasibility.FEASIBLE or stalled.y is None:
             return LOAD_PATH, decided
         attempts.append(_record("net", LOAD_PATH, decided))
-        log.info("the load-path LP found friction-net %s: Newton resumes",
-                 decided.info["verdict"])
+        log.info("the load-path LP found friction-net feasible: Newton resumes")
         return "newton", BACKENDS["newton"].solve_rbe(system, "net", dict(options),
                                                       workspace, y0=stalled.y)
 
