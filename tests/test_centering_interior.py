@@ -11,11 +11,15 @@ from test_rbe import SUPPORT as SUPPORT_KIND
 from test_rbe import box, make_interfaces, rot_y
 
 from masonry.blocks import Blocks
+from masonry.params import from_preset
+from masonry.pipeline import build_model
 from masonry.rbe.boundary import Model, kept_blocks, restrict
 from masonry.rbe.centering import INTERIOR, SOLVER, centering_force, solve_centering
 from masonry.rbe.sequence import StageSequence, part_system
-from masonry.rbe.solvers import interior_centering
+from masonry.rbe.solvers import interior_centering, predictor_corrector
 from masonry.rbe.solvers.base import USER_LIMIT
+from masonry.rbe.solvers.newton import NewtonSystem
+from masonry.stages.plans import make_plan
 
 MU, DENSITY = 0.7, 2000.0
 AGREE = (1e-4, 1e-5)
@@ -57,6 +61,43 @@ def test_the_interior_point_method_meets_clarabel(top_course, cone, cohesion, st
     if cohesion:
         dry = solve_centering(_stage_system(model, plan, stage, cone), solver=SOLVER)
         assert ours.total_N < dry.total_N
+
+
+@pytest.mark.slow
+def test_the_method_reaches_the_optimum_where_its_scalings_span_many_decades():
+    """A stage of preset 1's cyclic section near its top (728 bricks, laid pattern-first):
+    without the primal regularization (CenteringOptions.proximal) the method stalled
+    there as its dual rows' residual grew, and Clarabel answered; with it the method's
+    own point meets Clarabel's within :data:`AGREE`."""
+    stage = 728
+    scene, model = build_model(from_preset("1", boundary="cyclic"))
+    plan = make_plan(scene, "brick", "pattern-first")
+    system = _stage_system(model, plan, stage, "circle")
+    ours, theirs = (solve_centering(system, solver=solver) for solver in (INTERIOR, SOLVER))
+    assert ours.solver == INTERIOR
+    assert ours.total_N == pytest.approx(theirs.total_N, rel=AGREE[0],
+                                         abs=AGREE[1] * np.mean(theirs.block_weight))
+    assert max(ours.residual_eq, ours.friction_violation) <= CHECK
+
+
+def test_a_direction_that_does_not_solve_ends_the_iterations(top_course, monkeypatch):
+    """A step that is not a number (a direction that did not solve) ends the method at
+    once, with the last point within its reduced tolerance or none, instead of walking
+    NaNs to the iteration limit."""
+    model, plan = top_course
+    system = _stage_system(model, plan, 1, "circle")
+    steps = []
+    solved = predictor_corrector._step
+
+    def failing(*args):
+        step, direction = solved(*args)
+        steps.append(step)
+        return (np.nan if len(steps) > 3 else step), direction
+
+    monkeypatch.setattr(predictor_corrector, "_step", failing)
+    found = interior_centering.solve(NewtonSystem(system, "net"))
+    assert len(steps) == 4 and found.iterations == 3
+    assert found.status == USER_LIMIT and np.isfinite(found.x).all()
 
 
 def test_a_stage_that_stands_needs_none(top_course):

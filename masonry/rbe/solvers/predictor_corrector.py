@@ -56,7 +56,7 @@ def iterate(program, p, options, tolerances, name) -> tuple:
         except np.linalg.LinAlgError as error:
             log.debug("%s: reduced matrix not positive definite: %s", name, error)
             step = 0.0
-        if step < options.min_step:
+        if not step >= options.min_step:  # NaN too: a direction that did not solve
             log.debug("%s: stopped at iteration %d (step %.1e; primal %.1e, dual %.1e, "
                       "gap %.1e)", name, iterations, step, *measures)
             break
