@@ -30,12 +30,11 @@ from masonry.rbe.lp_check import lp_feasible
 from masonry.rbe.solve import ACCURACY, LOAD_PATH, RBEProblem, solve_rbe
 from masonry.rbe.cores import solver_threads
 from masonry.rbe.solvers import BACKENDS, COLLAPSE, RBE, backend, names
-from masonry.rbe.solvers import cholesky, ordering
+from masonry.rbe.solvers import cholesky, net_feasibility, ordering
 from masonry.rbe.solvers.cholesky import BlockCholesky
 from masonry.rbe.solvers.embedded import Embedded
 from masonry.rbe.solvers.highs import highs_lp
 from masonry.rbe.solvers.interior import scaling_of, vertex_cones, vertex_inverse
-from masonry.rbe.solvers import net_feasibility
 from masonry.rbe.solvers.net_feasibility import decide
 from masonry.rbe.solvers.newton import COMPONENTS, NewtonOptions, NewtonSystem
 from masonry.rbe.solvers.standard_form import standard_form
@@ -711,7 +710,7 @@ def test_the_load_path_lp_decides_past_an_early_load_factor_above_one(monkeypatc
     # preset 1's cyclic section with p 20 at mu 0.45 (2,606 bricks): an early iterate of
     # the LP has lambda >= 1 while its point misses the dead load by 20 times its
     # largest entry, and the optimum is 0.97; the verdict is the certificate, recomputed
-    # from the layout's matrices, and Newton's start from it is never asked for
+    # from the layout's matrices
     system = problem(model("1", p=20, boundary="cyclic")).system.with_material(
         mu=0.45, density=2000.0)
     tol = NewtonOptions().infeasibility_tol

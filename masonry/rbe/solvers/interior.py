@@ -215,9 +215,10 @@ def start_scale(mu) -> float:
 
 def largest_step(cones, s, z, ds, dz) -> float:
     """The largest step ``<= 1`` that keeps every slack and multiplier in its cone (one
-    of ``cones`` each)."""
-    return min(min(cone.max_step(sb, dsb), cone.max_step(zb, dzb))
-               for cone, sb, zb, dsb, dzb in zip(cones, s, z, ds, dz))
+    of ``cones`` each); NaN where a direction has one (Python's ``min`` would drop it
+    unless it came first)."""
+    return float(np.min([[cone.max_step(sb, dsb), cone.max_step(zb, dzb)]
+                         for cone, sb, zb, dsb, dzb in zip(cones, s, z, ds, dz)]))
 
 
 def _dot(a, b) -> float:

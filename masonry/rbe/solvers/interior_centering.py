@@ -25,8 +25,9 @@ leaves ::
 the pattern is the same. ``rho H`` (``H`` the friction-net QP's diagonal,
 :attr:`CenteringOptions.proximal` ``rho``) is a primal regularization: the Hessian of
 ``rho / 2 ||x - x_k||_H^2`` about the iterate ``x_k``, whose gradient there is zero, so
-the rows and the optimum are the program's and only the direction is damped; iterative
-refinement on the unregularized rows takes the damping out again where it converges.
+the rows and the optimum are the program's and only the direction is damped; near the
+optimum (``refine_gap``) iterative refinement on the unregularized rows takes the
+damping out again where it converges.
 Without it ``D_v`` of a vertex strictly inside its cone grows as its slack over its
 multiplier, without bound, and near the optimum ``A D A^T`` spans more decades than a
 factorization keeps. Mehrotra's predictor-corrector (:mod:`.predictor_corrector`,
@@ -87,6 +88,8 @@ class CenteringOptions:
         ``gap_floor`` of the mean block weight of the optimum, its rows within the
         acceptance tolerance the caller checks them to.
     max_iter : int
+        Iterations before the method gives up (Clarabel then answers): preset 1's
+        cyclic section with ``p`` 27 meets the reduced tolerance at about the 75th.
     step_fraction : float
         Fraction of the largest step to the boundary of the cones that is taken (at
         0.99 the iterates of preset 1's upper brick stages lost their centring near the
@@ -97,12 +100,10 @@ class CenteringOptions:
     proximal : float
         ``rho`` of the primal regularization (module docstring), relative to the
         friction-net QP's diagonal ``H``. Without it the method stalled near the optimum
-        as its dual rows' residual grew (preset 1's cyclic section: with ``p`` 20 at
-        ``mu`` 0.45 at a gap of 1e-3 of the objective, with ``p`` 27 at ``mu`` 0.7 of 2e-2,
-        and Clarabel took 200 iterations and six minutes to an almost solved point);
-        with 1e-8 it ends within the reduced tolerance at 1,609.77 N and 213.02 N,
-        within 2e-5 of Clarabel's almost solved points; with 1e-4 it damps too much and
-        ends far from them.
+        of preset 1's large cyclic sections as its dual rows' residual grew, at gaps of
+        1e-3 to 2e-2 of the objective, and Clarabel ended almost solved at its iteration
+        limit; with 1e-8 it ends within the reduced tolerance, within 2e-5 of Clarabel's
+        points; 1e-4 damps too much (``docs/bench.md``, "How time and memory grow").
     refinements, refine_gap : int, float
         Passes of iterative refinement of a direction (CVXOPT's) once the gap is below
         ``refine_gap`` times the objective (or ``gap_floor``): near the optimum the

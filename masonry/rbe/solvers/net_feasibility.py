@@ -14,19 +14,20 @@ right-hand side ``r`` and live load ``l = r - b``. ``lambda = 0`` is feasible (`
 so the LP is never infeasible:
 
 - ``lambda >= 1``: ``g' = g / lambda + (1 - 1 / lambda) g0`` (in ``K``) has ``M g' =
-  b + e / lambda`` where the iterate's primal rows miss by ``e``. Its residual is
+  b + d / lambda`` where the iterate's primal rows miss by ``d``. Its residual is
   recomputed here: within the QP's acceptance residual ``g'`` is a friction-net point
   and the verdict is ``feasible``. Further from the rows an iterate's ``lambda`` says
-  nothing: on preset 1's cyclic section with ``p`` 27 at ``mu`` 0.7 the fourth iterate
-  has ``lambda`` 1.27 with ``g'`` missing the dead load by 12 times its largest entry,
-  and the optimum is 0.985 (a certificate at the 24th).
+  nothing: an early iterate may pass 1 with ``g'`` far from the dead load where the
+  optimum is below 1 (``docs/bench.md``, "Newton's hand-over to the load-path LP").
 - an optimum below 1: the dual point has ``-M^T y`` in ``K`` and ``b^T y = r^T y + 1 >
   0`` (``l^T y = -1``, and ``-r^T y`` bounds ``lambda``), a Farkas certificate: no ``g``
   in ``K`` has ``M g = b``.
 
 The interior point method stops at the first iterate that decides either way (it need
 not converge; the LP is unbounded when ``b - r`` itself is carried, and the stop at a
-``g'`` within the residual comes first). The certificate is checked on ``M^T y`` and ``b^T y``
+``g'`` within the residual comes first). Where neither comes (an optimum at 1 to
+within the residual, approached from below) it runs to its iteration limit and the
+verdict is ``undecided``. The certificate is checked on ``M^T y`` and ``b^T y``
 recomputed from the matrices, with the margins the QP's acceptance allows. Let
 ``delta`` be how far ``-M^T y`` lies outside ``K`` (its most negative eigenvalue: the
 largest entry of ``M^T y`` for the orthant of a pyramid's rays); then for ``M g = b +
@@ -113,10 +114,10 @@ class _LoadPath:
 
 
 OPTIONS = LoadFactorOptions(correctors=1)
-"""The LP's settings: one centrality corrector, not the collapse LP's two. The verdict
-comes within a few iterations, too few for a second corrector to pay for its solve
+"""The LP's settings: one centrality corrector, not the collapse LP's two, measured
+when the LP stopped at its first ``lambda >= 1``, within a few iterations
 (``docs/bench.md``, "friction+ by the interior point method", the load-path LP's
-correctors)."""
+correctors); a verdict now takes 15 to 35 on preset 1's large sections."""
 
 
 def decide(ns: NewtonSystem, infeasibility_tol, residual, options=OPTIONS) -> Outcome:
