@@ -171,7 +171,7 @@ class _Program:
     def __init__(self, ns: NewtonSystem, options: CenteringOptions):
         self.ns = ns
         self.diagonal_shift = options.regularization * ns.diagonal_scale
-        self.proximal = options.proximal * ns.h
+        self.proximal_h = options.proximal * ns.h  # rho H, the diagonal of the damping
         self.gap_floor = options.gap_floor
         self.friction = vertex_cones(ns.components, ns.cone, ns.mu)[0]
         self.vertex = [self.friction] + ([CUTOFF] if ns.floor is not None else [])
@@ -235,7 +235,7 @@ class _Iterate(predictor_corrector.ConeIterate):
         super().__init__(program.cones, s, z)
         ns, w_inverse = program.ns, self.w_inverse
         self.program = program
-        self.D = vertex_inverse(program.proximal, program.vertex, w_inverse[:-1])
+        self.D = vertex_inverse(program.proximal_h, program.vertex, w_inverse[:-1])
         self.E = self.scalings[-1].D                       # W_3^2, (F, 4, 4)
         # the vertices whose friction slack outweighs its multiplier (W^2 large): their
         # dz from the cone rows, the others' from the dual rows (_solve)
@@ -284,7 +284,7 @@ class _Iterate(predictor_corrector.ConeIterate):
             ds.append(-r_cones[b] - dx @ vc.G.T)     # from the cone rows: keeps them exact
             dz.append(wq[b] + self.w2i(b, r_cones[b] + dx @ vc.G.T))
         if program.square is not None:  # Coulomb's cone: its dz from the dual rows
-            rest = pushed - r_x - program.proximal * dx
+            rest = pushed - r_x - program.proximal_h * dx
             for vc, dzb in zip(program.vertex[1:], dz[1:]):
                 rest = rest - dzb @ vc.G
             scaling, keep = self.scalings[0], self.slack[:, None]
