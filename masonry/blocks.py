@@ -527,13 +527,19 @@ def rotation_z(angle) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def rotated_web(blocks: Blocks, web: int, n: int, mask=None) -> Blocks:
-    """Blocks (or those selected by ``mask``, (B,) bool) rotated by ``2 pi web / n`` about
-    z, named ``w<web>_<name>`` and marked as web ``web % n``."""
-    part = blocks if mask is None else blocks.subset(mask)
+def web_motion(web: int, n: int) -> np.ndarray:
+    """(4, 4) motion that turns web 0 of ``n`` equal webs to web ``web``'s place: a
+    rotation by ``2 pi web / n`` about z."""
     motion = np.eye(4)
     motion[:3, :3] = rotation_z(2 * np.pi * web / n)
-    part = part.transformed(motion)
+    return motion
+
+
+def rotated_web(blocks: Blocks, web: int, n: int, mask=None) -> Blocks:
+    """Blocks (or those selected by ``mask``, (B,) bool) rotated by ``2 pi web / n`` about
+    z (:func:`web_motion`), named ``w<web>_<name>`` and marked as web ``web % n``."""
+    part = blocks if mask is None else blocks.subset(mask)
+    part = part.transformed(web_motion(web, n))
     return dataclasses.replace(
         part,
         block_name=np.array([f"w{web % n}_{name}" for name in part.block_name], dtype=object),

@@ -157,6 +157,47 @@ def test_3dm_has_one_named_closed_unwelded_mesh_per_brick_with_user_text():
                                        np.tile(blocks.face_normal[f], (4, 1)), atol=1e-6)
 
 
+def test_3dm_of_a_cyclic_section_turns_it_to_the_whole_dome_as_block_instances():
+    """The section's bricks as meshes; each other web an instance of one block definition
+    of them, which Rhino's own transform puts where the whole dome's bricks are."""
+    from masonry.export import EXPORTERS, RunOutputs
+    from masonry.export.rhino import COPIES_DEFINITION, COPIES_LAYER
+    from masonry.params import from_preset, validate
+    from masonry.scenes import build
+
+    rhino3dm = pytest.importorskip("rhino3dm")
+    params = validate(from_preset("3", boundary="cyclic", p=4))
+    made = RunOutputs(params, build(params), None)
+    blocks, whole, webs = made.scene.blocks, made.shown, made.webs
+    rhino = next(e for e in EXPORTERS if e.name == "rhino")
+    file = rhino3dm.File3dm.FromByteArray(rhino.make(made).files["bricks.3dm"])
+
+    normal = [o for o in file.Objects if o.Attributes.Mode == rhino3dm.ObjectMode.Normal]
+    meshes = [o for o in normal if isinstance(o.Geometry, rhino3dm.Mesh)]
+    assert [o.Attributes.Name for o in meshes] == blocks.block_name.tolist()
+    assert {o.Attributes.GetUserString("solved") for o in meshes} == {"yes"}
+    (definition,) = file.InstanceDefinitions
+    assert definition.Name == COPIES_DEFINITION
+    parts = [file.Objects.FindId(i).Geometry for i in definition.GetObjectIds()]
+    assert len(parts) == blocks.n_blocks
+
+    copies = [o for o in normal if isinstance(o.Geometry, rhino3dm.InstanceReference)]
+    assert [o.Attributes.Name for o in copies] == [f"w{k}" for k in range(1, webs)]
+    for k, copy in enumerate(copies, start=1):
+        assert copy.Attributes.GetUserString("web") == str(k)
+        assert file.Layers[copy.Attributes.LayerIndex].Name == COPIES_LAYER
+        assert copy.Geometry.ParentIdefId == definition.Id
+        for i, part in enumerate(parts):
+            turned = part.Duplicate()
+            assert turned.Transform(copy.Geometry.Xform)
+            points = np.array([[p.X, p.Y, p.Z] for p in turned.Vertices.ToPoint3dArray()])
+            faces = whole.block_faces(k * blocks.n_blocks + i)
+            corners = np.concatenate([whole.face_vertices[whole.face_offsets[f]:
+                                                          whole.face_offsets[f + 1]]
+                                      for f in faces])
+            np.testing.assert_allclose(points, whole.vertices[corners], atol=1e-12)
+
+
 def test_3dm_user_text_carries_each_bricks_largest_forces():
     """Two interfaces of a three-block stack by hand: block 1 bears on both, so its
     largest compression is the larger of the two; the ground support on the first."""

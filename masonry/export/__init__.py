@@ -16,7 +16,7 @@ from pathlib import PurePosixPath
 
 import numpy as np
 
-from masonry.blocks import whole_of_web
+from masonry.blocks import web_motion, whole_of_web
 from masonry.export import (compas_json, csv, html, obj, rhino, stl, summaries, threemf,
                             vtu)
 from masonry.printable import PrintableError, printable_blocks, printable_body
@@ -201,14 +201,17 @@ def _rhino_wanted(made: RunOutputs) -> bool:
 
 
 def _rhino_files(made: RunOutputs) -> Export:
-    text = rhino.block_user_text(made.scene.blocks, made.model, made.forces)
-    solved = made.is_solved
-    text = {key: made.per_shown(values) for key, values in text.items()}
-    text["web"] = made.shown.block_web.astype(str)
-    if not solved.all():
-        text["solved"] = np.where(solved, "yes", "no (a turned copy)")
-    return Export({"bricks.3dm": rhino.blocks_3dm(made.shown, user_text=text,
-                                                  is_copy=~solved)})
+    """``bricks.3dm``: the scene's blocks, and a cyclic section's turned copies as
+    instances of them, named and marked as the webs of :attr:`RunOutputs.shown`."""
+    blocks = made.scene.blocks
+    text = rhino.block_user_text(blocks, made.model, made.forces)
+    copies = None
+    if made.webs is not None:
+        text["solved"] = np.full(blocks.n_blocks, "yes")
+        copies = {f"w{web}": (web_motion(web, made.webs),
+                              {"web": str(web), "solved": "no (a turned copy)"})
+                  for web in range(1, made.webs)}
+    return Export({"bricks.3dm": rhino.blocks_3dm(blocks, user_text=text, copies=copies)})
 
 
 @functools.lru_cache(maxsize=1)

@@ -1,6 +1,7 @@
 """Rhino 3DM of blocks: one named, closed, unwelded mesh per block, on a layer per block
-class and a ``supports`` layer (a cyclic section's turned copies on a layer of their
-own), with user text (rhino3dm, a dependency).
+class and a ``supports`` layer, with user text (rhino3dm, a dependency); a cyclic
+section's turned copies are instances of one block definition of the section, on a layer
+of their own.
 
 Names are the OBJ object names (``blocks.block_name``); layers are the
 :data:`~masonry.blocks.BLOCK_CLASSES` of the free blocks and :data:`SUPPORT_LAYER` for the
@@ -26,8 +27,11 @@ _LAYER_COLOURS = ((128, 128, 128, 255), (200, 120, 80, 255), (200, 40, 40, 255),
 SUPPORT_LAYER = "supports"
 _SUPPORT_COLOUR = (60, 60, 60, 255)
 COPIES_LAYER = "turned copies (not solved)"
-"""The layer of a whole dome's blocks that copy the solved section by rotation (a cyclic
-section's run); the solved section's blocks are on the class and support layers."""
+"""The layer of a whole dome's webs that copy the solved section by rotation (a cyclic
+section's run) and of their block definition's meshes; the solved section's blocks are on
+the class and support layers."""
+COPIES_DEFINITION = "solved section"
+"""The name of the block definition the turned copies are instances of."""
 _COPIES_COLOUR = (190, 190, 190, 255)
 
 
@@ -74,12 +78,18 @@ def block_user_text(blocks: Blocks, model=None, forces=None) -> dict:
     return text
 
 
-def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, is_copy=None) -> bytes:
+def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, copies=None) -> bytes:
     """3DM bytes (Rhino 8 file format) with one closed, unwelded mesh per block.
 
     Faces of 3 and 4 vertices become mesh triangles and quads; larger faces are fanned
     from their first vertex (Rhino meshes have no n-gon faces). Vertices are stored in
     double precision.
+
+    Copies of the whole of ``blocks`` are block instances (Rhino: Insert, Explode): the
+    meshes are stored once more as the geometry of the block definition
+    :data:`COPIES_DEFINITION`, and each copy is a named instance of it with its motion,
+    on :data:`COPIES_LAYER`; Rhino draws a copy as the blocks moved, and a file of a
+    section and its seven turned copies holds two sets of meshes, not eight.
 
     Parameters
     ----------
@@ -88,8 +98,8 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, is_copy=None) -> b
         Positions to write instead of ``blocks.vertices`` (e.g. the CAD-offset ones).
     user_text : dict str -> (B,) str, optional
         Per-block user text (Rhino: Properties > Attribute User Text), key -> values.
-    is_copy : (B,) bool, optional
-        Blocks on :data:`COPIES_LAYER` instead of their class's or the supports' layer.
+    copies : dict str -> ((4, 4) float, dict str -> str), optional
+        Name -> (motion of the copy, its user text).
 
     Raises
     ------
@@ -109,28 +119,27 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, is_copy=None) -> b
              for code in np.unique(blocks.block_class[free])}
     if blocks.block_is_support.any():
         support_layer = model.Layers.AddLayer(SUPPORT_LAYER, _SUPPORT_COLOUR)
-    is_copy = np.zeros(blocks.n_blocks, bool) if is_copy is None else np.asarray(is_copy)
-    if is_copy.any():
-        copies_layer = model.Layers.AddLayer(COPIES_LAYER, _COPIES_COLOUR)
 
     face_start = blocks.block_face_offsets
     corner_start = blocks.face_offsets[face_start].tolist()
     corners = vertices[blocks.face_vertices].tolist()  # every face's corners, in order
     sizes = np.diff(blocks.face_offsets).tolist()
-    layers = [copies_layer if copy else layer[code] if is_free else support_layer
-              for copy, code, is_free in zip(is_copy.tolist(), blocks.block_class.tolist(),
-                                             free.tolist())]
+    layers = [layer[code] if is_free else support_layer
+              for code, is_free in zip(blocks.block_class.tolist(), free.tolist())]
     texts = {key: list(map(str, np.asarray(values).tolist()))
              for key, values in user_text.items()}
     attributes = rhino3dm.ObjectAttributes()  # AddMesh copies it: one for every block
+    meshes = []
     for i, name in enumerate(blocks.block_name.tolist()):
-        mesh = _unwelded_mesh(rhino3dm, corners[corner_start[i]:corner_start[i + 1]],
-                              sizes[face_start[i]:face_start[i + 1]])
+        meshes.append(_unwelded_mesh(rhino3dm, corners[corner_start[i]:corner_start[i + 1]],
+                                     sizes[face_start[i]:face_start[i + 1]]))
         attributes.Name = str(name)
         attributes.LayerIndex = layers[i]
         for key, values in texts.items():
             attributes.SetUserString(key, values[i])
-        model.Objects.AddMesh(mesh, attributes)
+        model.Objects.AddMesh(meshes[-1], attributes)
+    if copies:
+        _add_copies(rhino3dm, model, meshes, copies)
 
     # rhino3dm writes to paths only
     with tempfile.TemporaryDirectory() as folder:
@@ -139,6 +148,26 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, is_copy=None) -> b
             raise OSError("rhino3dm could not write the 3dm file")
         with open(path, "rb") as f:
             return f.read()
+
+
+def _add_copies(rhino3dm, model, meshes, copies):
+    """The block definition of ``meshes`` and an instance of it per copy (name -> (4, 4)
+    motion, user text), on :data:`COPIES_LAYER` (:func:`blocks_3dm`)."""
+    attributes = rhino3dm.ObjectAttributes()
+    attributes.LayerIndex = model.Layers.AddLayer(COPIES_LAYER, _COPIES_COLOUR)
+    index = model.InstanceDefinitions.Add(
+        COPIES_DEFINITION, "the solved section's blocks, turned to the copies' places",
+        "", "", rhino3dm.Point3d(0, 0, 0), tuple(meshes), (attributes,) * len(meshes))
+    definition = model.InstanceDefinitions[index].Id
+    for name, (motion, text) in copies.items():
+        xform = rhino3dm.Transform(1.0)
+        for row, col in np.ndindex(4, 4):
+            setattr(xform, f"M{row}{col}", float(motion[row][col]))
+        copy = rhino3dm.ObjectAttributes()
+        copy.Name, copy.LayerIndex = name, attributes.LayerIndex
+        for key, value in text.items():
+            copy.SetUserString(key, value)
+        model.Objects.AddInstanceObject(rhino3dm.InstanceReference(definition, xform), copy)
 
 
 def _unwelded_mesh(rhino3dm, corners, sizes):
