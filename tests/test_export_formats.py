@@ -178,13 +178,24 @@ def test_3dm_of_a_cyclic_section_turns_it_to_the_whole_dome_as_block_instances()
     assert {o.Attributes.GetUserString("solved") for o in meshes} == {"yes"}
     (definition,) = file.InstanceDefinitions
     assert definition.Name == COPIES_DEFINITION
-    parts = [file.Objects.FindId(i).Geometry for i in definition.GetObjectIds()]
-    assert len(parts) == blocks.n_blocks
+    parts = [file.Objects.FindId(i) for i in definition.GetObjectIds()]
+    # exploded, a copy's bricks are named and described as the section's
+    assert [o.Attributes.Name for o in parts] == blocks.block_name.tolist()
+    assert [o.Attributes.GetUserString("course") for o in parts] == [
+        o.Attributes.GetUserString("course") for o in meshes]
+    # but the two keys each copy states itself
+    assert {o.Attributes.UserStringCount for o in parts} == {
+        o.Attributes.UserStringCount - 2 for o in meshes}
+    assert {o.Attributes.GetUserString(key) for o in parts for key in ("web", "solved")} == {
+        ""}  # rhino3dm's answer for a key not set
+    parts = [o.Geometry for o in parts]
 
     copies = [o for o in normal if isinstance(o.Geometry, rhino3dm.InstanceReference)]
+    assert len(normal) == len(meshes) + len(copies) == blocks.n_blocks + webs - 1
     assert [o.Attributes.Name for o in copies] == [f"w{k}" for k in range(1, webs)]
     for k, copy in enumerate(copies, start=1):
         assert copy.Attributes.GetUserString("web") == str(k)
+        assert copy.Attributes.GetUserString("solved") == "no (a turned copy)"
         assert file.Layers[copy.Attributes.LayerIndex].Name == COPIES_LAYER
         assert copy.Geometry.ParentIdefId == definition.Id
         for i, part in enumerate(parts):

@@ -82,10 +82,11 @@ class RunOutputs:
     @functools.cached_property
     def shown(self):
         """The blocks of the files that show the structure (``bricks.obj``,
-        ``bricks.3dm``, ``dome.html``, ``locations.csv``): the scene's, or the whole dome
-        a cyclic section stands for (:func:`~masonry.blocks.whole_of_web`: the section
-        first, under the names its analysis reports, then its turned copies, web after
-        web), so that the files are the structure the verdict is about."""
+        ``dome.html``, ``locations.csv``; ``bricks.3dm`` turns the section to the other
+        webs by block instances): the scene's, or the whole dome a cyclic section stands
+        for (:func:`~masonry.blocks.whole_of_web`: the section first, under the names its
+        analysis reports, then its turned copies, web after web), so that the files are
+        the structure the verdict is about."""
         return self._whole(self.scene.blocks)
 
     @functools.cached_property

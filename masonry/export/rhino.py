@@ -129,17 +129,19 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, copies=None) -> by
     texts = {key: list(map(str, np.asarray(values).tolist()))
              for key, values in user_text.items()}
     attributes = rhino3dm.ObjectAttributes()  # AddMesh copies it: one for every block
-    meshes = []
+    definition = _Definition(rhino3dm, model, copies) if copies else None
     for i, name in enumerate(blocks.block_name.tolist()):
-        meshes.append(_unwelded_mesh(rhino3dm, corners[corner_start[i]:corner_start[i + 1]],
-                                     sizes[face_start[i]:face_start[i + 1]]))
+        mesh = _unwelded_mesh(rhino3dm, corners[corner_start[i]:corner_start[i + 1]],
+                              sizes[face_start[i]:face_start[i + 1]])
         attributes.Name = str(name)
         attributes.LayerIndex = layers[i]
         for key, values in texts.items():
             attributes.SetUserString(key, values[i])
-        model.Objects.AddMesh(meshes[-1], attributes)
-    if copies:
-        _add_copies(rhino3dm, model, meshes, copies)
+        model.Objects.AddMesh(mesh, attributes)
+        if definition is not None:
+            definition.add(mesh, str(name), {key: values[i] for key, values in texts.items()})
+    if definition is not None:
+        definition.place(copies)
 
     # rhino3dm writes to paths only
     with tempfile.TemporaryDirectory() as folder:
@@ -150,24 +152,45 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, copies=None) -> by
             return f.read()
 
 
-def _add_copies(rhino3dm, model, meshes, copies):
-    """The block definition of ``meshes`` and an instance of it per copy (name -> (4, 4)
-    motion, user text), on :data:`COPIES_LAYER` (:func:`blocks_3dm`)."""
-    attributes = rhino3dm.ObjectAttributes()
-    attributes.LayerIndex = model.Layers.AddLayer(COPIES_LAYER, _COPIES_COLOUR)
-    index = model.InstanceDefinitions.Add(
-        COPIES_DEFINITION, "the solved section's blocks, turned to the copies' places",
-        "", "", rhino3dm.Point3d(0, 0, 0), tuple(meshes), (attributes,) * len(meshes))
-    definition = model.InstanceDefinitions[index].Id
-    for name, (motion, text) in copies.items():
-        xform = rhino3dm.Transform(1.0)
-        for row, col in np.ndindex(4, 4):
-            setattr(xform, f"M{row}{col}", float(motion[row][col]))
-        copy = rhino3dm.ObjectAttributes()
-        copy.Name, copy.LayerIndex = name, attributes.LayerIndex
+class _Definition:
+    """The block definition :data:`COPIES_DEFINITION` of :func:`blocks_3dm`'s copies, on
+    :data:`COPIES_LAYER`: its meshes carry their block's name and user text but the keys
+    each copy states itself (``web``, ``solved``), so that an exploded copy's bricks
+    are named and described as the section's."""
+
+    def __init__(self, rhino3dm, model, copies):
+        self.rhino3dm, self.model = rhino3dm, model
+        self.layer = model.Layers.AddLayer(COPIES_LAYER, _COPIES_COLOUR)
+        self.own = set().union(*(text for _, text in copies.values()))
+        self.meshes, self.attributes = [], []
+
+    def add(self, mesh, name, text):
+        attributes = self.rhino3dm.ObjectAttributes()
+        attributes.Name, attributes.LayerIndex = name, self.layer
         for key, value in text.items():
-            copy.SetUserString(key, value)
-        model.Objects.AddInstanceObject(rhino3dm.InstanceReference(definition, xform), copy)
+            if key not in self.own:
+                attributes.SetUserString(key, value)
+        self.meshes.append(mesh)
+        self.attributes.append(attributes)
+
+    def place(self, copies):
+        """The definition, and an instance of it per copy (name -> (4, 4) motion, user
+        text)."""
+        rhino3dm = self.rhino3dm
+        index = self.model.InstanceDefinitions.Add(
+            COPIES_DEFINITION, "the solved section's blocks, turned to the copies' places",
+            "", "", rhino3dm.Point3d(0, 0, 0), tuple(self.meshes), tuple(self.attributes))
+        definition_id = self.model.InstanceDefinitions[index].Id
+        for name, (motion, text) in copies.items():
+            xform = rhino3dm.Transform(1.0)
+            for row, col in np.ndindex(4, 4):
+                setattr(xform, f"M{row}{col}", float(motion[row][col]))
+            attributes = rhino3dm.ObjectAttributes()
+            attributes.Name, attributes.LayerIndex = name, self.layer
+            for key, value in text.items():
+                attributes.SetUserString(key, value)
+            self.model.Objects.AddInstanceObject(
+                rhino3dm.InstanceReference(definition_id, xform), attributes)
 
 
 def _unwelded_mesh(rhino3dm, corners, sizes):
