@@ -535,6 +535,12 @@ def web_motion(web: int, n: int) -> np.ndarray:
     return motion
 
 
+def web_name(web: int) -> str:
+    """``w<web>``: what the names of web ``web``'s turned blocks start with
+    (:func:`rotated_web`), and a 3DM file's name of that turned web."""
+    return f"w{web}"
+
+
 def rotated_web(blocks: Blocks, web: int, n: int, mask=None) -> Blocks:
     """Blocks (or those selected by ``mask``, (B,) bool) rotated by ``2 pi web / n`` about
     z (:func:`web_motion`), named ``w<web>_<name>`` and marked as web ``web % n``."""
@@ -542,7 +548,8 @@ def rotated_web(blocks: Blocks, web: int, n: int, mask=None) -> Blocks:
     part = part.transformed(web_motion(web, n))
     return dataclasses.replace(
         part,
-        block_name=np.array([f"w{web % n}_{name}" for name in part.block_name], dtype=object),
+        block_name=np.array([f"{web_name(web % n)}_{name}" for name in part.block_name],
+                            dtype=object),
         block_web=np.full(part.n_blocks, web % n))
 
 

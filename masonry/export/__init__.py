@@ -16,7 +16,7 @@ from pathlib import PurePosixPath
 
 import numpy as np
 
-from masonry.blocks import web_motion, whole_of_web
+from masonry.blocks import web_motion, web_name, whole_of_web
 from masonry.export import (compas_json, csv, html, obj, rhino, stl, summaries, threemf,
                             vtu)
 from masonry.printable import PrintableError, printable_blocks, printable_body
@@ -209,8 +209,8 @@ def _rhino_files(made: RunOutputs) -> Export:
     copies = None
     if made.webs is not None:
         text["solved"] = np.full(blocks.n_blocks, "yes")
-        copies = {f"w{web}": (web_motion(web, made.webs),
-                              {"web": str(web), "solved": "no (a turned copy)"})
+        copies = {web_name(web): (web_motion(web, made.webs),
+                                  {"web": str(web), "solved": "no (a turned copy)"})
                   for web in range(1, made.webs)}
     return Export({"bricks.3dm": rhino.blocks_3dm(blocks, user_text=text, copies=copies)})
 
