@@ -141,7 +141,7 @@ def blocks_3dm(blocks: Blocks, vertices=None, user_text=None, copies=None) -> by
         if definition is not None:
             definition.add(mesh, str(name), {key: values[i] for key, values in texts.items()})
     if definition is not None:
-        definition.place(copies)
+        definition.place()
 
     # rhino3dm writes to paths only
     with tempfile.TemporaryDirectory() as folder:
@@ -159,7 +159,7 @@ class _Definition:
     are named and described as the section's."""
 
     def __init__(self, rhino3dm, model, copies):
-        self.rhino3dm, self.model = rhino3dm, model
+        self.rhino3dm, self.model, self.copies = rhino3dm, model, copies
         self.layer = model.Layers.AddLayer(COPIES_LAYER, _COPIES_COLOUR)
         self.own = set().union(*(text for _, text in copies.values()))
         self.meshes, self.attributes = [], []
@@ -173,7 +173,7 @@ class _Definition:
         self.meshes.append(mesh)
         self.attributes.append(attributes)
 
-    def place(self, copies):
+    def place(self):
         """The definition, and an instance of it per copy (name -> (4, 4) motion, user
         text)."""
         rhino3dm = self.rhino3dm
@@ -181,7 +181,7 @@ class _Definition:
             COPIES_DEFINITION, "the solved section's blocks, turned to the copies' places",
             "", "", rhino3dm.Point3d(0, 0, 0), tuple(self.meshes), tuple(self.attributes))
         definition_id = self.model.InstanceDefinitions[index].Id
-        for name, (motion, text) in copies.items():
+        for name, (motion, text) in self.copies.items():
             xform = rhino3dm.Transform(1.0)
             for row, col in np.ndindex(4, 4):
                 setattr(xform, f"M{row}{col}", float(motion[row][col]))
