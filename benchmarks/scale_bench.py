@@ -24,12 +24,16 @@ import numpy as np
 from masonry.scenes import memory_estimate
 
 SCALE_COLUMNS = ("structure", "bricks", "verdict", "wall_s", "cpu_s", "solve_s",
-                 "newton_steps", "newton_setup_s", "exports_s", "peak_gib", "estimate_gib")
+                 "newton_steps", "other_iterations", "newton_setup_s", "exports_s",
+                 "peak_gib", "estimate_gib")
 """Columns of a scale row: ``solve_s`` the RBE solve (``timings_s.solve``),
 ``newton_steps`` and ``newton_setup_s`` its Newton attempts' iterations and symbolic
-set-up summed, ``exports_s`` the files after the forces (``timings_s``: ``exports``,
-``html`` and the wait for the other process), ``estimate_gib`` what ``--max-bricks``'s
-message says the run needs (:func:`masonry.scenes.memory_estimate`)."""
+set-up summed, ``other_iterations`` its other attempts' of both friction models, in
+order (the load-path LP, the interior point method, Clarabel, Newton's polish; -1 where
+a solver does not say; empty where Newton alone solved), ``exports_s`` the
+files after the forces (``timings_s``: ``exports``, ``html`` and the wait for the other
+process), ``estimate_gib`` what ``--max-bricks``'s message says the run needs
+(:func:`masonry.scenes.memory_estimate`)."""
 
 WALLS = (50, 112, 224, 354, 500)
 """The walls' courses: ``0.4 courses`` bricks in each (``--wall-length 1.6 courses``),
@@ -39,15 +43,20 @@ DOMES = (4, 10, 16, 21, 26)
 """Preset 1's full dome at these ``p``: 1,664 to 31,712 bricks, every one standing
 (docs/scale.md: from p 27 its profile does not)."""
 
+ARCHES = (1024, 4096, 8192, 16384)
+"""A semicircular arch of 10 m span and 0.6 m thickness (the arch scene's defaults)
+in this many voussoirs: one geometry at every size, where the dome's profile thins as
+it grows."""
+
 FIT_FROM = 5000
 """The exponents are fitted to the rows of at least this many bricks: below, the
 start-up (imports, about a second) hides how the work grows."""
 
 
-def scale_structures(walls=WALLS, domes=DOMES) -> dict:
+def scale_structures(walls=WALLS, domes=DOMES, arches=ARCHES) -> dict:
     """``{name: (family, preset, inputs)}`` of the default rows: the inputs as
-    :func:`~masonry.params.from_preset` takes them, the command line's options by their
-    names."""
+    :func:`~masonry.params.from_preset` takes them (no preset for the arch), the command
+    line's options by their names."""
     out = {}
     for courses in walls:
         length = round(1.6 * courses)
@@ -56,6 +65,9 @@ def scale_structures(walls=WALLS, domes=DOMES) -> dict:
     for p in domes:
         out[f"preset 1 full dome, p {p}"] = ("preset 1 full dome", "1",
                                              {"scene": "dome", "p": p})
+    for blocks in arches:
+        out[f"arch of {blocks:,} voussoirs"] = ("arch", None, {"scene": "arch",
+                                                              "blocks": blocks})
     return out
 
 
@@ -65,8 +77,8 @@ def scale_bench(structures: dict, progress=None) -> list:
 
     Parameters
     ----------
-    structures : dict str -> (str, str, dict)
-        Name -> (its family, its preset, its inputs): :func:`scale_structures`.
+    structures : dict str -> (str, str or None, dict)
+        Name -> (its family, its preset (None: none), its inputs): :func:`scale_structures`.
     progress : callable(str), optional
         Called with a line per row.
 
@@ -79,8 +91,9 @@ def scale_bench(structures: dict, progress=None) -> list:
     for name, (family, preset, inputs) in structures.items():
         options = [f"--{key.replace('_', '-')}={value}" for key, value in inputs.items()]
         with tempfile.TemporaryDirectory(prefix="masonry-scale-") as out:
-            arguments = [f"--preset={preset}", *options, "--no-plots", "--no-printable",
-                         "--quiet", "--max-bricks=10000000", f"--out={out}"]
+            arguments = [*([f"--preset={preset}"] if preset else []), *options,
+                         "--no-plots", "--no-printable", "--quiet", "--max-bricks=10000000",
+                         f"--out={out}"]
             wall, cpu, peak, code = _run(arguments)
             written = list(Path(out).glob("*/run.json"))
             if not written:  # a run that gives no verdict still writes its run.json
@@ -114,12 +127,15 @@ def _run(arguments) -> tuple:
 def _from_record(record: dict) -> dict:
     """A row's columns read from the run's ``run.json``."""
     timings = record["timings_s"]
-    newton = [a for a in record["rbe"].get("attempts", []) if a.get("solver") == "newton"]
+    attempts = record["rbe"].get("attempts", [])
+    newton = [a for a in attempts if a.get("solver") == "newton"]
     bricks = record["counts"]["bricks"]
     estimate = memory_estimate(bricks, record["params"]["accuracy"])
     return {"bricks": bricks, "verdict": record["rbe"]["verdict"],
             "solve_s": timings.get("solve"),
             "newton_steps": sum(a["iterations"] for a in newton),
+            "other_iterations": ", ".join(f"{a['solver']} {a['iterations']}"
+                                          for a in attempts if a.get("solver") != "newton"),
             "newton_setup_s": sum(a.get("setup_s", 0.0) for a in newton),
             "exports_s": sum(timings.get(k, 0.0) for k in ("exports", "html",
                                                            "other_process")),

@@ -6,6 +6,7 @@ between friction models and friction coefficients must not change results. Speed
 measured by ``masonry bench``, never here.
 """
 
+import dataclasses
 import functools
 import logging
 
@@ -17,6 +18,7 @@ import scipy.sparse as sp
 
 from masonry import forking
 from masonry.export.csv import header
+from masonry.export.summaries import objective_text
 from masonry_benchmarks.bench import (COLUMNS, bench, frontier_png, ratios, ratios_markdown,
                                    table_csv, table_markdown)
 from masonry.friction import FrictionCone
@@ -31,6 +33,9 @@ from masonry.rbe.solve import ACCURACY, LOAD_PATH, RBEProblem, solve_rbe
 from masonry.rbe.cores import solver_threads
 from masonry.rbe.solvers import BACKENDS, COLLAPSE, RBE, backend, names
 from masonry.rbe.solvers import cholesky, net_feasibility, ordering
+from masonry.rbe.solvers import direct_clarabel as clarabel_module
+from masonry.rbe.solvers import interior as interior_module
+from masonry.rbe.solvers.base import Outcome
 from masonry.rbe.solvers.cholesky import BlockCholesky
 from masonry.rbe.solvers.embedded import Embedded
 from masonry.rbe.solvers.highs import highs_lp
@@ -771,6 +776,62 @@ def test_a_feasible_load_path_verdict_resumes_newton(monkeypatch, caplog):
         ("newton", "user_limit"), (LOAD_PATH, "user_limit"), ("newton", "optimal")]
     assert result.verdict == reference.verdict == "feasible"
     np.testing.assert_allclose(result.x, reference.x, rtol=0, atol=1e-6 * scale(reference))
+
+
+@functools.lru_cache(maxsize=None)
+def _arch_model(blocks):
+    """A semicircular arch of 10 m span, 0.6 m thick, cut into ``blocks`` voussoirs."""
+    return build_model(Params.of(scene="arch", arch_blocks=blocks, arch_thickness=0.6))[1]
+
+
+def test_newton_stalled_twice_hands_friction_net_to_the_interior_point_method():
+    # an arch of 1,024 voussoirs: Newton's steps crawl a hinge at a time, the LP finds
+    # friction-net feasible, the resumed Newton stalls again and the interior point
+    # method (polished) finds Clarabel's optimum: Clarabel is not on the path
+    reference = problem(_arch_model(1024)).solve(mu=0.7, solver="clarabel",
+                                                 accuracy="accurate")
+    result = problem(_arch_model(1024)).solve(mu=0.7, accuracy="balanced")
+    assert [(a["solver"], a["status"]) for a in result.attempts] == [
+        ("newton", "user_limit"), (LOAD_PATH, "user_limit"), ("newton", "user_limit"),
+        ("interior", "optimal"), ("newton-polish", "optimal")]
+    assert result.verdict == reference.verdict == "feasible"
+    np.testing.assert_allclose(result.x, reference.x, rtol=0, atol=1e-6 * scale(reference))
+
+
+@pytest.mark.parametrize("clarabel_status", ["user_limit", "infeasible"])
+def test_the_load_path_lp_point_answers_where_no_solver_reaches_the_optimum(
+        clarabel_status, monkeypatch, caplog):
+    # after the LP found the arch's friction-net feasible, the interior point method
+    # made to fail (as it and Clarabel did at their precision floor on 16,384
+    # voussoirs) and Clarabel to fail or to certify infeasibility: the verdict is the
+    # LP's, not friction+'s tension, and its forces balance the dead load within the
+    # friction model, recomputed here from the matrices
+    def failing(status):
+        return lambda system, method, options, workspace, **extra: Outcome(
+            status=status, x=None, iterations=0)
+
+    for module, status in ((interior_module, "user_limit"),
+                           (clarabel_module, clarabel_status)):
+        monkeypatch.setattr(module, "BACKEND", dataclasses.replace(
+            module.BACKEND, rbe=failing(status)))
+    prepared = problem(_arch_model(1024))
+    with caplog.at_level(logging.WARNING, logger="masonry.rbe"):
+        result = prepared.solve(mu=0.7, accuracy="balanced")
+    assert "the LP's point is the answer" in caplog.text
+    assert [(a["solver"], a["status"]) for a in result.attempts] == [
+        ("newton", "user_limit"), (LOAD_PATH, "user_limit"), ("newton", "user_limit"),
+        ("interior", "user_limit"), ("clarabel", clarabel_status)]
+    assert result.verdict == "feasible" and result.solver == LOAD_PATH
+    # RBE/00_objective.txt does not call these forces the QP's optimum
+    summary = objective_text(result)
+    assert "the load-path LP found forces" in summary and "to tolerance" not in summary
+    system = prepared.system.with_material(mu=0.7, density=2000.0, cone="circle")
+    x = system.to_scaled(result.x)
+    residual = np.abs(system.A_eq @ x + system.f_ext).max() / np.abs(system.f_ext).max()
+    assert residual <= Tolerances().residual
+    c, t, f1, f2 = result.x.reshape(-1, 4).T
+    largest = np.abs(result.x).max()
+    assert c.min() >= 0 and (np.hypot(f1, f2) - 0.7 * (c - t)).max() <= 1e-9 * largest
 
 
 @pytest.mark.slow

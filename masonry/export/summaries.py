@@ -1,7 +1,7 @@
 """The text summaries of a run: ``00_parameters.txt`` and ``RBE/00_objective.txt``."""
 
 from masonry.parameters import declarations, values
-from masonry.rbe.solve import ACCURACY
+from masonry.rbe.solve import ACCURACY, LOAD_PATH
 from masonry.tolerances import MECHANISM_MAIN, MOTION_TOL
 
 
@@ -72,9 +72,17 @@ def objective_text(result, centering=None) -> str:
     where the structure cannot stand."""
     d = result.to_dict()
     verdict = "feasible" if d["feasible"] else "infeasible"
-    meaning = ("stands without tension: the friction-net QP was solved to tolerance"
-               if d["feasible"] else
-               "cannot stand without tension; friction+ measures how much it needs")
+    by_lp = d["solver"] == LOAD_PATH  # docs/model.md 6.6: the LP's point answers
+    if by_lp:
+        meaning = ("stands without tension: the load-path LP found forces within the "
+                   "friction model that balance every block; no solver reached the "
+                   "friction-net QP's optimum, so they are one equilibrium, not the "
+                   "least-norm one")
+    elif d["feasible"]:
+        meaning = "stands without tension: the friction-net QP was solved to tolerance"
+    else:
+        meaning = "cannot stand without tension; friction+ measures how much it needs"
+    whose = "; of these forces, above the QP's minimum" if by_lp else ""
     lines = [
         f"feasibility:        {verdict} ({meaning})",
         f"friction method:    friction-{d['friction']} (mu = {d['mu']:g}; the problem "
@@ -82,7 +90,7 @@ def objective_text(result, centering=None) -> str:
         f"friction model:     {result.cone.describe()}",
         f"contact law:        {result.contact_law}",
         f"objective:          {d['objective']:.6g} N^2 (1/2 x^T H x, weights: tension 1, "
-        "compression and friction 1e-3)",
+        f"compression and friction 1e-3{whose})",
         f"MoI:                {d['moi']:.6g} N (sum of all vertex tensions: the QP's "
         "optimality measure, not a force anyone supplies)",
         f"MoI factor:         {d['moi_factor']:.6g} (MoI / weight)",

@@ -81,7 +81,8 @@ ACCURACY = {
     # (Newton alone on friction+ is slowed by the 1,000:1 tension weight). When Newton
     # neither solves nor certifies friction-net (low-friction domes), the load-path LP
     # on the same matrix decides, in fewer iterations than Clarabel on its KKT system;
-    # Clarabel takes over when either method fails. Measured: docs/bench.md.
+    # where it finds a load path, Newton resumes and then the interior point method
+    # solves friction-net; Clarabel takes over when these fail. Measured: docs/bench.md.
     "balanced": AccuracyPreset(
         "balanced", "newton", "interior", residual=ACCEPT_RESIDUAL, lp_check=False,
         load_path=True,

@@ -45,7 +45,9 @@ class RBEResult:
         Total weight of the free blocks.
     solver, status : str
         Solver name and its status (cvxpy's words) for the problem that produced ``x``
-        (the last attempt).
+        (the last attempt; ``load-path-lp`` with ``user_limit`` where the load-path
+        LP's friction-net point answers, an equilibrium but not the QP's optimum:
+        docs/model.md 6.6).
     iterations : int
         That solver's iterations, -1 when not reported.
     residual_eq : float

@@ -40,7 +40,7 @@ from masonry.rbe.result import RBEResult
 from masonry.rbe.solvers import BACKENDS, RBE, backend, names, net_feasibility
 from masonry.rbe.solvers.base import INFEASIBLE, OPTIMAL
 from masonry.rbe.solvers.newton import NewtonOptions, prepared_system
-from masonry.rbe.solvers.residuals import Residuals
+from masonry.rbe.solvers.residuals import Residuals, rbe_residuals
 from masonry.tolerances import Tolerances
 
 __all__ = ["ACCURACY", "AccuracyPreset", "RBEProblem", "RBEResult", "friction_model",
@@ -80,6 +80,14 @@ its stall; no feasible structure measured ended two steps in a row there (docs/b
 "Newton's hand-over to the load-path LP"). A wrong
 hand-over costs one LP, never a wrong verdict: a feasible verdict resumes Newton without
 this rule."""
+
+RESUME_STALL = 16
+"""Newton's ``stall`` when it resumes after the load-path LP found friction-net
+feasible; then the interior point method takes over. A dome near its limit resumes and
+converges with long gaps between halvings of its residual (a shorter stall handed the
+largest measured to the interior point method, which took longer); an arch of many
+voussoirs crawls, a hinge at a time, where the interior point method's iterations do
+not grow with the count (docs/bench.md, "Newton's steps and the size of the model")."""
 
 WARM_NEWTON = "newton-warm"
 """Among the candidates: Newton from a given warm start (:meth:`RBEProblem.of_system`),
@@ -236,14 +244,18 @@ class RBEProblem:
         """One friction model: the candidate solvers in turn until one returns an
         accepted point (polished if the preset says so) or certifies infeasibility.
         Every QP solved is appended to ``attempts``; ``before_lp`` (a callable) is
-        called when Newton hands friction-net over to the load-path LP."""
-        outcome = None
+        called when Newton hands friction-net over to the load-path LP. Where the LP
+        found an accepted friction-net point and no solver then reached the QP's
+        optimum, or one certified infeasibility within its tolerance against that
+        point, the LP's point is the answer (:meth:`_load_path_point`)."""
+        outcome = found = None
         candidates = _stated(system, method, candidates, attempts)
         for index, name in enumerate(candidates):
             if name == LOAD_PATH:
                 if before_lp is not None:
                     before_lp()
-                name, outcome = self._load_path(system, preset, tol, outcome, attempts)
+                name, outcome, found = self._load_path(system, preset, tol, outcome,
+                                                       attempts)
             else:
                 # Newton hands over sooner when the load-path LP follows it
                 hand_over = ({"stall": LOAD_PATH_STALL, "damped_out": LOAD_PATH_DAMPED_OUT}
@@ -267,6 +279,8 @@ class RBEProblem:
                     outcome, checks, name = polished, polished.residuals, f"{name}+newton"
             if accepted and outcome.y is not None:
                 self.duals[method] = outcome.y
+            if outcome.status == INFEASIBLE and found is not None:
+                return self._load_path_point(method, found, certifier=name)
             if accepted or outcome.status == INFEASIBLE:
                 if outcome.status == INFEASIBLE:
                     log.info("%s certified friction-%s infeasible", name, method)
@@ -275,27 +289,68 @@ class RBEProblem:
                 # no silent fallback: a fallback warns and stays in ``attempts``
                 log.info("%s found no %s solution (%s); trying %s", name, method,
                          outcome.status, candidates[index + 1])
+        if found is not None:
+            return self._load_path_point(method, found)
         return _Solved(method, name, outcome, checks, False)
 
     def _load_path(self, system, preset, tol, stalled, attempts):
         """After Newton (``stalled``, its outcome) neither solved nor certified
         friction-net: the load-path LP's verdict (:mod:`~masonry.rbe.solvers.net_feasibility`).
-        Its certificate, or its undecided outcome, is returned as is; when it finds
-        friction-net feasible, Newton resumes from its last dual point with its
-        own stall count (the LP's point is feasible but not the QP's optimum). Returns
-        ``(solver name, outcome)``; the LP's record joins ``attempts`` when Newton
-        resumes."""
+        Its certificate, or its undecided outcome, is returned as is. When it finds
+        friction-net feasible (a point within the accepted residual, not the QP's
+        optimum), Newton resumes from its last dual point until its residual stops
+        halving for :data:`RESUME_STALL` steps, and then the interior point method, which
+        assumes a feasible program, solves friction-net; where that method cannot state
+        the friction model (a cone truncated by a tension cut-off), Newton runs to its
+        own stall and the next candidate follows. Returns ``(solver name, outcome, the
+        LP's point)``: the last an outcome whose ``x`` is the LP's point with its
+        residuals, None unless the LP found one that passes the acceptance check (which,
+        unlike the LP, holds the tension cut-off); the records of the LP and of a resumed
+        Newton that stalled join ``attempts``."""
         workspace = self._workspace("newton")
         options = preset.options.get("newton", {})
-        decided = net_feasibility.decide(prepared_system(system, "net", workspace),
-                                         NewtonOptions(**options).infeasibility_tol,
+        ns = prepared_system(system, "net", workspace)
+        decided = net_feasibility.decide(ns, NewtonOptions(**options).infeasibility_tol,
                                          tol.residual)
-        if decided.info["verdict"] != net_feasibility.FEASIBLE or stalled.y is None:
-            return LOAD_PATH, decided
+        if decided.info["verdict"] != net_feasibility.FEASIBLE:
+            return LOAD_PATH, decided, None
+        x = ns.full_vector(decided.info["forces"], system.layout)
+        found = dataclasses.replace(decided, x=x, residuals=rbe_residuals(system, x, "net"))
+        found = found if _accepted(found.residuals, tol) else None
+        is_interior_next = BACKENDS["interior"].refusal(system) is None
+        if stalled.y is None and not is_interior_next:
+            return LOAD_PATH, decided, found
         attempts.append(_record("net", LOAD_PATH, decided))
-        log.info("the load-path LP found friction-net feasible: Newton resumes")
-        return "newton", BACKENDS["newton"].solve_rbe(system, "net", dict(options),
-                                                      workspace, y0=stalled.y)
+        if stalled.y is not None:
+            log.info("the load-path LP found friction-net feasible: Newton resumes")
+            stall = {"stall": RESUME_STALL} if is_interior_next else {}
+            resumed = BACKENDS["newton"].solve_rbe(system, "net", {**options, **stall},
+                                                   workspace, y0=stalled.y)
+            if resumed.status in (OPTIMAL, INFEASIBLE) or not is_interior_next:
+                return "newton", resumed, found
+            attempts.append(_record("net", "newton", resumed))
+        log.info("the interior point method solves friction-net, which the load-path LP "
+                 "found feasible")
+        return "interior", self._run(system, "net", "interior", preset), found
+
+    @staticmethod
+    def _load_path_point(method, found, certifier=None) -> "_Solved":
+        """Friction-net answered by the load-path LP's accepted point (``found``, its
+        outcome): no solver reached the QP's optimum after the LP found it, or
+        ``certifier`` (a solver's name) certified infeasibility within its tolerance
+        against it (a point that balances the dead load within the friction model and
+        the accepted residual, recomputed, is what feasible means). Without it friction+
+        would run and report the little tension its optimum trades for compression.
+        The forces are an equilibrium, not the QP's least-norm one (docs/model.md 6.6)."""
+        if certifier is None:
+            log.warning("no solver reached friction-net's optimum after the load-path LP "
+                        "found it feasible: the LP's point is the answer (an equilibrium "
+                        "within the friction model, not the QP's least-norm forces)")
+        else:
+            log.warning("%s certified friction-net infeasible within its tolerance, the "
+                        "load-path LP found a point within the accepted residual: the "
+                        "LP's point is the answer", certifier)
+        return _Solved(method, LOAD_PATH, found, found.residuals, True)
 
     def _polish(self, system, method, outcome, tol, attempts):
         """Newton steps from ``outcome``'s multipliers: the polished outcome, or None when
